@@ -1,0 +1,47 @@
+"""shipgnc — ship guidance, navigation and control.
+
+One batched simulation loop for every vessel, controller and scenario::
+
+    from shipgnc import simulate, VectoredThrustBoat
+    result = simulate(VectoredThrustBoat(), x0, controller=..., t_end=30, dt=0.05)
+
+Heavy modules (xarray, scipy, matplotlib, numba) are imported lazily, so ``import shipgnc``
+stays light.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+__version__ = "0.1.0"
+
+# public name -> module that defines it (imported on first access)
+_LAZY = {
+    "simulate": "shipgnc.sim.simulator",
+    "Actuator": "shipgnc.actuators",
+    "VectoredThrustBoat": "shipgnc.models.fossen3dof",
+    "BoatParams": "shipgnc.models.fossen3dof",
+    "HeadingSpeedAutopilot": "shipgnc.control.heading_speed",
+    "OpenLoopSchedule": "shipgnc.control.open_loop",
+    "LOSGuidance": "shipgnc.guidance.los",
+    "ReferenceSchedule": "shipgnc.guidance.schedule",
+    "WaypointPath": "shipgnc.guidance.path",
+    "load_scenario": "shipgnc.scenarios.registry",
+    "run_scenario": "shipgnc.scenarios.runner",
+    "ShipGNCError": "shipgnc.errors",
+    "ConfigError": "shipgnc.errors",
+    "DivergenceError": "shipgnc.errors",
+}
+
+__all__ = ["__version__", *sorted(_LAZY)]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'shipgnc' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return __all__

@@ -1,0 +1,130 @@
+"""Actuators between the controller's command and the model's input.
+
+Per input channel: saturation to ``[lower, upper]``, an optional rate limit ``rate`` [unit/s]
+and an optional first-order lag ``tau`` [s]. The controller's command is held over each step
+(zero-order hold); the applied input may move within the step:
+
+* no lag, no rate limit: u = sat(cmd), constant over the step (document 001's ``np.clip``);
+* rate limit, no lag: the applied value slews towards sat(cmd) at most ``rate·h`` per step,
+  moving linearly within the step (the exact motion of a slewing servo);
+* lag (τ > 0): ȧ = clip((sat(cmd) − a)/τ, −rate, rate), integrated in the same RK4 stages as the
+  plant (document 004 eq. (22)); u = a.
+
+Logged values: the command and the applied input at each sample instant.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+
+
+def _per_channel(value, n: int, field: str, default: float) -> np.ndarray:
+    if value is None:
+        return np.full(n, default, dtype=float)
+    arr = np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy()
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class Actuator:
+    """Saturation + rate limit + first-order lag, vectorised over channels and ships.
+
+    Parameters are per channel (scalars broadcast): ``lower``/``upper`` bounds, ``rate``
+    (``inf`` = none) and ``tau`` (0 = no lag). ``names`` label the channels in errors.
+    """
+
+    lower: np.ndarray
+    upper: np.ndarray
+    rate: np.ndarray | None = None
+    tau: np.ndarray | None = None
+    names: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        lower = np.atleast_1d(np.asarray(self.lower, dtype=float))
+        n = lower.size
+        names = self.names or tuple(f"input[{i}]" for i in range(n))
+        upper = _per_channel(self.upper, n, "upper", np.inf)
+        rate = _per_channel(self.rate, n, "rate", np.inf)
+        tau = _per_channel(self.tau, n, "tau", 0.0)
+        for i, name in enumerate(names):
+            require(not np.isnan(lower[i]) and not np.isnan(upper[i]), f"actuator.{name}.limits",
+                    (lower[i], upper[i]), "limits must be numbers")
+            require(lower[i] < upper[i], f"actuator.{name}.limits", (lower[i], upper[i]),
+                    "lower limit must be below upper limit")
+            require(rate[i] > 0, f"actuator.{name}.rate", rate[i], "rate limit must be > 0")
+            require(np.isfinite(tau[i]) and tau[i] >= 0, f"actuator.{name}.tau", tau[i],
+                    "time constant must be >= 0 s (0 = no lag)")
+        object.__setattr__(self, "lower", lower)
+        object.__setattr__(self, "upper", upper)
+        object.__setattr__(self, "rate", rate)
+        object.__setattr__(self, "tau", tau)
+        object.__setattr__(self, "names", names)
+
+    @classmethod
+    def for_model(cls, model, *, rate=None, tau=None) -> Actuator:
+        """The actuator with the model's own hardware limits (``model.input_limits()``)."""
+        lower, upper = model.input_limits()
+        return cls(lower, upper, rate=rate, tau=tau, names=tuple(s.name for s in model.inputs))
+
+    @property
+    def n(self) -> int:
+        return self.lower.size
+
+    @property
+    def has_lag(self) -> bool:
+        return bool(np.any(self.tau > 0))
+
+    @property
+    def has_rate_limit(self) -> bool:
+        return bool(np.any(np.isfinite(self.rate)))
+
+    @property
+    def is_static(self) -> bool:
+        """Saturation only: the applied input is a memoryless function of the command."""
+        return not (self.has_lag or self.has_rate_limit)
+
+    def saturate(self, command: np.ndarray) -> np.ndarray:
+        """Clip each channel to its limits (NaN passes through, for the divergence guard)."""
+        return np.clip(command, self.lower, self.upper)
+
+    def check_command_shape(self, command: np.ndarray) -> None:
+        if command.shape[-1:] != (self.n,):
+            raise ConfigError(f"controller command has shape {command.shape}; the actuator "
+                              f"expects (..., {self.n}) for channels {', '.join(self.names)}")
+
+    def initial(self, command0: np.ndarray) -> np.ndarray:
+        """Applied input at t = 0: the saturated initial command."""
+        return self.saturate(command0)
+
+    def begin_step(self, applied: np.ndarray, command: np.ndarray, h: float):
+        """Plan one step of length ``h``: returns ``(start, end)`` of the non-lag channels.
+
+        Without a rate limit start = end = sat(cmd); with one, end = applied moved towards
+        sat(cmd) by at most rate·h, and the input ramps linearly from start = applied to end.
+        """
+        target = self.saturate(command)
+        if not self.has_rate_limit:
+            return target, target
+        step = np.clip(target - applied, -self.rate * h, self.rate * h)
+        end = applied + step
+        start = np.where(np.isfinite(self.rate), applied, end)
+        return start, end
+
+    def input_at(self, plan, theta: float, lag_state: np.ndarray | None) -> np.ndarray:
+        """Applied input at fraction ``theta`` ∈ [0, 1] of the step (lag channels: ``lag_state``)."""
+        start, end = plan
+        u = end if theta == 1.0 or start is end else start + theta * (end - start)
+        if lag_state is not None:
+            u = np.where(self.tau > 0, lag_state, u)
+        return u
+
+    def lag_derivative(self, command: np.ndarray, lag_state: np.ndarray) -> np.ndarray:
+        """ȧ = clip((sat(cmd) − a)/τ, −rate, rate) on lag channels, 0 elsewhere (eq. (22), doc 004)."""
+        target = self.saturate(command)
+        tau = np.where(self.tau > 0, self.tau, 1.0)
+        rate = np.clip((target - lag_state) / tau, -self.rate, self.rate)
+        return np.where(self.tau > 0, rate, 0.0)

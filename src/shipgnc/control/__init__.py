@@ -1,0 +1,1 @@
+"""Controllers: discrete, explicit, batched (``reset(batch_shape)`` / ``step(t, y, ref)``)."""

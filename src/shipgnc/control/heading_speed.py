@@ -1,0 +1,98 @@
+"""Heading + speed autopilot for the vectored-thrust boat (controller ``boat-heading-speed``).
+
+Spec 001 §1.10. Design model: M₃₃ṙ = N_r r + τ_r and M₁₁u̇ = X_u u + τ_u.
+
+* reference model (critically damped, ω_ref): ψ_r, r_r = ψ̇_r, ψ̈_r;
+* heading PID with model feed-forward, e = wrap(ψ − ψ_r), z = ∫e dt:
+  τ_r = M₃₃ψ̈_r − N_r r_r − N_|r|r|r_r|r_r − K_p e − K_d (r − r_r) − K_i z,
+  gains placing the error poles at (s + ω)³: K_p = 3M₃₃ω², K_d = 3M₃₃ω + N_r, K_i = M₃₃ω³;
+* speed PI with damping feed-forward, poles at (s + ω_u)²:
+  τ_u = max(0, −X_u u_d + K_pu (u_d − u) + K_iu ∫(u_d − u) dt), K_pu = 2M₁₁ω_u + X_u, K_iu = M₁₁ω_u²;
+* allocation, the exact inverse of eq. (5): T = √(τ_u² + (τ_r/L_m)²), α = atan2(−τ_r/L_m, τ_u);
+* anti-windup by conditional integration: z holds while α_cmd is outside ±α_max, the speed
+  integral while T_cmd is outside [T_min, T_max].
+
+Reference ``[psi_d, u_d]``; measurement: the boat's state ``[north, east, psi, u, v, r]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from shipgnc.errors import require
+from shipgnc.frames import wrap_angle
+from shipgnc.guidance.reference import HeadingReferenceModel
+from shipgnc.models.base import Signal
+from shipgnc.models.fossen3dof import BoatParams, allocate_thrust
+
+
+@dataclass(frozen=True)
+class HeadingSpeedGains:
+    """Gains of the autopilot, from pole placement on the design model."""
+
+    Kp: float
+    Kd: float
+    Ki: float
+    Kpu: float
+    Kiu: float
+
+    @classmethod
+    def design(cls, p: BoatParams, omega: float, omega_u: float) -> HeadingSpeedGains:
+        """Closed form: (s + ω)³ for the heading error, (s + ω_u)² for the speed error."""
+        return cls(Kp=3 * p.M33 * omega**2, Kd=3 * p.M33 * omega + p.N_r, Ki=p.M33 * omega**3,
+                   Kpu=2 * p.M11 * omega_u + p.X_u, Kiu=p.M11 * omega_u**2)
+
+
+class HeadingSpeedAutopilot:
+    """The default autopilot of the vectored-thrust boat (see module docstring)."""
+
+    signals = (
+        Signal("psi_r", "rad", "reference-model heading", angle=True),
+        Signal("r_r", "rad/s", "reference-model yaw rate"),
+    )
+    continuous = False
+
+    def __init__(self, params: BoatParams, *, Ts: float = 0.05, omega_ref: float = 1.0,
+                 omega: float = 1.0, omega_u: float = 1.0, yaw_feedforward: bool = True):
+        for name, value in (("Ts", Ts), ("omega", omega), ("omega_u", omega_u)):
+            require(np.isfinite(value) and value > 0, f"controller.{name}", value, "must be > 0")
+        self.params = params
+        self.Ts = float(Ts)
+        self.omega, self.omega_u = float(omega), float(omega_u)
+        self.yaw_feedforward = bool(yaw_feedforward)
+        self.gains = HeadingSpeedGains.design(params, omega, omega_u)
+        self.reference_model = HeadingReferenceModel(omega_ref)
+        self.z = None
+        self.z_u = None
+
+    def reset(self, batch_shape) -> None:
+        self.reference_model.reset()
+        self.z = np.zeros(batch_shape)
+        self.z_u = np.zeros(batch_shape)
+
+    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        p, g, Ts = self.params, self.gains, self.Ts
+        psi, u, r = measurement[..., 2], measurement[..., 3], measurement[..., 5]
+        psi_d, u_d = reference[..., 0], reference[..., 1]
+        ref = self.reference_model
+        ref.start(psi)
+        acc = ref.acceleration(psi_d)
+        e = wrap_angle(psi - ref.psi)
+        damping_ff = -p.N_r * ref.rate
+        if self.yaw_feedforward:
+            damping_ff = damping_ff - p.N_rr * np.abs(ref.rate) * ref.rate
+        tau_r = p.M33 * acc + damping_ff - g.Kp * e - g.Kd * (r - ref.rate) - g.Ki * self.z
+        speed_error = u_d - u
+        tau_u = np.maximum(0.0, -p.X_u * u_d + g.Kpu * speed_error + g.Kiu * self.z_u)
+        thrust, alpha = allocate_thrust(tau_u, tau_r, p.L_m)
+        self.z = np.where(np.abs(alpha) <= p.alpha_max, self.z + Ts * e, self.z)
+        self.z_u = np.where((thrust >= p.T_min) & (thrust <= p.T_max),
+                            self.z_u + Ts * speed_error, self.z_u)
+        self._logged = {"psi_r": ref.psi.copy(), "r_r": ref.rate.copy()}
+        ref.advance(acc, Ts)
+        return np.stack([thrust, alpha], axis=-1)
+
+    def signal_values(self) -> dict[str, np.ndarray]:
+        return self._logged

@@ -1,0 +1,38 @@
+"""Open-loop command sequences: document 001's hand-written ``if/elif`` block as data."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from shipgnc.errors import require
+from shipgnc.timeseries import PiecewiseConstant
+
+
+class OpenLoopSchedule:
+    """Piecewise-constant commands ``values[i]`` from ``times[i]`` on (ignores the measurement).
+
+    ``labels`` annotate the segments in figures (e.g. "starboard turn (document: 'left')").
+    """
+
+    signals = ()
+    continuous = False
+
+    def __init__(self, times, values, *, Ts: float | None = None, labels=None):
+        self.schedule = PiecewiseConstant(times, np.atleast_2d(np.asarray(values, float).T).T
+                                          if np.ndim(values) == 1 else values,
+                                          field="controller.schedule")
+        self.Ts = Ts
+        self.labels = tuple(labels) if labels is not None else ("",) * len(self.schedule.times)
+        require(len(self.labels) == len(self.schedule.times), "controller.schedule.label",
+                self.labels, "one label per entry")
+        self._batch_shape: tuple[int, ...] = ()
+
+    def reset(self, batch_shape: tuple[int, ...]) -> None:
+        self._batch_shape = tuple(batch_shape)
+
+    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        value = self.schedule(t)
+        return np.broadcast_to(value, (*self._batch_shape, value.size)).copy()
+
+    def signal_values(self) -> dict[str, np.ndarray]:
+        return {}

@@ -1,0 +1,1 @@
+"""Environment: disturbances acting on a vessel (forces, currents, waves)."""

@@ -1,0 +1,39 @@
+"""Exceptions that carry a message meant for people.
+
+Every error raised at a public boundary names what was wrong (field, value, what is allowed);
+the CLI prints ``str(error)`` on one line and exits non-zero.
+"""
+
+from __future__ import annotations
+
+
+class ShipGNCError(Exception):
+    """Base class of every error shipgnc raises on purpose."""
+
+    exit_code = 2
+
+
+class ConfigError(ShipGNCError, ValueError):
+    """Invalid configuration or argument: the message names the field, the value and the rule."""
+
+
+class DivergenceError(ShipGNCError, FloatingPointError):
+    """The simulation left the physically meaningful region (NaN, inf or a runaway state).
+
+    Attributes name the time, the state, its value and the ship (batch index).
+    """
+
+    exit_code = 3
+
+    def __init__(self, message: str, *, time: float, state: str, value: float, index: tuple):
+        super().__init__(message)
+        self.time = time
+        self.state = state
+        self.value = value
+        self.index = index
+
+
+def require(condition: bool, field: str, value: object, rule: str) -> None:
+    """Raise :class:`ConfigError` ``"<field> = <value>: <rule>"`` unless ``condition`` holds."""
+    if not condition:
+        raise ConfigError(f"{field} = {value!r}: {rule}")

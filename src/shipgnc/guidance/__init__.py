@@ -1,0 +1,1 @@
+"""Guidance: references for the controller (schedules, waypoint paths, LOS)."""

@@ -1,0 +1,42 @@
+"""Time-scheduled references (heading and speed set-points)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from shipgnc.models.base import Signal
+from shipgnc.timeseries import PiecewiseConstant
+
+
+class ReferenceSchedule:
+    """Piecewise-constant heading and speed set-points ``[psi_d, u_d]`` (rad, m/s)."""
+
+    references = (
+        Signal("psi_d", "rad", "desired heading", angle=True, tracks="psi"),
+        Signal("u_d", "m/s", "desired surge speed", tracks="u"),
+    )
+    outputs = ()
+
+    def __init__(self, times, psi_d, u_d):
+        values = np.column_stack([np.asarray(psi_d, float), np.asarray(u_d, float)])
+        self.schedule = PiecewiseConstant(times, values, field="guidance.schedule")
+        self._batch_shape: tuple[int, ...] = ()
+
+    @property
+    def step_times(self) -> np.ndarray:
+        """Times at which the heading set-point changes (for the settling metrics)."""
+        psi = self.schedule.values[:, 0]
+        return self.schedule.times[1:][np.diff(psi) != 0]
+
+    def reset(self, batch_shape, model=None) -> None:
+        self._batch_shape = tuple(batch_shape)
+
+    def reference(self, t: float, x: np.ndarray) -> np.ndarray:
+        value = self.schedule(t)
+        return np.broadcast_to(value, (*self._batch_shape, value.size)).copy()
+
+    def output_values(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def finished(self):
+        return None

@@ -1,0 +1,1 @@
+"""Vessel models: frozen parameter dataclasses with pure, batched ``derivatives(x, u, d)``."""

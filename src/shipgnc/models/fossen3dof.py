@@ -1,0 +1,236 @@
+"""Small boat with one vectored thruster (stern kick): Fossen 3-DOF model of document 001.
+
+Equations (spec 001 §1.3–1.5; document 001 eq. (1)–(11))::
+
+    η̇ = J(ψ) ν                                                     (1–3)
+    M ν̇ + C(ν) ν + D(ν) ν = τ + τ_env                              (4)
+    M₁₁ u̇ = τ_u + X_env + M₂₂ v r + X_u u                           (9)
+    M₂₂ v̇ = τ_v + Y_env − M₁₁ u r + Y_v v                           (10)
+    M₃₃ ṙ = τ_r + N_env + c_M (Y_v̇ − X_u̇) u v + N_r r + N_|r|r |r| r  (11')
+    τ = [T cos α, T sin α, −L_m T sin α]                            (5)
+
+State ``[north, east, psi, u, v, r]`` (NED, ψ clockwise from north), input ``[T, alpha]``
+(thrust ≥ 0 [N]; angle of the thrust vector from body x, positive to starboard [rad]),
+disturbance ``[X_env, Y_env, N_env]`` in body axes. α < 0 turns the boat to starboard.
+
+``munk_factor`` c_M: +1 follows eq. (7) (energy-conserving), −1 the printed eq. (11), 0 (default)
+drops the Munk yaw moment as Fossen's Otter model did (spec 001 A2, A3).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields, replace
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+from shipgnc.frames import body_to_ned
+from shipgnc.models.base import Signal
+from shipgnc.units import KNOT, G
+
+
+@dataclass(frozen=True)
+class BoatParams:
+    """Parameters of the vectored-thrust boat (defaults: preset ``otter``, spec 001 table 1.6).
+
+    All SI: kg, kg·m², N·s/m, N·m·s/rad, N·m·s²/rad², m, N, rad.
+    """
+
+    m: float = 80.0
+    X_udot: float = -5.28
+    Y_vdot: float = -82.5
+    I_z: float = 14.44
+    N_rdot: float = -24.54
+    X_u: float = -77.55
+    Y_v: float = -162.5
+    N_r: float = -38.98
+    N_rr: float = -389.8
+    munk_factor: float = 0.0
+    L_m: float = 1.0
+    T_min: float = 0.0
+    T_max: float = 200.0
+    alpha_max: float = math.radians(45.0)
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            require(isinstance(value, (int, float)) and not isinstance(value, bool),
+                    f"vessel.params.{f.name}", value, "must be a number")
+            require(math.isfinite(value), f"vessel.params.{f.name}", value, "must be finite")
+        require(self.m > 0, "vessel.params.m", self.m, "mass must be > 0 kg")
+        require(self.I_z > 0, "vessel.params.I_z", self.I_z, "yaw inertia must be > 0 kg·m²")
+        for name, value in (("M11 = m - X_udot", self.M11), ("M22 = m - Y_vdot", self.M22),
+                            ("M33 = I_z - N_rdot", self.M33)):
+            require(value > 0, f"vessel.params ({name})", round(value, 6),
+                    "the mass matrix must be positive definite")
+        for name in ("X_u", "Y_v", "N_r", "N_rr"):
+            require(getattr(self, name) <= 0, f"vessel.params.{name}", getattr(self, name),
+                    "damping coefficients must be <= 0 (dissipative)")
+        require(self.L_m > 0, "vessel.params.L_m", self.L_m,
+                "thruster lever arm must be > 0 m (thruster behind the CG)")
+        require(0 <= self.T_min < self.T_max, "vessel.params.T_min/T_max",
+                (self.T_min, self.T_max), "need 0 <= T_min < T_max [N]")
+        require(0 < self.alpha_max <= math.pi / 2, "vessel.params.alpha_max", self.alpha_max,
+                "need 0 < alpha_max <= pi/2 rad (90°)")
+        require(-1.0 <= self.munk_factor <= 1.0, "vessel.params.munk_factor", self.munk_factor,
+                "allowed range is [-1, 1] (+1 eq. (7), -1 printed eq. (11), 0 neglected)")
+
+    @property
+    def M11(self) -> float:
+        return self.m - self.X_udot
+
+    @property
+    def M22(self) -> float:
+        return self.m - self.Y_vdot
+
+    @property
+    def M33(self) -> float:
+        return self.I_z - self.N_rdot
+
+    @property
+    def munk_coefficient(self) -> float:
+        """k = c_M (Y_v̇ − X_u̇) [kg], the Munk yaw-moment coefficient of eq. (11')."""
+        return self.munk_factor * (self.Y_vdot - self.X_udot)
+
+    def top_speed(self, thrust: float) -> float:
+        """Straight-line steady speed T/(−X_u) [m/s] (spec 001 §1.7)."""
+        return thrust / -self.X_u
+
+    @property
+    def surge_time_constant(self) -> float:
+        """τ_s = M₁₁/(−X_u) [s]."""
+        return self.M11 / -self.X_u
+
+    def with_(self, **changes: float) -> BoatParams:
+        """A copy with some parameters changed (validated; unknown names rejected)."""
+        known = {f.name for f in fields(self)}
+        for key in changes:
+            if key not in known:
+                raise ConfigError(f"vessel.params.{key}: unknown parameter; allowed: "
+                                  f"{', '.join(sorted(known))}")
+        return replace(self, **changes)
+
+    def as_dict(self) -> dict[str, float]:
+        return asdict(self)
+
+
+#: Named parameter sets of spec 001 §1.6 (overrides on top of the ``otter`` defaults).
+PRESETS: dict[str, dict[str, float]] = {
+    "otter": {},
+    "doc-eq7": {"munk_factor": 1.0, "N_rr": 0.0},
+    "doc-printed": {"munk_factor": -1.0, "N_rr": 0.0},
+    "otter-munk": {"munk_factor": 1.0},
+}
+
+
+def preset(name: str, **overrides: float) -> BoatParams:
+    """Parameters of a named preset, with optional overrides."""
+    if name not in PRESETS:
+        raise ConfigError(f"vessel.preset = {name!r}: unknown preset; allowed: "
+                          f"{', '.join(PRESETS)}")
+    return BoatParams().with_(**{**PRESETS[name], **overrides})
+
+
+def otter_rules(L: float = 2.0, m_hull: float = 55.0, m_payload: float = 25.0,
+                U_max: float = 6.0 * KNOT, bollard_thrust_kgf: float = 24.4,
+                T_sway: float = 1.0, T_yaw: float = 1.0, R66_over_L: float = 0.25,
+                hull_cg_ahead: float = 0.2, payload_x: float = 0.0, rho: float = 1025.0,
+                yaw_quadratic_ratio: float = 10.0, **other: float) -> BoatParams:
+    """Derive a consistent parameter set by the rules of Fossen's Otter model (spec 001 table 1.6).
+
+    X_u̇ = −2.7 ρ ∇^{5/3}/L² (Söding 1982, ∇ = m_hull/ρ), Y_v̇ = −1.5 m_hull, N_ṙ = −1.7 I_z,
+    X_u = −bollard thrust / U_max, Y_v = −M₂₂/T_sway, N_r = −M₃₃/T_yaw, N_|r|r = 10 N_r. I_z is the
+    hull's m_hull (R₆₆ L)² plus both masses moved to the combined CG. With the defaults this returns
+    the unrounded column of the table; ``other`` sets the remaining fields (L_m, limits, c_M).
+    """
+    for name, value in (("L", L), ("m_hull", m_hull), ("U_max", U_max),
+                        ("bollard_thrust_kgf", bollard_thrust_kgf), ("T_sway", T_sway),
+                        ("T_yaw", T_yaw), ("R66_over_L", R66_over_L), ("rho", rho)):
+        require(value > 0, f"otter_rules.{name}", value, "must be > 0")
+    require(m_payload >= 0, "otter_rules.m_payload", m_payload, "must be >= 0")
+    m = m_hull + m_payload
+    volume = m_hull / rho
+    X_udot = -2.7 * rho * volume ** (5.0 / 3.0) / L**2
+    Y_vdot = -1.5 * m_hull
+    x_cg = (m_hull * hull_cg_ahead + m_payload * payload_x) / m
+    I_z = (m_hull * (R66_over_L * L) ** 2 + m_hull * (hull_cg_ahead - x_cg) ** 2
+           + m_payload * (payload_x - x_cg) ** 2)
+    N_rdot = -1.7 * I_z
+    X_u = -bollard_thrust_kgf * G / U_max
+    Y_v = -(m - Y_vdot) / T_sway
+    N_r = -(I_z - N_rdot) / T_yaw
+    return BoatParams(m=m, X_udot=X_udot, Y_vdot=Y_vdot, I_z=I_z, N_rdot=N_rdot, X_u=X_u,
+                      Y_v=Y_v, N_r=N_r, N_rr=yaw_quadratic_ratio * N_r).with_(**other)
+
+
+def thrust_forces(thrust, alpha, lever_arm: float):
+    """Generalised force of one vectored thruster at (−L_m, 0), document 001 eq. (5).
+
+    Returns ``(tau_u, tau_v, tau_r)`` = (T cos α, T sin α, −L_m T sin α).
+    """
+    lateral = thrust * np.sin(alpha)
+    return thrust * np.cos(alpha), lateral, -lever_arm * lateral
+
+
+def allocate_thrust(tau_u, tau_r, lever_arm: float):
+    """Exact inverse of eq. (5) in (τ_u, τ_r): T = √(τ_u² + (τ_r/L_m)²), α = atan2(−τ_r/L_m, τ_u)."""
+    lateral = -tau_r / lever_arm
+    return np.hypot(tau_u, lateral), np.arctan2(lateral, tau_u)
+
+
+STATES = (
+    Signal("north", "m", "north position (NED x)"),
+    Signal("east", "m", "east position (NED y)"),
+    Signal("psi", "rad", "heading, clockwise from north (unwrapped)", angle=True),
+    Signal("u", "m/s", "surge velocity"),
+    Signal("v", "m/s", "sway velocity (to starboard)"),
+    Signal("r", "rad/s", "yaw rate (bow to starboard)"),
+)
+INPUTS = (
+    Signal("T", "N", "thrust"),
+    Signal("alpha", "rad", "thruster angle from body x, positive to starboard", angle=True),
+)
+DISTURBANCES = (
+    Signal("X_env", "N", "environmental surge force"),
+    Signal("Y_env", "N", "environmental sway force"),
+    Signal("N_env", "N m", "environmental yaw moment"),
+)
+
+
+@dataclass(frozen=True)
+class VectoredThrustBoat:
+    """Document 001's boat: Fossen 3-DOF, one vectored thruster (see module docstring)."""
+
+    params: BoatParams = field(default_factory=BoatParams)
+    preset_name: str = "otter"
+    length: float = 2.0  #: drawing outline only [m]
+    beam: float = 1.08  #: drawing outline only [m]
+
+    states = STATES
+    inputs = INPUTS
+    disturbances = DISTURBANCES
+    state_limits = (1e7, 1e7, 1e5, 50.0, 50.0, 50.0)
+
+    @classmethod
+    def from_preset(cls, name: str = "otter", **overrides: float) -> VectoredThrustBoat:
+        return cls(params=preset(name, **overrides), preset_name=name)
+
+    def input_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds of ``[T, alpha]`` (the thruster's hardware limits)."""
+        p = self.params
+        return np.array([p.T_min, -p.alpha_max]), np.array([p.T_max, p.alpha_max])
+
+    def derivatives(self, x, u, d=None):
+        """ẋ of eq. (1)–(5), (9)–(11') for ``x`` (..., 6), ``u`` (..., 2), ``d`` (..., 3) or None."""
+        p = self.params
+        psi, su, sv, sr = x[..., 2], x[..., 3], x[..., 4], x[..., 5]
+        tau_u, tau_v, tau_r = thrust_forces(u[..., 0], u[..., 1], p.L_m)
+        if d is not None:
+            tau_u, tau_v, tau_r = tau_u + d[..., 0], tau_v + d[..., 1], tau_r + d[..., 2]
+        north_dot, east_dot = body_to_ned(psi, su, sv)
+        u_dot = (tau_u + p.M22 * sv * sr + p.X_u * su) / p.M11
+        v_dot = (tau_v - p.M11 * su * sr + p.Y_v * sv) / p.M22
+        r_dot = (tau_r + p.munk_coefficient * su * sv + p.N_r * sr
+                 + p.N_rr * np.abs(sr) * sr) / p.M33
+        return np.stack([north_dot, east_dot, sr, u_dot, v_dot, r_dot], axis=-1)

@@ -1,0 +1,1 @@
+"""The one simulation loop (``simulate``), its integrators and its result format."""

@@ -1,0 +1,347 @@
+"""``simulate``: the one simulation loop of shipgnc.
+
+    guidance ──ref──▶ controller ──command──▶ actuator ──u──▶ model ẋ = f(x, u, d) ◀── disturbance
+
+At each sample t_k = k·dt the state x(t_k) is logged together with the command and the applied
+input acting from t_k (document 001's loop records the state before the step, spec 001 A13).
+Every ``Ts/dt`` samples the guidance and the controller are evaluated; the command is held in
+between. The plant (and any actuator lag) is integrated with fixed-step RK4 or with
+``scipy.integrate.solve_ivp`` over each ``dt``. The last sample is t_end itself.
+
+Batched: ``x0`` of shape ``(..., n)`` simulates every leading index as one ship, in one array
+operation per RK stage. A compiled (numba) twin of the loop serves large batches of the built-in
+boat; ``backend="numpy"`` forces this readable reference loop.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from shipgnc.actuators import Actuator
+from shipgnc.errors import ConfigError, DivergenceError, require
+from shipgnc.frames import wrap_angle
+from shipgnc.models.base import Signal, names
+from shipgnc.sim.integrators import rk4_step, solve_ivp_step
+
+INTEGRATORS = ("rk4", "solve_ivp")
+BACKENDS = ("auto", "numpy", "compiled")
+#: batch size from which ``backend="auto"`` uses the compiled loop (compilation then pays off)
+COMPILED_MIN_BATCH = 64
+
+
+class StopSimulation(Exception):
+    """Raised by an observer to end a run early and keep what was gathered."""
+
+
+@dataclass
+class Log:
+    """Samples gathered by a loop: variable name → array ``(time, *batch)`` plus metadata."""
+
+    time: np.ndarray
+    data: dict[str, np.ndarray]
+    signals: dict[str, Signal]
+    status: dict = field(default_factory=dict)
+
+
+@dataclass
+class SimSetup:
+    """Validated inputs of one run (shared by the numpy loop and the compiled twin)."""
+
+    model: object
+    x0: np.ndarray
+    t_end: float
+    dt: float
+    n_steps: int
+    hold: int  # samples per control period, Ts/dt
+    controller: object | None
+    actuator: Actuator
+    guidance: object | None
+    disturbance: object | None
+    integrator: str
+    solver_options: dict
+    rng: np.random.Generator
+    on_divergence: str
+    observer: Callable | None
+    progress: Callable | None
+    log_every: int
+    u0: np.ndarray
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        return self.x0.shape[:-1]
+
+
+def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=None,
+             guidance=None, disturbance=None, u0=None, integrator: str = "rk4",
+             method: str = "RK45", rtol: float = 1e-3, atol: float = 1e-6, seed=None,
+             on_divergence: str = "raise", observer: Callable | None = None,
+             progress: Callable | None = None, log_every: int = 1,
+             batch_dims: tuple[str, ...] | None = None, backend: str = "auto",
+             attrs: dict | None = None):
+    """Simulate ``model`` from ``x0`` (shape ``(..., n)``) for ``t_end`` seconds.
+
+    Parameters
+    ----------
+    controller : a :class:`~shipgnc.control.base.Controller` (``Ts`` = its sample time, default
+        ``dt``) or ``None`` for a constant input ``u0``.
+    actuator : :class:`~shipgnc.actuators.Actuator`; default: the model's own input limits.
+    guidance : references for the controller (:mod:`shipgnc.guidance`).
+    disturbance : see :mod:`shipgnc.environment.disturbance`; drawn from ``seed``.
+    integrator : ``"rk4"`` (fixed step) or ``"solve_ivp"`` (adaptive, ``method``/``rtol``/``atol``,
+        one call per ``dt`` with the batch flattened).
+    on_divergence : ``"raise"`` (default) raises :class:`DivergenceError` naming time, state,
+        value and ship; ``"stop"`` returns the partial result with ``attrs["diverged"] = 1``.
+    observer : ``observer(t, x, command, applied)`` at every logged sample (live plots); it may
+        raise :class:`StopSimulation` to end the run and keep the result.
+    progress : ``progress(k, n_steps)`` called about a hundred times per run.
+    log_every : keep every n-th sample (large batches); the final sample is always kept.
+    batch_dims : names of the batch dimensions (default ``("ship",)`` for one batch axis).
+
+    Returns an ``xarray.Dataset`` (see :mod:`shipgnc.sim.result`).
+    """
+    setup = _validate(model, x0, t_end=t_end, dt=dt, controller=controller, actuator=actuator,
+                      guidance=guidance, disturbance=disturbance, u0=u0, integrator=integrator,
+                      method=method, rtol=rtol, atol=atol, seed=seed,
+                      on_divergence=on_divergence, observer=observer, progress=progress,
+                      log_every=log_every)
+    require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
+    log = None
+    if backend != "numpy":
+        from shipgnc.sim import compiled
+
+        reason = compiled.unsupported_reason(setup)
+        if backend == "compiled" and reason:
+            raise ConfigError(f"backend = 'compiled': {reason}; use backend='numpy'")
+        batch = math.prod(setup.batch_shape)
+        if not reason and (backend == "compiled" or batch >= COMPILED_MIN_BATCH):
+            log = compiled.run(setup)
+    if log is None:
+        log = run_numpy(setup)
+    from shipgnc.sim.result import build_dataset
+
+    run_attrs = {"integrator": integrator, "dt": dt, "Ts": dt * setup.hold, "t_end": t_end,
+                 "model": type(model).__name__, **(attrs or {})}
+    return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
+
+
+def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturbance, u0,
+              integrator, method, rtol, atol, seed, on_divergence, observer, progress,
+              log_every) -> SimSetup:
+    for name, value in (("dt", dt), ("t_end", t_end)):
+        require(isinstance(value, (int, float)) and math.isfinite(value) and value > 0,
+                name, value, "must be a finite number > 0 s")
+    n_steps = round(t_end / dt)
+    require(n_steps >= 1 and abs(n_steps * dt - t_end) <= 1e-9 * max(1.0, t_end), "t_end",
+            t_end, f"must be a whole multiple of dt = {dt:g} s")
+    Ts = getattr(controller, "Ts", None) or dt
+    require(math.isfinite(Ts) and Ts > 0, "controller.Ts", Ts, "must be > 0 s")
+    hold = round(Ts / dt)
+    require(hold >= 1 and abs(hold * dt - Ts) <= 1e-9 * Ts, "controller.Ts", Ts,
+            f"must be a whole multiple of dt = {dt:g} s")
+    require(integrator in INTEGRATORS, "integrator", integrator,
+            f"allowed: {', '.join(INTEGRATORS)}")
+    require(on_divergence in ("raise", "stop"), "on_divergence", on_divergence,
+            "allowed: raise, stop")
+    require(isinstance(log_every, int) and log_every >= 1, "log_every", log_every,
+            "must be an integer >= 1")
+    n_states = len(model.states)
+    try:
+        x0 = np.array(x0, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"x0: not a numeric array ({exc})") from None
+    require(x0.ndim >= 1 and x0.shape[-1] == n_states, "x0 shape", x0.shape,
+            f"last axis must hold the {n_states} states {', '.join(names(model.states))}")
+    require(bool(np.all(np.isfinite(x0))), "x0", x0.tolist() if x0.size < 20 else "...",
+            "initial state must be finite")
+    if actuator is None:
+        actuator = Actuator.for_model(model)
+    require(actuator.n == len(model.inputs), "actuator channels", actuator.n,
+            f"the model has {len(model.inputs)} inputs ({', '.join(names(model.inputs))})")
+    u0 = np.zeros(actuator.n) if u0 is None else np.asarray(u0, dtype=float)
+    require(u0.shape[-1:] == (actuator.n,), "u0 shape", u0.shape,
+            f"must end in {actuator.n} (one value per input)")
+    if getattr(controller, "continuous", False):
+        require(not (actuator.has_rate_limit and not np.all(actuator.tau > 0)), "actuator.rate",
+                actuator.rate.tolist(), "a continuous controller needs a lag (tau > 0) on "
+                "every rate-limited channel")
+    if seed is not None and not isinstance(seed, np.random.Generator):
+        require(isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and seed >= 0,
+                "seed", seed, "must be a non-negative integer or a numpy Generator")
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    return SimSetup(model=model, x0=x0, t_end=float(t_end), dt=float(dt), n_steps=n_steps,
+                    hold=hold, controller=controller, actuator=actuator, guidance=guidance,
+                    disturbance=disturbance, integrator=integrator,
+                    solver_options={"method": method, "rtol": rtol, "atol": atol}, rng=rng,
+                    on_divergence=on_divergence, observer=observer, progress=progress,
+                    log_every=log_every, u0=u0)
+
+
+def log_signals(setup: SimSetup) -> dict[str, Signal]:
+    """Every variable a run logs, in order: states, commands, inputs, references, errors, ..."""
+    model, ctrl, gd = setup.model, setup.controller, setup.guidance
+    out: dict[str, Signal] = {s.name: s for s in model.states}
+    for s in model.inputs:
+        out[f"{s.name}_cmd"] = Signal(f"{s.name}_cmd", s.unit, f"commanded {s.long_name}",
+                                      s.angle)
+    out.update({s.name: s for s in model.inputs})
+    if gd is not None:
+        out.update({s.name: s for s in gd.references})
+        state_signals = {s.name: s for s in model.states}
+        for s in gd.references:
+            if s.tracks:
+                tracked = state_signals[s.tracks]
+                out[f"{s.tracks}_error"] = Signal(f"{s.tracks}_error", tracked.unit,
+                                                  f"{s.tracks} - {s.name}", tracked.angle)
+        out.update({s.name: s for s in gd.outputs})
+    if ctrl is not None:
+        out.update({s.name: s for s in getattr(ctrl, "signals", ())})
+    return out
+
+
+def tracking_errors(setup: SimSetup, x: np.ndarray, ref: np.ndarray) -> dict[str, np.ndarray]:
+    """``<state>_error = state − reference`` (wrapped to (−π, π] for angles)."""
+    out = {}
+    state_names = names(setup.model.states)
+    for i, s in enumerate(setup.guidance.references):
+        if s.tracks:
+            err = x[..., state_names.index(s.tracks)] - ref[..., i]
+            out[f"{s.tracks}_error"] = wrap_angle(err) if s.angle else err
+    return out
+
+
+def check_divergence(setup: SimSetup, t: float, x: np.ndarray,
+                     command: np.ndarray) -> DivergenceError | None:
+    """None if state and command are sane, else the error naming time, state, value and ship."""
+    limits = np.asarray(setup.model.state_limits, dtype=float)
+    bad = ~np.isfinite(x) | (np.abs(x) > limits)
+    where, source, kind = x, setup.model.states, "state"
+    if not bad.any():
+        bad = ~np.isfinite(command)
+        if not bad.any():
+            return None
+        where, source, kind = command, setup.model.inputs, "controller command"
+    idx = tuple(int(i) for i in np.argwhere(bad)[0])
+    signal = source[idx[-1]]
+    value = float(where[idx])
+    ship = f" of ship {idx[:-1]}" if idx[:-1] else ""
+    rule = ("not finite" if not math.isfinite(value) else
+            f"beyond the runaway limit |{signal.name}| <= {limits[idx[-1]]:g} {signal.unit}")
+    message = (f"simulation diverged at t = {t:.4g} s: {kind} '{signal.name}'{ship} = "
+               f"{value:.6g} {signal.unit} ({rule})")
+    return DivergenceError(message, time=t, state=signal.name, value=value, index=idx[:-1])
+
+
+def run_numpy(setup: SimSetup) -> Log:
+    """The reference loop in plain numpy (readable; batched over ships)."""
+    model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller, setup.guidance,
+                                  setup.disturbance)
+    batch, n = setup.batch_shape, setup.x0.shape[-1]
+    dt = setup.dt
+    continuous = bool(getattr(ctrl, "continuous", False))
+    if ctrl is not None:
+        ctrl.reset(batch)
+    if gd is not None:
+        gd.reset(batch, model)
+    if dist is not None:
+        dist.reset(batch, setup.rng)
+
+    signals = log_signals(setup)
+    n_log = setup.n_steps // setup.log_every + 2
+    data = {name: np.full((n_log, *batch), np.nan) for name in signals}
+    times = np.full(n_log, np.nan)
+    input_names = names(model.inputs)
+
+    x = setup.x0.copy()
+    command = np.broadcast_to(setup.u0, (*batch, act.n)).copy()
+    applied = act.initial(command)
+    lag = applied.copy() if act.has_lag else None
+    ref = np.zeros((*batch, 0))
+    extra: dict[str, np.ndarray] = {}
+    held_d = None
+    status: dict = {"diverged": 0, "stopped_early": 0, "message": ""}
+    n_logged = 0
+    progress_every = max(1, setup.n_steps // 100)
+
+    def rhs_factory(t0: float, plan, ref_now, d_now):
+        def rhs(t: float, z: np.ndarray) -> np.ndarray:
+            xs = z[..., :n]
+            lag_s = z[..., n:] if lag is not None else None
+            if continuous:
+                cmd = ctrl.law(t, xs, ref_now)
+                u = act.saturate(cmd) if lag_s is None else np.where(act.tau > 0, lag_s,
+                                                                       act.saturate(cmd))
+            else:
+                cmd = command
+                u = act.input_at(plan, (t - t0) / dt, lag_s)
+            d = dist(t, xs) if (dist is not None and dist.per_stage) else d_now
+            xdot = model.derivatives(xs, u, d)
+            if lag_s is None:
+                return xdot
+            return np.concatenate([xdot, act.lag_derivative(cmd, lag_s)], axis=-1)
+        return rhs
+
+    for k in range(setup.n_steps + 1):
+        t = k * dt
+        if k % setup.hold == 0:
+            if gd is not None:
+                ref = gd.reference(t, x)
+                extra = {**gd.output_values(), **tracking_errors(setup, x, ref)}
+            if ctrl is not None:
+                command = (ctrl.law(t, x, ref) if continuous else ctrl.step(t, x, ref))
+                command = np.asarray(command, dtype=float)
+                act.check_command_shape(command)
+                extra.update(ctrl.signal_values())
+        plan = act.begin_step(applied, command, dt)
+        applied_now = act.input_at(plan, 0.0, lag)
+        if dist is not None and not dist.per_stage:
+            held_d = dist(t, x)
+        last = k == setup.n_steps
+        finished = gd.finished() if gd is not None else None
+        all_done = finished is not None and bool(np.all(finished))
+        if k % setup.log_every == 0 or last or all_done:
+            times[n_logged] = t
+            for i, s in enumerate(model.states):
+                data[s.name][n_logged] = x[..., i]
+            for i, name in enumerate(input_names):
+                data[f"{name}_cmd"][n_logged] = command[..., i]
+                data[name][n_logged] = applied_now[..., i]
+            if gd is not None:
+                for i, s in enumerate(gd.references):
+                    data[s.name][n_logged] = ref[..., i]
+            for name, value in extra.items():
+                data[name][n_logged] = value
+            n_logged += 1
+        if setup.observer is not None:
+            try:
+                setup.observer(t, x, command, applied_now)
+            except StopSimulation as stop:
+                status.update(stopped_early=1, message=str(stop) or "stopped by observer")
+                break
+        if setup.progress is not None and (k % progress_every == 0 or last):
+            setup.progress(k, setup.n_steps)
+        if last or all_done:
+            break
+        z = x if lag is None else np.concatenate([x, lag], axis=-1)
+        rhs = rhs_factory(t, plan, ref, held_d)
+        with np.errstate(all="ignore"):
+            if setup.integrator == "rk4":
+                z = rk4_step(rhs, t, z, dt)
+            else:
+                z = solve_ivp_step(rhs, t, z, dt, **setup.solver_options)
+        x = z[..., :n]
+        if lag is not None:
+            lag = z[..., n:]
+        applied = act.input_at(plan, 1.0, lag)
+        error = check_divergence(setup, t + dt, x, command)
+        if error is not None:
+            if setup.on_divergence == "raise":
+                error.args = (f"{error}; pass on_divergence='stop' to keep the partial result",)
+                raise error
+            status.update(diverged=1, message=str(error))
+            break
+    return Log(time=times[:n_logged], data={k: v[:n_logged] for k, v in data.items()},
+               signals=signals, status=status)
