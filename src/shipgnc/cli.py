@@ -1,0 +1,192 @@
+"""The ``shipgnc`` command line (typer + rich).
+
+    shipgnc list                          built-in scenarios
+    shipgnc show NAME_OR_YAML [--set ..]  the scenario as validated YAML
+    shipgnc run NAME_OR_YAML [--out DIR] [--set k=v ...] [--json] [--live]
+
+Bad input ends with a one-line ``error: ...`` on stderr and a non-zero exit code (2: bad input,
+3: the simulation diverged, 1: an internal error); never a traceback (set ``SHIPGNC_DEBUG=1`` to
+see one). With ``--json`` stdout carries exactly the metrics JSON object.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from shipgnc import __version__
+from shipgnc.errors import ShipGNCError
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+                  help="shipgnc: ship guidance, navigation and control. "
+                       "Run built-in scenarios, write results, metrics and figures.")
+stdout = Console(highlight=False)
+stderr = Console(stderr=True, highlight=False)
+
+
+@contextmanager
+def friendly_errors():
+    """Turn errors into one line on stderr and an exit code."""
+    try:
+        yield
+    except ShipGNCError as exc:
+        stderr.print(f"[bold red]error:[/] {_one_line(exc)}", soft_wrap=True)
+        raise typer.Exit(exc.exit_code) from None
+    except KeyboardInterrupt:
+        stderr.print("interrupted")
+        raise typer.Exit(130) from None
+    except Exception as exc:
+        if os.environ.get("SHIPGNC_DEBUG"):
+            raise
+        stderr.print(f"[bold red]internal error:[/] {type(exc).__name__}: {_one_line(exc)} "
+                     "(set SHIPGNC_DEBUG=1 for the traceback)", soft_wrap=True)
+        raise typer.Exit(1) from None
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
+def _version(value: bool) -> None:
+    if value:
+        stdout.print(f"shipgnc {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True,
+                                                help="Print the version and exit.")] = False):
+    """shipgnc: ship guidance, navigation and control."""
+
+
+@app.command("list")
+def list_command() -> None:
+    """List the built-in scenarios."""
+    with friendly_errors():
+        from shipgnc.scenarios.registry import list_scenarios
+
+        table = Table(title="built-in scenarios", title_justify="left")
+        table.add_column("name", style="bold")
+        table.add_column("doc")
+        table.add_column("description")
+        for sc in list_scenarios():
+            table.add_row(sc.name, sc.document, sc.description)
+        stdout.print(table)
+
+
+SetOption = Annotated[list[str] | None, typer.Option(
+    "--set", help="Override a scenario field: KEY=VALUE with a dotted key, e.g. "
+                  "simulation.dt=0.01 or vessel.preset=otter-munk (repeatable).")]
+
+
+@app.command("show")
+def show_command(scenario: Annotated[str, typer.Argument(help="Built-in name or YAML file.")],
+                 set_: SetOption = None) -> None:
+    """Print a scenario as validated YAML (all defaults filled in)."""
+    with friendly_errors():
+        from shipgnc.scenarios.registry import load_scenario, scenario_yaml
+
+        sys.stdout.write(scenario_yaml(load_scenario(scenario, set_ or [])))
+
+
+@app.command("run")
+def run_command(
+    scenario: Annotated[str, typer.Argument(help="Built-in scenario name or a YAML file.")],
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Output directory "
+                                             "[default: runs/<scenario>].")] = None,
+    set_: SetOption = None,
+    json_: Annotated[bool, typer.Option("--json", help="Print only the metrics JSON on stdout.")] = False,
+    live: Annotated[bool, typer.Option("--live", help="Animate the dashboard while simulating.")] = False,
+    realtime: Annotated[float | None, typer.Option(
+        "--realtime", help="With --live: pace the run against the wall clock (1.0 = real time).")] = None,
+    figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write PNG figures.")] = True,
+    keep_partial: Annotated[bool, typer.Option(
+        "--keep-partial", help="If the run diverges, still write the partial result (exit 3).")] = False,
+) -> None:
+    """Run a scenario: write result.nc, metrics.json and figures; print the metrics."""
+    with friendly_errors():
+        from shipgnc.errors import ConfigError
+        from shipgnc.scenarios.registry import load_scenario
+        from shipgnc.scenarios.runner import metrics_json, run_scenario, write_outputs
+
+        if realtime is not None and not (realtime > 0 and realtime < float("inf")):
+            raise ConfigError(f"--realtime = {realtime}: must be a number > 0 (1.0 = real time)")
+        if realtime is not None and not live:
+            raise ConfigError("--realtime needs --live")
+        sc = load_scenario(scenario, set_ or [])
+        out_dir = out if out is not None else Path("runs") / sc.name
+        observer = _live_observer(sc, realtime) if live else None
+        with _progress(enabled=not live) as progress:
+            run = run_scenario(sc, observer=observer, progress=progress,
+                               on_divergence="stop" if keep_partial else "raise")
+        written = write_outputs(run, out_dir, figures=figures)
+        if json_:
+            sys.stdout.write(metrics_json(run.metrics) + "\n")
+        else:
+            _print_metrics(sc.name, run.metrics)
+        stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}")
+        if run.result.attrs.get("diverged"):
+            stderr.print(f"[bold red]error:[/] {run.result.attrs['message']}", soft_wrap=True)
+            raise typer.Exit(3)
+
+
+def _live_observer(sc, realtime):
+    from shipgnc.scenarios.runner import build
+    from shipgnc.viz.live import LiveDashboard
+
+    setup = build(sc)
+    lower, upper = setup.model.input_limits()
+    g = sc.guidance
+    return LiveDashboard(t_end=sc.simulation.t_end,
+                         waypoints=g.waypoints if g is not None and g.type == "los" else None,
+                         limits={"T": (lower[0], upper[0]), "alpha": (lower[1], upper[1])},
+                         title=sc.name, realtime=realtime)
+
+
+@contextmanager
+def _progress(enabled: bool):
+    """A rich progress bar on stderr (only on a terminal); yields the simulator's callback."""
+    if not enabled or not stderr.is_terminal:
+        yield None
+        return
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.percentage:>3.0f}%"),
+                  TimeRemainingColumn(), console=stderr, transient=True) as bar:
+        task = bar.add_task("sim", total=1.0)
+
+        def update(k: int, n: int) -> None:
+            bar.update(task, completed=k / n)
+
+        yield update
+
+
+def _print_metrics(name: str, metrics: dict) -> None:
+    table = Table(title=f"{name}: metrics", title_justify="left")
+    table.add_column("metric", style="bold")
+    table.add_column("value", justify="right")
+    for key, value in metrics.items():
+        if isinstance(value, float):
+            text = f"{value:.6g}"
+        elif isinstance(value, list):
+            text = ", ".join("—" if v is None else f"{v:.4g}" for v in value)
+        else:
+            text = "—" if value is None else str(value)
+        table.add_row(key, text)
+    stdout.print(table)
+
+
+def main() -> None:
+    """Console-script entry point."""
+    app()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,115 @@
+"""Built-in scenarios and loading of scenario files, with ``key=value`` overrides."""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+import yaml
+
+from shipgnc.errors import ConfigError
+from shipgnc.scenarios.schema import Scenario, validate
+
+BUILTIN_PACKAGE = "shipgnc.scenarios.builtin"
+
+
+def _builtin_files() -> dict[str, object]:
+    root = resources.files(BUILTIN_PACKAGE)
+    return {entry.name.removesuffix(".yaml"): entry for entry in root.iterdir()
+            if entry.name.endswith(".yaml")}
+
+
+def builtin_names() -> list[str]:
+    """Names of the built-in scenarios, sorted."""
+    return sorted(_builtin_files())
+
+
+def list_scenarios() -> list[Scenario]:
+    """Every built-in scenario, validated."""
+    return [load_scenario(name) for name in builtin_names()]
+
+
+def _read_yaml(text: str, source: str) -> object:
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or "invalid YAML"
+        raise ConfigError(f"scenario {source}: not valid YAML{where}: {problem}") from None
+
+
+def raw_scenario(name_or_path: str) -> tuple[dict, str]:
+    """The unvalidated mapping of a built-in name or a YAML path, and a label for messages."""
+    builtins = _builtin_files()
+    path = Path(name_or_path)
+    if name_or_path in builtins:
+        text, source = builtins[name_or_path].read_text(encoding="utf-8"), repr(name_or_path)
+    elif path.suffix in (".yaml", ".yml") or path.exists():
+        if not path.is_file():
+            raise ConfigError(f"scenario file {str(path)!r}: no such file")
+        text, source = path.read_text(encoding="utf-8"), repr(str(path))
+    else:
+        raise ConfigError(f"unknown scenario {name_or_path!r}; built-in scenarios: "
+                          f"{', '.join(sorted(builtins))} (or give a path to a .yaml file)")
+    data = _read_yaml(text, source)
+    if not isinstance(data, dict):
+        raise ConfigError(f"scenario {source}: expected a mapping of fields at the top level, "
+                          f"got {type(data).__name__}")
+    return data, source
+
+
+def load_scenario(name_or_path: str, overrides: list[str] | tuple[str, ...] = ()) -> Scenario:
+    """Load a built-in scenario by name or a YAML file by path, apply ``key=value`` overrides
+    (dotted keys, YAML values: ``simulation.dt=0.01``, ``vessel.preset=otter-munk``) and validate."""
+    data, source = raw_scenario(name_or_path)
+    for item in overrides:
+        key, value = parse_override(item)
+        set_path(data, key, value)
+    return validate(data, source)
+
+
+def parse_override(item: str) -> tuple[str, object]:
+    """``"a.b=1.5"`` → ``("a.b", 1.5)``; the value is read as YAML (numbers, lists, strings)."""
+    key, sep, text = item.partition("=")
+    key = key.strip()
+    if not sep or not key or any(not part for part in key.split(".")):
+        raise ConfigError(f"--set {item!r}: expected KEY=VALUE with a dotted key, "
+                          f"e.g. simulation.dt=0.01")
+    try:
+        value = yaml.safe_load(text) if text.strip() else None
+    except yaml.YAMLError:
+        value = text
+    if value is None:
+        raise ConfigError(f"--set {item!r}: missing value after '='")
+    return key, value
+
+
+def set_path(data: dict, key: str, value: object) -> None:
+    """Set ``data[k1][k2]... = value`` for a dotted key; integer parts index lists."""
+    parts = key.split(".")
+    node: object = data
+    for depth, part in enumerate(parts):
+        last = depth == len(parts) - 1
+        where = ".".join(parts[: depth + 1])
+        if isinstance(node, dict):
+            if last:
+                node[part] = value
+            else:
+                node = node.setdefault(part, {})
+        elif isinstance(node, list):
+            if not part.lstrip("-").isdigit() or not -len(node) <= int(part) < len(node):
+                raise ConfigError(f"--set {key}: {where!r} is not a valid index "
+                                  f"(the list has {len(node)} entries)")
+            if last:
+                node[int(part)] = value
+            else:
+                node = node[int(part)]
+        else:
+            raise ConfigError(f"--set {key}: {'.'.join(parts[:depth])!r} is a value "
+                              f"({node!r}), not a section")
+
+
+def scenario_yaml(scenario: Scenario) -> str:
+    """The scenario as YAML (what ``shipgnc show`` prints)."""
+    return yaml.safe_dump(scenario.model_dump(mode="json", exclude_none=True), sort_keys=False)
