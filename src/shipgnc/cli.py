@@ -22,7 +22,7 @@ from rich.console import Console
 from rich.table import Table
 
 from shipgnc import __version__
-from shipgnc.errors import ShipGNCError
+from shipgnc.errors import DivergenceError, ShipGNCError
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="shipgnc: ship guidance, navigation and control. "
@@ -36,8 +36,11 @@ def friendly_errors():
     """Turn errors into one line on stderr and an exit code."""
     try:
         yield
+    except typer.Exit:
+        raise
     except ShipGNCError as exc:
-        stderr.print(f"[bold red]error:[/] {_one_line(exc)}", soft_wrap=True)
+        hint = "; --keep-partial writes the partial result" if isinstance(exc, DivergenceError) else ""
+        stderr.print(f"[bold red]error:[/] {_one_line(exc)}{hint}", soft_wrap=True)
         raise typer.Exit(exc.exit_code) from None
     except KeyboardInterrupt:
         stderr.print("interrupted")

@@ -76,12 +76,12 @@ def parse_override(item: str) -> tuple[str, object]:
     if not sep or not key or any(not part for part in key.split(".")):
         raise ConfigError(f"--set {item!r}: expected KEY=VALUE with a dotted key, "
                           f"e.g. simulation.dt=0.01")
+    if not text.strip():
+        raise ConfigError(f"--set {item!r}: missing value after '='")
     try:
-        value = yaml.safe_load(text) if text.strip() else None
+        value = yaml.safe_load(text)
     except yaml.YAMLError:
         value = text
-    if value is None:
-        raise ConfigError(f"--set {item!r}: missing value after '='")
     return key, value
 
 

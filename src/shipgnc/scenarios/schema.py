@@ -228,7 +228,7 @@ def format_validation_error(error: ValidationError, source: str) -> str:
     ``scenario 'x.yaml': simulation.dt = -1: Input should be greater than 0``."""
     parts = []
     for item in error.errors():
-        loc = ".".join(str(p) for p in item["loc"] if not _is_union_tag(p))
+        loc = _location(item["loc"])
         msg = item["msg"].removeprefix("Value error, ")
         value = item.get("input")
         if item["type"] == "extra_forbidden":
@@ -242,9 +242,11 @@ def format_validation_error(error: ValidationError, source: str) -> str:
     return f"scenario {source}: " + "; ".join(parts)
 
 
-def _is_union_tag(part) -> bool:
-    return isinstance(part, str) and part in {
-        "open-loop", "heading-speed", "schedule", "los", "constant", "gaussian"}
+def _location(loc: tuple) -> str:
+    """Dotted field path without pydantic's union tags (``controller.open-loop.schedule``)."""
+    sections = ("controller", "guidance", "disturbance")
+    kept = [str(p) for i, p in enumerate(loc) if not (i > 0 and loc[i - 1] in sections and i == 1)]
+    return ".".join(kept)
 
 
 def validate(data: object, source: str) -> Scenario:

@@ -110,14 +110,15 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
                       log_every=log_every)
     require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
     log = None
-    if backend != "numpy":
+    wants_compiled = backend == "compiled" or (
+        backend == "auto" and math.prod(setup.batch_shape) >= COMPILED_MIN_BATCH)
+    if wants_compiled:
         from shipgnc.sim import compiled
 
         reason = compiled.unsupported_reason(setup)
         if backend == "compiled" and reason:
             raise ConfigError(f"backend = 'compiled': {reason}; use backend='numpy'")
-        batch = math.prod(setup.batch_shape)
-        if not reason and (backend == "compiled" or batch >= COMPILED_MIN_BATCH):
+        if not reason:
             log = compiled.run(setup)
     if log is None:
         log = run_numpy(setup)
@@ -339,7 +340,6 @@ def run_numpy(setup: SimSetup) -> Log:
         error = check_divergence(setup, t + dt, x, command)
         if error is not None:
             if setup.on_divergence == "raise":
-                error.args = (f"{error}; pass on_divergence='stop' to keep the partial result",)
                 raise error
             status.update(diverged=1, message=str(error))
             break

@@ -1,0 +1,5 @@
+"""Test configuration: headless matplotlib, numpy errors surface as failures."""
+
+import matplotlib
+
+matplotlib.use("Agg")

@@ -1,0 +1,163 @@
+"""The ``shipgnc`` command line: contracts (names, files, --json) and one-line errors."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from shipgnc.cli import app
+
+runner = CliRunner()
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def test_list_names_the_builtin_scenarios():
+    result = invoke("list")
+    assert result.exit_code == 0
+    for name in ("boat-stern-kick", "boat-autopilot", "boat-los"):
+        assert name in result.stdout
+
+
+def test_run_writes_result_metrics_and_figures(tmp_path):
+    result = invoke("run", "boat-stern-kick", "--out", tmp_path)
+    assert result.exit_code == 0, result.stderr
+    sizes = {p.name: p.stat().st_size for p in tmp_path.iterdir()}
+    assert sizes["metrics.json"] > 100
+    for name in ("result.nc", "dashboard.png", "stern_kick_closeup.png"):
+        assert sizes[name] > 10_000, (name, sizes)
+    assert "heading_change_deg" in result.stdout  # the metrics table
+
+
+def test_json_flag_prints_exactly_the_metrics_object(tmp_path):
+    result = invoke("run", "boat-stern-kick", "--out", tmp_path, "--json", "--no-figures")
+    assert result.exit_code == 0, result.stderr
+    metrics = json.loads(result.stdout)  # nothing but JSON on stdout
+    on_disk = json.loads((tmp_path / "metrics.json").read_text())
+    assert metrics == on_disk
+    for key in ("initial_sway_sign", "initial_yaw_rate_sign", "steady_yaw_rate_sign",
+                "max_speed_mps", "final_speed_mps", "heading_change_deg"):
+        assert key in metrics
+    # spec 001 §1.9: the signs of the stern kick in NED
+    assert (metrics["initial_sway_sign"], metrics["initial_yaw_rate_sign"],
+            metrics["steady_yaw_rate_sign"]) == (-1, 1, 1)
+
+
+def test_set_override_changes_the_run(tmp_path):
+    result = invoke("run", "boat-stern-kick", "--out", tmp_path, "--json", "--no-figures",
+                    "--set", "vessel.params.N_rr=0", "--set", "simulation.t_end=12")
+    assert result.exit_code == 0, result.stderr
+    metrics = json.loads(result.stdout)
+    # linear damping: r = -tau_r/N_r = L_m T sin(15°)/38.98 ≈ 0.996 rad/s, 5 s of turning ≈ 228.6°
+    assert metrics["heading_change_deg"] > 200
+
+
+def test_show_prints_validated_yaml():
+    result = invoke("show", "boat-los", "--set", "guidance.lookahead=5")
+    assert result.exit_code == 0
+    assert "lookahead: 5" in result.stdout
+
+
+def test_version():
+    result = invoke("--version")
+    assert result.exit_code == 0 and "shipgnc" in result.stdout
+
+
+BAD_INPUTS = [
+    # (arguments, words the one-line message must contain)
+    (["run", "no-such-scenario"], ["unknown scenario", "no-such-scenario", "boat-los"]),
+    (["run", "boat-stern-kick", "--set", "simulation.dt"], ["--set", "KEY=VALUE"]),
+    (["run", "boat-stern-kick", "--set", "=3"], ["--set", "KEY=VALUE"]),
+    (["run", "boat-stern-kick", "--set", "simulation.dt="], ["missing value"]),
+    (["run", "boat-stern-kick", "--set", "simulation.dt=-0.1"], ["simulation.dt", "-0.1", "greater than 0"]),
+    (["run", "boat-stern-kick", "--set", "simulation.dt=0"], ["simulation.dt", "greater than 0"]),
+    (["run", "boat-stern-kick", "--set", "simulation.dt=fast"], ["simulation.dt", "fast", "number"]),
+    (["run", "boat-stern-kick", "--set", "simulation.t_end=30.01"], ["t_end", "whole multiple"]),
+    (["run", "boat-autopilot", "--set", "controller.Ts=0.07"], ["controller.Ts", "0.07", "whole multiple"]),
+    (["run", "boat-stern-kick", "--set", "simulation.speed=3"], ["simulation.speed", "unknown field"]),
+    (["run", "boat-stern-kick", "--set", "vessel.preset=speedboat"], ["vessel.preset", "speedboat", "otter"]),
+    (["run", "boat-stern-kick", "--set", "vessel.params.mass=3"], ["unknown parameter", "mass"]),
+    (["run", "boat-stern-kick", "--set", "vessel.params.m=-1"], ["vessel.params.m", "-1", "> 0"]),
+    (["run", "boat-stern-kick", "--set", "vessel.params.X_u=5"], ["vessel.params.X_u", "<= 0"]),
+    (["run", "boat-stern-kick", "--set", "vessel.params.T_min=300"], ["T_min", "T_max", "300"]),
+    (["run", "boat-stern-kick", "--set", "vessel.params.alpha_max_deg=120"], ["alpha_max", "90"]),
+    (["run", "boat-stern-kick", "--set", "vessel.params.m=.nan"], ["vessel.params.m", "finite"]),
+    (["run", "boat-stern-kick", "--set", "controller.schedule.1.t=0"], ["schedule", "increase"]),
+    (["run", "boat-stern-kick", "--set", "controller.schedule.9.t=1"], ["controller.schedule.9", "index"]),
+    (["run", "boat-stern-kick", "--set", "simulation.dt.x=1"], ["simulation.dt", "not a section"]),
+    (["run", "boat-stern-kick", "--set", "simulation.integrator=euler"], ["simulation.integrator", "euler", "rk4"]),
+    (["run", "boat-stern-kick", "--set", "simulation.seed=-4"], ["simulation.seed", "-4"]),
+    (["run", "boat-los", "--set", "guidance.waypoints=[[0,0]]"], ["guidance.waypoints", "at least 2"]),
+    (["run", "boat-los", "--set", "guidance.waypoints=[[0,0],[0,0]]"], ["guidance.waypoints", "zero-length"]),
+    (["run", "boat-los", "--set", "guidance.lookahead=0"], ["guidance.lookahead", "greater than 0"]),
+    (["run", "boat-los", "--set", "guidance=null"], ["heading-speed", "guidance"]),
+    (["run", "boat-stern-kick", "--set", "controller.type=pid"], ["controller", "pid"]),
+    (["run", "boat-stern-kick", "--set", "actuator.thrust_time_constant=-1"], ["actuator.thrust_time_constant", "-1"]),
+    (["run", "boat-stern-kick", "--realtime", "2"], ["--realtime", "--live"]),
+    (["run", "boat-stern-kick", "--live"], ["--live", "interactive", "agg"]),
+    (["run", "missing-file.yaml"], ["missing-file.yaml", "no such file"]),
+    (["show", "boat-los", "--set", "metrics=speed"], ["metrics", "speed"]),
+]
+
+
+@pytest.mark.parametrize(("args", "words"), BAD_INPUTS, ids=[" ".join(a[1:]) for a, _ in BAD_INPUTS])
+def test_bad_input_gives_one_line_error(args, words):
+    result = invoke(*args)
+    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
+    message = result.stderr.strip()
+    assert "\n" not in message, message
+    assert message.startswith("error:"), message
+    assert "Traceback" not in message
+    for word in words:
+        assert word.lower() in message.lower(), (word, message)
+
+
+def test_bad_input_messages_are_distinct():
+    messages = {invoke(*args).stderr for args, _ in BAD_INPUTS}
+    assert len(messages) == len(BAD_INPUTS) >= 15
+
+
+def test_unknown_yaml_field_in_a_file(tmp_path):
+    path = tmp_path / "mine.yaml"
+    text = invoke("show", "boat-stern-kick").stdout.replace("name: boat-stern-kick",
+                                                            "name: mine\ncolour: red")
+    path.write_text(text)
+    result = invoke("run", path, "--out", tmp_path / "out")
+    assert result.exit_code == 2
+    assert "colour: unknown field" in result.stderr and "mine.yaml" in result.stderr
+
+
+def test_invalid_yaml_syntax(tmp_path):
+    path = tmp_path / "broken.yaml"
+    path.write_text("name: x\nsimulation: {dt: 0.05\n")
+    result = invoke("run", path)
+    assert result.exit_code == 2
+    assert "not valid YAML" in result.stderr and "line" in result.stderr
+
+
+def test_out_directory_that_is_a_file(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    result = invoke("run", "boat-stern-kick", "--out", blocker, "--no-figures")
+    assert result.exit_code == 2
+    assert "--out" in result.stderr
+
+
+def test_divergence_exit_code_and_partial_result(tmp_path):
+    # A tiny yaw inertia with strong yaw damping: the yaw time constant (1e-6 s) is far below
+    # dt = 0.5 s, RK4 is unstable, and the guard must name the time and the state.
+    args = ["run", "boat-stern-kick", "--out", tmp_path, "--no-figures",
+            "--set", "simulation.dt=0.5", "--set", "vessel.params.I_z=0.001",
+            "--set", "vessel.params.N_rdot=0", "--set", "vessel.params.N_rr=-1000",
+            "--set", "vessel.params.N_r=-1000"]
+    result = invoke(*args)
+    assert result.exit_code == 3, (result.stdout, result.stderr)
+    assert "diverged at t = " in result.stderr and "state '" in result.stderr
+    assert "--keep-partial" in result.stderr
+    kept = invoke(*args, "--keep-partial")
+    assert kept.exit_code == 3
+    assert (tmp_path / "result.nc").exists()
