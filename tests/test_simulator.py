@@ -1,0 +1,183 @@
+"""The simulation loop itself: sample-and-hold, logging, continuous laws, observers, errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from shipgnc.actuators import Actuator
+from shipgnc.control.open_loop import OpenLoopSchedule
+from shipgnc.environment.disturbance import ConstantDisturbance
+from shipgnc.errors import ConfigError
+from shipgnc.models.base import Signal
+from shipgnc.models.fossen3dof import VectoredThrustBoat
+from shipgnc.sim.simulator import StopSimulation, simulate
+
+BOAT = VectoredThrustBoat()
+
+
+class Counter:
+    """A controller that counts its calls and commands a thrust equal to the call count."""
+
+    signals = (Signal("calls", "1", "number of controller calls"),)
+
+    def __init__(self, Ts):
+        self.Ts = Ts
+
+    def reset(self, batch_shape):
+        self.calls = np.zeros(batch_shape)
+
+    def step(self, t, x, ref):
+        self.calls = self.calls + 1
+        return np.stack([self.calls, np.zeros_like(self.calls)], axis=-1)
+
+    def signal_values(self):
+        return {"calls": self.calls}
+
+
+def test_sample_and_hold_every_Ts():
+    ds = simulate(BOAT, np.zeros(6), t_end=1.0, dt=0.05, controller=Counter(Ts=0.2),
+                  backend="numpy")
+    assert ds.attrs["Ts"] == pytest.approx(0.2)
+    calls = ds.calls.values
+    # called at t = 0, 0.2, ..., 1.0 and held in between
+    np.testing.assert_array_equal(calls, np.floor(np.round(ds.time.values / 0.2, 9)) + 1)
+    np.testing.assert_array_equal(ds.T_cmd.values, calls)
+
+
+def test_log_every_keeps_the_final_sample():
+    ds = simulate(BOAT, np.zeros(6), t_end=1.0, dt=0.05, u0=[100.0, 0.0], log_every=7,
+                  backend="numpy")
+    np.testing.assert_allclose(ds.time.values, [0, 0.35, 0.7, 1.0])
+    full = simulate(BOAT, np.zeros(6), t_end=1.0, dt=0.05, u0=[100.0, 0.0], backend="numpy")
+    np.testing.assert_array_equal(full.u.sel(time=ds.time.values, method="nearest").values,
+                                  ds.u.values)
+
+
+def test_constant_input_without_controller_and_units_in_attrs():
+    ds = simulate(BOAT, np.zeros(6), t_end=2.0, dt=0.05, u0=[50.0, 0.0], backend="numpy")
+    assert ds.u.attrs["units"] == "m/s" and ds.psi.attrs["units"] == "rad"
+    assert ds["T"].attrs["units"] == "N" and ds.time.attrs["units"] == "s"
+    assert float(ds.u[-1]) > 0
+
+
+def test_batch_dims_are_named_and_multidimensional_batches_work():
+    x0 = np.zeros((2, 3, 6))
+    x0[..., 3] = np.arange(6).reshape(2, 3) * 0.2
+    ds = simulate(BOAT, x0, t_end=0.5, dt=0.05, u0=[80.0, 0.1], batch_dims=("speed", "member"),
+                  backend="numpy")
+    assert ds.u.dims == ("time", "speed", "member")
+    single = simulate(BOAT, x0[1, 2], t_end=0.5, dt=0.05, u0=[80.0, 0.1], backend="numpy")
+    np.testing.assert_allclose(ds.u.values[:, 1, 2], single.u.values, rtol=0, atol=1e-12)
+
+
+class ProportionalYawLaw:
+    """A stateless continuous law α = −k (ψ_d − ψ), evaluated in every RK stage."""
+
+    continuous = True
+    signals = ()
+    Ts = None
+
+    def reset(self, batch_shape):
+        pass
+
+    def law(self, t, x, ref):
+        return np.stack([np.full(x.shape[:-1], 100.0), -0.5 * (0.3 - x[..., 2])], axis=-1)
+
+    def signal_values(self):
+        return {}
+
+
+def test_continuous_controller_is_evaluated_inside_the_stages():
+    ds = simulate(BOAT, np.zeros(6), t_end=20.0, dt=0.05, controller=ProportionalYawLaw(),
+                  backend="numpy")
+    assert float(ds.psi[-1]) == pytest.approx(0.3, abs=1e-3)
+    # logged command equals the law at the sample instants
+    np.testing.assert_allclose(ds.alpha_cmd.values, -0.5 * (0.3 - ds.psi.values), atol=1e-12)
+
+
+def test_per_stage_disturbance_sees_stage_time():
+    class Ramp:
+        per_stage = True
+
+        def reset(self, batch_shape, rng):
+            self.shape = (*batch_shape, 3)
+
+        def __call__(self, t, x):
+            return np.broadcast_to(np.array([10.0 * t, 0.0, 0.0]), self.shape)
+
+    p = BOAT.params
+    ds = simulate(BOAT, np.zeros(6), t_end=0.5, dt=0.05, disturbance=Ramp(), backend="numpy")
+    # M11 u' = 10 t + X_u u  => for small t, u ≈ 10 t²/(2 M11); RK4 integrates the ramp exactly
+    t = ds.time.values
+    tau = p.M11 / -p.X_u
+    exact = 10.0 / -p.X_u * (t - tau * (1 - np.exp(-t / tau)))
+    np.testing.assert_allclose(ds.u.values, exact, atol=1e-8)
+
+
+def test_constant_environment_force_pushes_the_boat():
+    ds = simulate(BOAT, np.zeros(6), t_end=30.0, dt=0.05,
+                  disturbance=ConstantDisturbance([0.0, 16.25, 0.0]), backend="numpy")
+    p = BOAT.params
+    assert float(ds.v[-1]) == pytest.approx(16.25 / -p.Y_v, rel=1e-6)
+
+
+def test_observer_sees_every_sample_and_can_stop_the_run():
+    seen = []
+
+    def observer(t, x, command, applied):
+        seen.append(t)
+        if t >= 1.0 - 1e-9:
+            raise StopSimulation("closed")
+
+    ds = simulate(BOAT, np.zeros(6), t_end=5.0, dt=0.05, u0=[50.0, 0.0], observer=observer,
+                  backend="numpy")
+    assert ds.attrs["stopped_early"] == 1
+    assert len(seen) == 21 and float(ds.time[-1]) == pytest.approx(1.0)
+
+
+def test_rate_limited_applied_input_ramps_within_the_step():
+    act = Actuator.for_model(BOAT, rate=[np.inf, np.radians(10.0)])
+    ctrl = OpenLoopSchedule([0.0], [[100.0, np.radians(40.0)]])
+    ds = simulate(BOAT, np.zeros(6), t_end=5.0, dt=0.05, controller=ctrl, actuator=act,
+                  backend="numpy")
+    alpha = np.degrees(ds.alpha.values)
+    np.testing.assert_allclose(alpha[:41], 10.0 * ds.time.values[:41], atol=1e-9)
+    assert alpha[-1] == pytest.approx(40.0)
+
+
+@pytest.mark.parametrize(("kwargs", "words"), [
+    ({"dt": -0.1}, ["dt", "> 0"]),
+    ({"dt": 0.0}, ["dt", "> 0"]),
+    ({"dt": float("nan")}, ["dt", "finite"]),
+    ({"t_end": 1.01}, ["t_end", "whole multiple"]),
+    ({"x0": np.zeros(5)}, ["x0 shape", "north, east, psi, u, v, r"]),
+    ({"x0": [0, 0, 0, np.nan, 0, 0]}, ["x0", "finite"]),
+    ({"x0": "boat"}, ["x0", "numeric"]),
+    ({"controller": Counter(Ts=0.07)}, ["controller.Ts", "whole multiple"]),
+    ({"integrator": "euler"}, ["integrator", "rk4"]),
+    ({"on_divergence": "ignore"}, ["on_divergence", "raise"]),
+    ({"log_every": 0}, ["log_every", ">= 1"]),
+    ({"seed": -1}, ["seed", "non-negative"]),
+    ({"backend": "gpu"}, ["backend", "numpy"]),
+    ({"u0": [1.0, 2.0, 3.0]}, ["u0", "one value per input"]),
+    ({"batch_dims": ("a", "b")}, ["batch_dims", "need 0 names"]),
+])
+def test_simulate_rejects_bad_arguments_clearly(kwargs, words):
+    args = {"t_end": 1.0, "dt": 0.05, "backend": "numpy", **kwargs}
+    x0 = args.pop("x0", np.zeros(6))
+    with pytest.raises(ConfigError) as info:
+        simulate(BOAT, x0, **args)
+    message = str(info.value)
+    assert "\n" not in message
+    for word in words:
+        assert word in message, (word, message)
+
+
+def test_actuator_rejects_reversed_limits_and_bad_dynamics():
+    with pytest.raises(ConfigError, match="lower limit must be below upper limit"):
+        Actuator([200.0, -1.0], [0.0, 1.0], names=("T", "alpha"))
+    with pytest.raises(ConfigError, match=r"actuator\.T\.tau"):
+        Actuator([0.0, -1.0], [200.0, 1.0], tau=[-1.0, 0.0], names=("T", "alpha"))
+    with pytest.raises(ConfigError, match=r"actuator\.alpha\.rate"):
+        Actuator([0.0, -1.0], [200.0, 1.0], rate=[np.inf, 0.0], names=("T", "alpha"))
