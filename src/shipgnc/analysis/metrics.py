@@ -7,6 +7,7 @@ A metric's name carries the unit it is reported in.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -87,7 +88,7 @@ def heading_step_metrics(ds, step_times, tolerance_deg: float = 2.0) -> dict:
     psi_d = ds.psi_d.values
     bounds = [*step_times, t[-1] + 1.0]
     settling, overshoot = [], []
-    for t_k, t_next in zip(bounds[:-1], bounds[1:], strict=False):
+    for t_k, t_next in itertools.pairwise(bounds):
         window = (t >= t_k - 1e-9) & (t < t_next - 1e-9)
         if not window.any():
             continue

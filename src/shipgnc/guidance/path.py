@@ -29,20 +29,15 @@ class WaypointPath:
                 wp[bad[0]].tolist() if bad.size else None,
                 "consecutive waypoints must differ (zero-length leg)")
         object.__setattr__(self, "waypoints", wp)
+        d = np.diff(wp, axis=0)
+        #: length of each leg [m]
+        object.__setattr__(self, "leg_lengths", lengths)
+        #: path angle π_p of each leg, clockwise from north [rad]
+        object.__setattr__(self, "leg_angles", np.arctan2(d[:, 1], d[:, 0]))
 
     @property
     def n_legs(self) -> int:
         return self.waypoints.shape[0] - 1
-
-    @property
-    def leg_lengths(self) -> np.ndarray:
-        return np.hypot(*np.diff(self.waypoints, axis=0).T)
-
-    @property
-    def leg_angles(self) -> np.ndarray:
-        """Path angle π_p of each leg, clockwise from north [rad]."""
-        d = np.diff(self.waypoints, axis=0)
-        return np.arctan2(d[:, 1], d[:, 0])
 
     def project(self, north, east, leg):
         """Along-track ``s`` and cross-track ``e`` (positive to starboard) on leg ``leg`` (batched)."""

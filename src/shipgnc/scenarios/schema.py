@@ -7,6 +7,7 @@ what is allowed (:func:`format_validation_error`).
 
 from __future__ import annotations
 
+import itertools
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -218,7 +219,7 @@ class Scenario(Strict):
 def _check_times(times: list[float]) -> None:
     if times[0] != 0:
         raise ValueError(f"the first entry must start at t = 0 (got t = {times[0]!r})")
-    for a, b in zip(times, times[1:], strict=False):
+    for a, b in itertools.pairwise(times):
         if not b > a:
             raise ValueError(f"times must increase strictly (t = {a!r} is followed by t = {b!r})")
 
