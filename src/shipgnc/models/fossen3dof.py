@@ -133,14 +133,14 @@ def preset(name: str, **overrides: float) -> BoatParams:
 
 
 def otter_rules(L: float = 2.0, m_hull: float = 55.0, m_payload: float = 25.0,
-                U_max: float = 6.0 * KNOT, bollard_thrust_kgf: float = 24.4,
+                U_max: float = 6.0 * 0.5144, bollard_thrust_kgf: float = 24.4,
                 T_sway: float = 1.0, T_yaw: float = 1.0, R66_over_L: float = 0.25,
                 hull_cg_ahead: float = 0.2, payload_x: float = 0.0, rho: float = 1025.0,
                 yaw_quadratic_ratio: float = 10.0, **other: float) -> BoatParams:
     """Derive a consistent parameter set by the rules of Fossen's Otter model (spec 001 table 1.6).
 
     X_u̇ = −2.7 ρ ∇^{5/3}/L² (Söding 1982, ∇ = m_hull/ρ), Y_v̇ = −1.5 m_hull, N_ṙ = −1.7 I_z,
-    X_u = −bollard thrust / U_max, Y_v = −M₂₂/T_sway, N_r = −M₃₃/T_yaw, N_|r|r = 10 N_r. I_z is the
+    X_u = −bollard thrust / U_max (U_max = 6 kn converted as otter.m does, 6 × 0.5144 m/s), Y_v = −M₂₂/T_sway, N_r = −M₃₃/T_yaw, N_|r|r = 10 N_r. I_z is the
     hull's m_hull (R₆₆ L)² plus both masses moved to the combined CG. With the defaults this returns
     the unrounded column of the table; ``other`` sets the remaining fields (L_m, limits, c_M).
     """

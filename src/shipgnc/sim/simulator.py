@@ -214,17 +214,23 @@ def tracking_errors(setup: SimSetup, x: np.ndarray, ref: np.ndarray) -> dict[str
     return out
 
 
-def check_divergence(setup: SimSetup, t: float, x: np.ndarray,
-                     command: np.ndarray) -> DivergenceError | None:
-    """None if state and command are sane, else the error naming time, state, value and ship."""
-    limits = np.asarray(setup.model.state_limits, dtype=float)
-    bad = ~np.isfinite(x) | (np.abs(x) > limits)
-    where, source, kind = x, setup.model.states, "state"
-    if not bad.any():
+def check_divergence(setup: SimSetup, t: float, x: np.ndarray | None = None,
+                     command: np.ndarray | None = None) -> DivergenceError | None:
+    """None if the state (or the command) is sane, else the error naming time, signal, value, ship.
+
+    A state is bad when it is not finite or beyond the model's ``state_limits``; a command when it
+    is not finite (checked at the sample where the controller produced it).
+    """
+    if x is not None:
+        limits = np.asarray(setup.model.state_limits, dtype=float)
+        bad = ~np.isfinite(x) | (np.abs(x) > limits)
+        where, source, kind = x, setup.model.states, "state"
+    else:
+        limits = None
         bad = ~np.isfinite(command)
-        if not bad.any():
-            return None
         where, source, kind = command, setup.model.inputs, "controller command"
+    if not bad.any():
+        return None
     idx = tuple(int(i) for i in np.argwhere(bad)[0])
     signal = source[idx[-1]]
     value = float(where[idx])
@@ -296,6 +302,12 @@ def run_numpy(setup: SimSetup) -> Log:
                 command = np.asarray(command, dtype=float)
                 act.check_command_shape(command)
                 extra.update(ctrl.signal_values())
+                error = check_divergence(setup, t, command=command)
+                if error is not None:
+                    if setup.on_divergence == "raise":
+                        raise error
+                    status.update(diverged=1, message=str(error))
+                    break
         plan = act.begin_step(applied, command, dt)
         applied_now = act.input_at(plan, 0.0, lag)
         if dist is not None and not dist.per_stage:
@@ -337,7 +349,7 @@ def run_numpy(setup: SimSetup) -> Log:
         if lag is not None:
             lag = z[..., n:]
         applied = act.input_at(plan, 1.0, lag)
-        error = check_divergence(setup, t + dt, x, command)
+        error = check_divergence(setup, t + dt, x)
         if error is not None:
             if setup.on_divergence == "raise":
                 raise error

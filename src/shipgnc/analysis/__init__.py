@@ -1,0 +1,1 @@
+"""Analysis of vessel models: equilibria, stability, linearised transfer functions, energy."""
