@@ -27,7 +27,7 @@ import numpy as np
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
 from shipgnc.models.base import Signal
-from shipgnc.units import KNOT, G
+from shipgnc.units import G
 
 
 @dataclass(frozen=True)
@@ -140,8 +140,9 @@ def otter_rules(L: float = 2.0, m_hull: float = 55.0, m_payload: float = 25.0,
     """Derive a consistent parameter set by the rules of Fossen's Otter model (spec 001 table 1.6).
 
     X_u̇ = −2.7 ρ ∇^{5/3}/L² (Söding 1982, ∇ = m_hull/ρ), Y_v̇ = −1.5 m_hull, N_ṙ = −1.7 I_z,
-    X_u = −bollard thrust / U_max (U_max = 6 kn converted as otter.m does, 6 × 0.5144 m/s), Y_v = −M₂₂/T_sway, N_r = −M₃₃/T_yaw, N_|r|r = 10 N_r. I_z is the
-    hull's m_hull (R₆₆ L)² plus both masses moved to the combined CG. With the defaults this returns
+    X_u = −bollard thrust / U_max (U_max = 6 kn converted as otter.m does, 6 × 0.5144 m/s),
+    Y_v = −M₂₂/T_sway, N_r = −M₃₃/T_yaw, N_|r|r = 10 N_r. I_z is the hull's
+    m_hull (R₆₆ L)² plus both masses moved to the combined CG. With the defaults this returns
     the unrounded column of the table; ``other`` sets the remaining fields (L_m, limits, c_M).
     """
     for name, value in (("L", L), ("m_hull", m_hull), ("U_max", U_max),
