@@ -18,9 +18,10 @@ class OpenLoopSchedule:
     continuous = False
 
     def __init__(self, times, values, *, Ts: float | None = None, labels=None):
-        self.schedule = PiecewiseConstant(times, np.atleast_2d(np.asarray(values, float).T).T
-                                          if np.ndim(values) == 1 else values,
-                                          field="controller.schedule")
+        values = np.asarray(values, dtype=float)
+        require(values.ndim == 2, "controller.schedule", values.shape,
+                "values must be a table: one row of inputs per time")
+        self.schedule = PiecewiseConstant(times, values, field="controller.schedule")
         self.Ts = Ts
         self.labels = tuple(labels) if labels is not None else ("",) * len(self.schedule.times)
         require(len(self.labels) == len(self.schedule.times), "controller.schedule.label",

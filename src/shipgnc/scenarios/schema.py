@@ -244,10 +244,12 @@ def format_validation_error(error: ValidationError, source: str) -> str:
 
 
 def _location(loc: tuple) -> str:
-    """Dotted field path without pydantic's union tags (``controller.open-loop.schedule``)."""
-    sections = ("controller", "guidance", "disturbance")
-    kept = [str(p) for i, p in enumerate(loc) if not (i > 0 and loc[i - 1] in sections and i == 1)]
-    return ".".join(kept)
+    """Dotted field path without pydantic's union tag (``controller.open-loop.schedule`` →
+    ``controller.schedule``)."""
+    parts = [str(p) for p in loc]
+    if len(parts) > 1 and parts[0] in ("controller", "guidance", "disturbance"):
+        del parts[1]
+    return ".".join(parts)
 
 
 def validate(data: object, source: str) -> Scenario:
