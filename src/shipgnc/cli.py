@@ -129,12 +129,17 @@ def run_command(
         with _progress(enabled=not live) as progress:
             run = run_scenario(sc, observer=observer, progress=progress,
                                on_divergence="stop" if keep_partial else "raise")
+        if observer is not None:
+            observer.finish()  # draw the last samples (a LOS run may end before t_end)
         written = write_outputs(run, out_dir, figures=figures)
         if json_:
             sys.stdout.write(metrics_json(run.metrics) + "\n")
         else:
             _print_metrics(sc.name, run.metrics)
         stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}")
+        if observer is not None and not observer.closed:
+            stderr.print("close the live window to exit")
+            observer.finish(block=True)
         if run.result.attrs.get("diverged"):
             stderr.print(f"[bold red]error:[/] {run.result.attrs['message']}", soft_wrap=True)
             raise typer.Exit(3)

@@ -131,8 +131,16 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                       seed=sim.seed, observer=observer, progress=progress,
                       backend="numpy" if observer is not None else sim.backend,
                       on_divergence=on_divergence,
-                      attrs={"scenario": scenario.name, "preset": scenario.vessel.preset})
+                      attrs={"scenario": scenario.name, "preset": scenario.vessel.preset,
+                             **_vessel_attrs(setup.model)})
     return ScenarioRun(scenario, setup, result, compute_metrics(scenario, result, setup))
+
+
+def _vessel_attrs(model: VectoredThrustBoat) -> dict[str, float]:
+    """Geometry and actuator limits kept with the result, so figures can be drawn from the file."""
+    p = model.params
+    return {"T_min": p.T_min, "T_max": p.T_max, "alpha_max": p.alpha_max, "L_m": p.L_m,
+            "length": model.length, "beam": model.beam}
 
 
 def figure_title(run: ScenarioRun) -> str:
