@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 import sys
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Annotated
 
@@ -114,7 +114,7 @@ def run_command(
         "--keep-partial", help="If the run diverges, still write the partial result (exit 3).")] = False,
 ) -> None:
     """Run a scenario: write result.nc, metrics.json and figures; print the metrics."""
-    with friendly_errors():
+    with friendly_errors(), ExitStack() as stack:
         from shipgnc.errors import ConfigError
         from shipgnc.scenarios.registry import load_scenario
         from shipgnc.scenarios.runner import metrics_json, run_scenario, write_outputs
@@ -123,6 +123,11 @@ def run_command(
             raise ConfigError(f"--realtime = {realtime}: must be a number > 0 (1.0 = real time)")
         if realtime is not None and not live:
             raise ConfigError("--realtime needs --live")
+        figure_process = None
+        if figures and not live:
+            from shipgnc.viz.background import FigureProcess
+
+            figure_process = stack.enter_context(FigureProcess())  # imports matplotlib meanwhile
         sc = load_scenario(scenario, set_ or [])
         out_dir = out if out is not None else Path("runs") / sc.name
         observer = _live_observer(sc, realtime) if live else None
@@ -131,7 +136,7 @@ def run_command(
                                on_divergence="stop" if keep_partial else "raise")
         if observer is not None:
             observer.finish()  # draw the last samples (a LOS run may end before t_end)
-        written = write_outputs(run, out_dir, figures=figures)
+        written = write_outputs(run, out_dir, figures=figures, figure_process=figure_process)
         if json_:
             sys.stdout.write(metrics_json(run.metrics) + "\n")
         else:

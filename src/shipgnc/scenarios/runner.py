@@ -152,41 +152,47 @@ def figure_title(run: ScenarioRun) -> str:
     return f"{run.scenario.name} (preset {run.scenario.vessel.preset}): " + ", ".join(shown)
 
 
-def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True) -> list[Path]:
-    """Write ``result.nc``, ``metrics.json`` and the figures into ``out_dir``; return the paths."""
+def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True,
+                  figure_process=None) -> list[Path]:
+    """Write ``result.nc``, ``metrics.json`` and the figures into ``out_dir``; return the paths.
+
+    ``figure_process`` (a :class:`shipgnc.viz.background.FigureProcess`) draws the figures in a
+    worker process while this one writes the data files.
+    """
     from shipgnc.sim.result import save
+    from shipgnc.viz.figures import render_figures
 
     out = Path(out_dir)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise ConfigError(f"--out {str(out)!r}: cannot create the directory ({exc.strerror})") from None
+    pending = None
+    if figures and figure_process is not None:
+        pending = figure_process.submit(render_figures, figure_job(run, out))
     written = [save(run.result, out / "result.nc")]
     metrics_path = out / "metrics.json"
     metrics_path.write_text(metrics_json(run.metrics) + "\n", encoding="utf-8")
     written.append(metrics_path)
-    if figures:
-        written.extend(draw_figures(run, out))
+    if pending is not None:
+        written.extend(pending.result())
+    elif figures:
+        written.extend(render_figures(figure_job(run, out)))
     return written
 
 
-def draw_figures(run: ScenarioRun, out: Path) -> list[Path]:
-    from shipgnc.viz.dashboard import dashboard, save_figure, stern_kick_closeup
-    from shipgnc.viz.style import use_headless_backend
+def figure_job(run: ScenarioRun, out: Path):
+    """The :class:`~shipgnc.viz.figures.FigureJob` of a run's figures."""
+    from shipgnc.viz.figures import FigureJob
 
-    use_headless_backend()
     model, g = run.setup.model, run.scenario.guidance
     lower, upper = model.input_limits()
-    limits = {"T": (lower[0], upper[0]), "alpha": (lower[1], upper[1])}
-    fig = dashboard(run.result, title=figure_title(run),
-                    waypoints=g.waypoints if g is not None and g.type == "los" else None,
-                    limits=limits, outline=(model.length, model.beam),
-                    lever_arm=model.params.L_m)
-    paths = [save_figure(fig, out / "dashboard.png")]
-    if run.scenario.metrics == "stern-kick":
-        paths.append(save_figure(stern_kick_closeup(run.result, lever_arm=model.params.L_m),
-                                 out / "stern_kick_closeup.png"))
-    return paths
+    return FigureJob(result=run.result, out=out, title=figure_title(run),
+                     waypoints=list(g.waypoints) if g is not None and g.type == "los" else None,
+                     limits={"T": (float(lower[0]), float(upper[0])),
+                             "alpha": (float(lower[1]), float(upper[1]))},
+                     outline=(model.length, model.beam), lever_arm=model.params.L_m,
+                     closeup=run.scenario.metrics == "stern-kick")
 
 
 def metrics_json(metrics: dict) -> str:

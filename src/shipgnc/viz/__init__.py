@@ -1,12 +1,26 @@
 """Figures drawn from result datasets, and the live telemetry dashboard (spec 001 §1.11, §1.14).
 
-Importing this package imports matplotlib (``import shipgnc`` alone does not). In scripts without
-a display, call :func:`use_headless_backend` before drawing.
+The public names are imported lazily: ``import shipgnc.viz`` does not import matplotlib until a
+figure function is used (the ``dashboard`` function lives in :mod:`shipgnc.viz.dashboard`, the module
+of the same name). In scripts without a display, call :func:`use_headless_backend` first.
 """
 
-from shipgnc.viz.dashboard import DashboardLayout, dashboard, save_figure, stern_kick_closeup
-from shipgnc.viz.live import LiveDashboard
-from shipgnc.viz.style import use_headless_backend
+from __future__ import annotations
 
-__all__ = ["DashboardLayout", "LiveDashboard", "dashboard", "save_figure", "stern_kick_closeup",
-           "use_headless_backend"]
+import importlib
+from typing import Any
+
+_LAZY = {
+    "DashboardLayout": "shipgnc.viz.dashboard",
+    "save_figure": "shipgnc.viz.dashboard",
+    "stern_kick_closeup": "shipgnc.viz.dashboard",
+    "LiveDashboard": "shipgnc.viz.live",
+    "use_headless_backend": "shipgnc.viz.style",
+}
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'shipgnc.viz' has no attribute {name!r}")

@@ -17,8 +17,8 @@ import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 from matplotlib.patches import FancyArrow, Patch, Polygon
 
 from shipgnc.errors import ConfigError
@@ -410,7 +410,7 @@ def dashboard(result, *, title: str = "", waypoints=None, limits: Mapping | None
         boat_every = nice_interval(duration, int(min(10, max(1, travelled // (2.0 * length)))))
     elif not (isinstance(boat_every, (int, float)) and math.isfinite(boat_every) and boat_every > 0):
         raise ConfigError(f"boat_every = {boat_every!r}: must be a number > 0 s")
-    fig = plt.figure(figsize=style.DASHBOARD_SIZE)
+    fig = Figure(figsize=style.DASHBOARD_SIZE)  # no pyplot: no window, no global registry
     t_max = float(np.nanmax(np.abs(data["T"]))) if "T" in data and np.any(np.isfinite(data["T"])) else None
     try:
         layout = DashboardLayout(fig, title=title, waypoints=waypoints, limits=limits,
@@ -424,7 +424,7 @@ def dashboard(result, *, title: str = "", waypoints=None, limits: Mapping | None
         layout.update(data)
         layout.legends()
     except Exception:
-        plt.close(fig)
+        close_figure(fig)
         raise
     return fig
 
@@ -475,8 +475,9 @@ def stern_kick_closeup(result, *, lever_arm: float = 1.0, t0: float | None = Non
     y_bow = lateral_offset(north + half * c, east + half * s, n0, e0, psi0)
     y_stern = lateral_offset(north - lever_arm * c, east - lever_arm * s, n0, e0, psi0)
 
-    fig, (ax, ax_cg) = plt.subplots(2, 1, sharex=True, figsize=style.SMALL_SIZE,
-                                    gridspec_kw={"height_ratios": (1.4, 1.0), "hspace": 0.1})
+    fig = Figure(figsize=style.SMALL_SIZE)
+    ax, ax_cg = fig.subplots(2, 1, sharex=True,
+                             gridspec_kw={"height_ratios": (1.4, 1.0), "hspace": 0.1})
     tw = t[window]
     for values, key, label in ((y_bow, "bow", f"bow (+{half:g} m)"), (y_cg, "cg", "CG"),
                                (y_stern, "stern", f"stern / thruster (−{lever_arm:g} m)")):
@@ -540,11 +541,19 @@ def save_figure(fig, path) -> Path:
     if not path.suffix:
         path = path.with_suffix(".png")
     elif path.suffix.lower() != ".png":
-        plt.close(fig)
+        close_figure(fig)
         raise ConfigError(f"figure path {str(path)!r}: figures are written as PNG (use a .png name)")
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         fig.savefig(path, dpi=style.DPI, format="png")
     finally:
-        plt.close(fig)
+        close_figure(fig)
     return path
+
+
+def close_figure(fig) -> None:
+    """Release a figure: pyplot-managed ones (live windows) are closed through pyplot."""
+    if getattr(fig.canvas, "manager", None) is not None:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)

@@ -1,0 +1,83 @@
+"""Draw figures in a worker process that starts while the simulation runs.
+
+Importing matplotlib and rendering the PNGs of a small scenario take about as long as importing
+xarray and simulating it. A worker forked first, while the command line has imported little more
+than typer (no numpy threads yet), imports matplotlib and xarray on the second core meanwhile, so
+a command-line run costs the longer of the two, not their sum. Linux only (``fork``); elsewhere,
+and on any failure of the worker, the figures are drawn in this process.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import multiprocessing
+import os
+import sys
+from collections.abc import Callable
+
+
+def _preload() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import xarray  # noqa: F401  (the imports are the point: they happen while the parent works)
+
+    import shipgnc.viz.dashboard  # noqa: F401
+
+
+def _ready() -> bool:
+    return True
+
+
+class FigureProcess:
+    """A one-worker process pool, warmed up at construction. Use as a context manager.
+
+    ``SHIPGNC_FIGURE_PROCESS=0`` disables it (figures are then drawn in the calling process).
+    """
+
+    def __init__(self) -> None:
+        self._pool = None
+        if os.environ.get("SHIPGNC_FIGURE_PROCESS", "1") == "0" or not sys.platform.startswith("linux"):
+            return
+        try:
+            ctx = multiprocessing.get_context("fork")
+            self._pool = concurrent.futures.ProcessPoolExecutor(
+                max_workers=1, mp_context=ctx, initializer=_preload)
+            self._pool.submit(_ready)  # start the worker (and its imports) now
+        except (OSError, RuntimeError, ValueError):
+            self._pool = None
+
+    def submit(self, fn: Callable, *args) -> _Pending:
+        """Start ``fn(*args)`` in the worker; ``.result()`` waits for it. If the worker is
+        unavailable or breaks, ``result()`` runs ``fn`` in this process instead."""
+        future = None
+        if self._pool is not None:
+            try:
+                future = self._pool.submit(fn, *args)
+            except (concurrent.futures.process.BrokenProcessPool, RuntimeError, OSError):
+                self.close()
+        return _Pending(future, fn, args)
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+
+    def __enter__(self) -> FigureProcess:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class _Pending:
+    def __init__(self, future, fn: Callable, args: tuple):
+        self._future, self._fn, self._args = future, fn, args
+
+    def result(self):
+        if self._future is not None:
+            try:
+                return self._future.result()
+            except (concurrent.futures.process.BrokenProcessPool, OSError, EOFError):
+                pass
+        return self._fn(*self._args)
