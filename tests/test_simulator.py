@@ -181,3 +181,31 @@ def test_actuator_rejects_reversed_limits_and_bad_dynamics():
         Actuator([0.0, -1.0], [200.0, 1.0], tau=[-1.0, 0.0], names=("T", "alpha"))
     with pytest.raises(ConfigError, match=r"actuator\.alpha\.rate"):
         Actuator([0.0, -1.0], [200.0, 1.0], rate=[np.inf, 0.0], names=("T", "alpha"))
+
+
+def test_autopilot_without_guidance_is_a_clear_error():
+    from shipgnc.control.heading_speed import HeadingSpeedAutopilot
+
+    with pytest.raises(ConfigError, match="needs references psi_d, u_d"):
+        simulate(BOAT, np.zeros(6), t_end=1.0, dt=0.05,
+                 controller=HeadingSpeedAutopilot(BOAT.params), backend="numpy")
+
+
+def test_nan_initial_input_is_rejected():
+    with pytest.raises(ConfigError, match="u0"):
+        simulate(BOAT, np.zeros(6), t_end=1.0, dt=0.05, u0=[np.nan, 0.0], backend="numpy")
+
+
+@pytest.mark.parametrize("backend", ["numpy", "compiled"])
+def test_errors_use_the_current_state_between_control_samples(backend):
+    from shipgnc.control.heading_speed import HeadingSpeedAutopilot
+    from shipgnc.frames import wrap_angle
+    from shipgnc.guidance.schedule import ReferenceSchedule
+
+    ds = simulate(BOAT, np.zeros(6), t_end=20.0, dt=0.05,
+                  controller=HeadingSpeedAutopilot(BOAT.params, Ts=0.2),
+                  guidance=ReferenceSchedule([0, 5], np.radians([0, 60]), [1.5, 1.5]),
+                  backend=backend)
+    np.testing.assert_allclose(ds.psi_error.values, wrap_angle(ds.psi.values - ds.psi_d.values),
+                               atol=1e-15)
+    np.testing.assert_allclose(ds.u_error.values, ds.u.values - ds.u_d.values, atol=1e-15)

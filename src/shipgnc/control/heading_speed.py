@@ -53,6 +53,8 @@ class HeadingSpeedAutopilot:
         Signal("r_r", "rad/s", "reference-model yaw rate"),
     )
     continuous = False
+    #: references the controller reads, in order (from the guidance)
+    reference_names = ("psi_d", "u_d")
 
     def __init__(self, params: BoatParams, *, Ts: float = 0.05, omega_ref: float = 1.0,
                  omega: float = 1.0, omega_u: float = 1.0, yaw_feedforward: bool = True):

@@ -165,6 +165,13 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
     u0 = np.zeros(actuator.n) if u0 is None else np.asarray(u0, dtype=float)
     require(u0.shape[-1:] == (actuator.n,), "u0 shape", u0.shape,
             f"must end in {actuator.n} (one value per input)")
+    require(bool(np.all(np.isfinite(u0))), "u0", u0.tolist(), "initial input must be finite")
+    needed = getattr(controller, "reference_names", ())
+    if needed:
+        given = tuple(s.name for s in getattr(guidance, "references", ()))
+        require(given[:len(needed)] == tuple(needed), "guidance", type(guidance).__name__,
+                f"{type(controller).__name__} needs references {', '.join(needed)} "
+                f"(e.g. ReferenceSchedule or LOSGuidance)")
     if getattr(controller, "continuous", False):
         require(not (actuator.has_rate_limit and not np.all(actuator.tau > 0)), "actuator.rate",
                 actuator.rate.tolist(), "a continuous controller needs a lag (tau > 0) on "
@@ -296,7 +303,7 @@ def run_numpy(setup: SimSetup) -> Log:
         if k % setup.hold == 0:
             if gd is not None:
                 ref = gd.reference(t, x)
-                extra = {**gd.output_values(), **tracking_errors(setup, x, ref)}
+                extra = dict(gd.output_values())
             if ctrl is not None:
                 command = (ctrl.law(t, x, ref) if continuous else ctrl.step(t, x, ref))
                 command = np.asarray(command, dtype=float)
@@ -327,6 +334,9 @@ def run_numpy(setup: SimSetup) -> Log:
                     data[s.name][n_logged] = ref[..., i]
             for name, value in extra.items():
                 data[name][n_logged] = value
+            if gd is not None:  # errors of the current state against the held reference
+                for name, value in tracking_errors(setup, x, ref).items():
+                    data[name][n_logged] = value
             n_logged += 1
         if setup.observer is not None:
             try:
