@@ -9,17 +9,21 @@ from shipgnc.frames import wrap_angle
 
 
 class HeadingReferenceModel:
-    """Critically damped heading filter ψ̈_r + 2ω ψ̇_r + ω² ψ_r = ω² ψ_d (spec 001 §1.10).
+    """Second-order heading filter ψ̈_r + 2ζω ψ̇_r + ω² ψ_r = ω² ψ_d.
 
-    Driven by wrap(ψ_d − ψ_r), so it turns the shortest way round; initialised at the measured
-    heading with ψ̇_r = 0; advanced by explicit Euler at the controller's sample time.
+    ζ = 1 (critically damped) is spec 001 §1.10's autopilot; document 003 eq. (15) uses ω_n = 0.1,
+    ζ = 0.85. Driven by wrap(ψ_d − ψ_r), so it turns the shortest way round; initialised at the
+    measured heading with ψ̇_r = 0; advanced by explicit Euler at the controller's sample time.
     Batched: the state arrays take the batch shape.
     """
 
-    def __init__(self, omega: float):
+    def __init__(self, omega: float, zeta: float = 1.0):
         require(np.isfinite(omega) and omega > 0, "controller.omega_ref", omega,
                 "reference-model bandwidth must be > 0 rad/s")
+        require(np.isfinite(zeta) and zeta > 0, "controller.zeta", zeta,
+                "reference-model damping ratio must be > 0")
         self.omega = float(omega)
+        self.zeta = float(zeta)
         self.psi = None
         self.rate = None
 
@@ -28,9 +32,9 @@ class HeadingReferenceModel:
         self.rate = None
 
     def acceleration(self, psi_d):
-        """ψ̈_r = ω² wrap(ψ_d − ψ_r) − 2ω ψ̇_r."""
+        """ψ̈_r = ω² wrap(ψ_d − ψ_r) − 2ζω ψ̇_r."""
         w = self.omega
-        return w * w * wrap_angle(psi_d - self.psi) - 2.0 * w * self.rate
+        return w * w * wrap_angle(psi_d - self.psi) - 2.0 * self.zeta * w * self.rate
 
     def start(self, psi_measured) -> None:
         if self.psi is None:
