@@ -184,10 +184,11 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
 def figure_job(run: ScenarioRun, out: Path):
     """The :class:`~shipgnc.viz.figures.FigureJob` of a run's figures."""
     from shipgnc.viz.figures import FigureJob
+    from shipgnc.viz.series import result_series
 
     model, g = run.setup.model, run.scenario.guidance
     lower, upper = model.input_limits()
-    return FigureJob(result=run.result, out=out, title=figure_title(run),
+    return FigureJob(result=result_series(run.result), out=out, title=figure_title(run),
                      waypoints=list(g.waypoints) if g is not None and g.type == "los" else None,
                      limits={"T": (float(lower[0]), float(upper[0])),
                              "alpha": (float(lower[1]), float(upper[1]))},

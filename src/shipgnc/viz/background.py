@@ -2,7 +2,7 @@
 
 Importing matplotlib and rendering the PNGs of a small scenario take about as long as importing
 xarray and simulating it. A worker forked first, while the command line has imported little more
-than typer (no numpy threads yet), imports matplotlib and xarray on the second core meanwhile, so
+than typer (no numpy threads yet), imports matplotlib on the second core meanwhile, so
 a command-line run costs the longer of the two, not their sum. Linux only (``fork``); elsewhere,
 and on any failure of the worker, the figures are drawn in this process.
 """
@@ -20,9 +20,7 @@ def _preload() -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    import xarray  # noqa: F401  (the imports are the point: they happen while the parent works)
-
-    import shipgnc.viz.dashboard  # noqa: F401
+    import shipgnc.viz.dashboard  # noqa: F401  (the import is the point: it runs meanwhile)
 
 
 def _ready() -> bool:

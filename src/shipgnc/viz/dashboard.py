@@ -23,11 +23,15 @@ from matplotlib.patches import FancyArrow, Patch, Polygon
 
 from shipgnc.errors import ConfigError
 from shipgnc.viz import style
+from shipgnc.viz.series import (  # noqa: F401  (re-exported)
+    INPUT_KEYS,
+    REFERENCE_KEYS,
+    STATE_KEYS,
+    result_series,
+    select_ship,
+)
 
 #: variables the dashboard draws, in SI units (angles in rad); the states are required
-STATE_KEYS = ("north", "east", "psi", "u", "v", "r")
-INPUT_KEYS = ("T_cmd", "alpha_cmd", "T", "alpha")
-REFERENCE_KEYS = ("psi_d", "psi_r")
 
 # figure margins [in]
 _LEFT, _RIGHT, _BOTTOM, _TOP, _TITLE_LINE, _GAP = 0.72, 0.22, 0.58, 0.25, 0.24, 0.95
@@ -83,44 +87,6 @@ def nice_interval(duration: float, count: int = 10) -> float:
 
 
 # --------------------------------------------------------------------------- data access
-def select_ship(result, ship=0):
-    """The dataset of one ship: ``ship`` indexes the batch dimension (``{dim: i}`` for several)."""
-    extra = [d for d in result.dims if d != "time"]
-    if not extra:
-        return result
-    if isinstance(ship, Mapping):
-        return result.isel(dict(ship))
-    if not isinstance(ship, (int, np.integer)) or isinstance(ship, bool):
-        raise ConfigError(f"ship = {ship!r}: must be an integer index (or a dict of batch indices)")
-    if len(extra) == 1:
-        size = result.sizes[extra[0]]
-        if not -size <= ship < size:
-            raise ConfigError(f"ship = {ship}: the result has {size} ships ({extra[0]} = 0..{size - 1})")
-        return result.isel({extra[0]: int(ship)})
-    flat = result.stack(_ship=extra)
-    size = flat.sizes["_ship"]
-    if not -size <= ship < size:
-        raise ConfigError(f"ship = {ship}: the result has {size} ships over {extra}")
-    return flat.isel(_ship=int(ship)).drop_vars(["_ship", *extra], errors="ignore")
-
-
-def result_series(ds) -> dict[str, np.ndarray]:
-    """The dashboard's variables of a one-ship dataset as float arrays (SI), ``time`` included."""
-    if "time" not in ds.coords:
-        raise ConfigError("result: no 'time' coordinate (not a shipgnc result dataset)")
-    missing = [k for k in STATE_KEYS if k not in ds]
-    if missing:
-        raise ConfigError(f"result: missing variable(s) {', '.join(missing)}; the dashboard needs "
-                          f"the states {', '.join(STATE_KEYS)}")
-    out = {"time": np.asarray(ds["time"].values, dtype=float)}
-    for key in (*STATE_KEYS, *INPUT_KEYS, *REFERENCE_KEYS):
-        if key in ds:
-            out[key] = np.asarray(ds[key].values, dtype=float).reshape(-1)
-    if out["time"].size == 0:
-        raise ConfigError("result: no samples (empty time axis)")
-    return out
-
-
 # --------------------------------------------------------------------------- layout
 class DashboardLayout:
     """Axes and artists of the telemetry dashboard on ``fig``; :meth:`update` fills them.

@@ -13,7 +13,7 @@ from pathlib import Path
 class FigureJob:
     """Everything needed to draw a run's figures (picklable: it may go to a worker process)."""
 
-    result: object
+    result: dict  #: one ship's series (viz.series.result_series): light to send to a worker
     out: Path
     title: str
     waypoints: list | None
