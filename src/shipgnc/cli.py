@@ -141,7 +141,7 @@ def run_command(
             sys.stdout.write(metrics_json(run.metrics) + "\n")
         else:
             _print_metrics(sc.name, run.metrics)
-        stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}")
+        stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
         if observer is not None and not observer.closed:
             stderr.print("close the live window to exit")
             observer.finish(block=True)
@@ -181,18 +181,33 @@ def _progress(enabled: bool):
         yield update
 
 
+def _cell(value) -> str:
+    if isinstance(value, bool) or value is None:
+        return "—" if value is None else str(value)
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, list):
+        return ", ".join("—" if v is None else f"{v:.4g}" for v in value)
+    return str(value)
+
+
 def _print_metrics(name: str, metrics: dict) -> None:
+    """A metric/value table, or for a comparison one row per controller."""
+    if metrics and all(isinstance(v, dict) for v in metrics.values()):
+        columns = list(dict.fromkeys(k for m in metrics.values() for k in m))
+        table = Table(title=f"{name}: metrics by controller", title_justify="left")
+        table.add_column("controller", style="bold")
+        for column in columns:
+            table.add_column(column, justify="right")
+        for controller, values in metrics.items():
+            table.add_row(controller, *(_cell(values.get(c)) for c in columns))
+        stdout.print(table)
+        return
     table = Table(title=f"{name}: metrics", title_justify="left")
     table.add_column("metric", style="bold")
     table.add_column("value", justify="right")
     for key, value in metrics.items():
-        if isinstance(value, float):
-            text = f"{value:.6g}"
-        elif isinstance(value, list):
-            text = ", ".join("—" if v is None else f"{v:.4g}" for v in value)
-        else:
-            text = "—" if value is None else str(value)
-        table.add_row(key, text)
+        table.add_row(key, _cell(value))
     stdout.print(table)
 
 

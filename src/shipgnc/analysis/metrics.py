@@ -140,3 +140,42 @@ def waypoint_metrics(ds, leg_lengths, capture_distance: float = 20.0) -> dict:
         "max_thruster_angle_deg": float(to_deg(np.abs(ds.alpha.values).max())),
         "final_crosstrack_m": float(e[-1]),
     }
+
+
+def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
+                           diverged: bool = False, bound_deg: float = 90.0,
+                           settle_window_s: float = 30.0, settle_band_deg: float = 2.0) -> dict:
+    """Document 003's quality index and course-keeping figures (spec 003 §3.1, §3.8).
+
+    On every sample t_i: Δψ_i = wrap(ψ_d − ψ_i) [rad]; ``psi_E`` = Σ Δψ_i², ``delta_E`` = λ Σ δ_i²
+    with the applied rudder δ [rad], ``J`` = ``psi_E`` + ``delta_E`` (eq. 2). ``min_surge_mps``,
+    ``final_heading_error_deg`` (Δψ at the last sample), ``max_rudder_deg`` (applied). ``stable``:
+    the run reached ``t_end`` without the divergence guard and |Δψ| stayed below 90°. Extras:
+    ``settled`` (|Δψ| ≤ 2° over the last 30 s) and ``psi_E_ref`` (Σ wrap(ψ_z − ψ)² against the
+    reference model, for controllers that have one; spec 003 B11).
+    """
+    t = ds.time.values
+    dpsi = -ds.psi_error.values  # psi_error = wrap(ψ − ψ_d)
+    delta = ds.delta.values
+    finite = np.isfinite(dpsi)
+    dpsi, delta, t = dpsi[finite], delta[finite], t[finite]
+    psi_E = float(np.sum(dpsi**2))
+    delta_E = float(lam * np.sum(delta**2))
+    reached = t_end is None or (t.size and t[-1] >= t_end - 1e-9)
+    late = t >= t[-1] - settle_window_s
+    out = {
+        "psi_E": psi_E,
+        "delta_E": delta_E,
+        "J": psi_E + delta_E,
+        "min_surge_mps": float(np.min(ds.u.values[np.isfinite(ds.u.values)])),
+        "final_heading_error_deg": float(to_deg(dpsi[-1])),
+        "max_rudder_deg": float(to_deg(np.max(np.abs(delta)))),
+        "stable": bool(reached and not diverged and np.all(np.abs(to_deg(dpsi)) < bound_deg)),
+        "settled": bool(np.all(np.abs(to_deg(dpsi[late])) <= settle_band_deg)),
+    }
+    if "psi_z" in ds and np.isfinite(ds.psi_z.values).any():
+        ref = wrap_angle(ds.psi_z.values[finite] - ds.psi.values[finite])
+        out["psi_E_ref"] = float(np.nansum(ref**2))
+    else:
+        out["psi_E_ref"] = None
+    return out

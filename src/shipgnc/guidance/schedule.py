@@ -40,3 +40,31 @@ class ReferenceSchedule:
 
     def finished(self):
         return None
+
+
+class CourseSchedule:
+    """Piecewise-constant course set-points ``[psi_d]`` [rad] (document 003's course changes).
+
+    The propellers are held by the controller, so there is no speed reference.
+    """
+
+    references = (Signal("psi_d", "rad", "desired heading", angle=True, tracks="psi"),)
+    outputs = ()
+
+    def __init__(self, times, psi_d):
+        self.schedule = PiecewiseConstant(times, np.asarray(psi_d, float)[:, None],
+                                          field="guidance.schedule")
+        self._batch_shape: tuple[int, ...] = ()
+
+    def reset(self, batch_shape, model=None) -> None:
+        self._batch_shape = tuple(batch_shape)
+
+    def reference(self, t: float, x: np.ndarray) -> np.ndarray:
+        value = self.schedule(t)
+        return np.broadcast_to(value, (*self._batch_shape, 1)).copy()
+
+    def output_values(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def finished(self):
+        return None

@@ -32,24 +32,28 @@ from shipgnc.units import deg
 class Setup:
     """The objects a scenario describes, ready for :func:`shipgnc.sim.simulator.simulate`."""
 
-    model: VectoredThrustBoat
+    model: object
     x0: np.ndarray
     actuator: Actuator
     controller: object
     guidance: object | None
     disturbance: object | None
+    u0: np.ndarray | None = None
 
 
 @dataclass
 class ScenarioRun:
+    """A finished run: for a comparison (``controllers``), ``setup`` is the first variant's,
+    ``result`` has a ``controller`` dimension and ``metrics`` is keyed by controller."""
+
     scenario: Scenario
     setup: Setup
     result: object  # xarray.Dataset
     metrics: dict
+    setups: dict | None = None
 
 
-def build(scenario: Scenario) -> Setup:
-    """Instantiate the scenario's components (parameter errors name the field)."""
+def _boat(scenario: Scenario):
     params = dict(scenario.vessel.params)
     if "alpha_max_deg" in params:
         params["alpha_max"] = deg(params.pop("alpha_max_deg"))
@@ -60,42 +64,79 @@ def build(scenario: Scenario) -> Setup:
         rate=[act.thrust_rate or np.inf,
               deg(act.angle_rate_deg_s) if act.angle_rate_deg_s else np.inf],
         tau=[act.thrust_time_constant, act.angle_time_constant])
+    return model, actuator, None
+
+
+def _cybership(scenario: Scenario):
+    from shipgnc.models.cybership2 import CyberShip2, CyberShip2Params, steering_machine
+
+    v = scenario.vessel
+    rate = deg(v.rudder_rate_deg_s) if v.rudder_rate_deg_s else math.inf
+    params = CyberShip2Params(rudder_model=v.rudder_model, delta_max=deg(v.rudder_max_deg),
+                              delta_rate=rate)
+    model = CyberShip2(params)
+    return model, steering_machine(params), np.array([v.propeller_rps, 0.0])
+
+
+def _controller(cfg, model, scenario: Scenario):
+    if cfg.type == "open-loop":
+        entries = cfg.schedule
+        return OpenLoopSchedule([e.t for e in entries], [[e.T, deg(e.alpha_deg)] for e in entries],
+                                labels=[e.label for e in entries])
+    if cfg.type == "heading-speed":
+        return HeadingSpeedAutopilot(model.params, Ts=cfg.Ts, omega_ref=cfg.omega_ref,
+                                     omega=cfg.omega, omega_u=cfg.omega_u,
+                                     yaw_feedforward=cfg.yaw_feedforward)
+    from shipgnc.control.course import course_controller
+
+    return course_controller(cfg.variant, model.params, Ts=cfg.Ts,
+                             propeller_rps=scenario.vessel.propeller_rps)
+
+
+def _guidance(g):
+    if g is None:
+        return None
+    if g.type == "schedule":
+        return ReferenceSchedule([e.t for e in g.schedule], [deg(e.psi_deg) for e in g.schedule],
+                                 [e.u for e in g.schedule])
+    if g.type == "los":
+        return LOSGuidance(WaypointPath(g.waypoints), lookahead=g.lookahead, speed=g.speed,
+                           switch_radius=g.switch_radius)
+    from shipgnc.guidance.schedule import CourseSchedule
+
+    return CourseSchedule([e.t for e in g.schedule], [deg(e.psi_deg) for e in g.schedule])
+
+
+def _disturbance(d, scenario: Scenario):
+    if d is None:
+        return None
+    if d.type == "constant":
+        return ConstantDisturbance(d.values)
+    if d.type == "gaussian":
+        return GaussianForceNoise(d.std, d.mean)
+    from shipgnc.environment.waves import wave_loads_for
+
+    return wave_loads_for(d, scenario)
+
+
+def build(scenario: Scenario, variant: str | None = None) -> Setup:
+    """Instantiate the scenario's components for one controller ``variant`` (default: the first)."""
+    model, actuator, u0 = (_cybership if scenario.vessel.model == "cybership2" else _boat)(scenario)
+    variants = scenario.variants
+    name = variant if variant is not None else next(iter(variants))
+    if name not in variants:
+        raise ConfigError(f"controller {name!r}: not in this scenario; have {', '.join(variants)}")
     init = scenario.simulation.initial_state
     x0 = np.array([init.north, init.east, deg(init.psi_deg), init.u, init.v, deg(init.r_deg_s)])
-
-    ctrl_cfg = scenario.controller
-    if ctrl_cfg.type == "open-loop":
-        entries = ctrl_cfg.schedule
-        controller = OpenLoopSchedule([e.t for e in entries],
-                                      [[e.T, deg(e.alpha_deg)] for e in entries],
-                                      labels=[e.label for e in entries])
-    else:
-        controller = HeadingSpeedAutopilot(model.params, Ts=ctrl_cfg.Ts,
-                                           omega_ref=ctrl_cfg.omega_ref, omega=ctrl_cfg.omega,
-                                           omega_u=ctrl_cfg.omega_u,
-                                           yaw_feedforward=ctrl_cfg.yaw_feedforward)
-    guidance = None
-    g = scenario.guidance
-    if g is not None and g.type == "schedule":
-        guidance = ReferenceSchedule([e.t for e in g.schedule],
-                                     [deg(e.psi_deg) for e in g.schedule],
-                                     [e.u for e in g.schedule])
-    elif g is not None and g.type == "los":
-        guidance = LOSGuidance(WaypointPath(g.waypoints), lookahead=g.lookahead, speed=g.speed,
-                               switch_radius=g.switch_radius)
-    disturbance = None
-    d = scenario.disturbance
-    if d is not None and d.type == "constant":
-        disturbance = ConstantDisturbance(d.values)
-    elif d is not None and d.type == "gaussian":
-        disturbance = GaussianForceNoise(d.std, d.mean)
-    return Setup(model, x0, actuator, controller, guidance, disturbance)
+    return Setup(model, x0, actuator, _controller(variants[name], model, scenario),
+                 _guidance(scenario.guidance), _disturbance(scenario.disturbance, scenario), u0)
 
 
 def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
-    """The scenario's metric set (``scenario.metrics``) from a single-ship result."""
+    """The scenario's metric set (``scenario.metrics``) from a single-ship, single-controller result."""
     from shipgnc.analysis import metrics
 
+    diverged = bool(result.attrs.get("diverged", 0))
     if scenario.metrics == "stern-kick":
         out = metrics.stern_kick_metrics(result)
     elif scenario.metrics == "heading-steps":
@@ -103,9 +144,12 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     elif scenario.metrics == "waypoints":
         out = metrics.waypoint_metrics(result, setup.guidance.path.leg_lengths,
                                        scenario.guidance.capture_distance)
+    elif scenario.metrics == "course-quality":
+        out = metrics.course_quality_metrics(result, lam=scenario.quality.lam,
+                                             t_end=scenario.simulation.t_end, diverged=diverged)
     else:
         out = {}
-    out["diverged"] = bool(result.attrs.get("diverged", 0))
+    out["diverged"] = diverged
     return out
 
 
@@ -113,8 +157,11 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                  on_divergence: str = "raise") -> ScenarioRun:
     """Run a scenario (object, built-in name or YAML path) and compute its metrics.
 
+    With ``controllers`` every variant runs on the same plant, guidance and disturbance (same
+    seed); the result gets a ``controller`` dimension and the metrics are keyed by controller.
     ``on_divergence="stop"`` keeps the partial result of a diverging run (flagged in
-    ``result.attrs["diverged"]`` and ``metrics["diverged"]``) instead of raising.
+    ``result.attrs["diverged"]`` and ``metrics["diverged"]``) instead of raising; comparisons
+    always keep going, since a controller that diverges is a finding, not an error.
     """
     from shipgnc.sim.simulator import simulate
 
@@ -122,25 +169,44 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         scenario = load_scenario(scenario, overrides)
     elif overrides:
         raise ConfigError("overrides apply to a scenario name or file, not to a Scenario object")
-    setup = build(scenario)
     sim = scenario.simulation
-    result = simulate(setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt,
-                      controller=setup.controller, actuator=setup.actuator,
-                      guidance=setup.guidance, disturbance=setup.disturbance,
-                      integrator=sim.integrator, method=sim.method, rtol=sim.rtol, atol=sim.atol,
-                      seed=sim.seed, observer=observer, progress=progress,
-                      backend="numpy" if observer is not None else sim.backend,
-                      on_divergence=on_divergence,
-                      attrs={"scenario": scenario.name, "preset": scenario.vessel.preset,
-                             **_vessel_attrs(setup.model)})
-    return ScenarioRun(scenario, setup, result, compute_metrics(scenario, result, setup))
+    compare = scenario.controllers is not None
+    results, all_metrics, setups = {}, {}, {}
+    for name in scenario.variants:
+        setup = build(scenario, name)
+        result = simulate(setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt,
+                          controller=setup.controller, actuator=setup.actuator,
+                          guidance=setup.guidance, disturbance=setup.disturbance, u0=setup.u0,
+                          integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
+                          atol=sim.atol, seed=sim.seed, observer=observer, progress=progress,
+                          backend="numpy" if observer is not None else sim.backend,
+                          on_divergence="stop" if compare else on_divergence,
+                          attrs={"scenario": scenario.name, "controller": name,
+                                 **_vessel_attrs(setup.model, scenario)})
+        results[name], setups[name] = result, setup
+        all_metrics[name] = compute_metrics(scenario, result, setup)
+    first = next(iter(results))
+    if not compare:
+        return ScenarioRun(scenario, setups[first], results[first], all_metrics[first])
+    import xarray as xr
+
+    combined = xr.concat(list(results.values()), dim="controller", data_vars="all", join="outer",
+                         combine_attrs="drop_conflicts")
+    combined = combined.assign_coords(controller=list(results))
+    combined.attrs["diverged"] = int(any(r.attrs.get("diverged", 0) for r in results.values()))
+    return ScenarioRun(scenario, setups[first], combined, all_metrics, setups)
 
 
-def _vessel_attrs(model: VectoredThrustBoat) -> dict[str, float]:
+def _vessel_attrs(model, scenario: Scenario) -> dict:
     """Geometry and actuator limits kept with the result, so figures can be drawn from the file."""
-    p = model.params
-    return {"T_min": p.T_min, "T_max": p.T_max, "alpha_max": p.alpha_max, "L_m": p.L_m,
-            "length": model.length, "beam": model.beam}
+    lower, upper = model.input_limits()
+    attrs = {"vessel": scenario.vessel.model}
+    for i, s in enumerate(model.inputs):
+        attrs[f"{s.name}_min"], attrs[f"{s.name}_max"] = float(lower[i]), float(upper[i])
+    if isinstance(model, VectoredThrustBoat):
+        attrs.update(preset=scenario.vessel.preset, L_m=model.params.L_m, length=model.length,
+                     beam=model.beam)
+    return attrs
 
 
 def figure_title(run: ScenarioRun) -> str:
@@ -149,7 +215,9 @@ def figure_title(run: ScenarioRun) -> str:
     for key, value in run.metrics.items():
         if isinstance(value, (int, float)) and not isinstance(value, bool) and len(shown) < 4:
             shown.append(f"{key} = {value:.4g}")
-    return f"{run.scenario.name} (preset {run.scenario.vessel.preset}): " + ", ".join(shown)
+    preset = getattr(run.scenario.vessel, "preset", None)
+    label = f"{run.scenario.name} (preset {preset})" if preset else run.scenario.name
+    return f"{label}: " + ", ".join(shown) if shown else label
 
 
 def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True,
@@ -174,6 +242,8 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
     metrics_path = out / "metrics.json"
     metrics_path.write_text(metrics_json(run.metrics) + "\n", encoding="utf-8")
     written.append(metrics_path)
+    if run.setups is not None:
+        written.extend(write_table(comparison_table(run), out))
     if pending is not None:
         written.extend(pending.result())
     elif figures:
@@ -184,16 +254,61 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
 def figure_job(run: ScenarioRun, out: Path):
     """The :class:`~shipgnc.viz.figures.FigureJob` of a run's figures."""
     from shipgnc.viz.figures import FigureJob
-    from shipgnc.viz.series import result_series
 
     model, g = run.setup.model, run.scenario.guidance
     lower, upper = model.input_limits()
+    limits = {s.name: (float(lower[i]), float(upper[i])) for i, s in enumerate(model.inputs)}
+    if run.setups is not None:
+        from shipgnc.viz.comparison import course_series
+
+        return FigureJob(result={name: course_series(run.result, name) for name in run.setups},
+                         out=out, title=run.scenario.name, kind="course-comparison",
+                         limits=limits)
+    from shipgnc.viz.series import result_series
+
     return FigureJob(result=result_series(run.result), out=out, title=figure_title(run),
                      waypoints=list(g.waypoints) if g is not None and g.type == "los" else None,
-                     limits={"T": (float(lower[0]), float(upper[0])),
-                             "alpha": (float(lower[1]), float(upper[1]))},
-                     outline=(model.length, model.beam), lever_arm=model.params.L_m,
+                     limits=limits, outline=(model.length, model.beam), lever_arm=model.params.L_m,
                      closeup=run.scenario.metrics == "stern-kick")
+
+
+def comparison_table(run: ScenarioRun) -> list[dict]:
+    """Rows of the comparison table: our figures per controller, the document's beside them."""
+    doc = run.scenario.document_figures
+    rows = []
+    for name, metrics in run.metrics.items():
+        row = {"controller": name}
+        for key, value in metrics.items():
+            if isinstance(value, (int, float)) or value is None:
+                row[key] = value
+        for key, value in doc.get(name, {}).items():
+            row[f"document_{key}"] = value
+        rows.append(row)
+    return rows
+
+
+def write_table(rows: list[dict], out: Path) -> list[Path]:
+    """``table.csv`` and ``table.md`` of the comparison rows."""
+    import csv
+
+    columns = list(dict.fromkeys(k for row in rows for k in row))
+    csv_path, md_path = out / "table.csv", out / "table.md"
+    with csv_path.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns)
+        writer.writeheader()
+        writer.writerows(rows)
+
+    def cell(value) -> str:
+        if value is None:
+            return "—"
+        if isinstance(value, float):
+            return f"{value:.4g}"
+        return str(value)
+
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(cell(row.get(c)) for c in columns) + " |" for row in rows]
+    md_path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return [csv_path, md_path]
 
 
 def metrics_json(metrics: dict) -> str:

@@ -10,7 +10,16 @@ from __future__ import annotations
 import itertools
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Discriminator,
+    Field,
+    Tag,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from shipgnc.errors import ConfigError
 
@@ -31,7 +40,7 @@ BOAT_PARAM_NAMES = ("m", "X_udot", "Y_vdot", "I_z", "N_rdot", "X_u", "Y_v", "N_r
 
 
 class VesselConfig(Strict):
-    """``vessel``: the model, a named parameter preset and overrides of single parameters."""
+    """``vessel`` for document 001's boat: a named parameter preset and overrides."""
 
     model: Literal["vectored-thrust-boat"] = "vectored-thrust-boat"
     preset: Literal["otter", "doc-eq7", "doc-printed", "otter-munk"] = "otter"
@@ -46,6 +55,31 @@ class VesselConfig(Strict):
         if "alpha_max" in params and "alpha_max_deg" in params:
             raise ValueError("give alpha_max (rad) or alpha_max_deg, not both")
         return params
+
+
+class CyberShipVesselConfig(Strict):
+    """``vessel`` for CyberShip II (document 003): rudder force model, steering machine, propellers."""
+
+    model: Literal["cybership2"]
+    rudder_model: Literal["table1", "skjetne"] = "table1"
+    propeller_rps: Positive = 8.13
+    rudder_max_deg: Annotated[float, Field(gt=0, le=90, allow_inf_nan=False)] = 35.0
+    #: steering-machine rate limit; null for none (spec 003 B8 compares both)
+    rudder_rate_deg_s: Positive | None = 19.4
+
+
+def _vessel_tag(value) -> str:
+    if isinstance(value, dict):
+        return value.get("model", "vectored-thrust-boat")
+    return getattr(value, "model", "vectored-thrust-boat")
+
+
+Vessel = Annotated[
+    Annotated[VesselConfig, Tag("vectored-thrust-boat")]
+    | Annotated[CyberShipVesselConfig, Tag("cybership2")],
+    Discriminator(_vessel_tag, custom_error_type="vessel_model",
+                  custom_error_message="unknown vessel model; allowed: vectored-thrust-boat, cybership2"),
+]
 
 
 class ActuatorConfig(Strict):
@@ -120,7 +154,20 @@ class HeadingSpeedConfig(Strict):
     yaw_feedforward: bool = True
 
 
-ControllerConfig = Annotated[OpenLoopConfig | HeadingSpeedConfig, Field(discriminator="type")]
+COURSE_CONTROLLERS = ("pd", "smc_printed", "smc_consistent", "smc_tuned")
+
+
+class CourseControllerConfig(Strict):
+    """Document 003's course autopilots for CyberShip II (spec 003 §3.2): ``variant`` picks the law
+    and its published (or, for ``smc_tuned``, documented) gains."""
+
+    type: Literal["course"]
+    variant: Literal["pd", "smc_printed", "smc_consistent", "smc_tuned"]
+    Ts: Positive = 0.1
+
+
+ControllerConfig = Annotated[OpenLoopConfig | HeadingSpeedConfig | CourseControllerConfig,
+                             Field(discriminator="type")]
 
 
 # --------------------------------------------------------------------------- guidance
@@ -155,7 +202,26 @@ class LOSConfig(Strict):
     capture_distance: NonNegative = 20.0
 
 
-GuidanceConfig = Annotated[ScheduleGuidanceConfig | LOSConfig, Field(discriminator="type")]
+class CourseEntry(Strict):
+    t: NonNegative
+    psi_deg: Finite
+
+
+class CourseScheduleConfig(Strict):
+    """Course set-points ψ_d from time t on (no speed reference: the propellers are held)."""
+
+    type: Literal["course-schedule"]
+    schedule: Annotated[list[CourseEntry], Field(min_length=1)]
+
+    @field_validator("schedule")
+    @classmethod
+    def _ordered(cls, schedule: list[CourseEntry]) -> list[CourseEntry]:
+        _check_times([e.t for e in schedule])
+        return schedule
+
+
+GuidanceConfig = Annotated[ScheduleGuidanceConfig | LOSConfig | CourseScheduleConfig,
+                           Field(discriminator="type")]
 
 
 # --------------------------------------------------------------------------- disturbance
@@ -175,44 +241,93 @@ class GaussianForceConfig(Strict):
     mean: tuple[Finite, Finite, Finite] = (0.0, 0.0, 0.0)
 
 
-DisturbanceConfig = Annotated[ConstantForceConfig | GaussianForceConfig,
+class WavesConfig(Strict):
+    """Irregular waves from a spectrum and the wave loads they put on the hull (spec 003 §3.6).
+
+    ``hs`` [m] and ``t0`` [s] at model scale (1:70 Froude-correct: 3 m → 42.9 mm; the document's
+    printed 5 mm is selectable); ``heading_deg``: the direction the waves travel to, relative to
+    north (head seas for a ship on course 0° come from ahead: ψ_f = 180°).
+    """
+
+    type: Literal["waves"]
+    spectrum: Literal["modified-pm", "jonswap", "pm"] = "modified-pm"
+    hs: Positive = 0.0429
+    t0: Positive = 0.8
+    gamma: Annotated[float, Field(ge=1, allow_inf_nan=False)] = 3.3
+    heading_deg: Finite = 180.0
+    components: Annotated[int, Field(ge=4, le=2000)] = 200
+
+
+DisturbanceConfig = Annotated[ConstantForceConfig | GaussianForceConfig | WavesConfig,
                               Field(discriminator="type")]
 
 # --------------------------------------------------------------------------- scenario
 
-METRIC_SETS = ("stern-kick", "heading-steps", "waypoints", "none")
+METRIC_SETS = ("stern-kick", "heading-steps", "waypoints", "course-quality", "none")
+
+
+class QualityConfig(Strict):
+    """Quality index J = Σ(Δψ² + λδ²) of document 003 eq. (2)."""
+
+    lam: NonNegative = 1.0
 
 
 class Scenario(Strict):
-    """A complete, runnable scenario."""
+    """A complete, runnable scenario: one ``controller``, or ``controllers`` to compare by name."""
 
     name: Annotated[str, Field(min_length=1, pattern=r"^[A-Za-z0-9_.\-]+$")]
     description: str = ""
     document: str = ""
-    metrics: Literal["stern-kick", "heading-steps", "waypoints", "none"] = "none"
-    vessel: VesselConfig = Field(default_factory=VesselConfig)
+    metrics: Literal["stern-kick", "heading-steps", "waypoints", "course-quality", "none"] = "none"
+    vessel: Vessel = Field(default_factory=VesselConfig)
     actuator: ActuatorConfig = Field(default_factory=ActuatorConfig)
     simulation: SimulationConfig
-    controller: ControllerConfig
+    controller: ControllerConfig | None = None
+    controllers: dict[Annotated[str, Field(pattern=r"^[A-Za-z0-9_]+$")], ControllerConfig] | None = None
     guidance: GuidanceConfig | None = None
     disturbance: DisturbanceConfig | None = None
+    quality: QualityConfig = Field(default_factory=QualityConfig)
+    #: the document's own figures, by controller (shown beside ours in comparison tables)
+    document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
+
+    @property
+    def variants(self) -> dict[str, object]:
+        """Controllers by name (one unnamed controller is called ``controller``)."""
+        return dict(self.controllers) if self.controllers else {"controller": self.controller}
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
-        if self.controller.type == "heading-speed" and self.guidance is None:
-            raise ValueError("controller 'heading-speed' needs a guidance section "
-                             "(type: schedule or los)")
-        needs = {"heading-steps": "schedule", "waypoints": "los"}
-        wanted = needs.get(self.metrics)
+        if (self.controller is None) == (self.controllers is None):
+            raise ValueError("give either 'controller' or 'controllers' (a mapping name: controller)")
+        if self.controllers is not None and not self.controllers:
+            raise ValueError("'controllers' is empty")
+        boat = self.vessel.model == "vectored-thrust-boat"
+        for name, ctrl in self.variants.items():
+            where = "controller" if self.controller is not None else f"controllers.{name}"
+            if (ctrl.type == "course") == boat:
+                raise ValueError(f"{where}: type {ctrl.type!r} does not fit vessel model "
+                                 f"{self.vessel.model!r}")
+            needs = {"heading-speed": ("schedule", "los"), "course": ("course-schedule",)}.get(ctrl.type)
+            if needs and (self.guidance is None or self.guidance.type not in needs):
+                raise ValueError(f"{where}: type {ctrl.type!r} needs a guidance section of type "
+                                 f"{' or '.join(needs)}")
+            if boat:
+                Ts = getattr(ctrl, "Ts", self.simulation.dt)
+            else:
+                Ts = ctrl.Ts
+            ratio = Ts / self.simulation.dt
+            if round(ratio) < 1 or abs(round(ratio) - ratio) > 1e-9 * ratio:
+                raise ValueError(f"{where}.Ts = {Ts!r} must be a whole multiple of "
+                                 f"simulation.dt = {self.simulation.dt!r}")
+        metric_guidance = {"heading-steps": "schedule", "waypoints": "los",
+                           "course-quality": "course-schedule"}
+        wanted = metric_guidance.get(self.metrics)
         if wanted and (self.guidance is None or self.guidance.type != wanted):
             raise ValueError(f"metrics = {self.metrics!r} needs guidance type {wanted!r}")
-        if self.metrics == "stern-kick" and self.controller.type != "open-loop":
+        if self.metrics == "stern-kick" and any(c.type != "open-loop" for c in self.variants.values()):
             raise ValueError("metrics = 'stern-kick' needs controller type 'open-loop'")
-        Ts = getattr(self.controller, "Ts", self.simulation.dt)
-        ratio = Ts / self.simulation.dt
-        if round(ratio) < 1 or abs(round(ratio) - ratio) > 1e-9 * ratio:
-            raise ValueError(f"controller.Ts = {Ts!r} must be a whole multiple of "
-                             f"simulation.dt = {self.simulation.dt!r}")
+        if self.disturbance is not None and self.disturbance.type == "waves" and boat:
+            raise ValueError("disturbance type 'waves' has a wave-load model for cybership2 only")
         return self
 
 
@@ -244,11 +359,13 @@ def format_validation_error(error: ValidationError, source: str) -> str:
 
 
 def _location(loc: tuple) -> str:
-    """Dotted field path without pydantic's union tag (``controller.open-loop.schedule`` →
-    ``controller.schedule``)."""
+    """Dotted field path without pydantic's union tags (``controller.open-loop.schedule`` →
+    ``controller.schedule``; ``controllers.pd.course.Ts`` → ``controllers.pd.Ts``)."""
     parts = [str(p) for p in loc]
-    if len(parts) > 1 and parts[0] in ("controller", "guidance", "disturbance"):
+    if len(parts) > 1 and parts[0] in ("controller", "guidance", "disturbance", "vessel"):
         del parts[1]
+    elif len(parts) > 2 and parts[0] == "controllers":
+        del parts[2]
     return ".".join(parts)
 
 
