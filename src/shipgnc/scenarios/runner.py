@@ -114,9 +114,15 @@ def _disturbance(d, scenario: Scenario):
         return ConstantDisturbance(d.values)
     if d.type == "gaussian":
         return GaussianForceNoise(d.std, d.mean)
-    from shipgnc.environment.waves import wave_loads_for
+    from shipgnc.environment.waves import FroudeKrylovWaveLoads, WaveSpectrum
 
-    return wave_loads_for(d, scenario)
+    if d.spectrum == "modified-pm":
+        spectrum = WaveSpectrum.modified_pierson_moskowitz(d.hs, d.t0)
+    elif d.spectrum == "jonswap":
+        spectrum = WaveSpectrum.jonswap(d.hs, d.t0, gamma=d.gamma)  # t0 is the peak period here
+    else:
+        spectrum = WaveSpectrum.pierson_moskowitz(hs=d.hs)  # one parameter: the period follows
+    return FroudeKrylovWaveLoads(spectrum, direction=deg(d.heading_deg), n_components=d.components)
 
 
 def build(scenario: Scenario, variant: str | None = None) -> Setup:

@@ -245,8 +245,10 @@ class WavesConfig(Strict):
     """Irregular waves from a spectrum and the wave loads they put on the hull (spec 003 §3.6).
 
     ``hs`` [m] and ``t0`` [s] at model scale (1:70 Froude-correct: 3 m → 42.9 mm; the document's
-    printed 5 mm is selectable); ``heading_deg``: the direction the waves travel to, relative to
-    north (head seas for a ship on course 0° come from ahead: ψ_f = 180°).
+    printed 5 mm is selectable); ``t0`` is the modal period (the peak period for JONSWAP; unused by
+    the one-parameter ``pm``); ``heading_deg``: the direction the waves travel to, clockwise from
+    north (head seas for a ship on course 0°: ψ_f = 180°). Loads: Froude–Krylov pressure of each
+    component integrated over the hull box (:class:`shipgnc.environment.waves.FroudeKrylovWaveLoads`).
     """
 
     type: Literal["waves"]
