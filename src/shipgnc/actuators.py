@@ -6,7 +6,9 @@ and an optional first-order lag ``tau`` [s]. The controller's command is held ov
 
 * no lag, no rate limit: u = sat(cmd), constant over the step (document 001's ``np.clip``);
 * rate limit, no lag: the applied value slews towards sat(cmd) at most ``rate·h`` per step,
-  moving linearly within the step (the exact motion of a slewing servo);
+  moving linearly within the step (``rate_mode="ramp"``, the motion of a slewing servo), or
+  jumping to the slewed value at the step's start and holding it (``rate_mode="hold"``, a
+  discrete rate limiter, as many published simulations do);
 * lag (τ > 0): ȧ = clip((sat(cmd) − a)/τ, −rate, rate), integrated in the same RK4 stages as the
   plant (document 004 eq. (22)); u = a.
 
@@ -42,8 +44,11 @@ class Actuator:
     rate: np.ndarray | None = None
     tau: np.ndarray | None = None
     names: tuple[str, ...] = ()
+    rate_mode: str = "ramp"
 
     def __post_init__(self) -> None:
+        require(self.rate_mode in ("ramp", "hold"), "actuator.rate_mode", self.rate_mode,
+                "allowed: ramp (linear within the step), hold (slewed value held over the step)")
         lower = np.atleast_1d(np.asarray(self.lower, dtype=float))
         n = lower.size
         names = self.names or tuple(f"input[{i}]" for i in range(n))
@@ -65,10 +70,11 @@ class Actuator:
         object.__setattr__(self, "names", names)
 
     @classmethod
-    def for_model(cls, model, *, rate=None, tau=None) -> Actuator:
+    def for_model(cls, model, *, rate=None, tau=None, rate_mode: str = "ramp") -> Actuator:
         """The actuator with the model's own hardware limits (``model.input_limits()``)."""
         lower, upper = model.input_limits()
-        return cls(lower, upper, rate=rate, tau=tau, names=tuple(s.name for s in model.inputs))
+        return cls(lower, upper, rate=rate, tau=tau, names=tuple(s.name for s in model.inputs),
+                   rate_mode=rate_mode)
 
     @property
     def n(self) -> int:
@@ -104,13 +110,16 @@ class Actuator:
         """Plan one step of length ``h``: returns ``(start, end)`` of the non-lag channels.
 
         Without a rate limit start = end = sat(cmd); with one, end = applied moved towards
-        sat(cmd) by at most rate·h, and the input ramps linearly from start = applied to end.
+        sat(cmd) by at most rate·h, and the input ramps linearly from start = applied to end
+        (``rate_mode="hold"``: start = end).
         """
         target = self.saturate(command)
         if not self.has_rate_limit:
             return target, target
         step = np.clip(target - applied, -self.rate * h, self.rate * h)
         end = applied + step
+        if self.rate_mode == "hold":
+            return end, end
         start = np.where(np.isfinite(self.rate), applied, end)
         return start, end
 

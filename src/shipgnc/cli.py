@@ -194,13 +194,13 @@ def _cell(value) -> str:
 def _print_metrics(name: str, metrics: dict) -> None:
     """A metric/value table, or for a comparison one row per controller."""
     if metrics and all(isinstance(v, dict) for v in metrics.values()):
-        columns = list(dict.fromkeys(k for m in metrics.values() for k in m))
+        rows = list(dict.fromkeys(k for m in metrics.values() for k in m))
         table = Table(title=f"{name}: metrics by controller", title_justify="left")
-        table.add_column("controller", style="bold")
-        for column in columns:
-            table.add_column(column, justify="right")
-        for controller, values in metrics.items():
-            table.add_row(controller, *(_cell(values.get(c)) for c in columns))
+        table.add_column("metric", style="bold")
+        for controller in metrics:
+            table.add_column(controller, justify="right")
+        for row in rows:
+            table.add_row(row, *(_cell(values.get(row)) for values in metrics.values()))
         stdout.print(table)
         return
     table = Table(title=f"{name}: metrics", title_justify="left")

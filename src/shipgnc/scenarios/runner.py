@@ -75,7 +75,8 @@ def _cybership(scenario: Scenario):
     params = CyberShip2Params(rudder_model=v.rudder_model, delta_max=deg(v.rudder_max_deg),
                               delta_rate=rate)
     model = CyberShip2(params)
-    return model, steering_machine(params), np.array([v.propeller_rps, 0.0])
+    return (model, steering_machine(params, rate_mode=v.rudder_rate_mode),
+            np.array([v.propeller_rps, 0.0]))
 
 
 def _controller(cfg, model, scenario: Scenario):

@@ -66,6 +66,9 @@ class CyberShipVesselConfig(Strict):
     rudder_max_deg: Annotated[float, Field(gt=0, le=90, allow_inf_nan=False)] = 35.0
     #: steering-machine rate limit; null for none (spec 003 B8 compares both)
     rudder_rate_deg_s: Positive | None = 19.4
+    #: ``ramp``: the rudder slews linearly within a step; ``hold``: the slewed value is held over
+    #: the step (a discrete rate limiter, the setting of spec 003's indicative figures)
+    rudder_rate_mode: Literal["ramp", "hold"] = "ramp"
 
 
 def _vessel_tag(value) -> str:

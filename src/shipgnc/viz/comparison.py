@@ -38,8 +38,8 @@ def course_comparison(series: Mapping[str, Mapping[str, np.ndarray]], *, title: 
         t = data["time"]
         ax_u, ax_psi, ax_d = axes[:, col]
         ax_u.plot(t, data["u"], color=style.COLORS["u"], **style.APPLIED)
-        psi = style.unwrap_deg(data["psi"])
-        ax_psi.plot(t, psi, color=style.COLORS["psi"], label="ψ", **style.APPLIED)
+        psi = np.radians(style.unwrap_deg(data["psi"]))  # continuous heading [rad]
+        ax_psi.plot(t, style.to_deg(psi), color=style.COLORS["psi"], label="ψ", **style.APPLIED)
         if "psi_d" in data:
             ax_psi.plot(t, style.align_deg(data["psi_d"], psi), label="ψ_d", **style.REFERENCE,
                         **style.HELD)

@@ -1,0 +1,345 @@
+"""CyberShip II: the 1:70 supply-vessel model of document 003 (Skjetne, Smogeli & Fossen, 2004).
+
+Equations (spec 003 §3.5)::
+
+    η̇ = J(ψ) ν,   ν = [u, v, r]
+    M ν̇ + C(ν) ν + D(ν) ν = τ + τ_env,          M = M_RB + M_A
+    M  = [[m − X_u̇, 0, 0], [0, m − Y_v̇, m x_G − Y_ṙ], [0, m x_G − N_v̇, I_z − N_ṙ]]
+    C  = [[0, 0, c₁₃], [0, 0, c₂₃], [−c₁₃, −c₂₃, 0]],
+         c₁₃ = −m(x_G r + v) + Y_v̇ v + ½(N_v̇ + Y_ṙ) r,  c₂₃ = (m − X_u̇) u
+    D  = [[d₁₁, 0, 0], [0, d₂₂, d₂₃], [0, d₃₂, d₃₃]],
+         d₁₁ = −X_u − X_|u|u |u| − X_uuu u²
+         d₂₂ = −Y_v − Y_|v|v |v| − Y_|r|v |r|,   d₂₃ = −Y_r − Y_|v|r |v| − Y_|r|r |r|
+         d₃₂ = −N_v − N_|v|v |v| − N_|r|v |r|,   d₃₃ = −N_r − N_|v|r |v| − N_|r|r |r|
+
+Actuators: two main propellers at y = ±0.078 m, both at the same speed n [rps], each giving
+T = T_nn|n|n − T_nu|n|u (forward quadrant; clipped at 0 for n ≥ 0 as in the source), so
+τ_X = 2T and their yaw moments cancel; two rudders, both at the same angle δ [rad], at
+x_R = −0.549 m:
+
+* ``rudder_model="table1"`` (default): the document's linear coefficients (Table 1, eq. (16)),
+  τ_Y = −Y_δ δ = 0.4304 δ, τ_N = −N_δ δ = −0.2363 δ, independent of speed;
+* ``rudder_model="skjetne"``: each rudder in the propeller slipstream gives
+  L = (L_δ δ − L_|δ|δ |δ|δ)|u_rud|u_rud with u_rud = u + k_u(√(8T/(πρd²) + u²) − u) (u ≥ 0),
+  τ_Y = 2L, τ_N = x_R τ_Y. Linearised at 0.3 m/s and 8.13 rps it is 4.88 × stronger than
+  Table 1 (∂τ_Y/∂δ = 2.10 N/rad, spec §3.5).
+
+**Rudder sign:** δ > 0 pushes the stern to starboard, so the bow turns to **port** (r < 0):
+b₂ < 0, the opposite of spec 000's Mariner. The document's laws (3) and (14) are written for this
+sign. Linearised at (u₀, 0, 0) the sway–yaw equations are eq. (16) term by term
+(:func:`shipgnc.analysis.nomoto.davidson_schiff`).
+
+State ``[north, east, psi, u, v, r]`` (NED, ψ clockwise from north), input ``[n, delta]``,
+disturbance ``[X_env, Y_env, N_env]`` in body axes (N, N, N·m; e.g. wave loads).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields, replace
+from functools import cached_property
+
+import numpy as np
+
+from shipgnc.actuators import Actuator
+from shipgnc.errors import ConfigError, require
+from shipgnc.frames import body_to_ned
+from shipgnc.models.base import Signal
+from shipgnc.models.fossen3dof import DISTURBANCES, STATES
+
+RUDDER_MODELS = ("table1", "skjetne")
+#: propeller speed of document 003 (both main propellers) [rps]; cruise ≈ 0.3 m/s in calm water
+CRUISE_RPS = 8.13
+
+
+@dataclass(frozen=True)
+class CyberShip2Params:
+    """Parameters of CyberShip II (defaults: the published model; SI units throughout).
+
+    ==================  ===========  ==============================================================
+    parameter           value        source
+    ==================  ===========  ==============================================================
+    m                   23.8 kg      Table 1; Skjetne et al. (2004)
+    I_z                 1.76 kg·m²   Table 1; Skjetne et al. (2004)
+    x_G                 0.046 m      Table 1; Skjetne et al. (2004)
+    X_udot              −2.0 kg      Table 1 "X_u" (dots lost, spec B3)
+    Y_vdot              −10.0 kg     Table 1 "Y_v" third column (B3)
+    Y_rdot, N_vdot      0.0          Table 1 "Y_ṙ = N_v̇ = 0"
+    N_rdot              −1.0 kg·m²   Table 1 "N_r" third column (B3)
+    Y_v                 −0.88965     Table 1; Skjetne et al. (2004)  [N·s/m]
+    Y_r                 −7.250       Table 1  [N·s]
+    N_v                 0.03130      Table 1  [N·s]
+    N_r                 −1.900       Table 1  [N·m·s]
+    Y_delta             −0.4304      Table 1  [N/rad]  (rudder model ``table1``)
+    N_delta             0.2363       Table 1  [N·m/rad]  (N_δ/Y_δ = −0.549 = x_R)
+    X_u                 −0.72253     spec §3.5 (Skjetne et al. 2004 via TUD_RL ``FossenCS2.py``)
+    X_absu_u            −1.32742     X_|u|u, same source  [kg/m]
+    X_uuu               −5.86643     same source  [kg·s/m²]
+    Y_absv_v            −36.47287    Y_|v|v, same source
+    Y_absr_v            −0.805       Y_|r|v
+    Y_absv_r            −0.845       Y_|v|r
+    Y_absr_r            −3.450       Y_|r|r
+    N_absv_v            3.95645      N_|v|v
+    N_absr_v            0.130        N_|r|v
+    N_absv_r            0.080        N_|v|r
+    N_absr_r            −0.750       N_|r|r
+    T_nn                3.65034e-3   propeller thrust T = T_nn|n|n − T_nu|n|u  [N/rps²]
+    T_nu                1.52468e-4   [N·s/(m·rps)]
+    L_delta             6.43306      rudder lift L = (L_δ δ − L_|δ|δ |δ|δ)|u_rud|u_rud  [kg/m]
+    L_absdelta_delta    5.83594      L_|δ|δ
+    k_u                 0.5          induced-velocity factor of u_rud
+    d_prop              0.06 m       propeller diameter (Lindegaard's thesis, via TUD_RL)
+    rho                 1014 kg/m³   water density of the source
+    x_rudder            −0.549 m     rudder position (N = x_R · Y; spec §3.5)
+    y_prop              0.078 m      propellers at y = ±0.078 m (equal n: no yaw moment)
+    rudder_model        "table1"     ``table1`` (document, default) or ``skjetne``
+    delta_max           35°          steering machine (spec B8, assumption)  [rad]
+    delta_rate          19.4°/s      IMO 2.32°/s Froude-scaled by √70 (B8)  [rad/s]
+    n_min, n_max        0, 30 rps    propeller-speed limits (toolkit choice)
+    ==================  ===========  ==============================================================
+
+    Cross-check: ``NTNU-TTO/SFI-AutoShip-COLAV-simulator`` (``CyberShip2Params``, MIC 2004).
+    """
+
+    m: float = 23.8
+    I_z: float = 1.76
+    x_G: float = 0.046
+    X_udot: float = -2.0
+    Y_vdot: float = -10.0
+    Y_rdot: float = 0.0
+    N_vdot: float = 0.0
+    N_rdot: float = -1.0
+    X_u: float = -0.72253
+    X_absu_u: float = -1.32742
+    X_uuu: float = -5.86643
+    Y_v: float = -0.88965
+    Y_absv_v: float = -36.47287
+    Y_absr_v: float = -0.805
+    Y_r: float = -7.250
+    Y_absv_r: float = -0.845
+    Y_absr_r: float = -3.450
+    N_v: float = 0.03130
+    N_absv_v: float = 3.95645
+    N_absr_v: float = 0.130
+    N_r: float = -1.900
+    N_absv_r: float = 0.080
+    N_absr_r: float = -0.750
+    Y_delta: float = -0.4304
+    N_delta: float = 0.2363
+    T_nn: float = 3.65034e-3
+    T_nu: float = 1.52468e-4
+    L_delta: float = 6.43306
+    L_absdelta_delta: float = 5.83594
+    k_u: float = 0.5
+    d_prop: float = 0.06
+    rho: float = 1014.0
+    x_rudder: float = -0.549
+    y_prop: float = 0.078
+    rudder_model: str = "table1"
+    delta_max: float = math.radians(35.0)
+    delta_rate: float = math.radians(19.4)
+    n_min: float = 0.0
+    n_max: float = 30.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            if f.name == "rudder_model":
+                continue
+            value = getattr(self, f.name)
+            require(isinstance(value, (int, float)) and not isinstance(value, bool),
+                    f"vessel.params.{f.name}", value, "must be a number")
+            require(math.isfinite(value), f"vessel.params.{f.name}", value, "must be finite")
+        require(self.rudder_model in RUDDER_MODELS, "vessel.params.rudder_model", self.rudder_model,
+                f"allowed: {', '.join(RUDDER_MODELS)}")
+        require(self.m > 0, "vessel.params.m", self.m, "mass must be > 0 kg")
+        require(self.I_z > 0, "vessel.params.I_z", self.I_z, "yaw inertia must be > 0 kg·m²")
+        require(self.M11 > 0, "vessel.params (M11 = m - X_udot)", round(self.M11, 6),
+                "the mass matrix must be positive definite")
+        m2 = self.sway_yaw_mass
+        require(m2[0, 0] > 0 and np.linalg.det(m2) > 0,
+                "vessel.params (sway-yaw mass [[m - Y_vdot, m x_G - Y_rdot], "
+                "[m x_G - N_vdot, I_z - N_rdot]])",
+                np.round(m2, 6).tolist(), "the mass matrix must be positive definite")
+        for name in ("X_u", "X_absu_u", "X_uuu"):
+            require(getattr(self, name) <= 0, f"vessel.params.{name}", getattr(self, name),
+                    "surge damping coefficients must be <= 0 (dissipative)")
+        for name in ("T_nn", "T_nu", "L_delta", "L_absdelta_delta"):
+            require(getattr(self, name) >= 0, f"vessel.params.{name}", getattr(self, name), "must be >= 0")
+        require(0 <= self.k_u <= 1, "vessel.params.k_u", self.k_u, "allowed range is [0, 1]")
+        for name in ("d_prop", "rho"):
+            require(getattr(self, name) > 0, f"vessel.params.{name}", getattr(self, name), "must be > 0")
+        require(0 < self.delta_max <= math.pi / 2, "vessel.params.delta_max", self.delta_max,
+                "need 0 < delta_max <= pi/2 rad (90°)")
+        require(self.delta_rate > 0, "vessel.params.delta_rate", self.delta_rate,
+                "rudder rate limit must be > 0 rad/s")
+        require(0 <= self.n_min < self.n_max, "vessel.params.n_min/n_max", (self.n_min, self.n_max),
+                "need 0 <= n_min < n_max [rps] (forward propeller quadrant)")
+
+    @property
+    def M11(self) -> float:
+        """m − X_u̇ [kg]."""
+        return self.m - self.X_udot
+
+    @property
+    def sway_yaw_mass(self) -> np.ndarray:
+        """The sway–yaw block of M: [[m − Y_v̇, m x_G − Y_ṙ], [m x_G − N_v̇, I_z − N_ṙ]]."""
+        mx = self.m * self.x_G
+        return np.array([[self.m - self.Y_vdot, mx - self.Y_rdot],
+                         [mx - self.N_vdot, self.I_z - self.N_rdot]])
+
+    @property
+    def mass_matrix(self) -> np.ndarray:
+        """The 3 × 3 M = M_RB + M_A."""
+        M = np.zeros((3, 3))
+        M[0, 0] = self.M11
+        M[1:, 1:] = self.sway_yaw_mass
+        return M
+
+    def with_(self, **changes) -> CyberShip2Params:
+        """A copy with some parameters changed (validated; unknown names rejected)."""
+        known = {f.name for f in fields(self)}
+        for key in changes:
+            if key not in known:
+                raise ConfigError(f"vessel.params.{key}: unknown parameter; allowed: "
+                                  f"{', '.join(sorted(known))}")
+        return replace(self, **changes)
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def propeller_thrust(params: CyberShip2Params, n, u):
+    """Thrust of one main propeller T = T_nn|n|n − T_nu|n|u [N], clipped at 0 when n ≥ 0."""
+    p = params
+    n = np.asarray(n, dtype=float)
+    raw = p.T_nn * np.abs(n) * n - p.T_nu * np.abs(n) * u
+    return np.where(n >= 0, np.maximum(raw, 0.0), raw)
+
+
+def rudder_inflow(params: CyberShip2Params, n, u):
+    """u_rud = u + k_u(√(8T/(πρd²) + u²) − u) for u ≥ 0 (else u): the slipstream speed [m/s]."""
+    p = params
+    u = np.asarray(u, dtype=float)
+    thrust = propeller_thrust(p, n, u)
+    jet = np.sqrt(np.maximum(0.0, 8.0 * thrust / (math.pi * p.rho * p.d_prop**2) + u * u))
+    return np.where(u >= 0, u + p.k_u * (jet - u), u)
+
+
+def rudder_forces(params: CyberShip2Params, delta, u, n):
+    """Sway force and yaw moment ``(tau_Y, tau_N)`` of both rudders at angle ``delta`` [rad]."""
+    p = params
+    delta = np.asarray(delta, dtype=float)
+    if p.rudder_model == "table1":
+        tau_y = -p.Y_delta * delta
+        return tau_y, -p.N_delta * delta
+    u_rud = rudder_inflow(p, n, u)
+    lift = (p.L_delta * delta - p.L_absdelta_delta * np.abs(delta) * delta) * np.abs(u_rud) * u_rud
+    tau_y = 2.0 * lift
+    return tau_y, p.x_rudder * tau_y
+
+
+def rudder_gains(params: CyberShip2Params, u: float, n: float = CRUISE_RPS) -> tuple[float, float]:
+    """(∂τ_Y/∂δ, ∂τ_N/∂δ) at δ = 0, speed ``u`` [m/s] and propeller speed ``n`` [rps].
+
+    ``table1``: (−Y_δ, −N_δ) = (0.4304, −0.2363); ``skjetne``: 2 L_δ |u_rud|u_rud and x_R times it
+    (2.10 N/rad and −1.153 N·m/rad at 0.3 m/s, 8.13 rps).
+    """
+    p = params
+    if p.rudder_model == "table1":
+        return -p.Y_delta, -p.N_delta
+    u_rud = float(rudder_inflow(p, n, u))
+    y = 2.0 * p.L_delta * abs(u_rud) * u_rud
+    return y, p.x_rudder * y
+
+
+def surge_damping(params: CyberShip2Params, u):
+    """d₁₁(u) = −X_u − X_|u|u|u| − X_uuu u² [kg/s]."""
+    p = params
+    return -p.X_u - p.X_absu_u * np.abs(u) - p.X_uuu * u * u
+
+
+def surge_equilibrium(params: CyberShip2Params, n: float) -> float:
+    """Straight-run speed u [m/s] at propeller speed ``n`` [rps] with δ = 0: 2T(n, u) = d₁₁(u)u.
+
+    At 8.13 rps this is 0.2958 m/s (spec §3.5; the document's 0.3 m/s).
+    """
+    from scipy.optimize import brentq
+
+    require(math.isfinite(n) and n >= 0, "n", n, "propeller speed must be a finite number >= 0 rps")
+    p = params
+
+    def imbalance(u: float) -> float:
+        return float(2.0 * propeller_thrust(p, n, u) - surge_damping(p, u) * u)
+
+    if imbalance(0.0) <= 0.0:
+        return 0.0
+    upper = 1.0
+    while imbalance(upper) > 0.0:
+        upper *= 2.0
+    return float(brentq(imbalance, 0.0, upper, xtol=1e-14, rtol=1e-14))
+
+
+INPUTS = (
+    Signal("n", "rps", "propeller speed (both main propellers)"),
+    Signal("delta", "rad", "rudder angle (both rudders), positive turns the bow to port", angle=True),
+)
+
+
+@dataclass(frozen=True)
+class CyberShip2:
+    """CyberShip II, nonlinear 3-DOF (see module docstring)."""
+
+    params: CyberShip2Params = field(default_factory=CyberShip2Params)
+    length: float = 1.255  #: drawing outline only [m]
+    beam: float = 0.29  #: drawing outline only [m]
+
+    states = STATES
+    inputs = INPUTS
+    disturbances = DISTURBANCES
+    state_limits = (1e6, 1e6, 1e5, 10.0, 10.0, 20.0)
+
+    def input_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds of ``[n, delta]`` (propeller speed range, ±delta_max)."""
+        p = self.params
+        return np.array([p.n_min, -p.delta_max]), np.array([p.n_max, p.delta_max])
+
+    def derivatives(self, x, u, d=None):
+        """ẋ for ``x`` (..., 6), ``u`` (..., 2) = [n, δ], ``d`` (..., 3) or None."""
+        p = self.params
+        psi, su, sv, sr = x[..., 2], x[..., 3], x[..., 4], x[..., 5]
+        n, delta = u[..., 0], u[..., 1]
+        tau_x = 2.0 * propeller_thrust(p, n, su)
+        tau_y, tau_n = rudder_forces(p, delta, su, n)
+        if d is not None:
+            tau_x, tau_y, tau_n = tau_x + d[..., 0], tau_y + d[..., 1], tau_n + d[..., 2]
+        c13 = -p.m * (p.x_G * sr + sv) + p.Y_vdot * sv + 0.5 * (p.N_vdot + p.Y_rdot) * sr
+        c23 = (p.m - p.X_udot) * su
+        abs_v, abs_r = np.abs(sv), np.abs(sr)
+        d22 = -p.Y_v - p.Y_absv_v * abs_v - p.Y_absr_v * abs_r
+        d23 = -p.Y_r - p.Y_absv_r * abs_v - p.Y_absr_r * abs_r
+        d32 = -p.N_v - p.N_absv_v * abs_v - p.N_absr_v * abs_r
+        d33 = -p.N_r - p.N_absv_r * abs_v - p.N_absr_r * abs_r
+        f_x = tau_x - c13 * sr - surge_damping(p, su) * su
+        f_y = tau_y - c23 * sr - d22 * sv - d23 * sr
+        f_n = tau_n + c13 * su + c23 * sv - d32 * sv - d33 * sr
+        (a, b), (c, e) = self._sway_yaw_inverse
+        north_dot, east_dot = body_to_ned(psi, su, sv)
+        return np.stack([north_dot, east_dot, sr, f_x / p.M11, a * f_y + b * f_n, c * f_y + e * f_n],
+                        axis=-1)
+
+    @cached_property
+    def _sway_yaw_inverse(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        inv = np.linalg.inv(self.params.sway_yaw_mass)
+        return (float(inv[0, 0]), float(inv[0, 1])), (float(inv[1, 0]), float(inv[1, 1]))
+
+
+def steering_machine(params: CyberShip2Params, *, rate_limit: bool = True,
+                     rate_mode: str = "ramp") -> Actuator:
+    """The actuator of CyberShip II: propeller speed within [n_min, n_max] (no rate limit) and the
+    steering machine, δ within ±delta_max slewing at most delta_rate (35°, 19.4°/s; spec B8).
+    ``rate_limit=False`` drops the rudder rate limit (B8's comparison); ``rate_mode="hold"`` applies
+    the slewed rudder over the whole step instead of ramping within it (see :class:`Actuator`)."""
+    p = params
+    rate = [math.inf, p.delta_rate if rate_limit else math.inf]
+    return Actuator(np.array([p.n_min, -p.delta_max]), np.array([p.n_max, p.delta_max]), rate=rate,
+                    names=tuple(s.name for s in INPUTS), rate_mode=rate_mode)
