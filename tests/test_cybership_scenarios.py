@@ -110,6 +110,9 @@ def test_froude_scaled_wave_height_is_the_default():
     ("disturbance.hs=-1", ["disturbance.hs", "greater than 0"]),
     ("quality.lam=-1", ["quality.lam"]),
     ("guidance.type=los", ["guidance"]),
+    ("controllers.pd.lam1=-0.1", ["controllers.pd", "lam1 does not apply", "Kp, Kd"]),
+    ("controllers.smc_tuned.eta=3", ["eta does not apply", "eta_rudder"]),
+    ("controllers.smc_printed.lam2=2", ["controllers.smc_printed.lam2", "less than 0"]),
 ])
 def test_bad_cybership_input_names_the_field(override, words):
     from shipgnc.errors import ConfigError
@@ -120,3 +123,16 @@ def test_bad_cybership_input_names_the_field(override, words):
     assert "\n" not in message
     for word in words:
         assert word in message, (word, message)
+
+
+def test_gains_in_the_yaml_are_the_documents_and_settable():
+    sc = load_scenario("cybership-calm")
+    assert (sc.controllers["pd"].Kp, sc.controllers["pd"].Kd) == (2.0, 50.0)  # eq. (3)
+    assert (sc.controllers["smc_printed"].lam2, sc.controllers["smc_printed"].eta) == (-7.8128, 10.0)
+    short = ["simulation.t_end=40"]
+    base = load_scenario("cybership-calm", short)
+    soft = load_scenario("cybership-calm", [*short, "controllers.pd.Kd=20"])
+    only_pd = {"pd": base.controllers["pd"]}
+    a = run_scenario(base.model_copy(update={"controllers": only_pd})).metrics["pd"]
+    b = run_scenario(soft.model_copy(update={"controllers": {"pd": soft.controllers["pd"]}})).metrics["pd"]
+    assert a["J"] != b["J"]

@@ -88,10 +88,24 @@ def _controller(cfg, model, scenario: Scenario):
         return HeadingSpeedAutopilot(model.params, Ts=cfg.Ts, omega_ref=cfg.omega_ref,
                                      omega=cfg.omega, omega_u=cfg.omega_u,
                                      yaw_feedforward=cfg.yaw_feedforward)
-    from shipgnc.control.course import course_controller
+    return _course_controller(cfg, model.params, scenario.vessel.propeller_rps)
 
-    return course_controller(cfg.variant, model.params, Ts=cfg.Ts,
-                             propeller_rps=scenario.vessel.propeller_rps)
+
+def _course_controller(cfg, params, propeller_rps: float):
+    """Document 003's PD or sliding-mode autopilot with the scenario's gains (spec 003 §3.2)."""
+    from shipgnc.control import course
+
+    gains = cfg.gains()
+    common = {"Ts": cfg.Ts, "propeller_rps": propeller_rps}
+    if cfg.variant == "pd":
+        return course.CoursePD(**gains, **common)
+    design_model = course.design_model_of(params, gains.pop("design_model", "eq18"))
+    if cfg.variant == "smc_tuned":
+        return course.smc_tuned(design_model, **common, **gains)
+    lam1, lam2 = gains.pop("lam1", course.PAPER_LAMBDAS[0]), gains.pop("lam2", course.PAPER_LAMBDAS[1])
+    form = "consistent" if cfg.variant == "smc_consistent" else "printed"
+    return course.SlidingModeCourse(course.design_smc(*design_model, lam1, lam2), form=form,
+                                    **common, **gains)
 
 
 def _guidance(g):

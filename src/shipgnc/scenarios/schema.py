@@ -160,13 +160,52 @@ class HeadingSpeedConfig(Strict):
 COURSE_CONTROLLERS = ("pd", "smc_printed", "smc_consistent", "smc_tuned")
 
 
+COURSE_GAINS = {
+    "pd": ("Kp", "Kd"),
+    "smc_printed": ("design_model", "lam1", "lam2", "eta", "phi", "omega_n", "zeta"),
+    "smc_consistent": ("design_model", "lam1", "lam2", "eta", "phi", "omega_n", "zeta"),
+    "smc_tuned": ("design_model", "lam1", "lam2", "eta_rudder", "phi"),
+}
+
+
 class CourseControllerConfig(Strict):
-    """Document 003's course autopilots for CyberShip II (spec 003 §3.2): ``variant`` picks the law
-    and its published (or, for ``smc_tuned``, documented) gains."""
+    """Document 003's course autopilots for CyberShip II (spec 003 §3.2): ``variant`` picks the law;
+    gains left out take the document's values (``smc_tuned``: the documented retuned ones).
+
+    PD (eq. 3): ``Kp``, ``Kd``. SMC (eq. 9–15): the design model (``eq18`` as printed, ``eq17``,
+    ``eq16``), eigenvalues ``lam1``, ``lam2`` [1/s], switching gain ``eta`` and boundary layer
+    ``phi``, reference model ``omega_n`` [rad/s], ``zeta``; ``smc_tuned`` takes its switching gain
+    as a rudder angle ``eta_rudder`` [rad] (η_h = η_δ |hᵀB_h|).
+    """
 
     type: Literal["course"]
     variant: Literal["pd", "smc_printed", "smc_consistent", "smc_tuned"]
     Ts: Positive = 0.1
+    Kp: Positive | None = None
+    Kd: NonNegative | None = None
+    design_model: Literal["eq18", "eq17", "eq16"] | None = None
+    lam1: Annotated[float, Field(lt=0, allow_inf_nan=False)] | None = None
+    lam2: Annotated[float, Field(lt=0, allow_inf_nan=False)] | None = None
+    eta: Positive | None = None
+    eta_rudder: Positive | None = None
+    phi: Positive | None = None
+    omega_n: Positive | None = None
+    zeta: Positive | None = None
+
+    @model_validator(mode="after")
+    def _gains_fit_the_variant(self) -> CourseControllerConfig:
+        allowed = COURSE_GAINS[self.variant]
+        for name in ("Kp", "Kd", "design_model", "lam1", "lam2", "eta", "eta_rudder", "phi",
+                     "omega_n", "zeta"):
+            if getattr(self, name) is not None and name not in allowed:
+                raise ValueError(f"{name} does not apply to variant {self.variant!r}; "
+                                 f"its settings: {', '.join(allowed)}")
+        return self
+
+    def gains(self) -> dict:
+        """The settings given (the rest keep the controller's defaults)."""
+        return {k: v for k, v in self.model_dump(exclude={"type", "variant", "Ts"}).items()
+                if v is not None}
 
 
 ControllerConfig = Annotated[OpenLoopConfig | HeadingSpeedConfig | CourseControllerConfig,
