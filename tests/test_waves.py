@@ -495,3 +495,20 @@ def test_periodogram_of_a_realisation_follows_the_spectrum():
     assert band.sum() >= 15
     assert np.all(np.abs(ratio - 1.0) < 0.35), ratio
     assert abs(np.median(ratio) - 1.0) < 0.08
+
+
+def test_compiled_wave_loads_equal_the_numpy_reference():
+    from shipgnc.environment.waves import FroudeKrylovWaveLoads, WaveSpectrum
+
+    spectrum = WaveSpectrum.modified_pierson_moskowitz(0.0429, 0.8)
+    rng = np.random.default_rng(3)
+    x = np.zeros((4, 3, 6))
+    x[..., 0], x[..., 1] = rng.normal(0, 5, (4, 3)), rng.normal(0, 5, (4, 3))
+    x[..., 2] = rng.uniform(-np.pi, np.pi, (4, 3))
+    for spreading in (None, 1.0):
+        loads = FroudeKrylovWaveLoads(spectrum, spreading=spreading)
+        loads.reset((4, 3), np.random.default_rng(9))
+        for t in (0.0, 1.3, 57.1):
+            compiled, reference = loads(t, x), loads.loads_numpy(t, x)
+            assert compiled.shape == (4, 3, 3)
+            np.testing.assert_allclose(compiled, reference, rtol=1e-10, atol=1e-12)

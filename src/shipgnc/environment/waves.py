@@ -726,9 +726,13 @@ class FroudeKrylovWaveLoads:
     def __init__(self, spectrum: WaveSpectrum, *, direction: float = math.pi, n_components: int = 200,
                  spreading: float | None = None, length: float = 1.255, beam: float = 0.29,
                  draft: float = 0.05, rho: float = 1014.0, gains=(1.0, 1.0, 1.0),
-                 state_index: tuple[int, int, int] = (0, 1, 2)):
+                 state_index: tuple[int, int, int] = (0, 1, 2), backend: str = "auto"):
         require(isinstance(spectrum, WaveSpectrum), "waves.spectrum", type(spectrum).__name__,
                 "must be a WaveSpectrum")
+        require(backend in ("auto", "numpy"), "waves.backend", backend,
+                "allowed: auto (compiled kernel when numba is available), numpy")
+        self.backend = backend
+        self._flat = None
         self.spectrum = spectrum
         self.direction = _angle(direction)
         require(isinstance(n_components, (int, np.integer)) and not isinstance(n_components, bool)
@@ -760,6 +764,8 @@ class FroudeKrylovWaveLoads:
         self._weights = (-2.0 * self.gains[0] * c, -2.0 * self.gains[1] * c, self.gains[2] * c)
         self._half_kL = 0.5 * self.length * r.wavenumber
         self._half_kB = 0.5 * self.beam * r.wavenumber
+        self._batch = tuple(batch_shape)
+        self._flat = None  # the compiled kernel's flattened arrays, made on first use
 
     def _require_reset(self) -> WaveRealisation:
         if self.realisation is None:
@@ -804,7 +810,45 @@ class FroudeKrylovWaveLoads:
         return np.sum(r.amplitude * np.cos(r.phase_at(t, north, east)), axis=-1)
 
     def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
-        """[X_env, Y_env, N_env] (*batch, 3) at time t [s] for states ``x`` (*batch, n)."""
+        """[X_env, Y_env, N_env] (*batch, 3) at time t [s] for states ``x`` (*batch, n).
+
+        Evaluated by the compiled twin (:mod:`shipgnc.environment.wave_kernel`) when numba is
+        available and ``backend`` allows it, else by :meth:`loads_numpy` (the reference).
+        """
+        if self.backend == "numpy" or not self._compiled_ok():
+            return self.loads_numpy(t, x)
+        from shipgnc.environment import wave_kernel
+
+        north, east, psi = (np.ascontiguousarray(np.broadcast_to(a, self._batch).reshape(-1),
+                                                 dtype=float) for a in self._state(x))
+        out = wave_kernel.loads(t, north, east, psi, self._flat, self.length, self.beam,
+                                self.spreading is None)
+        return out.reshape(*self._batch, 3)
+
+    def _compiled_ok(self) -> bool:
+        if self._flat is None:
+            from shipgnc.environment import wave_kernel
+
+            if not wave_kernel.available():
+                return False
+            r = self._require_reset()
+            n = r.omega.shape[-1]
+            chi = np.broadcast_to(self.direction if self.spreading is None else r.direction,
+                                  r.omega.shape)
+
+            def flat(a):
+                return np.ascontiguousarray(np.broadcast_to(a, r.omega.shape).reshape(-1, n),
+                                            dtype=float)
+
+            self._flat = {"omega": flat(r.omega), "k_north": flat(r._k_north),
+                          "k_east": flat(r._k_east), "phase": flat(r.phase),
+                          "half_kL": flat(self._half_kL), "half_kB": flat(self._half_kB),
+                          "chi": flat(chi), "wX": flat(self._weights[0]),
+                          "wY": flat(self._weights[1]), "wN": flat(self._weights[2])}
+        return True
+
+    def loads_numpy(self, t: float, x: np.ndarray) -> np.ndarray:
+        """The reference numpy form of :meth:`__call__`."""
         r = self._require_reset()
         north, east, psi = self._state(x)
         theta = r.phase_at(t, north, east)
