@@ -1,0 +1,251 @@
+"""Mariner-class cargo ship: the de Wit–Oppe simulation model (25) of document 000.
+
+Equations (spec 000 §0.3, eq. (25); signs restored, A3)::
+
+    ẋ = u cos ψ − v sin ψ + c_N          ẏ = u sin ψ + v cos ψ + c_E
+    ψ̇ = r                                ṙ = −a r − b r³ + c δ + b_r
+    u̇ = −f u − W r² + S                  v = r₁ r + r₂ r³   (algebraic)
+
+State ``[north, east, psi, u, r]`` (NED, ψ clockwise from north; the document's x, y are the
+toolkit's ``north``, ``east``), input ``[delta]`` [rad], disturbance ``[b_r, current_north,
+current_east]``: a yaw acceleration [rad/s²] added to ṙ (A9) and a current [m/s] added to the
+kinematics. The document's cross current d_y acts along the active leg's Y_r axis (A10); the
+scenario turns it into NED with the leg's angle ψ_r0, e.g. ``body_to_ned(psi_r0, 0.0, d_y)``.
+
+**Sway is algebraic.** v is not a state: ``sway(r)`` = r₁ r + r₂ r³ is evaluated from the yaw rate
+wherever it is needed. With r₁ < 0 a starboard turn (r > 0) gives v < 0 at the centre of gravity;
+the pivot point, where the hull's lateral velocity v + x r vanishes, lies −r₁ = 69.45 m ahead of
+the CG (for r₂ = 0).
+
+**Rudder sign:** c > 0, so δ > 0 gives ṙ > 0: the bow turns to **starboard** (the opposite of
+CyberShip II, spec 003). The steering machine (±35°, 3.8°/s) is an actuator, :func:`rudder`.
+
+The document works in minutes, nautical miles and radians (A1); :class:`MarinerParams` holds SI
+values and converts at this boundary (:meth:`MarinerParams.from_paper_units`,
+:meth:`MarinerParams.to_paper_units`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field, fields, replace
+from types import MappingProxyType
+
+import numpy as np
+
+from shipgnc.actuators import Actuator
+from shipgnc.errors import ConfigError, require
+from shipgnc.frames import body_to_ned
+from shipgnc.models.base import Signal
+from shipgnc.units import MINUTE, NAUTICAL_MILE
+
+#: per parameter: (the document's unit, SI value of one document unit). Angles are rad in both.
+PAPER_UNITS: Mapping[str, tuple[str, float]] = MappingProxyType({
+    "a": ("1/min", 1.0 / MINUTE),
+    "b": ("min", MINUTE),
+    "c": ("1/min^2", 1.0 / MINUTE**2),
+    "r1": ("nm/rad", NAUTICAL_MILE),
+    "r2": ("nm min^2/rad^3", NAUTICAL_MILE * MINUTE**2),
+    "f": ("1/min", 1.0 / MINUTE),
+    "W": ("nm/rad^2", NAUTICAL_MILE),
+    "S": ("nm/min^2", NAUTICAL_MILE / MINUTE**2),
+    "delta_max": ("rad", 1.0),
+    "delta_rate": ("rad/min", 1.0 / MINUTE),
+})
+
+#: the document's values in its own units (spec 000 table 0.1); δ̇_max = 3.8°/s = 228°/min
+PAPER_VALUES: Mapping[str, float] = MappingProxyType({
+    "a": 1.084, "b": 0.62, "c": 3.553, "r1": -0.0375, "r2": 0.0, "f": 0.86, "W": 0.067, "S": 0.215,
+    "delta_max": math.radians(35.0), "delta_rate": math.radians(228.0),
+})
+
+#: the document's yaw disturbance b_r = 0.1 rad/min² in SI [rad/s²] (A9)
+DOC_B_R = 0.1 / MINUTE**2
+#: the document's cross current d_y = 0.04 nm/min in SI [m/s] (2.4 kn, A10)
+DOC_D_Y = 0.04 * NAUTICAL_MILE / MINUTE
+
+
+def _si(name: str) -> float:
+    return PAPER_VALUES[name] * PAPER_UNITS[name][1]
+
+
+@dataclass(frozen=True)
+class MarinerParams:
+    """Parameters of the de Wit–Oppe model (defaults: the document's Mariner; SI throughout).
+
+    ==========  ================  ==================  =================  =======================
+    field       paper value       paper unit          SI value           SI unit
+    ==========  ================  ==================  =================  =======================
+    a           1.084             1/min               0.018067           1/s
+    b           0.62              min                 37.2               s  (multiplies r³)
+    c           3.553             1/min² (A2)         9.869e-4           1/s²  (δ in rad)
+    r1          −0.0375           nm/rad              −69.45             m/rad
+    r2          0                 nm·min²/rad³        0                  m·s²/rad³
+    f           0.86              1/min               0.014333           1/s
+    W           0.067             nm/rad²             124.08             m/rad²
+    S           0.215             nm/min²             0.11061            m/s²
+    delta_max   35° = 0.6109      rad                 0.6109             rad
+    delta_rate  228°/min (3.8°/s) rad/min             0.06632            rad/s
+    ==========  ================  ==================  =================  =======================
+
+    Straight-running speed U = S/f = 0.25 nm/min = 7.7167 m/s (15 kn). The rudder limits feed
+    :func:`rudder` and :meth:`MarinerWitOppe.input_limits`; the model itself does not clip δ.
+    """
+
+    a: float = _si("a")
+    b: float = _si("b")
+    c: float = _si("c")
+    r1: float = _si("r1")
+    r2: float = _si("r2")
+    f: float = _si("f")
+    W: float = _si("W")
+    S: float = _si("S")
+    delta_max: float = _si("delta_max")
+    delta_rate: float = _si("delta_rate")
+
+    def __post_init__(self) -> None:
+        for fl in fields(self):
+            value = getattr(self, fl.name)
+            require(isinstance(value, (int, float)) and not isinstance(value, bool),
+                    f"vessel.params.{fl.name}", value, "must be a number")
+            require(math.isfinite(value), f"vessel.params.{fl.name}", value, "must be finite")
+        require(self.b >= 0, "vessel.params.b", self.b, "cubic yaw damping must be >= 0 s")
+        require(self.a > 0 or self.b > 0, "vessel.params.a", self.a,
+                "a course-unstable ship (a <= 0) needs cubic yaw damping b > 0")
+        require(self.c > 0, "vessel.params.c", self.c,
+                "rudder gain must be > 0 1/s² (δ > 0 turns to starboard)")
+        require(self.f > 0, "vessel.params.f", self.f, "surge damping must be > 0 1/s")
+        require(self.S > 0, "vessel.params.S", self.S, "surge thrust must be > 0 m/s² (U = S/f > 0)")
+        require(self.W >= 0, "vessel.params.W", self.W, "speed loss in turns must be >= 0 m/rad²")
+        require(0 < self.delta_max <= math.pi / 2, "vessel.params.delta_max", self.delta_max,
+                "need 0 < delta_max <= pi/2 rad (90°)")
+        require(self.delta_rate > 0, "vessel.params.delta_rate", self.delta_rate,
+                "rudder rate limit must be > 0 rad/s")
+
+    @classmethod
+    def from_paper_units(cls, **values: float) -> MarinerParams:
+        """Parameters from the document's minute / nautical-mile / rad values (see the table).
+
+        Omitted names take the document's values; e.g. ``from_paper_units(r1=+0.0375)`` is the
+        sign-flipped sway coupling of spec 000 §0.5.
+        """
+        for key in values:
+            if key not in PAPER_UNITS:
+                raise ConfigError(f"vessel.params.{key}: unknown parameter; allowed: "
+                                  f"{', '.join(PAPER_UNITS)}")
+        merged = {**PAPER_VALUES, **values}
+        return cls(**{name: merged[name] * factor for name, (_, factor) in PAPER_UNITS.items()})
+
+    def to_paper_units(self) -> dict[str, float]:
+        """The parameters in the document's units (inverse of :meth:`from_paper_units`)."""
+        return {name: getattr(self, name) / factor for name, (_, factor) in PAPER_UNITS.items()}
+
+    @property
+    def U(self) -> float:
+        """Straight-running speed S/f [m/s] (δ = 0, r = 0): 7.7167 m/s for the Mariner."""
+        return self.S / self.f
+
+    def sway(self, r):
+        """Sway velocity v = r₁ r + r₂ r³ [m/s] at the CG for yaw rate ``r`` [rad/s] (arrays broadcast)."""
+        return self.r1 * r + self.r2 * r**3
+
+    def with_(self, **changes: float) -> MarinerParams:
+        """A copy with some SI parameters changed (validated; unknown names rejected)."""
+        known = {fl.name for fl in fields(self)}
+        for key in changes:
+            if key not in known:
+                raise ConfigError(f"vessel.params.{key}: unknown parameter; allowed: "
+                                  f"{', '.join(sorted(known))}")
+        return replace(self, **changes)
+
+    def as_dict(self) -> dict[str, float]:
+        return asdict(self)
+
+
+STATES = (
+    Signal("north", "m", "north position (NED x)"),
+    Signal("east", "m", "east position (NED y)"),
+    Signal("psi", "rad", "heading, clockwise from north (unwrapped)", angle=True),
+    Signal("u", "m/s", "surge velocity"),
+    Signal("r", "rad/s", "yaw rate (bow to starboard)"),
+)
+INPUTS = (Signal("delta", "rad", "rudder angle, positive turns the bow to starboard", angle=True),)
+DISTURBANCES = (
+    Signal("b_r", "rad/s^2", "yaw acceleration disturbance (added to r_dot)"),
+    Signal("current_north", "m/s", "current velocity, north component"),
+    Signal("current_east", "m/s", "current velocity, east component"),
+)
+
+
+@dataclass(frozen=True)
+class MarinerWitOppe:
+    """De Wit–Oppe model (25) of the Mariner (see module docstring); sway v is algebraic."""
+
+    params: MarinerParams = field(default_factory=MarinerParams)
+    length: float = 160.93  #: drawing outline only [m] (Mariner class, L_pp)
+    beam: float = 23.17  #: drawing outline only [m]
+
+    states = STATES
+    inputs = INPUTS
+    disturbances = DISTURBANCES
+    state_limits = (1e8, 1e8, 1e5, 100.0, 10.0)
+
+    @classmethod
+    def from_paper_units(cls, **values: float) -> MarinerWitOppe:
+        """The model with :meth:`MarinerParams.from_paper_units` parameters."""
+        return cls(params=MarinerParams.from_paper_units(**values))
+
+    def input_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds of ``[delta]`` (±delta_max)."""
+        d = self.params.delta_max
+        return np.array([-d]), np.array([d])
+
+    def sway(self, r):
+        """Sway velocity v = r₁ r + r₂ r³ [m/s] at the CG (v is not a state of this model)."""
+        return self.params.sway(r)
+
+    def derivatives(self, x, u, d=None):
+        """ẋ of eq. (25) for ``x`` (..., 5), ``u`` (..., 1) = [δ], ``d`` (..., 3) or None."""
+        p = self.params
+        psi, su, sr = x[..., 2], x[..., 3], x[..., 4]
+        north_dot, east_dot = body_to_ned(psi, su, p.sway(sr))
+        r_dot = -p.a * sr - p.b * sr**3 + p.c * u[..., 0]
+        if d is not None:
+            r_dot = r_dot + d[..., 0]
+            north_dot = north_dot + d[..., 1]
+            east_dot = east_dot + d[..., 2]
+        u_dot = -p.f * su - p.W * sr * sr + p.S
+        return np.stack([north_dot, east_dot, sr, u_dot, r_dot], axis=-1)
+
+
+def rudder(params: MarinerParams, *, rate_limit: bool = True, rate_mode: str = "ramp") -> Actuator:
+    """The Mariner's steering machine: δ within ±delta_max slewing at most delta_rate (35°, 3.8°/s).
+
+    ``rate_limit=False`` keeps only the saturation; ``rate_mode`` as in :class:`Actuator`.
+    """
+    p = params
+    return Actuator(np.array([-p.delta_max]), np.array([p.delta_max]),
+                    rate=[p.delta_rate if rate_limit else math.inf],
+                    names=tuple(s.name for s in INPUTS), rate_mode=rate_mode)
+
+
+def linear_tracking_model(params: MarinerParams, *,
+                          paper_units: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """(A, B) of the linear design model (8) for the state [y_r, ψ_r, r, e_I] and input δ::
+
+        A = [[0, U, 0, 0], [0, 0, 1, 0], [0, 0, −a, 0], [1, 0, 0, 0]],   B = [0, 0, c, 0]ᵀ
+
+    with U = S/f, sway neglected (eq. (7)). SI by default (m, rad, rad/s, m·s; s); with
+    ``paper_units=True`` in the document's nm, rad, rad/min, nm·min (min), the units the printed
+    LQR gain refers to (spec 000 §0.4). B has shape (4, 1).
+    """
+    values = params.to_paper_units() if paper_units else params.as_dict()
+    a, c = values["a"], values["c"]
+    U = values["S"] / values["f"]
+    A = np.array([[0.0, U, 0.0, 0.0],
+                  [0.0, 0.0, 1.0, 0.0],
+                  [0.0, 0.0, -a, 0.0],
+                  [1.0, 0.0, 0.0, 0.0]])
+    B = np.array([[0.0], [0.0], [c], [0.0]])
+    return A, B
