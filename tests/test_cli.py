@@ -101,6 +101,11 @@ BAD_INPUTS = [
     (["run", "boat-stern-kick", "--live"], ["--live", "interactive", "agg"]),
     (["run", "missing-file.yaml"], ["missing-file.yaml", "no such file"]),
     (["show", "boat-los", "--set", "metrics=speed"], ["metrics", "speed"]),
+    (["run", "boat-stern-kick", "--set", "simulation.initial_state.u=60"], ["initial_state.u", "60", "50"]),
+    (["run", "boat-stern-kick", "--set", "simulation.t_end=1e308"], ["t_end / dt", "at most"]),
+    (["run", "boat-stern-kick", "--set", "simulation.t_end=1e7", "--set", "simulation.dt=0.1"], ["log size", "GiB"]),
+    (["run", "cybership-calm", "--live"], ["--live", "cybership2"]),
+    (["run", "boat-autopilot", "--set", "controller=null", "--set", "controllers={a: {type: heading-speed}}"], ["controllers", "cybership2"]),
 ]
 
 
@@ -161,3 +166,16 @@ def test_divergence_exit_code_and_partial_result(tmp_path):
     kept = invoke(*args, "--keep-partial")
     assert kept.exit_code == 3
     assert (tmp_path / "result.nc").exists()
+
+
+def test_a_run_without_the_turn_reports_no_figures_instead_of_fake_zeros(tmp_path):
+    result = invoke("run", "boat-stern-kick", "--out", tmp_path, "--json", "--set", "simulation.t_end=2")
+    assert result.exit_code == 0, result.stderr
+    metrics = json.loads(result.stdout)
+    assert metrics["heading_change_deg"] is None and metrics["initial_sway_sign"] is None
+    assert (tmp_path / "dashboard.png").exists() and not (tmp_path / "stern_kick_closeup.png").exists()
+
+
+def test_times_are_clean_numbers(tmp_path):
+    result = invoke("run", "boat-los", "--out", tmp_path, "--json", "--no-figures")
+    assert json.loads(result.stdout)["completion_time_s"] == 121.05

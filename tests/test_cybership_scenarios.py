@@ -136,3 +136,22 @@ def test_gains_in_the_yaml_are_the_documents_and_settable():
     a = run_scenario(base.model_copy(update={"controllers": only_pd})).metrics["pd"]
     b = run_scenario(soft.model_copy(update={"controllers": {"pd": soft.controllers["pd"]}})).metrics["pd"]
     assert a["J"] != b["J"]
+
+
+def test_controllers_of_a_comparison_share_one_sea_without_a_seed():
+    sc = load_scenario("cybership-waves", ["simulation.t_end=20", "simulation.seed=null"])
+    pd = sc.controllers["pd"]
+    run = run_scenario(sc.model_copy(update={"controllers": {"a": pd, "b": pd}}))
+    assert run.metrics["a"]["J"] == run.metrics["b"]["J"]
+    assert isinstance(run.result.attrs["seed"], (int, np.integer))
+
+
+def test_no_rudder_rate_limit_and_a_single_controller(tmp_path):
+    result = CliRunner().invoke(app, ["run", "cybership-calm", "--out", str(tmp_path), "--json",
+                                      "--set", "simulation.t_end=30",
+                                      "--set", "vessel.rudder_rate_deg_s=null",
+                                      "--set", "controllers=null",
+                                      "--set", "controller={type: course, variant: pd}"])
+    assert result.exit_code == 0, result.stderr
+    assert "J" in json.loads(result.stdout)
+    assert (tmp_path / "comparison.png").stat().st_size > 10_000

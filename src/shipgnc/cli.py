@@ -129,6 +129,9 @@ def run_command(
 
             figure_process = stack.enter_context(FigureProcess())  # imports matplotlib meanwhile
         sc = load_scenario(scenario, set_ or [])
+        if live and (sc.vessel.model != "vectored-thrust-boat" or sc.controllers is not None):
+            raise ConfigError(f"--live: the live dashboard shows the vectored-thrust boat; scenario "
+                              f"{sc.name!r} ({sc.vessel.model}) writes comparison.png instead")
         out_dir = out if out is not None else Path("runs") / sc.name
         observer = _live_observer(sc, realtime) if live else None
         with _progress(enabled=not live) as progress:
@@ -146,7 +149,8 @@ def run_command(
             stderr.print("close the live window to exit")
             observer.finish(block=True)
         if run.result.attrs.get("diverged"):
-            stderr.print(f"[bold red]error:[/] {run.result.attrs['message']}", soft_wrap=True)
+            message = run.result.attrs.get("message") or "the simulation diverged"
+            stderr.print(f"[bold red]error:[/] {message}", soft_wrap=True)
             raise typer.Exit(3)
 
 

@@ -42,17 +42,26 @@ def turn_window(times: np.ndarray, alpha_cmd: np.ndarray) -> tuple[float, float]
     return float(times[start]), float(times[end])
 
 
+STERN_KICK_KEYS = ("initial_sway_sign", "initial_yaw_rate_sign", "steady_yaw_rate_sign",
+                   "max_speed_mps", "final_speed_mps", "heading_change_deg",
+                   "stern_kick_min_lateral_m", "steady_yaw_rate_rad_s", "final_heading_deg")
+
+
 def stern_kick_metrics(ds) -> dict:
     """Metrics of the open-loop turn (spec 001 §1.9).
 
     With the turn commanded over [t_on, t_off]: ``initial_sway_sign`` and
     ``initial_yaw_rate_sign`` are the signs of v and r at t_on + dt; ``steady_yaw_rate_sign`` and
-    ``steady_yaw_rate_rad_s`` use the mean r over the last 40 % of the turn ([8, 10] s in the
+    ``steady_yaw_rate_rad_s`` use the mean r over the last 40 % of the turn (every figure is
+    ``None`` when the run holds no turn command); ([8, 10] s in the
     document's sequence); ``heading_change_deg`` = ψ(t_off) − ψ(t_on); ``max_speed_mps`` and
     ``final_speed_mps`` use U = √(u² + v²); ``stern_kick_min_lateral_m`` is the least lateral
     offset of the CG during the turn, in the frame of the heading at t_on (positive to starboard).
     """
     t = ds.time.values
+    if t.size < 2 or not np.any(ds.alpha_cmd.values != 0):
+        # no turn inside the run (too short, or diverged first): the figures do not exist
+        return dict.fromkeys(STERN_KICK_KEYS)
     dt = float(t[1] - t[0])
     t_on, t_off = turn_window(t, ds.alpha_cmd.values)
     speed = np.hypot(ds.u.values, ds.v.values)
@@ -122,7 +131,8 @@ def waypoint_metrics(ds, leg_lengths, capture_distance: float = 20.0) -> dict:
     ``completion_time_s``: first sample at which the along-track distance reaches the end of the
     last leg (``None`` if never). ``crosstrack_max_m`` / ``crosstrack_rms_m``: max |e| and RMS of
     e over the samples with along-track distance ≥ ``capture_distance`` on their own leg.
-    ``waypoints_reached``: waypoints after the start whose leg was completed.
+    ``waypoints_reached``: waypoints after the start whose leg was completed. Samples after the
+    completion are left out (a ship of a batch keeps sailing until every ship is done).
     """
     t = ds.time.values
     leg = ds.leg.values.astype(int)
@@ -130,6 +140,9 @@ def waypoint_metrics(ds, leg_lengths, capture_distance: float = 20.0) -> dict:
     e = ds.cross_track_error.values
     last = len(leg_lengths) - 1
     done = (leg == last) & (s >= leg_lengths[last])
+    if done.any():
+        end = int(np.argmax(done)) + 1
+        t, leg, s, e, done = t[:end], leg[:end], s[:end], e[:end], done[:end]
     captured = s >= capture_distance
     e_c = e[captured]
     return {
@@ -137,7 +150,7 @@ def waypoint_metrics(ds, leg_lengths, capture_distance: float = 20.0) -> dict:
         "crosstrack_rms_m": _number(np.sqrt(np.mean(e_c**2))) if e_c.size else None,
         "crosstrack_max_m": _number(np.abs(e_c).max()) if e_c.size else None,
         "waypoints_reached": int(leg.max() + (1 if done.any() else 0)),
-        "max_thruster_angle_deg": float(to_deg(np.abs(ds.alpha.values).max())),
+        "max_thruster_angle_deg": float(to_deg(np.abs(ds.alpha.values[:t.size]).max())),
         "final_crosstrack_m": float(e[-1]),
     }
 

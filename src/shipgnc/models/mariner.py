@@ -240,12 +240,7 @@ def linear_tracking_model(params: MarinerParams, *,
     ``paper_units=True`` in the document's nm, rad, rad/min, nm·min (min), the units the printed
     LQR gain refers to (spec 000 §0.4). B has shape (4, 1).
     """
+    from shipgnc.control.lqr import tracking_model
+
     values = params.to_paper_units() if paper_units else params.as_dict()
-    a, c = values["a"], values["c"]
-    U = values["S"] / values["f"]
-    A = np.array([[0.0, U, 0.0, 0.0],
-                  [0.0, 0.0, 1.0, 0.0],
-                  [0.0, 0.0, -a, 0.0],
-                  [1.0, 0.0, 0.0, 0.0]])
-    B = np.array([[0.0], [0.0], [c], [0.0]])
-    return A, B
+    return tracking_model(values["a"], values["c"], values["S"] / values["f"])

@@ -71,11 +71,11 @@ def _cybership(scenario: Scenario):
     from shipgnc.models.cybership2 import CyberShip2, CyberShip2Params, steering_machine
 
     v = scenario.vessel
-    rate = deg(v.rudder_rate_deg_s) if v.rudder_rate_deg_s else math.inf
     params = CyberShip2Params(rudder_model=v.rudder_model, delta_max=deg(v.rudder_max_deg),
-                              delta_rate=rate)
+                              **({"delta_rate": deg(v.rudder_rate_deg_s)} if v.rudder_rate_deg_s else {}))
     model = CyberShip2(params)
-    return (model, steering_machine(params, rate_mode=v.rudder_rate_mode),
+    return (model, steering_machine(params, rate_limit=v.rudder_rate_deg_s is not None,
+                                    rate_mode=v.rudder_rate_mode),
             np.array([v.propeller_rps, 0.0]))
 
 
@@ -192,6 +192,8 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         raise ConfigError("overrides apply to a scenario name or file, not to a Scenario object")
     sim = scenario.simulation
     compare = scenario.controllers is not None
+    # one sea for every controller of a comparison, also when no seed is given (recorded)
+    seed = sim.seed if sim.seed is not None else int(np.random.SeedSequence().generate_state(1)[0])
     results, all_metrics, setups = {}, {}, {}
     for name in scenario.variants:
         setup = build(scenario, name)
@@ -199,10 +201,10 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                           controller=setup.controller, actuator=setup.actuator,
                           guidance=setup.guidance, disturbance=setup.disturbance, u0=setup.u0,
                           integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
-                          atol=sim.atol, seed=sim.seed, observer=observer, progress=progress,
+                          atol=sim.atol, seed=seed, observer=observer, progress=progress,
                           backend="numpy" if observer is not None else sim.backend,
                           on_divergence="stop" if compare else on_divergence,
-                          attrs={"scenario": scenario.name, "controller": name,
+                          attrs={"scenario": scenario.name, "controller": name, "seed": seed,
                                  **_vessel_attrs(setup.model, scenario)})
         results[name], setups[name] = result, setup
         all_metrics[name] = compute_metrics(scenario, result, setup)
@@ -214,7 +216,10 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     combined = xr.concat(list(results.values()), dim="controller", data_vars="all", join="outer",
                          combine_attrs="drop_conflicts")
     combined = combined.assign_coords(controller=list(results))
-    combined.attrs["diverged"] = int(any(r.attrs.get("diverged", 0) for r in results.values()))
+    diverged = [n for n, r in results.items() if r.attrs.get("diverged", 0)]
+    combined.attrs["diverged"] = int(bool(diverged))
+    combined.attrs["message"] = "; ".join(f"{n}: {results[n].attrs['message']}" for n in diverged)
+    combined.attrs.pop("controller", None)
     return ScenarioRun(scenario, setups[first], combined, all_metrics, setups)
 
 
@@ -273,24 +278,29 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
 
 
 def figure_job(run: ScenarioRun, out: Path):
-    """The :class:`~shipgnc.viz.figures.FigureJob` of a run's figures."""
+    """The :class:`~shipgnc.viz.figures.FigureJob` of a run's figures (by vessel: the boat's
+    telemetry dashboard, or document 003's course figure with one column per controller)."""
     from shipgnc.viz.figures import FigureJob
 
     model, g = run.setup.model, run.scenario.guidance
     lower, upper = model.input_limits()
     limits = {s.name: (float(lower[i]), float(upper[i])) for i, s in enumerate(model.inputs)}
-    if run.setups is not None:
+    if not isinstance(model, VectoredThrustBoat):
         from shipgnc.viz.comparison import course_series
 
-        return FigureJob(result={name: course_series(run.result, name) for name in run.setups},
+        names = list(run.setups) if run.setups is not None else list(run.scenario.variants)
+        return FigureJob(result={name: course_series(run.result, name) for name in names},
                          out=out, title=run.scenario.name, kind="course-comparison",
                          limits=limits)
     from shipgnc.viz.series import result_series
 
-    return FigureJob(result=result_series(run.result), out=out, title=figure_title(run),
+    series = result_series(run.result)
+    closeup = (run.scenario.metrics == "stern-kick" and series["time"].size > 1
+               and bool(np.any(series.get("alpha_cmd", np.zeros(1)) != 0)))
+    return FigureJob(result=series, out=out, title=figure_title(run),
                      waypoints=list(g.waypoints) if g is not None and g.type == "los" else None,
                      limits=limits, outline=(model.length, model.beam), lever_arm=model.params.L_m,
-                     closeup=run.scenario.metrics == "stern-kick")
+                     closeup=closeup)
 
 
 def comparison_table(run: ScenarioRun) -> list[dict]:

@@ -118,7 +118,10 @@ class SimulationConfig(Strict):
 
     @model_validator(mode="after")
     def _whole_steps(self) -> SimulationConfig:
-        n = round(self.t_end / self.dt)
+        steps = self.t_end / self.dt
+        if not steps <= 1e8:
+            raise ValueError(f"t_end / dt = {steps:.3g}: at most 1e+08 steps per run")
+        n = round(steps)
         if n < 1 or abs(n * self.dt - self.t_end) > 1e-9 * max(1.0, self.t_end):
             raise ValueError(f"t_end = {self.t_end!r} must be a whole multiple of dt = {self.dt!r}")
         return self
@@ -346,6 +349,12 @@ class Scenario(Strict):
         if self.controllers is not None and not self.controllers:
             raise ValueError("'controllers' is empty")
         boat = self.vessel.model == "vectored-thrust-boat"
+        if boat and self.controllers is not None:
+            raise ValueError("controllers: comparisons run on vessel model 'cybership2' in this "
+                             "release; for the boat give one 'controller'")
+        if not boat and self.actuator != ActuatorConfig():
+            raise ValueError("actuator: applies to the vectored-thrust boat; CyberShip II's steering "
+                             "machine is set in vessel (rudder_max_deg, rudder_rate_deg_s)")
         for name, ctrl in self.variants.items():
             where = "controller" if self.controller is not None else f"controllers.{name}"
             if (ctrl.type == "course") == boat:

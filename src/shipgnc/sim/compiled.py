@@ -375,6 +375,8 @@ def unsupported_reason(setup) -> str | None:
         return "the reference schedule does not hold 2 channels (psi_d, u_d)"
     if type(ctrl) is HeadingSpeedAutopilot and gd is None:
         return "HeadingSpeedAutopilot without guidance has no reference"
+    if type(ctrl) is HeadingSpeedAutopilot and ctrl.reference_model.zeta != 1.0:
+        return "a reference model with zeta != 1 is not compiled"
     if act.has_lag:
         return "actuator lag (tau > 0) is not compiled"
     if act.has_rate_limit:

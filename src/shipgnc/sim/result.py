@@ -29,7 +29,9 @@ def build_dataset(log, batch_shape: tuple[int, ...], batch_dims: tuple[str, ...]
     dims = ("time", *batch_dims)
     variables = {name: (dims, values, log.signals[name].attrs())
                  for name, values in log.data.items()}
-    coords = {"time": ("time", log.time, {"units": "s", "long_name": "time"})}
+    # k·dt carries float noise (121.05000000000001): round to 1e-9 s so times read and select cleanly
+    time = np.round(log.time, 9)
+    coords = {"time": ("time", time, {"units": "s", "long_name": "time"})}
     for dim, size in zip(batch_dims, batch_shape, strict=True):
         coords[dim] = (dim, np.arange(size))
     status = {k: (int(v) if isinstance(v, (bool, np.bool_)) else v)

@@ -31,6 +31,9 @@ INTEGRATORS = ("rk4", "solve_ivp")
 BACKENDS = ("auto", "numpy", "compiled")
 #: batch size from which ``backend="auto"`` uses the compiled loop (compilation then pays off)
 COMPILED_MIN_BATCH = 64
+#: most steps of one run, and most logged numbers (8 bytes each, 4 GB) of one result
+MAX_STEPS = 1e8
+MAX_LOGGED = 5e8
 
 
 class StopSimulation(Exception):
@@ -135,7 +138,10 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
     for name, value in (("dt", dt), ("t_end", t_end)):
         require(isinstance(value, (int, float)) and math.isfinite(value) and value > 0,
                 name, value, "must be a finite number > 0 s")
-    n_steps = round(t_end / dt)
+    steps = t_end / dt
+    require(math.isfinite(steps) and steps <= MAX_STEPS, "t_end / dt", steps,
+            f"at most {MAX_STEPS:.0e} steps per run")
+    n_steps = round(steps)
     require(n_steps >= 1 and abs(n_steps * dt - t_end) <= 1e-9 * max(1.0, t_end), "t_end",
             t_end, f"must be a whole multiple of dt = {dt:g} s")
     Ts = getattr(controller, "Ts", None) or dt
@@ -158,6 +164,17 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
             f"last axis must hold the {n_states} states {', '.join(names(model.states))}")
     require(bool(np.all(np.isfinite(x0))), "x0", x0.tolist() if x0.size < 20 else "...",
             "initial state must be finite")
+    limits = np.asarray(model.state_limits, dtype=float)
+    outside = np.argwhere(np.abs(x0) > limits)
+    if outside.size:
+        i = int(outside[0][-1])
+        s = model.states[i]
+        raise ConfigError(f"initial_state.{s.name} = {float(x0[tuple(outside[0])]):g}: beyond the "
+                          f"model's range |{s.name}| <= {limits[i]:g} {s.unit}")
+    logged = (n_steps // log_every + 2) * max(1, math.prod(x0.shape[:-1])) * (
+        2 * len(model.states) + 3 * len(model.inputs))
+    require(logged <= MAX_LOGGED, "log size", f"{logged * 8 / 2**30:.1f} GiB",
+            "too large: log fewer samples (log_every), shorten t_end or use fewer ships")
     if actuator is None:
         actuator = Actuator.for_model(model)
     require(actuator.n == len(model.inputs), "actuator channels", actuator.n,
@@ -173,7 +190,8 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
                 f"{type(controller).__name__} needs references {', '.join(needed)} "
                 f"(e.g. ReferenceSchedule or LOSGuidance)")
     if getattr(controller, "continuous", False):
-        require(not (actuator.has_rate_limit and not np.all(actuator.tau > 0)), "actuator.rate",
+        limited = np.isfinite(actuator.rate)
+        require(bool(np.all(actuator.tau[limited] > 0)), "actuator.rate",
                 actuator.rate.tolist(), "a continuous controller needs a lag (tau > 0) on "
                 "every rate-limited channel")
     if seed is not None and not isinstance(seed, np.random.Generator):
@@ -354,7 +372,10 @@ def run_numpy(setup: SimSetup) -> Log:
             if setup.integrator == "rk4":
                 z = rk4_step(rhs, t, z, dt)
             else:
-                z = solve_ivp_step(rhs, t, z, dt, **setup.solver_options)
+                try:
+                    z = solve_ivp_step(rhs, t, z, dt, **setup.solver_options)
+                except (FloatingPointError, ValueError, OverflowError):
+                    z = np.full_like(z, np.nan)  # the solver gave up: report it as a divergence
         x = z[..., :n]
         if lag is not None:
             lag = z[..., n:]

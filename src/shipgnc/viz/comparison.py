@@ -21,6 +21,8 @@ COURSE_KEYS = ("time", "u", "psi", "psi_d", "psi_z", "delta")
 def course_series(result, controller: str) -> dict[str, np.ndarray]:
     """One controller's plotted variables from a comparison result (NaN padding removed)."""
     ds = result.sel(controller=controller) if "controller" in result.dims else result
+    if "ship" in ds.dims:
+        ds = ds.isel(ship=0)
     keep = np.isfinite(ds["psi"].values)
     return {k: np.asarray(ds[k].values, dtype=float)[keep] for k in COURSE_KEYS if k in ds}
 

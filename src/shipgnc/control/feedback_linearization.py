@@ -1,0 +1,266 @@
+"""Feedback-linearising path tracking of document 000 (Mariner), spec 000 §0.5, A13, A14.
+
+Design model (14): a Norrbin yaw equation with the path-frame kinematics, x = [y_r, ψ_r, r]::
+
+    ẏ_r = u sin ψ_r + v cos ψ_r + d_y,   ψ̇_r = r,   ṙ = −H_N(r) + b_r + c δ,
+    v = r₁ r + r₂ r³,   H_N(r) = a r + b r³   (eq. (16); T = 1, K = c of the W–O plant (25)).
+
+Three controllers, each with the conventions of :mod:`shipgnc.control` (``Ts``, ``signals``,
+``reset(batch_shape)``, ``step`` → ``(..., 1)``, batched) and the path geometry of
+:class:`~shipgnc.control.lqr.PathLQR` (their own :class:`~shipgnc.control.lqr.LegTracker`, leg
+switching A6, ``reference_names = ()``):
+
+* :class:`OutputFL` with ``lookahead = 0`` — ``fl_paper``, the literal design (19)–(23) on
+  y = y_r. Differentiating twice (u̇ neglected, A13)::
+
+      ÿ = f(x) + g(x) δ,  f = u r cos ψ_r − r₁ r² sin ψ_r + r₁ cos ψ_r (b_r − H_N(r)),
+                          g = r₁ c cos ψ_r                                   (19)–(20)
+      δ = (ν − f)/g,  ν = −k₁ y_r − k₂ ẏ_r   ⇒   ÿ + k₂ ẏ + k₁ y = 0           (21)–(24)
+
+  with k₁ = 0.18 /min², k₂ = 0.7 /min (:data:`K1_PAPER`, :data:`K2_PAPER`; converted to SI).
+  **It is internally unstable** (see :func:`zero_dynamics_pole`).
+* :class:`OutputFL` with ``lookahead = l`` — ``fl_lookahead`` (default l = 0.1 nm): the same law
+  on z = y_r + l sin ψ_r, a point l ahead of the CG; f and g follow with r₁ → r₁ + l.
+* :class:`LOSFL` — ``los_fl``: LOS guidance with crab compensation
+  ψ_d,r = −atan(y_r/Δ) − asin(d_y/u) (Δ = 0.5 nm) feeding an exact FL of the yaw loop,
+  δ = (ν + H_N(r) − b_r)/c, ν = −k_p e − k_d (r − ψ̇_d,r), e = wrap(ψ_r − ψ_d,r),
+  k_p = 1 /min², k_d = 2 /min.
+
+With r₂ ≠ 0 the laws use ∂v/∂r = r₁ + 3r₂r² where the spec (r₂ = 0) has r₁; for the Mariner
+(r₂ = 0) they are the spec's formulas term by term.
+
+**Known disturbances.** b_r (added to ṙ) and the cross current d_y are known to the controller
+(A13; ``b_r`` [rad/s²], ``d_y`` [m/s] constructor arguments, default 0). The "measured" ẏ_r is the
+cross-track component of the ground velocity, u sin ψ_r + v cos ψ_r + d_y, formed from the state
+and the known current — what a GPS course-over-ground measurement gives. ``current_frame``:
+``"path"`` (default, A10) takes d_y along Y_r of the active leg; ``"global"`` along global y
+(east), whose cross-track component on a leg of angle ψ_r0 is d_y cos ψ_r0.
+
+**Parameters.** ``params`` is any object with the plant's SI coefficients ``a`` [1/s], ``b`` [s],
+``c`` [1/s²], ``r1`` [m/rad] and optionally ``r2`` [m·s²/rad³] (default 0) — e.g. the Mariner
+model's parameters. Every command is clipped to ±``delta_max`` (35°); near the singularity
+g = 0 (cos ψ_r = 0) the literal law saturates instead of dividing by zero.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from shipgnc.control.lqr import (
+    DELTA_MAX,
+    I_EAST,
+    I_NORTH,
+    I_PSI,
+    I_R,
+    I_U,
+    PATH_SIGNALS,
+    LegTracker,
+    check_controller_args,
+    nominal_speed,
+    plant_coefficient,
+)
+from shipgnc.errors import require
+from shipgnc.frames import wrap_angle
+from shipgnc.guidance.path import WaypointPath
+from shipgnc.models.base import Signal
+from shipgnc.units import MINUTE, NAUTICAL_MILE
+
+#: gains of (23) printed in the document [1/min², 1/min]
+K1_PAPER, K2_PAPER = 0.18, 0.7
+#: look-ahead distance of ``fl_lookahead`` [m] (0.1 nm)
+LOOKAHEAD = 0.1 * NAUTICAL_MILE
+#: LOS look-ahead Δ of ``los_fl`` [m] (0.5 nm) and its yaw-loop gains [1/min², 1/min]
+LOS_DELTA = 0.5 * NAUTICAL_MILE
+KP_PAPER, KD_PAPER = 1.0, 2.0
+CURRENT_FRAMES = ("path", "global")
+
+
+def zero_dynamics_pole(params, *, lookahead: float = 0.0, U: float | None = None) -> tuple[float, float]:
+    """Pole of the zero dynamics of the FL output, −U/(r₁ + l): ``(per_minute, per_second)``.
+
+    For the literal design (l = 0) and the Mariner (r₁ = −69.45 m/rad, U = 7.7167 m/s) this is
+    **+U/|r₁| = +6.667 /min = +0.1111 /s**: the design is internally unstable.
+
+    Why. The output y = y_r has relative degree 2 and the state [y_r, ψ_r, r] has dimension 3,
+    so one state is left unobserved by the linearised output loop (22)–(24): the zero dynamics.
+    Holding y ≡ 0 (hence ẏ ≡ 0) requires, with v = r₁r and no current,
+
+        ẏ_r = u sin ψ_r + r₁ r cos ψ_r = 0   ⇒   r = ψ̇_r = −(u/r₁) tan ψ_r,
+
+    whose linearisation at ψ_r = 0 is ψ̇_r = −(U/r₁) ψ_r. With r₁ < 0 (the pivot point lies
+    ahead of the CG, physically right) the pole −U/r₁ is **positive**: while the law drives
+    y_r → 0 the heading error grows like e^{+6.67 t/min}. Equivalently, the linearised transfer
+    function y_r/δ = c(U + r₁s)/(s²(s + a)) has the right-half-plane zero s = U/|r₁| (the CG
+    response is non-minimum-phase because v = r₁r first pushes it the wrong way), and the
+    inversion (21) cancels it with an unstable pole. In simulation the heading error runs past
+    90° (where g = r₁c cos ψ_r vanishes) and the ship ends in a rudder-saturated limit cycle
+    roughly perpendicular to the leg, its cross-track error growing without bound.
+
+    With the output z = y_r + l sin ψ_r (``lookahead`` l [m]) r₁ becomes r₁ + l: the pole
+    −U/(r₁ + l) is negative for l > −r₁ (−4 /min for l = 0.1 nm). ``U`` [m/s] defaults to
+    ``params.U`` or S/f. Raises :class:`~shipgnc.errors.ConfigError` at l = −r₁ (relative degree 3,
+    no zero dynamics).
+    """
+    r1 = plant_coefficient(params, "r1")
+    speed = nominal_speed(params) if U is None else float(U)
+    arm = r1 + float(lookahead)
+    require(arm != 0, "controller.lookahead", lookahead,
+            "l = -r1 (the pivot point) leaves no zero dynamics (relative degree 3)")
+    per_s = -speed / arm
+    return per_s * MINUTE, per_s
+
+
+class _PathFL:
+    """Shared plumbing: plant coefficients, known disturbances, path geometry, clipping, logging."""
+
+    continuous = False
+    reference_names = ()
+
+    def __init__(self, params, path: WaypointPath, *, Ts: float, delta_max: float, b_r: float,
+                 d_y: float, current_frame: str):
+        check_controller_args(Ts, delta_max)
+        for name, value in (("b_r", b_r), ("d_y", d_y)):
+            require(isinstance(value, (int, float, np.floating)) and np.isfinite(value),
+                    f"controller.{name}", value, "must be a finite number")
+        require(current_frame in CURRENT_FRAMES, "controller.current_frame", current_frame,
+                f"allowed: {', '.join(CURRENT_FRAMES)}")
+        self.a, self.b, self.c = (plant_coefficient(params, k) for k in ("a", "b", "c"))
+        self.r1 = plant_coefficient(params, "r1")
+        self.r2 = float(getattr(params, "r2", 0.0) or 0.0)
+        require(self.c != 0, "controller.params.c", self.c, "the rudder must act on the yaw rate")
+        self.params = params
+        self.tracker = LegTracker(path)
+        self.path = path
+        self.Ts = float(Ts)
+        self.delta_max = float(delta_max)
+        self.b_r, self.d_y = float(b_r), float(d_y)
+        self.current_frame = current_frame
+        self._logged: dict[str, np.ndarray] = {}
+
+    def reset(self, batch_shape) -> None:
+        self.tracker.reset(batch_shape)
+        self._logged = {}
+
+    def signal_values(self) -> dict[str, np.ndarray]:
+        return self._logged
+
+    def H_N(self, r):
+        """Norrbin manoeuvring characteristic H_N(r) = a r + b r³ [rad/s²] (eq. (16))."""
+        return self.a * r + self.b * r**3
+
+    def kinematics(self, measurement: np.ndarray) -> dict[str, np.ndarray]:
+        """Path-frame quantities of the active leg: y_r, ψ_r, u, r, v, ẏ_r ("measured"), leg angle."""
+        x = np.asarray(measurement, dtype=float)
+        _, y_r, angle = self.tracker.update(x[..., I_NORTH], x[..., I_EAST])
+        psi_r = wrap_angle(x[..., I_PSI] - angle)
+        u, r = x[..., I_U], x[..., I_R]
+        v = self.r1 * r + self.r2 * r**3
+        d_cross = self.d_y if self.current_frame == "path" else self.d_y * np.cos(angle)
+        y_dot = u * np.sin(psi_r) + v * np.cos(psi_r) + d_cross
+        return {"y_r": y_r, "psi_r": psi_r, "u": u, "r": r, "v": v, "y_dot": y_dot,
+                "d_cross": d_cross + np.zeros_like(y_r)}
+
+    def _finish(self, raw: np.ndarray, k: dict[str, np.ndarray], **extra) -> np.ndarray:
+        delta = np.clip(raw, -self.delta_max, self.delta_max)
+        self._logged = {"cross_track_error": k["y_r"], "heading_error": k["psi_r"],
+                        "leg": self.tracker.leg.astype(float), **extra}
+        return delta[..., None]
+
+
+class OutputFL(_PathFL):
+    """FL of the output z = y_r + l sin ψ_r (``fl_paper``: l = 0; ``fl_lookahead``: l = 0.1 nm).
+
+    ż = u sin ψ_r + (v + l r) cos ψ_r + d_y and, u̇ neglected, z̈ = f + g δ with m = r₁ + l + 3r₂r²::
+
+        f = (u cos ψ_r − (v + l r) sin ψ_r) r + m cos ψ_r (b_r − H_N(r)),   g = m c cos ψ_r
+        δ = (ν − f)/g,   ν = −k₁ z − k₂ ż
+
+    (l = 0, r₂ = 0: exactly (20)–(23)). Gains in SI: ``k1`` [1/s²] = 0.18/60², ``k2`` [1/s] = 0.7/60
+    by default; ``lookahead`` l [m]. Logged besides the path errors: ``fl_output`` z [m].
+    """
+
+    signals = (*PATH_SIGNALS, Signal("fl_output", "m", "linearised output z = y_r + l sin(psi_r)"))
+
+    def __init__(self, params, path: WaypointPath, *, Ts: float, lookahead: float = 0.0,
+                 k1: float = K1_PAPER / MINUTE**2, k2: float = K2_PAPER / MINUTE,
+                 delta_max: float = DELTA_MAX, b_r: float = 0.0, d_y: float = 0.0,
+                 current_frame: str = "path"):
+        super().__init__(params, path, Ts=Ts, delta_max=delta_max, b_r=b_r, d_y=d_y,
+                         current_frame=current_frame)
+        require(isinstance(lookahead, (int, float, np.floating)) and np.isfinite(lookahead)
+                and lookahead >= 0, "controller.lookahead", lookahead, "must be a finite length >= 0 m")
+        require(lookahead + self.r1 != 0 or self.r2 != 0, "controller.lookahead", lookahead,
+                "l = -r1 (the pivot point) makes g = 0: the output has relative degree 3")
+        for name, value in (("k1", k1), ("k2", k2)):
+            require(isinstance(value, (int, float, np.floating)) and np.isfinite(value) and value > 0,
+                    f"controller.{name}", value, "must be a finite number > 0")
+        self.lookahead = float(lookahead)
+        self.k1, self.k2 = float(k1), float(k2)
+
+    def linearization(self, k: dict[str, np.ndarray]) -> tuple[np.ndarray, ...]:
+        """(z, ż, f, g) of the output at the path-frame quantities ``k`` (see :meth:`kinematics`)."""
+        l, psi_r, u, r = self.lookahead, k["psi_r"], k["u"], k["r"]
+        s, c = np.sin(psi_r), np.cos(psi_r)
+        lateral = k["v"] + l * r
+        z = k["y_r"] + l * s
+        z_dot = k["y_dot"] + l * r * c
+        m = self.r1 + l + 3.0 * self.r2 * r**2
+        f = (u * c - lateral * s) * r + m * c * (self.b_r - self.H_N(r))
+        g = m * self.c * c
+        return z, z_dot, f, g
+
+    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        k = self.kinematics(measurement)
+        z, z_dot, f, g = self.linearization(k)
+        nu = -self.k1 * z - self.k2 * z_dot
+        # g = 0 only at ψ_r = ±90° (or r on the pivot point): saturate there instead of dividing
+        tiny = 1e-12 * abs(self.c) * (abs(self.r1) + self.lookahead + NAUTICAL_MILE)
+        g_safe = np.where(np.abs(g) < tiny, np.where(g < 0, -tiny, tiny), g)
+        return self._finish((nu - f) / g_safe, k, fl_output=z)
+
+
+def fl_paper(params, path: WaypointPath, *, Ts: float, **options) -> OutputFL:
+    """``fl_paper``: the literal FL (19)–(23) on y_r, k₁ = 0.18 /min², k₂ = 0.7 /min (unstable)."""
+    return OutputFL(params, path, Ts=Ts, lookahead=0.0, **options)
+
+
+def fl_lookahead(params, path: WaypointPath, *, Ts: float, lookahead: float = LOOKAHEAD,
+                 **options) -> OutputFL:
+    """``fl_lookahead``: the same law on y_r + l sin ψ_r, l = 0.1 nm by default (stable for l > −r₁)."""
+    return OutputFL(params, path, Ts=Ts, lookahead=lookahead, **options)
+
+
+class LOSFL(_PathFL):
+    """``los_fl``: LOS guidance with crab compensation feeding an exact FL of the yaw loop.
+
+    ψ_d,r = −atan(y_r/Δ) − asin(d_y/u);  ψ̇_d,r = −Δ ẏ_r/(Δ² + y_r²)  (u̇ neglected);
+    e = wrap(ψ_r − ψ_d,r);  ν = −k_p e − k_d (r − ψ̇_d,r);  δ = (ν + H_N(r) − b_r)/c.
+
+    SI arguments: ``delta_los`` Δ [m] (0.5 nm), ``kp`` [1/s²] = 1/60², ``kd`` [1/s] = 2/60.
+    Logged besides the path errors: ``los_heading`` ψ_d,r [rad] (relative to the leg).
+    """
+
+    signals = (*PATH_SIGNALS,
+               Signal("los_heading", "rad", "LOS desired heading relative to the leg psi_d,r", angle=True))
+
+    def __init__(self, params, path: WaypointPath, *, Ts: float, delta_los: float = LOS_DELTA,
+                 kp: float = KP_PAPER / MINUTE**2, kd: float = KD_PAPER / MINUTE,
+                 delta_max: float = DELTA_MAX, b_r: float = 0.0, d_y: float = 0.0,
+                 current_frame: str = "path"):
+        super().__init__(params, path, Ts=Ts, delta_max=delta_max, b_r=b_r, d_y=d_y,
+                         current_frame=current_frame)
+        for name, value in (("delta_los", delta_los), ("kp", kp), ("kd", kd)):
+            require(isinstance(value, (int, float, np.floating)) and np.isfinite(value) and value > 0,
+                    f"controller.{name}", value, "must be a finite number > 0")
+        self.delta_los, self.kp, self.kd = float(delta_los), float(kp), float(kd)
+
+    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        k = self.kinematics(measurement)
+        D, y_r = self.delta_los, k["y_r"]
+        crab = np.arcsin(np.clip(k["d_cross"] / np.maximum(k["u"], 1e-6), -1.0, 1.0))
+        psi_d = -np.arctan(y_r / D) - crab
+        psi_d_dot = -D * k["y_dot"] / (D**2 + y_r**2)
+        e = wrap_angle(k["psi_r"] - psi_d)
+        nu = -self.kp * e - self.kd * (k["r"] - psi_d_dot)
+        raw = (nu + self.H_N(k["r"]) - self.b_r) / self.c
+        return self._finish(raw, k, los_heading=psi_d)
