@@ -29,7 +29,6 @@ from shipgnc.control.lqr import (
     PAPER_LQR_GAIN,
     PAPER_Q,
     REPRODUCING_R,
-    LegTracker,
     PathLQR,
     design_lqr,
     gain_to_paper,
@@ -38,7 +37,7 @@ from shipgnc.control.lqr import (
 )
 from shipgnc.errors import ConfigError
 from shipgnc.frames import wrap_angle
-from shipgnc.guidance.path import WaypointPath
+from shipgnc.guidance.path import LegTracker, WaypointPath
 from shipgnc.sim.integrators import rk4_step
 from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
 

@@ -7,7 +7,7 @@ Design model (14): a Norrbin yaw equation with the path-frame kinematics, x = [y
 
 Three controllers, each with the conventions of :mod:`shipgnc.control` (``Ts``, ``signals``,
 ``reset(batch_shape)``, ``step`` → ``(..., 1)``, batched) and the path geometry of
-:class:`~shipgnc.control.lqr.PathLQR` (their own :class:`~shipgnc.control.lqr.LegTracker`, leg
+:class:`~shipgnc.control.lqr.PathLQR` (their own :class:`~shipgnc.guidance.path.LegTracker`, leg
 switching A6, ``reference_names = ()``):
 
 * :class:`OutputFL` with ``lookahead = 0`` — ``fl_paper``, the literal design (19)–(23) on
@@ -54,14 +54,14 @@ from shipgnc.control.lqr import (
     I_R,
     I_U,
     PATH_SIGNALS,
-    LegTracker,
     check_controller_args,
     nominal_speed,
     plant_coefficient,
 )
+from shipgnc.environment.current import CURRENT_FRAMES
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
-from shipgnc.guidance.path import WaypointPath
+from shipgnc.guidance.path import LegTracker, WaypointPath
 from shipgnc.models.base import Signal
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 
@@ -72,7 +72,6 @@ LOOKAHEAD = 0.1 * NAUTICAL_MILE
 #: LOS look-ahead Δ of ``los_fl`` [m] (0.5 nm) and its yaw-loop gains [1/min², 1/min]
 LOS_DELTA = 0.5 * NAUTICAL_MILE
 KP_PAPER, KD_PAPER = 1.0, 2.0
-CURRENT_FRAMES = ("path", "global")
 
 
 def zero_dynamics_pole(params, *, lookahead: float = 0.0, U: float | None = None) -> tuple[float, float]:

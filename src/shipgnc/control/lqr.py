@@ -36,7 +36,7 @@ import numpy as np
 
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
-from shipgnc.guidance.path import WaypointPath
+from shipgnc.guidance.path import LegTracker, WaypointPath
 from shipgnc.models.base import Signal
 from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
 
@@ -170,41 +170,6 @@ def plant_coefficient(params, name: str) -> float:
     value = float(value)
     require(np.isfinite(value), f"controller.params.{name}", value, "must be finite")
     return value
-
-
-class LegTracker:
-    """Active leg of each ship on a :class:`WaypointPath` and its path-frame position.
-
-    Switching rule of spec 000 (A6): leg i + 1 becomes active once x_r ≥ |P_i P_{i+1}| on leg i
-    (the ship crosses the normal through P_{i+1}); several switches in one sample are allowed;
-    the last leg is a half-line. Batched: one leg index per ship.
-    """
-
-    def __init__(self, path: WaypointPath):
-        require(isinstance(path, WaypointPath), "controller.path", type(path).__name__,
-                "must be a WaypointPath")
-        self.path = path
-        self.leg: np.ndarray | None = None
-
-    def reset(self, batch_shape) -> None:
-        self.leg = np.zeros(tuple(batch_shape), dtype=int)
-
-    def update(self, north, east) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Switch legs where due; return along-track x_r, cross-track y_r [m] and the leg angle ψ_r0."""
-        require(self.leg is not None, "controller", "LegTracker", "call reset(batch_shape) first")
-        path = self.path
-        last = path.n_legs - 1
-        leg = np.broadcast_to(self.leg, np.shape(north)).copy()
-        for _ in range(path.n_legs):
-            x_r, y_r = path.project(north, east, leg)
-            switch = (leg < last) & (x_r >= path.leg_lengths[leg])
-            if not np.any(switch):
-                break
-            leg = np.where(switch, leg + 1, leg)
-        else:
-            x_r, y_r = path.project(north, east, leg)
-        self.leg = leg
-        return np.asarray(x_r, dtype=float), np.asarray(y_r, dtype=float), path.leg_angles[leg]
 
 
 def check_controller_args(Ts: float, delta_max: float) -> None:

@@ -44,3 +44,38 @@ class WaypointPath:
         leg = np.asarray(leg)
         start = self.waypoints[leg]
         return path_frame(north, east, start[..., 0], start[..., 1], self.leg_angles[leg])
+
+
+class LegTracker:
+    """Active leg of each ship on a :class:`WaypointPath` and its path-frame position.
+
+    Switching rule of spec 000 (A6): leg i + 1 becomes active once x_r ≥ |P_i P_{i+1}| on leg i
+    (the ship crosses the normal through P_{i+1}); several switches in one sample are allowed;
+    the last leg is a half-line. Batched: one leg index per ship.
+    """
+
+    def __init__(self, path: WaypointPath):
+        require(isinstance(path, WaypointPath), "controller.path", type(path).__name__,
+                "must be a WaypointPath")
+        self.path = path
+        self.leg: np.ndarray | None = None
+
+    def reset(self, batch_shape) -> None:
+        self.leg = np.zeros(tuple(batch_shape), dtype=int)
+
+    def update(self, north, east) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Switch legs where due; return along-track x_r, cross-track y_r [m] and the leg angle ψ_r0."""
+        require(self.leg is not None, "controller", "LegTracker", "call reset(batch_shape) first")
+        path = self.path
+        last = path.n_legs - 1
+        leg = np.broadcast_to(self.leg, np.shape(north)).copy()
+        for _ in range(path.n_legs):
+            x_r, y_r = path.project(north, east, leg)
+            switch = (leg < last) & (x_r >= path.leg_lengths[leg])
+            if not np.any(switch):
+                break
+            leg = np.where(switch, leg + 1, leg)
+        else:
+            x_r, y_r = path.project(north, east, leg)
+        self.leg = leg
+        return np.asarray(x_r, dtype=float), np.asarray(y_r, dtype=float), path.leg_angles[leg]

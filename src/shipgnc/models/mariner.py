@@ -244,3 +244,35 @@ def linear_tracking_model(params: MarinerParams, *,
 
     values = params.to_paper_units() if paper_units else params.as_dict()
     return tracking_model(values["a"], values["c"], values["S"] / values["f"])
+
+
+class MarinerDisturbance:
+    """The disturbance vector ``[b_r, current_north, current_east]`` of spec 000 §0.6 (A9–A11).
+
+    ``b_r`` [rad/s²] constant yaw acceleration; ``current`` a
+    :class:`~shipgnc.environment.current.CrossCurrent` (d_y across the active leg, or along east)
+    or None; ``waves`` a :class:`~shipgnc.environment.filtered_noise.SecondOrderNoise` added to ṙ
+    or None. Sampled at each step's start and held over the step (``per_stage = False``).
+    """
+
+    per_stage = False
+
+    def __init__(self, b_r: float = 0.0, current=None, waves=None):
+        require(isinstance(b_r, (int, float)) and math.isfinite(b_r), "disturbance.b_r", b_r,
+                "must be a finite yaw acceleration in rad/s^2")
+        self.b_r, self.current, self.waves = float(b_r), current, waves
+
+    def reset(self, batch_shape, rng: np.random.Generator) -> None:
+        self._shape = tuple(batch_shape)
+        if self.current is not None:
+            self.current.reset(batch_shape, rng)
+        if self.waves is not None:
+            self.waves.reset(batch_shape, rng)
+
+    def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
+        yaw = np.full(x.shape[:-1], self.b_r)
+        if self.waves is not None:
+            yaw = yaw + self.waves(t, x)
+        if self.current is None:
+            return np.stack([yaw, np.zeros_like(yaw), np.zeros_like(yaw)], axis=-1)
+        return np.concatenate([yaw[..., None], self.current(t, x)], axis=-1)
