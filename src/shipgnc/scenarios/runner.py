@@ -25,7 +25,7 @@ from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.fossen3dof import VectoredThrustBoat
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.schema import Scenario
-from shipgnc.units import deg
+from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
 
 
 @dataclass
@@ -39,6 +39,8 @@ class Setup:
     guidance: object | None
     disturbance: object | None
     u0: np.ndarray | None = None
+    #: the waypoint path of document 000's path-frame controllers (they track it themselves)
+    path: WaypointPath | None = None
 
 
 @dataclass
@@ -77,6 +79,83 @@ def _cybership(scenario: Scenario):
     return (model, steering_machine(params, rate_limit=v.rudder_rate_deg_s is not None,
                                     rate_mode=v.rudder_rate_mode),
             np.array([v.propeller_rps, 0.0]))
+
+
+def _mariner(scenario: Scenario):
+    from shipgnc.models.mariner import MarinerWitOppe, rudder
+
+    v = scenario.vessel
+    model = MarinerWitOppe.from_paper_units(**v.params_paper)
+    changes = {"delta_max": deg(v.rudder_max_deg)}
+    if v.rudder_rate_deg_s is not None:
+        changes["delta_rate"] = deg(v.rudder_rate_deg_s)
+    model = MarinerWitOppe(params=model.params.with_(**changes))
+    return (model, rudder(model.params, rate_limit=v.rudder_rate_deg_s is not None,
+                          rate_mode=v.rudder_rate_mode), None)
+
+
+def mariner_path(g) -> WaypointPath:
+    """The path of spec 000 A4 from the printed points [nm] and their ``reading``, in NED [m]."""
+    points = np.asarray(g.points_nm, dtype=float)
+    if g.reading == "literal":
+        north_east = points
+    else:  # the printed pairs are (y, x): plot-horizontal (east), then plot-vertical (north)
+        north_east = points[:, ::-1]
+        if g.reading == "text":  # the third leg is a half-line parallel to OX from the third point
+            north_east = np.vstack([north_east[:3], north_east[2] + np.array([1.0, 0.0])])
+    return WaypointPath(north_east * NAUTICAL_MILE)
+
+
+def _mariner_controller(cfg, model, path: WaypointPath, scenario: Scenario):
+    """Document 000's path controllers (spec 000 §0.4–0.5) with the scenario's settings."""
+    from shipgnc.control import feedback_linearization as fl
+    from shipgnc.control.lqr import PathLQR, design_lqr, gain_to_si
+
+    p = model.params
+    if cfg.type == "lqr":
+        K = gain_to_si(cfg.K_paper) if cfg.K_paper is not None else design_lqr(p, Q=cfg.Q, R=cfg.R).K_si
+        return PathLQR(K, path, Ts=cfg.Ts, delta_max=p.delta_max, anti_windup=cfg.anti_windup)
+    d = scenario.disturbance
+    known = {}
+    if cfg.knows_disturbance and d is not None:
+        known = {"b_r": d.b_r_rad_min2 / MINUTE**2, "d_y": d.d_y_nm_min * NAUTICAL_MILE / MINUTE,
+                 "current_frame": d.current_frame}
+    if cfg.type == "fl":
+        return fl.OutputFL(p, path, Ts=cfg.Ts, lookahead=cfg.lookahead_nm * NAUTICAL_MILE,
+                           k1=cfg.k1_per_min2 / MINUTE**2, k2=cfg.k2_per_min / MINUTE,
+                           delta_max=p.delta_max, **known)
+    return fl.LOSFL(p, path, Ts=cfg.Ts, delta_los=cfg.delta_nm * NAUTICAL_MILE,
+                    kp=cfg.kp_per_min2 / MINUTE**2, kd=cfg.kd_per_min / MINUTE,
+                    delta_max=p.delta_max, **known)
+
+
+def _mariner_disturbance(d, path: WaypointPath):
+    from shipgnc.environment.current import CrossCurrent
+    from shipgnc.environment.filtered_noise import SecondOrderNoise
+    from shipgnc.models.mariner import MarinerDisturbance
+
+    current = CrossCurrent(d.d_y_nm_min * NAUTICAL_MILE / MINUTE, path, frame=d.current_frame)
+    waves = None
+    if d.wave_sigma_rad_min2 > 0:
+        waves = SecondOrderNoise(d.wave_sigma_rad_min2 / MINUTE**2, d.wave_period, d.wave_zeta)
+    return MarinerDisturbance(d.b_r_rad_min2 / MINUTE**2, current=current, waves=waves)
+
+
+def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
+    """x0 of the scenario's vessel: one state, or ``montecarlo.runs`` states with random offsets
+    (drawn from a stream of their own, so the waves of the same seed are not shifted)."""
+    init = scenario.simulation.initial_state
+    if scenario.vessel.model != "mariner":
+        return np.array([init.north, init.east, deg(init.psi_deg), init.u, init.v, deg(init.r_deg_s)])
+    x0 = np.array([init.north, init.east, deg(init.psi_deg), init.u, deg(init.r_deg_s)])
+    mc = scenario.montecarlo
+    if mc is None:
+        return x0
+    rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(1)[0])
+    batch = np.tile(x0, (mc.runs, 1))
+    batch[:, 1] += rng.uniform(*mc.east_offset_nm, size=mc.runs) * NAUTICAL_MILE
+    batch[:, 2] += deg(rng.uniform(*mc.heading_offset_deg, size=mc.runs))
+    return batch
 
 
 def _controller(cfg, model, scenario: Scenario):
@@ -140,15 +219,25 @@ def _disturbance(d, scenario: Scenario):
     return FroudeKrylovWaveLoads(spectrum, direction=deg(d.heading_deg), n_components=d.components)
 
 
-def build(scenario: Scenario, variant: str | None = None) -> Setup:
-    """Instantiate the scenario's components for one controller ``variant`` (default: the first)."""
-    model, actuator, u0 = (_cybership if scenario.vessel.model == "cybership2" else _boat)(scenario)
+VESSELS = {"vectored-thrust-boat": _boat, "cybership2": _cybership, "mariner": _mariner}
+
+
+def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = None) -> Setup:
+    """Instantiate the scenario's components for one controller ``variant`` (default: the first).
+
+    ``seed`` draws a Monte Carlo batch's initial offsets (default: ``simulation.seed`` or 0)."""
+    model, actuator, u0 = VESSELS[scenario.vessel.model](scenario)
     variants = scenario.variants
     name = variant if variant is not None else next(iter(variants))
     if name not in variants:
         raise ConfigError(f"controller {name!r}: not in this scenario; have {', '.join(variants)}")
-    init = scenario.simulation.initial_state
-    x0 = np.array([init.north, init.east, deg(init.psi_deg), init.u, init.v, deg(init.r_deg_s)])
+    seed = seed if seed is not None else (scenario.simulation.seed or 0)
+    x0 = initial_states(scenario, seed)
+    if scenario.vessel.model == "mariner":
+        path = mariner_path(scenario.guidance)
+        d = scenario.disturbance
+        return Setup(model, x0, actuator, _mariner_controller(variants[name], model, path, scenario),
+                     None, None if d is None else _mariner_disturbance(d, path), path=path)
     return Setup(model, x0, actuator, _controller(variants[name], model, scenario),
                  _guidance(scenario.guidance), _disturbance(scenario.disturbance, scenario), u0)
 
@@ -168,6 +257,17 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     elif scenario.metrics == "course-quality":
         out = metrics.course_quality_metrics(result, lam=scenario.quality.lam,
                                              t_end=scenario.simulation.t_end, diverged=diverged)
+    elif scenario.metrics == "path-tracking":
+        from shipgnc.analysis import path_tracking
+
+        delta_max = float(setup.model.params.delta_max)
+        if scenario.montecarlo is not None:
+            out = path_tracking.montecarlo_summary(result, delta_max=delta_max, diverged=diverged)
+        else:
+            out = path_tracking.path_tracking_metrics(result, delta_max=delta_max, diverged=diverged)
+        K_paper = getattr(setup.controller, "K_paper", None)
+        if K_paper is not None:
+            out["lqr_gain"] = [float(k) for k in K_paper]
     else:
         out = {}
     out["diverged"] = diverged
@@ -196,12 +296,13 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     seed = sim.seed if sim.seed is not None else int(np.random.SeedSequence().generate_state(1)[0])
     results, all_metrics, setups = {}, {}, {}
     for name in scenario.variants:
-        setup = build(scenario, name)
+        setup = build(scenario, name, seed=seed)
         result = simulate(setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt,
                           controller=setup.controller, actuator=setup.actuator,
                           guidance=setup.guidance, disturbance=setup.disturbance, u0=setup.u0,
                           integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
                           atol=sim.atol, seed=seed, observer=observer, progress=progress,
+                          log_every=sim.log_every,
                           backend="numpy" if observer is not None else sim.backend,
                           on_divergence="stop" if compare else on_divergence,
                           attrs={"scenario": scenario.name, "controller": name, "seed": seed,
@@ -279,16 +380,31 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
 
 def figure_job(run: ScenarioRun, out: Path):
     """The :class:`~shipgnc.viz.figures.FigureJob` of a run's figures (by vessel: the boat's
-    telemetry dashboard, or document 003's course figure with one column per controller)."""
+    telemetry dashboard, document 003's course figure with one column per controller, or
+    document 000's path-tracking figures (Fig. 3–5) or Monte Carlo spread)."""
     from shipgnc.viz.figures import FigureJob
 
     model, g = run.setup.model, run.scenario.guidance
     lower, upper = model.input_limits()
     limits = {s.name: (float(lower[i]), float(upper[i])) for i, s in enumerate(model.inputs)}
+    names = list(run.setups) if run.setups is not None else list(run.scenario.variants)
+    if run.setup.path is not None:
+        from shipgnc.viz import path_tracking as pt
+
+        waypoints = run.setup.path.waypoints.tolist()
+        if run.scenario.montecarlo is not None:
+            return FigureJob(result={n: pt.montecarlo_series(run.result, n) for n in names}, out=out,
+                             title=run.scenario.name, kind="montecarlo", waypoints=waypoints)
+        if run.setups is None:  # one controller: label it with the scenario's name
+            series = {run.scenario.name: pt.path_series(run.result, None)}
+        else:
+            series = {n: pt.path_series(run.result, n) for n in names}
+        return FigureJob(result=series,
+                         out=out, title=run.scenario.name, kind="path-tracking",
+                         waypoints=waypoints, limits=limits)
     if not isinstance(model, VectoredThrustBoat):
         from shipgnc.viz.comparison import course_series
 
-        names = list(run.setups) if run.setups is not None else list(run.scenario.variants)
         return FigureJob(result={name: course_series(run.result, name) for name in names},
                          out=out, title=run.scenario.name, kind="course-comparison",
                          limits=limits)

@@ -71,6 +71,32 @@ class CyberShipVesselConfig(Strict):
     rudder_rate_mode: Literal["ramp", "hold"] = "ramp"
 
 
+MARINER_PARAM_NAMES = ("a", "b", "c", "r1", "r2", "f", "W", "S")
+
+
+class MarinerVesselConfig(Strict):
+    """``vessel`` for document 000's Mariner (de Wit–Oppe model (25)).
+
+    ``params_paper``: coefficients in the **document's units** (min, nm, rad; spec 000 table 0.1),
+    e.g. ``{r1: 0.0375}`` for the sign-flipped sway coupling; converted to SI at the model boundary.
+    The steering machine: ``rudder_max_deg``, ``rudder_rate_deg_s`` (null: no rate limit).
+    """
+
+    model: Literal["mariner"]
+    params_paper: dict[str, Finite] = Field(default_factory=dict)
+    rudder_max_deg: Annotated[float, Field(gt=0, le=90, allow_inf_nan=False)] = 35.0
+    rudder_rate_deg_s: Positive | None = 3.8
+    rudder_rate_mode: Literal["ramp", "hold"] = "ramp"
+
+    @field_validator("params_paper")
+    @classmethod
+    def _known_params(cls, params: dict[str, float]) -> dict[str, float]:
+        for key in params:
+            if key not in MARINER_PARAM_NAMES:
+                raise ValueError(f"unknown parameter {key!r}; allowed: {', '.join(MARINER_PARAM_NAMES)}")
+        return params
+
+
 def _vessel_tag(value) -> str:
     if isinstance(value, dict):
         return value.get("model", "vectored-thrust-boat")
@@ -79,9 +105,11 @@ def _vessel_tag(value) -> str:
 
 Vessel = Annotated[
     Annotated[VesselConfig, Tag("vectored-thrust-boat")]
-    | Annotated[CyberShipVesselConfig, Tag("cybership2")],
+    | Annotated[CyberShipVesselConfig, Tag("cybership2")]
+    | Annotated[MarinerVesselConfig, Tag("mariner")],
     Discriminator(_vessel_tag, custom_error_type="vessel_model",
-                  custom_error_message="unknown vessel model; allowed: vectored-thrust-boat, cybership2"),
+                  custom_error_message="unknown vessel model; allowed: vectored-thrust-boat, "
+                                       "cybership2, mariner"),
 ]
 
 
@@ -114,6 +142,8 @@ class SimulationConfig(Strict):
     atol: Positive = 1e-6
     seed: Annotated[int, Field(ge=0)] | None = None
     backend: Literal["auto", "numpy", "compiled"] = "auto"
+    #: keep every n-th sample in the result (large batches); metrics use the kept samples
+    log_every: Annotated[int, Field(ge=1)] = 1
     initial_state: InitialState = Field(default_factory=InitialState)
 
     @model_validator(mode="after")
@@ -211,7 +241,49 @@ class CourseControllerConfig(Strict):
                 if v is not None}
 
 
-ControllerConfig = Annotated[OpenLoopConfig | HeadingSpeedConfig | CourseControllerConfig,
+class PathLQRConfig(Strict):
+    """Document 000's LQR with integral action (spec 000 §0.4): designed from ``Q``, ``R`` in the
+    document's units (min / nm / rad; R = 1 as stated, R = 0.5 reproduces the print), or the gain
+    ``K_paper`` = [k_y, k_ψ, k_r, k_e] used as given (min / nm / rad; the print: [3.4, 3.2, 1, 0.45]).
+    ``anti_windup``: conditional integration while the rudder saturates (the document has none)."""
+
+    type: Literal["lqr"]
+    Ts: Positive = 0.3
+    Q: tuple[NonNegative, NonNegative, NonNegative, NonNegative] = (0.1, 4.0, 0.0, 0.1)
+    R: Positive = 1.0
+    K_paper: tuple[Finite, Finite, Finite, Finite] | None = None
+    anti_windup: bool = False
+
+
+class OutputFLConfig(Strict):
+    """Document 000's feedback linearisation of the output z = y_r + l sin ψ_r (spec 000 §0.5):
+    ``lookahead_nm`` l = 0 is the literal design (``fl_paper``, unstable), 0.1 nm the sound variant;
+    gains of (23) in the document's units. ``knows_disturbance``: b_r and d_y known (A13)."""
+
+    type: Literal["fl"]
+    Ts: Positive = 0.3
+    lookahead_nm: NonNegative = 0.0
+    k1_per_min2: Positive = 0.18
+    k2_per_min: Positive = 0.7
+    knows_disturbance: bool = True
+
+
+class LOSFLConfig(Strict):
+    """LOS guidance with crab compensation feeding an exact FL of the yaw loop (spec 000 §0.5,
+    ``los_fl``): look-ahead ``delta_nm`` Δ, yaw-loop gains in the document's units."""
+
+    type: Literal["los-fl"]
+    Ts: Positive = 0.3
+    delta_nm: Positive = 0.5
+    kp_per_min2: Positive = 1.0
+    kd_per_min: Positive = 2.0
+    knows_disturbance: bool = True
+
+
+MARINER_CONTROLLERS = ("lqr", "fl", "los-fl")
+
+ControllerConfig = Annotated[OpenLoopConfig | HeadingSpeedConfig | CourseControllerConfig
+                             | PathLQRConfig | OutputFLConfig | LOSFLConfig,
                              Field(discriminator="type")]
 
 
@@ -265,7 +337,26 @@ class CourseScheduleConfig(Strict):
         return schedule
 
 
-GuidanceConfig = Annotated[ScheduleGuidanceConfig | LOSConfig | CourseScheduleConfig,
+class PathConfig(Strict):
+    """Document 000's waypoint path (spec 000 A4): ``points_nm`` as printed in the document, read as
+    ``caption`` (pairs are (y, x): plot-horizontal then plot-vertical; default), ``text`` (the same
+    first three points, then a half-line parallel to OX) or ``literal`` (pairs are (x, y)).
+    x is north, y east (NED); the last leg is a half-line; switching as in A6."""
+
+    type: Literal["path"]
+    reading: Literal["caption", "text", "literal"] = "caption"
+    points_nm: Annotated[list[tuple[Finite, Finite]], Field(min_length=2)] = [
+        (0.0, 0.0), (0.0, 10.0), (4.0, 12.0), (12.0, 18.0)]
+
+    @model_validator(mode="after")
+    def _enough_points(self) -> PathConfig:
+        if self.reading == "text" and len(self.points_nm) < 3:
+            raise ValueError("reading 'text' needs at least three points (the third leg starts at "
+                             "the third)")
+        return self
+
+
+GuidanceConfig = Annotated[ScheduleGuidanceConfig | LOSConfig | CourseScheduleConfig | PathConfig,
                            Field(discriminator="type")]
 
 
@@ -305,12 +396,49 @@ class WavesConfig(Strict):
     components: Annotated[int, Field(ge=4, le=2000)] = 200
 
 
-DisturbanceConfig = Annotated[ConstantForceConfig | GaussianForceConfig | WavesConfig,
-                              Field(discriminator="type")]
+class MarinerDisturbanceConfig(Strict):
+    """Document 000's disturbances in its units (spec 000 §0.6, A9–A11): yaw acceleration
+    ``b_r_rad_min2`` added to ṙ, cross current ``d_y_nm_min`` across the active leg
+    (``current_frame: path``) or along east (``global``), and narrow-band wave noise added to ṙ of
+    RMS ``wave_sigma_rad_min2`` (0 = off), period ``wave_period`` [s], damping ``wave_zeta``
+    (seeded by ``simulation.seed``)."""
+
+    type: Literal["mariner"]
+    b_r_rad_min2: Finite = 0.1
+    d_y_nm_min: Finite = 0.04
+    current_frame: Literal["path", "global"] = "path"
+    wave_sigma_rad_min2: NonNegative = 0.0
+    wave_period: Positive = 8.0
+    wave_zeta: Positive = 0.1
+
+
+DisturbanceConfig = Annotated[ConstantForceConfig | GaussianForceConfig | WavesConfig
+                              | MarinerDisturbanceConfig, Field(discriminator="type")]
 
 # --------------------------------------------------------------------------- scenario
 
-METRIC_SETS = ("stern-kick", "heading-steps", "waypoints", "course-quality", "none")
+METRIC_SETS = ("stern-kick", "heading-steps", "waypoints", "course-quality", "path-tracking", "none")
+
+
+class MonteCarloConfig(Strict):
+    """A batch of ``runs`` ships in one simulation, each with its own initial offset and sea.
+
+    The initial state is ``simulation.initial_state`` plus a cross-track offset drawn uniformly
+    from ``east_offset_nm`` (added to east) and a heading offset drawn uniformly from
+    ``heading_offset_deg``; each ship gets its own wave realisation (same ``simulation.seed``,
+    same batch)."""
+
+    runs: Annotated[int, Field(ge=1, le=100_000)] = 1000
+    east_offset_nm: tuple[Finite, Finite] = (-1.0, 1.0)
+    heading_offset_deg: tuple[Finite, Finite] = (-20.0, 20.0)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> MonteCarloConfig:
+        for name in ("east_offset_nm", "heading_offset_deg"):
+            low, high = getattr(self, name)
+            if not low <= high:
+                raise ValueError(f"{name} = [{low}, {high}]: need low <= high")
+        return self
 
 
 class QualityConfig(Strict):
@@ -325,7 +453,8 @@ class Scenario(Strict):
     name: Annotated[str, Field(min_length=1, pattern=r"^[A-Za-z0-9_.\-]+$")]
     description: str = ""
     document: str = ""
-    metrics: Literal["stern-kick", "heading-steps", "waypoints", "course-quality", "none"] = "none"
+    metrics: Literal["stern-kick", "heading-steps", "waypoints", "course-quality", "path-tracking",
+                     "none"] = "none"
     vessel: Vessel = Field(default_factory=VesselConfig)
     actuator: ActuatorConfig = Field(default_factory=ActuatorConfig)
     simulation: SimulationConfig
@@ -334,6 +463,7 @@ class Scenario(Strict):
     guidance: GuidanceConfig | None = None
     disturbance: DisturbanceConfig | None = None
     quality: QualityConfig = Field(default_factory=QualityConfig)
+    montecarlo: MonteCarloConfig | None = None
     #: the document's own figures, by controller (shown beside ours in comparison tables)
     document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
 
@@ -348,39 +478,54 @@ class Scenario(Strict):
             raise ValueError("give either 'controller' or 'controllers' (a mapping name: controller)")
         if self.controllers is not None and not self.controllers:
             raise ValueError("'controllers' is empty")
-        boat = self.vessel.model == "vectored-thrust-boat"
+        vessel = self.vessel.model
+        boat = vessel == "vectored-thrust-boat"
         if boat and self.controllers is not None:
-            raise ValueError("controllers: comparisons run on vessel model 'cybership2' in this "
-                             "release; for the boat give one 'controller'")
+            raise ValueError("controllers: comparisons run on vessel models 'cybership2' and "
+                             "'mariner' in this release; for the boat give one 'controller'")
         if not boat and self.actuator != ActuatorConfig():
-            raise ValueError("actuator: applies to the vectored-thrust boat; CyberShip II's steering "
+            raise ValueError(f"actuator: applies to the vectored-thrust boat; the {vessel} steering "
                              "machine is set in vessel (rudder_max_deg, rudder_rate_deg_s)")
+        fits = {"vectored-thrust-boat": ("open-loop", "heading-speed"), "cybership2": ("course",),
+                "mariner": MARINER_CONTROLLERS}[vessel]
         for name, ctrl in self.variants.items():
             where = "controller" if self.controller is not None else f"controllers.{name}"
-            if (ctrl.type == "course") == boat:
+            if ctrl.type not in fits:
                 raise ValueError(f"{where}: type {ctrl.type!r} does not fit vessel model "
-                                 f"{self.vessel.model!r}")
-            needs = {"heading-speed": ("schedule", "los"), "course": ("course-schedule",)}.get(ctrl.type)
+                                 f"{vessel!r} (allowed: {', '.join(fits)})")
+            needs = {"heading-speed": ("schedule", "los"), "course": ("course-schedule",),
+                     **dict.fromkeys(MARINER_CONTROLLERS, ("path",))}.get(ctrl.type)
             if needs and (self.guidance is None or self.guidance.type not in needs):
                 raise ValueError(f"{where}: type {ctrl.type!r} needs a guidance section of type "
                                  f"{' or '.join(needs)}")
-            if boat:
-                Ts = getattr(ctrl, "Ts", self.simulation.dt)
-            else:
-                Ts = ctrl.Ts
+            Ts = getattr(ctrl, "Ts", self.simulation.dt)
             ratio = Ts / self.simulation.dt
             if round(ratio) < 1 or abs(round(ratio) - ratio) > 1e-9 * ratio:
                 raise ValueError(f"{where}.Ts = {Ts!r} must be a whole multiple of "
                                  f"simulation.dt = {self.simulation.dt!r}")
+        if self.guidance is not None and self.guidance.type == "path" and vessel != "mariner":
+            raise ValueError("guidance type 'path' (document 000's path-frame controllers) needs "
+                             "vessel model 'mariner'")
         metric_guidance = {"heading-steps": "schedule", "waypoints": "los",
-                           "course-quality": "course-schedule"}
+                           "course-quality": "course-schedule", "path-tracking": "path"}
         wanted = metric_guidance.get(self.metrics)
         if wanted and (self.guidance is None or self.guidance.type != wanted):
             raise ValueError(f"metrics = {self.metrics!r} needs guidance type {wanted!r}")
         if self.metrics == "stern-kick" and any(c.type != "open-loop" for c in self.variants.values()):
             raise ValueError("metrics = 'stern-kick' needs controller type 'open-loop'")
-        if self.disturbance is not None and self.disturbance.type == "waves" and boat:
-            raise ValueError("disturbance type 'waves' has a wave-load model for cybership2 only")
+        dist = self.disturbance.type if self.disturbance is not None else None
+        allowed_dist = {"vectored-thrust-boat": ("constant", "gaussian"),
+                        "cybership2": ("constant", "gaussian", "waves"),
+                        "mariner": ("mariner",)}[vessel]
+        if dist is not None and dist not in allowed_dist:
+            raise ValueError(f"disturbance type {dist!r} does not fit vessel model {vessel!r} "
+                             f"(allowed: {', '.join(allowed_dist)})")
+        if vessel == "mariner" and self.simulation.initial_state.v != 0:
+            raise ValueError("simulation.initial_state.v: the Mariner's sway is algebraic "
+                             "(v = r1 r + r2 r^3); leave v at 0")
+        if self.montecarlo is not None and vessel != "mariner":
+            raise ValueError("montecarlo: batches of random initial states are built for vessel "
+                             "model 'mariner' in this release")
         return self
 
 

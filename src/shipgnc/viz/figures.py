@@ -13,8 +13,10 @@ from pathlib import Path
 class FigureJob:
     """Everything needed to draw a run's figures (picklable: it may go to a worker process).
 
-    ``kind`` is ``"dashboard"`` (``result``: one ship's series, :func:`viz.series.result_series`)
-    or ``"course-comparison"`` (``result``: series by controller, :func:`viz.comparison.course_series`).
+    ``kind`` is ``"dashboard"`` (``result``: one ship's series, :func:`viz.series.result_series`),
+    ``"course-comparison"`` (``result``: series by controller, :func:`viz.comparison.course_series`),
+    ``"path-tracking"`` (series by controller, :func:`viz.path_tracking.path_series`) or
+    ``"montecarlo"`` (:func:`viz.path_tracking.montecarlo_series` by controller).
     """
 
     result: dict
@@ -30,9 +32,12 @@ class FigureJob:
 
 def render_figures(job: FigureJob) -> list[Path]:
     """Draw the job's PNGs: ``dashboard.png`` (+ ``stern_kick_closeup.png`` for a stern-kick run),
-    or ``comparison.png`` for a course-autopilot comparison."""
+    ``comparison.png`` for a course-autopilot comparison, ``fig3_tracks.png``,
+    ``fig4_heading.png``, ``fig5_rudder.png`` for path tracking, ``montecarlo.png`` for a batch."""
     from shipgnc.viz.dashboard import dashboard, save_figure, stern_kick_closeup
 
+    if job.kind in ("path-tracking", "montecarlo"):
+        return _path_figures(job)
     if job.kind == "course-comparison":
         from shipgnc.units import to_deg
         from shipgnc.viz.comparison import course_comparison
@@ -48,3 +53,18 @@ def render_figures(job: FigureJob) -> list[Path]:
         paths.append(save_figure(stern_kick_closeup(job.result, lever_arm=job.lever_arm),
                                  job.out / "stern_kick_closeup.png"))
     return paths
+
+
+def _path_figures(job: FigureJob) -> list[Path]:
+    from shipgnc.units import to_deg
+    from shipgnc.viz import path_tracking as pt
+    from shipgnc.viz.dashboard import save_figure
+
+    if job.kind == "montecarlo":
+        fig = pt.montecarlo_figure(job.result, job.waypoints, title=job.title)
+        return [save_figure(fig, job.out / "montecarlo.png")]
+    limit = (job.limits or {}).get("delta")
+    return [save_figure(pt.tracks_figure(job.result, job.waypoints), job.out / "fig3_tracks.png"),
+            save_figure(pt.heading_figure(job.result), job.out / "fig4_heading.png"),
+            save_figure(pt.rudder_figure(job.result, rudder_limit_deg=None if limit is None
+                                         else float(to_deg(limit[1]))), job.out / "fig5_rudder.png")]

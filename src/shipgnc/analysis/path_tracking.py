@@ -1,0 +1,156 @@
+"""Path-tracking metrics of document 000 (spec 000 §0.8), batched over ships.
+
+Computed on the logged samples from the path-frame errors the controllers log
+(``cross_track_error`` y_r [m], ``heading_error`` ψ_r [rad], ``leg``) and the applied rudder
+``delta`` [rad]; reported in the document's units as the names say (min, nm, deg). "Leg 1" is the
+time before the first leg switch.
+
+* ``settle_time_min``: first time after which |y_r| < 0.05 nm holds for the rest of leg 1
+  (null if never);
+* ``overshoot_nm``: largest y_r of opposite sign to y_r(0) on leg 1, as a magnitude (0 if y_r
+  never crosses; null if y_r(0) = 0);
+* ``crosstrack_max_after_leg1_nm``, ``crosstrack_rms_after_leg1_nm``: max |y_r| and RMS of y_r
+  from the first switch to the end (null if leg 1 never ends);
+* ``final_crosstrack_nm``, ``final_heading_error_deg``, ``final_rudder_deg``: means over the last
+  10 min (signed);
+* ``rudder_rms_deg``; ``saturation_fraction``: share of samples with |δ| at δ_max;
+* ``stable``: the run reached its end without the divergence guard and |y_r| stayed below
+  max(3 nm, 2|y_r(0)|) (spec 000 §0.8, [A]).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from shipgnc.units import MINUTE, NAUTICAL_MILE, to_deg
+
+#: |y_r| below which leg 1 counts as settled [m] (0.05 nm)
+SETTLE_BAND = 0.05 * NAUTICAL_MILE
+#: window of the "final" means [s] (10 min)
+FINAL_WINDOW = 10.0 * MINUTE
+#: bound on |y_r| for ``stable`` [m]: max(3 nm, 2 |y_r(0)|)
+STABLE_BOUND = 3.0 * NAUTICAL_MILE
+
+PATH_TRACKING_KEYS = ("settle_time_min", "overshoot_nm", "crosstrack_max_after_leg1_nm",
+                      "crosstrack_rms_after_leg1_nm", "final_crosstrack_nm",
+                      "final_heading_error_deg", "final_rudder_deg", "rudder_rms_deg",
+                      "saturation_fraction", "stable")
+
+
+def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reached_end) -> dict:
+    """The metrics for every ship at once: arrays ``(time, ship)`` in SI → dict of ``(ship,)``
+    float arrays in the reported units (NaN where a figure does not exist; ``stable`` as bool).
+
+    ``reached_end``: bool per ship (or one bool), False when the run stopped early (divergence).
+    Samples after a run stopped (NaN padding) are ignored.
+    """
+    t = np.asarray(time, dtype=float)
+    y, psi, lg, d = (np.asarray(a, dtype=float).reshape(t.size, -1) for a in (y_r, psi_r, leg, delta))
+    valid = np.isfinite(y) & np.isfinite(lg)
+    n_t, n_ships = y.shape
+    rows = np.arange(n_t)[:, None]
+    switched = valid & (lg > 0)
+    has_switch = switched.any(axis=0)
+    first_switch = np.where(has_switch, switched.argmax(axis=0), n_t)  # first sample of leg 2+
+    leg1 = (rows < first_switch) & valid
+    n_leg1 = leg1.sum(axis=0)
+
+    # settle time: the sample after the last leg-1 sample outside the band
+    outside = leg1 & ~(np.abs(y) < SETTLE_BAND)
+    any_out = outside.any(axis=0)
+    last_out = n_t - 1 - outside[::-1].argmax(axis=0)
+    settle_idx = np.where(any_out, last_out + 1, 0)
+    settled = (settle_idx < n_leg1) & (n_leg1 > 0)
+    settle = np.where(settled, t[np.minimum(settle_idx, n_t - 1)] / MINUTE, np.nan)
+
+    y0 = y[0]
+    opposite = np.where(leg1, -np.sign(y0) * y, -np.inf)
+    overshoot = np.maximum(opposite.max(axis=0), 0.0) / NAUTICAL_MILE
+    overshoot = np.where(y0 == 0, np.nan, overshoot)
+
+    after = valid & (rows >= first_switch)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        abs_after = np.where(after, np.abs(y), np.nan)
+        max_after = np.where(has_switch, np.nanmax(np.where(after, abs_after, -np.inf), axis=0), np.nan)
+        rms_after = np.sqrt(np.nansum(np.where(after, y * y, np.nan), axis=0) / after.sum(axis=0))
+        rms_after = np.where(has_switch, rms_after, np.nan)
+
+        t_last = np.max(np.where(valid, t[:, None], -np.inf), axis=0)
+        final = valid & (t[:, None] >= t_last - FINAL_WINDOW - 1e-9)
+        count = final.sum(axis=0)
+
+        def final_mean(a):
+            return np.where(final, a, 0.0).sum(axis=0) / count
+
+        applied = valid & np.isfinite(d)
+        rudder_rms = np.sqrt(np.where(applied, d * d, 0.0).sum(axis=0) / applied.sum(axis=0))
+        saturated = applied & (np.abs(d) >= delta_max * (1.0 - 1e-9))
+        saturation = saturated.sum(axis=0) / applied.sum(axis=0)
+        peak = np.max(np.where(valid, np.abs(y), 0.0), axis=0)
+    bound = np.maximum(STABLE_BOUND, 2.0 * np.abs(y0))
+    stable = np.broadcast_to(np.asarray(reached_end, dtype=bool), (n_ships,)) & (peak < bound)
+    return {
+        "settle_time_min": settle,
+        "overshoot_nm": overshoot,
+        "crosstrack_max_after_leg1_nm": max_after / NAUTICAL_MILE,
+        "crosstrack_rms_after_leg1_nm": rms_after / NAUTICAL_MILE,
+        "final_crosstrack_nm": final_mean(y) / NAUTICAL_MILE,
+        "final_heading_error_deg": to_deg(final_mean(psi)),
+        "final_rudder_deg": to_deg(final_mean(np.where(np.isfinite(d), d, 0.0))),
+        "rudder_rms_deg": to_deg(rudder_rms),
+        "saturation_fraction": saturation,
+        "stable": stable,
+    }
+
+
+def _series(ds, name: str) -> np.ndarray:
+    values = np.asarray(ds[name].values, dtype=float)
+    return values.reshape(values.shape[0], -1)
+
+
+def path_tracking_metrics(ds, *, delta_max: float, diverged: bool = False) -> dict:
+    """Spec 000 §0.8 metrics of a single-ship result (plain numbers, ``None`` where undefined)."""
+    arrays = path_tracking_arrays(ds["time"].values, _series(ds, "cross_track_error"),
+                                  _series(ds, "heading_error"), _series(ds, "leg"),
+                                  _series(ds, "delta"), delta_max=delta_max,
+                                  reached_end=not diverged)
+    out = {}
+    for key in PATH_TRACKING_KEYS:
+        value = arrays[key][0]
+        out[key] = bool(value) if key == "stable" else (
+            float(value) if math.isfinite(value) else None)
+    return out
+
+
+def montecarlo_summary(ds, *, delta_max: float, diverged: bool = False) -> dict:
+    """Distribution of the path-tracking metrics over the ships of a batch result.
+
+    ``runs``; ``settled_fraction`` and ``stable_fraction``; median and 95th percentile of
+    ``settle_time_min`` (a ship that never settles counts as +∞, so a percentile it reaches is
+    null) and of ``crosstrack_rms_after_leg1_nm`` (ships whose leg 1 never ends excluded).
+    """
+    arrays = path_tracking_arrays(ds["time"].values, _series(ds, "cross_track_error"),
+                                  _series(ds, "heading_error"), _series(ds, "leg"),
+                                  _series(ds, "delta"), delta_max=delta_max,
+                                  reached_end=not diverged)
+    settle = np.where(np.isnan(arrays["settle_time_min"]), np.inf, arrays["settle_time_min"])
+    rms = arrays["crosstrack_rms_after_leg1_nm"]
+    rms = rms[np.isfinite(rms)]
+
+    def pct(values, q):
+        if values.size == 0:
+            return None
+        value = float(np.percentile(values, q, method="higher"))
+        return value if math.isfinite(value) else None
+
+    return {
+        "runs": int(settle.size),
+        "settled_fraction": float(np.isfinite(settle).mean()),
+        "stable_fraction": float(arrays["stable"].mean()),
+        "settle_time_min_median": pct(settle, 50),
+        "settle_time_min_p95": pct(settle, 95),
+        "crosstrack_rms_after_leg1_nm_median": pct(rms, 50),
+        "crosstrack_rms_after_leg1_nm_p95": pct(rms, 95),
+    }

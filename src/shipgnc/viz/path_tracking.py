@@ -1,0 +1,167 @@
+"""Document 000's figures: tracks on the path (Fig. 3), heading (Fig. 4), rudder (Fig. 5), with the
+controllers overlaid; and the spread of a Monte Carlo batch.
+
+Drawn from plain arrays (:func:`path_series`, :func:`montecarlo_series`) in the document's units
+for display (time in min, positions in nm, angles in deg), so a worker process needs no xarray.
+North is up and east to the right (NED, the document's x up, y right under the caption reading).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from shipgnc.errors import ConfigError
+from shipgnc.units import MINUTE, NAUTICAL_MILE
+from shipgnc.viz import style
+
+PATH_KEYS = ("time", "north", "east", "psi", "heading_error", "cross_track_error", "delta", "leg")
+#: one colour per controller of document 000 (others cycle through the tab10 palette)
+CONTROLLER_COLORS = {"lqr_paper": "#9467bd", "lqr": "#1f77b4", "fl_paper": "#d62728",
+                     "fl_lookahead": "#2ca02c", "los_fl": "#ff7f0e", "controller": "#1f77b4"}
+#: Monte Carlo tracks drawn per controller (the statistics use every run)
+TRACKS_DRAWN = 200
+
+
+def _color(name: str, i: int) -> str:
+    return CONTROLLER_COLORS.get(name, f"C{i % 10}")
+
+
+def path_series(result, controller: str | None) -> dict[str, np.ndarray]:
+    """One controller's plotted variables (first ship), NaN padding of an early stop removed."""
+    ds = result.sel(controller=controller) if controller is not None and "controller" in result.dims \
+        else result
+    if "ship" in ds.dims:
+        ds = ds.isel(ship=0)
+    keep = np.isfinite(ds["north"].values)
+    return {k: np.asarray(ds[k].values, dtype=float)[keep] for k in PATH_KEYS if k in ds}
+
+
+def _waypoint_plot(ax, waypoints) -> None:
+    wp = np.asarray(waypoints, dtype=float) / NAUTICAL_MILE
+    last = wp[-1] + 0.6 * (wp[-1] - wp[-2])  # the last leg is a half-line: draw it on
+    ax.plot(wp[:, 1], wp[:, 0], "o", color=style.COLORS["waypoint"], markersize=4, zorder=3)
+    ax.plot([*wp[:, 1], last[1]], [*wp[:, 0], last[0]], color=style.COLORS["path"], linewidth=1.2,
+            linestyle="--", label="path", zorder=1)
+
+
+def _finish_time_axis(axes, title: str, fig) -> None:
+    for ax in axes:
+        ax.grid(True, linewidth=0.4, alpha=0.5)
+        ax.tick_params(labelsize=style.TICK_SIZE)
+    axes[-1].set_xlabel("time t [min]", fontsize=style.LABEL_SIZE)
+    axes[0].legend(loc="best", **style.LEGEND)
+    if title:
+        fig.suptitle(title, fontsize=style.LABEL_SIZE + 1)
+
+
+def tracks_figure(series: Mapping[str, Mapping[str, np.ndarray]], waypoints, *,
+                  title: str = "") -> Figure:
+    """Fig. 3: the ships' tracks on the path, north up, in nm."""
+    _check(series)
+    fig = Figure(figsize=(7.5, 8.0))
+    ax = fig.subplots()
+    _waypoint_plot(ax, waypoints)
+    for i, (name, data) in enumerate(series.items()):
+        ax.plot(data["east"] / NAUTICAL_MILE, data["north"] / NAUTICAL_MILE, color=_color(name, i),
+                label=name, linewidth=1.6)
+        ax.plot(data["east"][0] / NAUTICAL_MILE, data["north"][0] / NAUTICAL_MILE, "o",
+                color=style.COLORS["start"], markersize=5)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("east y [nm]", fontsize=style.LABEL_SIZE)
+    ax.set_ylabel("north x [nm]", fontsize=style.LABEL_SIZE)
+    ax.grid(True, linewidth=0.4, alpha=0.5)
+    ax.legend(loc="best", **style.LEGEND)
+    ax.set_title(title or "tracks on the path (document 000, Fig. 3)", fontsize=style.LABEL_SIZE + 1)
+    return fig
+
+
+def heading_figure(series: Mapping[str, Mapping[str, np.ndarray]], *, title: str = "") -> Figure:
+    """Fig. 4: heading ψ, heading error ψ_r and cross-track error y_r against time."""
+    _check(series)
+    fig = Figure(figsize=(10.0, 8.0))
+    axes = fig.subplots(3, 1, sharex=True)
+    for i, (name, data) in enumerate(series.items()):
+        t, color = data["time"] / MINUTE, _color(name, i)
+        axes[0].plot(t, style.unwrap_deg(data["psi"]), color=color, label=name, linewidth=1.4)
+        axes[1].plot(t, style.to_deg(data["heading_error"]), color=color, linewidth=1.4)
+        axes[2].plot(t, data["cross_track_error"] / NAUTICAL_MILE, color=color, linewidth=1.4)
+    axes[0].set_ylabel("heading ψ [deg]", fontsize=style.LABEL_SIZE)
+    axes[1].set_ylabel("heading error ψ_r [deg]", fontsize=style.LABEL_SIZE)
+    axes[2].set_ylabel("cross-track y_r [nm]", fontsize=style.LABEL_SIZE)
+    for ax in axes[1:]:
+        ax.axhline(0.0, **style.ZERO)
+    _finish_time_axis(axes, title or "heading and path errors (document 000, Fig. 4)", fig)
+    return fig
+
+
+def rudder_figure(series: Mapping[str, Mapping[str, np.ndarray]], *, title: str = "",
+                  rudder_limit_deg: float | None = None) -> Figure:
+    """Fig. 5: the applied rudder angle δ against time, with its limits."""
+    _check(series)
+    fig = Figure(figsize=(10.0, 4.5))
+    ax = fig.subplots()
+    for i, (name, data) in enumerate(series.items()):
+        ax.plot(data["time"] / MINUTE, style.to_deg(data["delta"]), color=_color(name, i),
+                label=name, linewidth=1.2)
+    if rudder_limit_deg is not None:
+        for sign in (-1, 1):
+            ax.axhline(sign * rudder_limit_deg, **style.LIMIT)
+    ax.axhline(0.0, **style.ZERO)
+    ax.set_ylabel("rudder δ [deg]", fontsize=style.LABEL_SIZE)
+    _finish_time_axis([ax], title or "rudder angle (document 000, Fig. 5)", fig)
+    return fig
+
+
+def montecarlo_series(result, controller: str, *, tracks: int = TRACKS_DRAWN) -> dict[str, np.ndarray]:
+    """Tracks (the first ``tracks`` ships) and the cross-track error of every ship, for the spread
+    figure: arrays ``(time, ship)``."""
+    ds = result.sel(controller=controller) if "controller" in result.dims else result
+    return {"time": np.asarray(ds["time"].values, dtype=float),
+            "north": np.asarray(ds["north"].values[:, :tracks], dtype=float),
+            "east": np.asarray(ds["east"].values[:, :tracks], dtype=float),
+            "cross_track_error": np.asarray(ds["cross_track_error"].values, dtype=float)}
+
+
+def montecarlo_figure(series: Mapping[str, Mapping[str, np.ndarray]], waypoints, *,
+                      title: str = "") -> Figure:
+    """Spread of a batch: tracks on the path (left) and the cross-track error's median and 5–95 %
+    band against time (right), one row per controller."""
+    _check(series)
+    names = list(series)
+    fig = Figure(figsize=(13.0, 5.2 * len(names)))
+    axes = fig.subplots(len(names), 2, squeeze=False, gridspec_kw={"width_ratios": [1, 1.6]})
+    for i, name in enumerate(names):
+        data, color = series[name], _color(name, i)
+        ax_track, ax_err = axes[i]
+        _waypoint_plot(ax_track, waypoints)
+        ax_track.plot(data["east"] / NAUTICAL_MILE, data["north"] / NAUTICAL_MILE, color=color,
+                      linewidth=0.5, alpha=0.25)
+        ax_track.set_aspect("equal", adjustable="datalim")
+        ax_track.set_xlabel("east y [nm]", fontsize=style.LABEL_SIZE)
+        ax_track.set_ylabel("north x [nm]", fontsize=style.LABEL_SIZE)
+        ax_track.set_title(f"{name}: {data['north'].shape[1]} of "
+                           f"{data['cross_track_error'].shape[1]} tracks", fontsize=style.LABEL_SIZE)
+        t = data["time"] / MINUTE
+        y = data["cross_track_error"] / NAUTICAL_MILE
+        with np.errstate(invalid="ignore"):
+            low, mid, high = np.nanpercentile(y, [5, 50, 95], axis=1)
+        ax_err.fill_between(t, low, high, color=color, alpha=0.25, label="5–95 %")
+        ax_err.plot(t, mid, color=color, linewidth=1.6, label="median")
+        ax_err.axhline(0.0, **style.ZERO)
+        ax_err.set_ylabel("cross-track y_r [nm]", fontsize=style.LABEL_SIZE)
+        ax_err.set_xlabel("time t [min]", fontsize=style.LABEL_SIZE)
+        ax_err.legend(loc="best", **style.LEGEND)
+        for ax in (ax_track, ax_err):
+            ax.grid(True, linewidth=0.4, alpha=0.5)
+            ax.tick_params(labelsize=style.TICK_SIZE)
+    if title:
+        fig.suptitle(title, fontsize=style.LABEL_SIZE + 1)
+    return fig
+
+
+def _check(series) -> None:
+    if not series:
+        raise ConfigError("path-tracking figure: no controller series to draw")
