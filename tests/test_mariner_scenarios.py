@@ -25,7 +25,7 @@ COMPARED = ("lqr_paper", "lqr", "fl_paper", "fl_lookahead", "los_fl")
 U_PAPER, D_Y, B_R, C_PAPER = 0.215 / 0.86, 0.04, 0.1, 3.553
 PSI_SS_DEG = -math.degrees(math.asin(D_Y / U_PAPER))  # −9.2069°
 DELTA_SS_DEG = -math.degrees(B_R / C_PAPER)  # −1.6126°
-# a single straight leg north, 1 nm... off the path by 100 m, one hour
+# a single straight leg north, starting 100 m off the path, one hour
 STRAIGHT = ("guidance.points_nm=[[0, 0], [0, 60]]", "simulation.initial_state.east=-100.0",
             "simulation.t_end=3600.0")
 
@@ -155,7 +155,7 @@ def test_bad_settings_name_the_field(override, words):
 def test_montecarlo_batch(tmp_path):
     overrides = ["montecarlo.runs=40", "simulation.t_end=1800", "simulation.log_every=10"]
     result = CliRunner().invoke(app, ["run", "mariner-montecarlo", "--out", str(tmp_path), "--json",
-                                      *sum((["--set", o] for o in overrides), [])])
+                                      *[a for o in overrides for a in ("--set", o)]])
     assert result.exit_code == 0, result.stderr
     metrics = json.loads(result.stdout)
     assert tuple(metrics) == ("lqr", "los_fl")

@@ -1,0 +1,75 @@
+"""Wave noise of spec 000 A11 and the cross current of A10."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.signal
+
+from shipgnc.environment.current import CrossCurrent
+from shipgnc.environment.filtered_noise import SecondOrderNoise
+from shipgnc.errors import ConfigError
+from shipgnc.guidance.path import WaypointPath
+
+
+def realisation(noise, h, n, ships=1, seed=1):
+    return noise.sequence(np.arange(n) * h, (ships,), np.random.default_rng(seed))
+
+
+@pytest.mark.parametrize("h", [0.3, 1.0, 2.5])
+def test_stationary_rms_is_sigma_for_any_step(h):
+    """The exact discretisation keeps var(w) = σ² whatever the step (A11's scaling of q)."""
+    noise = SecondOrderNoise(sigma=2.0, period=8.0, zeta=0.1)
+    w = realisation(noise, h, 4000, ships=50)
+    # 200 000 correlated samples; the relative standard error of the variance is a few per cent
+    assert np.sqrt(np.mean(w**2)) == pytest.approx(2.0, rel=0.03)
+    assert abs(np.mean(w)) < 0.1
+
+
+def test_spectrum_peaks_at_the_filter_frequency():
+    """A lightly damped filter (ζ = 0.1) concentrates the power near ω₀ = 2π/T₀."""
+    noise = SecondOrderNoise(sigma=1.0, period=8.0, zeta=0.1)
+    h = 0.25
+    w = realisation(noise, h, 40_000)[:, 0]
+    f, pxx = scipy.signal.welch(w, fs=1.0 / h, nperseg=4096)
+    assert f[np.argmax(pxx)] == pytest.approx(1.0 / 8.0, rel=0.05)
+    # Parseval: the one-sided density integrates to the variance
+    assert np.trapezoid(pxx, f) == pytest.approx(np.var(w), rel=0.05)
+
+
+def test_same_seed_same_sea_and_call_equals_sequence():
+    noise = SecondOrderNoise(sigma=1.0, period=8.0, zeta=0.1)
+    a = realisation(noise, 0.3, 100, ships=3, seed=5)
+    b = realisation(noise, 0.3, 100, ships=3, seed=5)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, realisation(noise, 0.3, 100, ships=3, seed=6))
+    noise.reset((3,), np.random.default_rng(5))
+    np.testing.assert_array_equal(np.stack([noise(0.3 * k) for k in range(100)]), a)
+    assert not np.allclose(a[:, 0], a[:, 1])  # each ship its own realisation
+
+
+@pytest.mark.parametrize(("kwargs", "field"), [
+    ({"sigma": -1.0, "period": 8.0, "zeta": 0.1}, "wave_sigma"),
+    ({"sigma": 1.0, "period": 0.0, "zeta": 0.1}, "wave_period"),
+    ({"sigma": 1.0, "period": 8.0, "zeta": math.nan}, "wave_zeta"),
+])
+def test_bad_noise_settings(kwargs, field):
+    with pytest.raises(ConfigError, match=field):
+        SecondOrderNoise(**kwargs)
+
+
+def test_cross_current_turns_with_the_active_leg():
+    path = WaypointPath(np.array([[0.0, 0.0], [1000.0, 0.0], [1000.0, 1000.0]]))  # north, then east
+    current = CrossCurrent(2.0, path)
+    current.reset((2,))
+    x = np.array([[500.0, 0.0, 0, 0, 0], [1001.0, 10.0, 0, 0, 0]])  # on leg 1; past its end
+    c = current(0.0, x)
+    np.testing.assert_allclose(c[0], [0.0, 2.0], atol=1e-12)  # leg 1 (north): across = east
+    np.testing.assert_allclose(c[1], [-2.0, 0.0], atol=1e-12)  # leg 2 (east): across = south
+    glob = CrossCurrent(2.0, path, frame="global")
+    glob.reset((2,))
+    np.testing.assert_allclose(glob(0.0, x), [[0.0, 2.0], [0.0, 2.0]])
+    with pytest.raises(ConfigError, match="current_frame"):
+        CrossCurrent(2.0, path, frame="body")
