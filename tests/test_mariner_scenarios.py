@@ -88,6 +88,9 @@ def test_compare_writes_figures_and_table(tmp_path):
         assert metrics[name]["crosstrack_max_after_leg1_nm"] < 1.5  # never beyond the start
     assert not metrics["fl_paper"]["stable"]
     assert metrics["fl_paper"]["settle_time_min"] is None
+    # the zero dynamics −U/(r1 + l): +U/|r1| = +0.25/0.0375 /min for the literal law, −4 /min ahead
+    assert metrics["fl_paper"]["zero_dynamics_pole_per_min"] == pytest.approx(0.25 / 0.0375)
+    assert metrics["fl_lookahead"]["zero_dynamics_pole_per_min"] == pytest.approx(-4.0)
     # the document's claim, reproduced by the sound variant: the FL settles much faster than the
     # LQR, with a far smaller overshoot (spec 000 §0.9)
     assert metrics["fl_lookahead"]["settle_time_min"] < metrics["lqr"]["settle_time_min"] / 2

@@ -128,3 +128,16 @@ def test_seeded_disturbance_is_reproducible():
     c = run_scenario("boat-autopilot", overrides=[over[0], "simulation.seed=8"]).result
     np.testing.assert_array_equal(a.psi.values, b.psi.values)
     assert not np.array_equal(a.psi.values, c.psi.values)
+
+
+def test_integral_los_removes_the_offset_a_steady_side_force_leaves():
+    """A constant lateral force needs a crab angle: plain LOS only steers it with a standing
+    cross-track offset e = Δ·tan(crab); integral LOS drives e to zero (Børhaug et al. 2008)."""
+    common = ["guidance.waypoints=[[0, 0], [400, 0]]", "simulation.t_end=200",
+              "simulation.initial_state.east=0", "disturbance={type: constant, values: [0, 20, 0]}"]
+    plain = run_scenario("boat-los", overrides=common).result.cross_track_error.values[-200:]
+    ilos = run_scenario("boat-los", overrides=[*common, "guidance.integral_gain=0.5"])
+    e = ilos.result.cross_track_error.values[-200:]
+    assert abs(plain.mean()) > 0.3  # metres: a visible standing offset
+    assert np.ptp(plain) < 0.01 * abs(plain.mean())  # ... that is steady
+    assert np.abs(e).max() < 1e-3 * abs(plain.mean())

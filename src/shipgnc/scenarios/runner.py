@@ -195,7 +195,7 @@ def _guidance(g):
                                  [e.u for e in g.schedule])
     if g.type == "los":
         return LOSGuidance(WaypointPath(g.waypoints), lookahead=g.lookahead, speed=g.speed,
-                           switch_radius=g.switch_radius)
+                           switch_radius=g.switch_radius, integral_gain=g.integral_gain)
     from shipgnc.guidance.schedule import CourseSchedule
 
     return CourseSchedule([e.t for e in g.schedule], [deg(e.psi_deg) for e in g.schedule])
@@ -268,6 +268,12 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
         K_paper = getattr(setup.controller, "K_paper", None)
         if K_paper is not None:
             out["lqr_gain"] = [float(k) for k in K_paper]
+        lookahead = getattr(setup.controller, "lookahead", None)
+        if lookahead is not None:  # output feedback linearisation: its zero dynamics (spec 000 §0.5)
+            from shipgnc.control.feedback_linearization import zero_dynamics_pole
+
+            out["zero_dynamics_pole_per_min"] = zero_dynamics_pole(setup.model.params,
+                                                                   lookahead=lookahead)[0]
     else:
         out = {}
     out["diverged"] = diverged

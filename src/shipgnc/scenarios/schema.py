@@ -317,6 +317,8 @@ class LOSConfig(Strict):
     speed: Positive = 1.5
     switch_radius: NonNegative = 5.0
     capture_distance: NonNegative = 20.0
+    #: σ of integral LOS against currents and steady side forces (0 = plain LOS)
+    integral_gain: NonNegative = 0.0
 
 
 class CourseEntry(Strict):
