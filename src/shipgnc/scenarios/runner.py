@@ -434,6 +434,8 @@ def comparison_table(run: ScenarioRun) -> list[dict]:
         for key, value in metrics.items():
             if isinstance(value, (int, float)) or value is None:
                 row[key] = value
+            elif isinstance(value, (list, tuple)):  # e.g. a gain vector
+                row[key] = ", ".join(f"{v:.4g}" for v in value)
         for key, value in doc.get(name, {}).items():
             row[f"document_{key}"] = value
         rows.append(row)
