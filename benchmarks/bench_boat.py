@@ -210,11 +210,17 @@ def main(argv=None) -> dict:
                    "open_loop_heading_gap_deg": heading_gap_deg,
                    "first_compiled_call_s": warmup_s},
     }
+    write_report("bench_boat", report, quick)
+    return report
+
+
+def write_report(stem: str, report: dict, quick: bool) -> Path:
+    """Write ``results/<stem>.json`` (``<stem>_quick.json`` for a quick run) and say where."""
     RESULTS.mkdir(parents=True, exist_ok=True)
-    path = RESULTS / ("bench_boat_quick.json" if quick else "bench_boat.json")
+    path = RESULTS / (f"{stem}_quick.json" if quick else f"{stem}.json")
     path.write_text(json.dumps(report, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     print(f"wrote {path}")
-    return report
+    return path
 
 
 if __name__ == "__main__":

@@ -18,7 +18,6 @@ Writes ``benchmarks/results/bench_cybership.json`` (``..._quick.json`` with ``--
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
@@ -27,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_boat import RESULTS, best_time, machine_info
+from bench_boat import best_time, machine_info, write_report
 
 T_END, DT = 300.0, 0.1
 #: ship time of the batch runs [s]: long enough for the first course change, short enough to
@@ -90,9 +89,7 @@ def main(argv=None) -> dict:
         print(f"{label:12s} {r['ships']} ships x {r['steps']} steps: {r['seconds']:.2f} s, "
               f"{r['ship_steps_per_s']:.3g} ship-steps/s, final heading spread "
               f"{r['final_heading_spread_deg']:.3g} deg")
-    RESULTS.mkdir(exist_ok=True)
-    name = "bench_cybership_quick.json" if args.quick else "bench_cybership.json"
-    (RESULTS / name).write_text(json.dumps(report, indent=2) + "\n")
+    write_report("bench_cybership", report, args.quick)
     if not math.isfinite(calm_s):
         raise SystemExit(1)
     return report

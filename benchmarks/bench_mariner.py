@@ -18,14 +18,13 @@ Writes ``benchmarks/results/bench_mariner.json`` (``..._quick.json`` with ``--qu
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_boat import RESULTS, best_time, machine_info
+from bench_boat import best_time, machine_info, write_report
 
 STEPS = 20_000  # 100 min at dt = 0.3 s
 
@@ -65,9 +64,7 @@ def main(argv=None) -> dict:
     r = results["mariner-montecarlo"]
     print(f"mariner-montecarlo {runs} ships x 2 controllers x {STEPS} steps: {seconds:.2f} s, "
           f"{r['ship_steps_per_s']:.3g} ship-steps/s")
-    RESULTS.mkdir(exist_ok=True)
-    name = "bench_mariner_quick.json" if args.quick else "bench_mariner.json"
-    (RESULTS / name).write_text(json.dumps(report, indent=2) + "\n")
+    write_report("bench_mariner", report, args.quick)
     if not math.isfinite(compare_s):
         raise SystemExit(1)
     return report
