@@ -14,8 +14,9 @@ from typer.testing import CliRunner
 from shipgnc.analysis.path_tracking import path_tracking_arrays
 from shipgnc.cli import app
 from shipgnc.errors import ConfigError
+from shipgnc.scenarios.mariner import mariner_path
 from shipgnc.scenarios.registry import load_scenario
-from shipgnc.scenarios.runner import build, mariner_path, run_scenario
+from shipgnc.scenarios.runner import build, run_scenario
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 
 NM, MIN = NAUTICAL_MILE, MINUTE

@@ -25,7 +25,7 @@ from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.fossen3dof import VectoredThrustBoat
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.schema import Scenario
-from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
+from shipgnc.units import NAUTICAL_MILE, deg
 
 
 @dataclass
@@ -79,66 +79,6 @@ def _cybership(scenario: Scenario):
     return (model, steering_machine(params, rate_limit=v.rudder_rate_deg_s is not None,
                                     rate_mode=v.rudder_rate_mode),
             np.array([v.propeller_rps, 0.0]))
-
-
-def _mariner(scenario: Scenario):
-    from shipgnc.models.mariner import MarinerWitOppe, rudder
-
-    v = scenario.vessel
-    model = MarinerWitOppe.from_paper_units(**v.params_paper)
-    changes = {"delta_max": deg(v.rudder_max_deg)}
-    if v.rudder_rate_deg_s is not None:
-        changes["delta_rate"] = deg(v.rudder_rate_deg_s)
-    model = MarinerWitOppe(params=model.params.with_(**changes))
-    return (model, rudder(model.params, rate_limit=v.rudder_rate_deg_s is not None,
-                          rate_mode=v.rudder_rate_mode), None)
-
-
-def mariner_path(g) -> WaypointPath:
-    """The path of spec 000 A4 from the printed points [nm] and their ``reading``, in NED [m]."""
-    points = np.asarray(g.points_nm, dtype=float)
-    if g.reading == "literal":
-        north_east = points
-    else:  # the printed pairs are (y, x): plot-horizontal (east), then plot-vertical (north)
-        north_east = points[:, ::-1]
-        if g.reading == "text":  # the third leg is a half-line parallel to OX from the third point
-            north_east = np.vstack([north_east[:3], north_east[2] + np.array([1.0, 0.0])])
-    return WaypointPath(north_east * NAUTICAL_MILE)
-
-
-def _mariner_controller(cfg, model, path: WaypointPath, scenario: Scenario):
-    """Document 000's path controllers (spec 000 §0.4–0.5) with the scenario's settings."""
-    from shipgnc.control import feedback_linearization as fl
-    from shipgnc.control.lqr import PathLQR, design_lqr, gain_to_si
-
-    p = model.params
-    if cfg.type == "lqr":
-        K = gain_to_si(cfg.K_paper) if cfg.K_paper is not None else design_lqr(p, Q=cfg.Q, R=cfg.R).K_si
-        return PathLQR(K, path, Ts=cfg.Ts, delta_max=p.delta_max, anti_windup=cfg.anti_windup)
-    d = scenario.disturbance
-    known = {}
-    if cfg.knows_disturbance and d is not None:
-        known = {"b_r": d.b_r_rad_min2 / MINUTE**2, "d_y": d.d_y_nm_min * NAUTICAL_MILE / MINUTE,
-                 "current_frame": d.current_frame}
-    if cfg.type == "fl":
-        return fl.OutputFL(p, path, Ts=cfg.Ts, lookahead=cfg.lookahead_nm * NAUTICAL_MILE,
-                           k1=cfg.k1_per_min2 / MINUTE**2, k2=cfg.k2_per_min / MINUTE,
-                           delta_max=p.delta_max, **known)
-    return fl.LOSFL(p, path, Ts=cfg.Ts, delta_los=cfg.delta_nm * NAUTICAL_MILE,
-                    kp=cfg.kp_per_min2 / MINUTE**2, kd=cfg.kd_per_min / MINUTE,
-                    delta_max=p.delta_max, **known)
-
-
-def _mariner_disturbance(d, path: WaypointPath):
-    from shipgnc.environment.current import CrossCurrent
-    from shipgnc.environment.filtered_noise import SecondOrderNoise
-    from shipgnc.models.mariner import MarinerDisturbance
-
-    current = CrossCurrent(d.d_y_nm_min * NAUTICAL_MILE / MINUTE, path, frame=d.current_frame)
-    waves = None
-    if d.wave_sigma_rad_min2 > 0:
-        waves = SecondOrderNoise(d.wave_sigma_rad_min2 / MINUTE**2, d.wave_period, d.wave_zeta)
-    return MarinerDisturbance(d.b_r_rad_min2 / MINUTE**2, current=current, waves=waves)
 
 
 def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
@@ -219,6 +159,12 @@ def _disturbance(d, scenario: Scenario):
     return FroudeKrylovWaveLoads(spectrum, direction=deg(d.heading_deg), n_components=d.components)
 
 
+def _mariner(scenario: Scenario):
+    from shipgnc.scenarios import mariner
+
+    return mariner.vessel(scenario)
+
+
 VESSELS = {"vectored-thrust-boat": _boat, "cybership2": _cybership, "mariner": _mariner}
 
 
@@ -234,10 +180,12 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
     seed = seed if seed is not None else (scenario.simulation.seed or 0)
     x0 = initial_states(scenario, seed)
     if scenario.vessel.model == "mariner":
-        path = mariner_path(scenario.guidance)
+        from shipgnc.scenarios import mariner
+
+        path = mariner.mariner_path(scenario.guidance)
         d = scenario.disturbance
-        return Setup(model, x0, actuator, _mariner_controller(variants[name], model, path, scenario),
-                     None, None if d is None else _mariner_disturbance(d, path), path=path)
+        return Setup(model, x0, actuator, mariner.controller(variants[name], model, path, scenario),
+                     None, None if d is None else mariner.disturbance(d, path), path=path)
     return Setup(model, x0, actuator, _controller(variants[name], model, scenario),
                  _guidance(scenario.guidance), _disturbance(scenario.disturbance, scenario), u0)
 
