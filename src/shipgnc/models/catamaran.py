@@ -1,0 +1,369 @@
+"""Twin-azimuth-thruster research catamaran of document 004 (22.3 m, 155 t), in NED form.
+
+Equations (spec 004 §4.3; document 004 eq. (1)–(11), reconstructed from its MathCAD listing)::
+
+    m_x u̇ = 2T_v cos δ − R(V) cos β + m_y v r
+    m_y v̇ = −2T_v sin δ − R(V) sin β + σ m_x u r          σ = +1 printed, −1 sign-consistent
+    J ṙ   = L T_v sin δ − x_p(β) R(V) sin β − c_D V r + (m_x − m_y) u v
+    Ṅ = u cos ψ − v sin ψ,  Ė = u sin ψ + v cos ψ,  ψ̇ = r
+    δ̇ = u_δ                       (``delta_row="rate"``, eq. (2): the thruster turning rate is the input)
+    δ̇ = (−δ + k_t v_a)/T_t        (``delta_row="lag"``, eq. (22): the thruster's own first-order lag)
+
+with V = √(u² + v²), β = atan2(v, u) (= −β of the document), R(V) = 2000 R_K(V) [N] acting along
+−(u, v)/V, R_K = 8.1 − 8.436 V + 2.536 V² [kN] (one hull), x_p = 0.4 L (0.5 − |β|/π) and
+c_D = C_d (ρ/2) A_Ls L². The two thrusters are always at the same angle δ with equal thrust T_v;
+δ > 0 turns the bow to starboard (an azimuth angle from +x toward starboard α = −δ).
+
+State ``[u, v, r, north, east, psi, delta]`` (spec 004 §4.2), input ``[delta_rate]`` [rad/s] or
+``[v_a]`` [rad], disturbance ``[X_env, Y_env, N_env]`` (body-axis force [N] and moment [N m]).
+
+**δ is a state**, not the output of the foundation's actuator lag: the finite-state laws need δ in
+the state they are evaluated on, and the document's eq. (22) carries a gain k that the foundation's
+lag lacks. So the lag of (22) is the model's ``delta_row="lag"`` option (spec 004 §4.8) with the
+true plant's T_t, k_t; a slew limit is the foundation's saturation on u_δ (``slew_actuator``).
+
+**Presets** (spec 004 §4.4): ``si`` (default, consistent units) and ``paper`` (the listing's mixed
+units: ρ = 1.025 in M_D and J in t·m² used as kg·m², which reproduces the document's figures).
+Both keep the printed sway Coriolis sign; ``coriolis="consistent"`` flips it (the hull is then
+directionally unstable, spec 004 C3). The document-frame form (x forward, y to port, ω and K
+clockwise) is :func:`document_derivatives`, with :func:`to_document`/:func:`from_document`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields, replace
+
+import numpy as np
+
+from shipgnc.actuators import Actuator
+from shipgnc.errors import ConfigError, require
+from shipgnc.frames import body_to_ned
+from shipgnc.models.base import Signal
+
+#: resistance fit R_K(V) = a0 + a1 V + a2 V² [kN, one hull] of eq. (8)
+RK_COEFFS = (8.1, -8.436, 2.536)
+#: speed of the fit's minimum [m/s]: below it the continued resistance is used (spec 004 §4.3 [A])
+V_MIN_FIT = -RK_COEFFS[1] / (2.0 * RK_COEFFS[2])
+
+CORIOLIS = {"printed": 1.0, "consistent": -1.0}
+LOW_SPEED = ("continued", "literal")
+DELTA_ROWS = ("rate", "lag")
+
+
+def _is_number_or_array(value) -> bool:
+    if isinstance(value, bool):
+        return False
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return bool(arr.size) and bool(np.all(np.isfinite(arr)))
+
+
+@dataclass(frozen=True, eq=False)
+class CatamaranParams:
+    """Parameters of document 004's catamaran (defaults: preset ``si``; SI unless noted).
+
+    ============  ==============  ======================================================
+    field         default (si)    meaning
+    ============  ==============  ======================================================
+    Delta         155 000 kg      displacement mass Δ
+    k11/k22/k66   0.05/0.7/0.6    added-mass coefficients (surge, sway, yaw)
+    L             22.3 m          length
+    T_m           1.55 m          draught
+    C_B           0.697           block coefficient (the listing's "δ")
+    rho_MD        1025            density used in the yaw damping M_D (paper: 1.025)
+    J_zz          3.95035e6       rigid yaw inertia [kg m²] (paper: 3950.35, t·m² used as kg·m²)
+    T_v           20 400 N        thrust of each of the two thrusters
+    coriolis      "printed"       sway Coriolis sign σ: printed (+1) or consistent (−1)
+    low_speed     "continued"     R below V_m: quadratic continuation, or the literal fit
+    delta_row     "rate"          δ̇ = u_δ (rate) or the lag (22) with T_t, k_t
+    T_t, k_t      2 s, 1          true thruster lag time constant and gain (``lag`` row)
+    m_x_factor…   1               plant-uncertainty multipliers of m_x, m_y, J (floats or
+                                  per-ship arrays broadcasting against the batch)
+    ============  ==============  ======================================================
+    """
+
+    Delta: float = 155_000.0
+    k11: float = 0.05
+    k22: float = 0.7
+    k66: float = 0.6
+    L: float = 22.3
+    T_m: float = 1.55
+    C_B: float = 0.697
+    rho_MD: float = 1025.0
+    J_zz: float = 0.05 * 1025.0 * 155_000.0 * 22.3**2 / 1000.0
+    T_v: float = 20_400.0
+    coriolis: str = "printed"
+    low_speed: str = "continued"
+    delta_row: str = "rate"
+    T_t: float = 2.0
+    k_t: float = 1.0
+    m_x_factor: float | np.ndarray = 1.0
+    m_y_factor: float | np.ndarray = 1.0
+    J_factor: float | np.ndarray = 1.0
+
+    def __post_init__(self) -> None:
+        require(self.coriolis in CORIOLIS, "vessel.params.coriolis", self.coriolis,
+                f"allowed: {', '.join(CORIOLIS)}")
+        require(self.low_speed in LOW_SPEED, "vessel.params.low_speed", self.low_speed,
+                f"allowed: {', '.join(LOW_SPEED)}")
+        require(self.delta_row in DELTA_ROWS, "vessel.params.delta_row", self.delta_row,
+                f"allowed: {', '.join(DELTA_ROWS)}")
+        for f in fields(self):
+            if f.name in ("coriolis", "low_speed", "delta_row"):
+                continue
+            value = getattr(self, f.name)
+            require(_is_number_or_array(value), f"vessel.params.{f.name}", value,
+                    "must be a finite number")
+        for name in ("Delta", "L", "T_m", "C_B", "rho_MD", "J_zz", "T_v", "T_t",
+                     "m_x_factor", "m_y_factor", "J_factor"):
+            value = getattr(self, name)
+            require(bool(np.all(np.asarray(value) > 0)), f"vessel.params.{name}", value, "must be > 0")
+        for name in ("k11", "k22", "k66"):
+            require(getattr(self, name) >= 0, f"vessel.params.{name}", getattr(self, name),
+                    "added-mass coefficients must be >= 0")
+        require(self.k_t != 0, "vessel.params.k_t", self.k_t, "thruster gain must be non-zero")
+
+    # --- derived quantities (eq. (6)–(11)) ---------------------------------------------------
+    @property
+    def m_x(self):
+        """Surge mass (1 + k₁₁)Δ [kg] (times ``m_x_factor``)."""
+        return (1.0 + self.k11) * self.Delta * self.m_x_factor
+
+    @property
+    def m_y(self):
+        """Sway mass (1 + k₂₂)Δ [kg] (times ``m_y_factor``)."""
+        return (1.0 + self.k22) * self.Delta * self.m_y_factor
+
+    @property
+    def J(self):
+        """Yaw inertia with added inertia (1 + k₆₆) J_zz [kg m²] (times ``J_factor``)."""
+        return (1.0 + self.k66) * self.J_zz * self.J_factor
+
+    @property
+    def sigma(self) -> float:
+        """Sway Coriolis sign σ (+1 printed, −1 consistent)."""
+        return CORIOLIS[self.coriolis]
+
+    @property
+    def A_Ls(self) -> float:
+        """Lateral area C_B L T_m [m²]."""
+        return self.C_B * self.L * self.T_m
+
+    @property
+    def C_d(self) -> float:
+        """Yaw-damping coefficient (0.739 + 8.7 T_m/L)(1.611 C_B² − 2.873 C_B + 1.33)."""
+        return (0.739 + 8.7 * self.T_m / self.L) * (1.611 * self.C_B**2 - 2.873 * self.C_B + 1.33)
+
+    @property
+    def c_D(self) -> float:
+        """M_D = −c_D V r with c_D = C_d (ρ/2) A_Ls L² [N m s]."""
+        return self.C_d * 0.5 * self.rho_MD * self.A_Ls * self.L**2
+
+    def resistance(self, V):
+        """Hull resistance R(V) = 2000 R_K(V) [N], both hulls (continued below V_m unless literal)."""
+        V = np.asarray(V, dtype=float)
+        a0, a1, a2 = RK_COEFFS
+        fit = 2000.0 * (a0 + a1 * V + a2 * V * V)
+        if self.low_speed == "literal":
+            return fit
+        rk_min = a0 + a1 * V_MIN_FIT + a2 * V_MIN_FIT**2
+        return np.where(V >= V_MIN_FIT, fit, 2000.0 * rk_min * (V / V_MIN_FIT) ** 2)
+
+    def resistance_over_speed(self, V):
+        """R(V)/V [N s/m], finite at V = 0 (0 for the continued fit; R's direction is −(u, v)/V)."""
+        V = np.asarray(V, dtype=float)
+        safe = np.where(V > 0, V, 1.0)
+        return np.where(V > 0, self.resistance(safe) / safe, 0.0)
+
+    def top_speed(self) -> float:
+        """Straight-running speed: 2 T_v = R(V), i.e. 2.536 V² − 8.436 V + (8.1 − T_v/1000) = 0."""
+        a0, a1, a2 = RK_COEFFS
+        c = a0 - 2.0 * self.T_v / 2000.0
+        return (-a1 + math.sqrt(a1 * a1 - 4.0 * a2 * c)) / (2.0 * a2)
+
+    def with_(self, **changes) -> CatamaranParams:
+        """A copy with some parameters changed (validated; unknown names rejected)."""
+        known = {f.name for f in fields(self)}
+        for key in changes:
+            if key not in known:
+                raise ConfigError(f"vessel.params.{key}: unknown parameter; allowed: "
+                                  f"{', '.join(sorted(known))}")
+        return replace(self, **changes)
+
+    def as_dict(self) -> dict:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+#: named parameter sets (spec 004 §4.4); ``coriolis="consistent"`` is an override of either
+PRESETS: dict[str, dict] = {
+    "si": {},
+    "paper": {"rho_MD": 1.025, "J_zz": 0.05 * 1.025 * 155_000.0 * 22.3**2 / 1000.0},
+}
+#: the document's finite-state gains per preset: (T_u [s], h [s]) (spec 004 §4.4)
+FSM_GAINS: dict[str, tuple[float, float]] = {"paper": (0.1, 0.0625), "si": (2.5, 2.5)}
+
+
+def preset(name: str = "si", **overrides) -> CatamaranParams:
+    """Parameters of preset ``si`` or ``paper`` with optional overrides (e.g. ``coriolis=...``)."""
+    if name not in PRESETS:
+        raise ConfigError(f"vessel.preset = {name!r}: unknown preset; allowed: {', '.join(PRESETS)}")
+    return CatamaranParams().with_(**{**PRESETS[name], **overrides})
+
+
+STATES = (
+    Signal("u", "m/s", "surge velocity"),
+    Signal("v", "m/s", "sway velocity (to starboard)"),
+    Signal("r", "rad/s", "yaw rate (bow to starboard)"),
+    Signal("north", "m", "north position (NED x)"),
+    Signal("east", "m", "east position (NED y)"),
+    Signal("psi", "rad", "heading, clockwise from north (unwrapped)", angle=True),
+    Signal("delta", "rad", "thruster angle, positive turns the bow to starboard", angle=True),
+)
+RATE_INPUTS = (Signal("delta_rate", "rad/s", "thruster turning rate"),)
+LAG_INPUTS = (Signal("v_a", "rad", "thruster angle command of the lag (22)", angle=True),)
+DISTURBANCES = (
+    Signal("X_env", "N", "environmental surge force"),
+    Signal("Y_env", "N", "environmental sway force (to starboard)"),
+    Signal("N_env", "N m", "environmental yaw moment"),
+)
+U, V, R, NORTH, EAST, PSI, DELTA = range(7)
+
+
+@dataclass(frozen=True, eq=False)
+class Catamaran:
+    """Document 004's twin-azimuth catamaran in NED form (see the module docstring)."""
+
+    params: CatamaranParams = field(default_factory=CatamaranParams)
+    preset_name: str = "si"
+    length: float = 22.3  #: drawing outline only [m]
+    beam: float = 9.0  #: drawing outline only [m] (thrusters at ±3 m)
+
+    states = STATES
+    disturbances = DISTURBANCES
+    state_limits = (50.0, 50.0, 50.0, 1e8, 1e8, 1e6, 1e4)
+
+    @classmethod
+    def from_preset(cls, name: str = "si", **overrides) -> Catamaran:
+        return cls(params=preset(name, **overrides), preset_name=name)
+
+    @property
+    def inputs(self) -> tuple[Signal, ...]:
+        return RATE_INPUTS if self.params.delta_row == "rate" else LAG_INPUTS
+
+    def input_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """No hardware limit on the input by default (a slew limit: :func:`slew_actuator`)."""
+        return np.array([-np.inf]), np.array([np.inf])
+
+    def hull_forces(self, x):
+        """(X, Y, N) of the hull alone (resistance, yaw damping, Coriolis, Munk) in NED body axes."""
+        p = self.params
+        u, v, r = x[..., U], x[..., V], x[..., R]
+        speed = np.hypot(u, v)
+        r_over_v = p.resistance_over_speed(speed)
+        beta = np.arctan2(v, u)
+        x_p = 0.4 * p.L * (0.5 - np.abs(beta) / np.pi)
+        X = -r_over_v * u + p.m_y * v * r
+        Y = -r_over_v * v + p.sigma * p.m_x * u * r
+        N = -x_p * r_over_v * v - p.c_D * speed * r + (p.m_x - p.m_y) * u * v
+        return X, Y, N
+
+    def derivatives(self, x, u, d=None):
+        """ẋ for ``x`` (..., 7), ``u`` (..., 1) = [δ̇] or [v_a], ``d`` (..., 3) or None."""
+        p = self.params
+        delta = x[..., DELTA]
+        X, Y, N = self.hull_forces(x)
+        cd, sd = np.cos(delta), np.sin(delta)
+        X = X + 2.0 * p.T_v * cd
+        Y = Y - 2.0 * p.T_v * sd
+        N = N + p.L * p.T_v * sd
+        if d is not None:
+            X, Y, N = X + d[..., 0], Y + d[..., 1], N + d[..., 2]
+        north_dot, east_dot = body_to_ned(x[..., PSI], x[..., U], x[..., V])
+        if p.delta_row == "rate":
+            delta_dot = u[..., 0] + 0.0 * delta
+        else:
+            delta_dot = (-delta + p.k_t * u[..., 0]) / p.T_t
+        return np.stack([X / p.m_x, Y / p.m_y, N / p.J, north_dot, east_dot, x[..., R], delta_dot],
+                        axis=-1)
+
+    def yaw_acceleration(self, x, d=None):
+        """Φ₃ = ṙ at state ``x`` (it does not depend on the input)."""
+        p = self.params
+        _, _, N = self.hull_forces(x)
+        N = N + p.L * p.T_v * np.sin(x[..., DELTA])
+        if d is not None:
+            N = N + d[..., 2]
+        return N / p.J
+
+
+def slew_actuator(model: Catamaran, rate_deg_s: float) -> Actuator:
+    """Thruster slew limit |δ̇| ≤ ``rate_deg_s`` as the foundation's saturation on u_δ (§4.11.2)."""
+    require(model.params.delta_row == "rate", "vessel.params.delta_row", model.params.delta_row,
+            "a slew limit on the input needs the rate row (input delta_rate)")
+    require(math.isfinite(rate_deg_s) and rate_deg_s > 0, "actuator.slew_deg_s", rate_deg_s, "must be > 0")
+    rate = math.radians(rate_deg_s)
+    return Actuator(np.array([-rate]), np.array([rate]), names=("delta_rate",))
+
+
+# --- document frame (x forward, y to port, ω and K clockwise), spec 004 §4.2 ------------------
+def to_document(x):
+    """NED state [u, v, r, N, E, ψ, δ] → the document's z = [V_x, V_y, ω, x₁, x₂, K, δ]."""
+    z = np.array(x, dtype=float, copy=True)
+    z[..., 1] = -z[..., 1]
+    return z
+
+
+def from_document(z):
+    """The document's z = [V_x, V_y, ω, x₁, x₂, K, δ] → NED state (inverse of :func:`to_document`)."""
+    return to_document(z)
+
+
+def document_derivatives(params: CatamaranParams, z, u_delta):
+    """ż = Φ(z) + B u of eq. (1)–(3) written in the document's own frame (for the frame test)."""
+    p = params
+    Vx, Vy, w, K, delta = z[..., 0], z[..., 1], z[..., 2], z[..., 5], z[..., 6]
+    speed = np.sqrt(Vx**2 + Vy**2)
+    beta = np.arctan2(Vy, Vx)
+    R = p.resistance_over_speed(speed) * speed
+    Rx, Ry = R * np.cos(beta), R * np.sin(beta)
+    M_K = 0.4 * p.L * (0.5 - np.abs(beta) / np.pi) * Ry
+    M_D = -p.C_d * (p.rho_MD / 2.0) * p.A_Ls * p.L**2 * speed * w
+    s = p.sigma
+    phi = [
+        (2 * p.T_v * np.cos(delta) - Rx - p.m_y * w * Vy) / p.m_x,
+        (2 * p.T_v * np.sin(delta) - Ry - s * p.m_x * w * Vx) / p.m_y,
+        (p.L * p.T_v * np.sin(delta) + M_K + M_D - (p.m_x - p.m_y) * Vx * Vy) / p.J,
+        speed * np.cos(K - beta),
+        speed * np.sin(K - beta),
+        w,
+        np.asarray(u_delta, dtype=float) + 0.0 * delta,
+    ]
+    return np.stack(phi, axis=-1)
+
+
+def straight_running_state(params: CatamaranParams, speed: float | None = None) -> np.ndarray:
+    """State at straight running (δ = 0) with surge ``speed`` (default: the top speed)."""
+    x = np.zeros(7)
+    x[U] = params.top_speed() if speed is None else speed
+    return x
+
+
+def linearize(model: Catamaran, x0, *, step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """Central-difference Jacobians (A = ∂f/∂x, B = ∂f/∂u) of ``model`` at ``x0`` (input 0)."""
+    x0 = np.asarray(x0, dtype=float)
+    n = x0.size
+    eye = np.eye(n) * step
+    u0 = np.zeros(1)
+    A = (model.derivatives(x0 + eye, u0) - model.derivatives(x0 - eye, u0)).T / (2 * step)
+    B = ((model.derivatives(x0, u0 + step) - model.derivatives(x0, u0 - step)) / (2 * step))[:, None]
+    return A, B
+
+
+def straight_running_eigenvalues(model: Catamaran, speed: float | None = None) -> np.ndarray:
+    """Eigenvalues of the (u, v, r) subsystem at straight running (spec 004 check 15), sorted."""
+    A, _ = linearize(model, straight_running_state(model.params, speed))
+    eig = np.linalg.eigvals(A[:3, :3])
+    return eig[np.lexsort((eig.imag, eig.real))]
