@@ -1,7 +1,15 @@
-"""Compiled (numba) twin of :func:`shipgnc.sim.simulator.run_numpy` for the built-in boat.
+"""Compiled (numba) twins of :func:`shipgnc.sim.simulator.run_numpy`: the shared driver, and the
+twin of the built-in boat.
 
-The numpy loop stays the readable reference; this module repeats it step for step as scalar code
-for the vessel most runs use: :class:`~shipgnc.models.fossen3dof.VectoredThrustBoat` (spec 001
+The numpy loop stays the readable reference; a twin repeats it step for step as scalar code for
+one vessel model. This module holds what every twin shares — the scalar building blocks
+(:func:`_wrap`, :func:`_clip`, :func:`_sin_cos_shifted`), the numba plumbing (lazy import,
+:func:`jit`, :func:`_numba_error`) and the driver (:func:`drive`: thread count, chunked kernel
+calls for progress, divergence replay; :func:`make_log`: status, divergence errors, the ``Log``)
+— and the twin of the boat. :mod:`shipgnc.sim.compiled_mariner` is the twin of document 000's
+Mariner.
+
+**The boat twin** covers :class:`~shipgnc.models.fossen3dof.VectoredThrustBoat` (spec 001
 eq. (1)–(5), (9)–(11')) with a static (saturating) actuator; no controller, an
 :class:`~shipgnc.control.open_loop.OpenLoopSchedule` or the
 :class:`~shipgnc.control.heading_speed.HeadingSpeedAutopilot` (spec 001 §1.10); no guidance or a
@@ -25,9 +33,10 @@ operation for operation, with these shortcuts, which change results only at roun
 * LLVM may fuse multiply-adds and turn x/c into x·(1/c) (``fastmath={"contract", "arcp"}``);
   no other fast-math flag, so NaN and inf keep their meaning for the divergence guard.
 
-numba is imported on first use, so importing this module stays cheap; the kernel is cached on disk
-(``cache=True``). Without a progress callback the kernel is one call; with one, about twenty calls
-that carry each ship's state from one to the next (bit-identical results).
+numba is imported on first use, so importing this module stays cheap; the kernels are cached on
+disk (``cache=True``). A run is one kernel call, or several that carry each ship's state from one
+to the next (bit-identical results): about twenty with a progress callback, and short ones for a
+batch logging many samples (:func:`drive`).
 """
 
 from __future__ import annotations
@@ -38,15 +47,23 @@ import numpy as np
 
 from shipgnc.errors import ConfigError
 
-#: slots of the per-ship carried state ``S`` (N, N_SLOTS): everything a chunk hands to the next
+#: slots of the boat's per-ship carried state ``S`` (N, N_SLOTS): everything a chunk hands to the next
 X0, CMD, REF, ERR, SIG, Z, ZU, PSI_R, R_R, FORCE, APPLIED = 0, 6, 8, 10, 12, 14, 15, 16, 17, 18, 21
 N_SLOTS = 23
-#: controller modes of the kernel
+#: controller modes of the boat kernel
 CTRL_NONE, CTRL_TABLE, CTRL_AUTOPILOT = 0, 1, 2
 #: number of kernel calls when a progress callback is given
 PROGRESS_CHUNKS = 20
 #: ship-steps worth a thread of their own (≈ 10 ms)
 MIN_THREAD_WORK = 100_000
+#: most logged samples per ship of one kernel call in a batch: the log is (variable, sample, ship),
+#: so neighbouring ships share its cache lines, and short calls keep them cached from one ship to
+#: the next (a 1 000-ship log of every step is written ≈ 2× faster)
+LOG_SAMPLES_PER_CALL = 256
+#: numba options of every kernel and helper: cached on disk; fused multiply-add and x/c → x·(1/c)
+#: only, so NaN and inf keep their meaning (divergence guard); results move at round-off level,
+#: ≈20 % faster
+JIT_OPTIONS = {"cache": True, "error_model": "numpy", "fastmath": {"contract", "arcp"}}
 
 TWO_PI = 2.0 * math.pi
 
@@ -55,12 +72,13 @@ TWO_PI = 2.0 * math.pi
 prange = range
 
 _KERNEL = None
+_JITTED: dict = {}
 _NUMBA_ERROR: str | None = None
 _NUMBA_CHECKED = False
 
 
 # ----------------------------------------------------------------------------------------------
-# scalar building blocks (twins of frames.wrap_angle, fossen3dof.derivatives, autopilot.step)
+# scalar building blocks shared by the twins (frames.wrap_angle, np.clip, sin/cos of RK4 stages)
 # ----------------------------------------------------------------------------------------------
 
 def _wrap(angle):
@@ -94,14 +112,6 @@ def _clip(value, lower, upper):
     return value
 
 
-def _thruster(T_cmd, alpha_cmd, lower, upper, L_m):
-    """Applied input sat(cmd) of the static actuator and its force, eq. (5): (T, α, τ_u, τ_v, τ_r)."""
-    T = _clip(T_cmd, lower[0], upper[0])
-    alpha = _clip(alpha_cmd, lower[1], upper[1])
-    lateral = T * math.sin(alpha)
-    return T, alpha, T * math.cos(alpha), lateral, -L_m * lateral
-
-
 def _sin_cos_shifted(s, c, angle, delta):
     """sin and cos of ``angle + delta`` from s = sin(angle), c = cos(angle).
 
@@ -116,6 +126,172 @@ def _sin_cos_shifted(s, c, angle, delta):
                                                                         - d2 * (1.0 / 3628800.0)))))
         return s + (s * cm1 + c * sd), c + (c * cm1 - s * sd)
     return math.sin(angle + delta), math.cos(angle + delta)
+
+
+# ----------------------------------------------------------------------------------------------
+# numba plumbing
+# ----------------------------------------------------------------------------------------------
+
+def jit(function, *, parallel: bool = False):
+    """The numba dispatcher of a kernel function or scalar helper (one per function, shared by the
+    twins; :data:`JIT_OPTIONS`). Scalar helpers are inlined by LLVM into the kernels calling them.
+
+    A kernel finds its helpers as module globals, so each twin's ``_load`` rebinds its names to
+    the dispatchers before its kernel compiles. numba's disk cache is keyed to the source file of
+    the cached function only: after editing a helper of this module, delete the twins'
+    ``__pycache__/*.nbi`` files so that no kernel inlining the old helper is loaded.
+    """
+    import numba
+
+    py = _py(function)
+    key = (py, parallel)
+    if key not in _JITTED:
+        _JITTED[key] = numba.njit(parallel=parallel, **JIT_OPTIONS)(py)
+    return _JITTED[key]
+
+
+def _py(function):
+    """The plain Python function behind a (possibly already wrapped) numba dispatcher."""
+    return getattr(function, "py_func", function)
+
+
+def _numba_error() -> str | None:
+    """None if numba imports, else the reason (checked once per process)."""
+    global _NUMBA_CHECKED, _NUMBA_ERROR
+    if not _NUMBA_CHECKED:
+        _NUMBA_CHECKED = True
+        try:
+            import numba  # noqa: F401
+        except Exception as exc:  # ImportError, or a broken install (llvmlite mismatch, ...)
+            _NUMBA_ERROR = f"numba cannot be imported ({type(exc).__name__}: {exc})"
+    return _NUMBA_ERROR
+
+
+def _owned(values) -> np.ndarray:
+    """A fresh, writeable, C-ordered float64 copy: one kernel signature whatever the caller passes
+    (numba compiles read-only or strided arrays as other types)."""
+    return np.array(values, dtype=np.float64, order="C", copy=True)
+
+
+# ----------------------------------------------------------------------------------------------
+# the shared driver: chunked kernel calls, progress, divergence replay, the Log
+# ----------------------------------------------------------------------------------------------
+
+def log_layout(setup, names: list[str]):
+    """``log_signals(setup)``, after checking that a kernel's log columns ``names`` match it."""
+    from shipgnc.sim.simulator import log_signals
+
+    signals = log_signals(setup)
+    if list(names) != list(signals):  # the kernel's column layout must match the numpy loop's log
+        raise RuntimeError(f"compiled loop: log layout {list(names)} differs from {list(signals)}")
+    return signals
+
+
+def log_length(setup) -> int:
+    """Number of logged samples of a full run: every ``log_every``-th step and the last one."""
+    n_steps, every = int(setup.n_steps), int(setup.log_every)
+    return n_steps // every + 1 + (1 if n_steps % every else 0)
+
+
+def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 1,
+          prepare=None) -> int | None:
+    """Run a kernel over steps 0 … n_steps; returns the first divergence event or None.
+
+    ``call(k0, k1)`` runs steps ``k0 <= k < k1`` of every ship, carrying each ship's state in its
+    row of ``S`` and writing ``div_event[i]`` = 2k (bad command at sample k) or 2k + 1 (bad state
+    after step k) when ship i diverges. The steps are cut into ``n_chunks`` calls, or more: at
+    least :data:`PROGRESS_CHUNKS` with a progress callback (reported after each call), and for a
+    batch at most :data:`LOG_SAMPLES_PER_CALL` logged samples per call. ``prepare(k0, k1)`` runs
+    before each call (e.g. to fill the chunk's input tables). On a divergence the chunk is
+    replayed up to the event, as the numpy loop stops the whole batch at the first bad sample:
+    ``S`` then holds every ship's command of that sample or state after that step. The chunks
+    give bit-identical results.
+    """
+    import numba
+
+    n_ships, n_steps = S.shape[0], int(setup.n_steps)
+    # small runs on one thread: a parallel region waits for every worker thread, which costs a
+    # scheduler tick when the other cores are busy
+    threads = max(1, min(numba.get_num_threads(), n_ships, n_ships * n_steps // MIN_THREAD_WORK))
+
+    def limited(k0: int, k1: int) -> None:
+        previous = numba.get_num_threads()
+        numba.set_num_threads(threads)  # local to the calling thread
+        try:
+            call(k0, k1)
+        finally:
+            numba.set_num_threads(previous)
+
+    if setup.progress is not None:
+        n_chunks = max(n_chunks, PROGRESS_CHUNKS)
+    if n_ships > 1:
+        n_chunks = max(n_chunks, math.ceil(log_length(setup) / LOG_SAMPLES_PER_CALL))
+    bounds = np.linspace(0, n_steps + 1, min(n_chunks, n_steps + 1) + 1).round().astype(int)
+    if setup.progress is not None:
+        setup.progress(0, n_steps)
+    for k0, k1 in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+        if prepare is not None:
+            prepare(k0, k1)
+        start = S.copy()
+        limited(k0, k1)
+        if (div_event >= 0).any():
+            event = int(div_event[div_event >= 0].min())
+            S[:] = start
+            div_event[:] = -1
+            limited(k0, event // 2 + 1)
+            return event
+        if setup.progress is not None:
+            setup.progress(k1 - 1, n_steps)
+    return None
+
+
+def make_log(setup, signals, out: np.ndarray, S: np.ndarray, event: int | None, *, state_slot: int,
+             cmd_slot: int):
+    """The run's ``Log`` from the kernel's ``out`` (variable, sample, ship) and the first divergence
+    ``event`` (see :func:`drive`): the numpy loop's sample times, status and divergence error
+    (``S[:, state_slot:]`` holds the states, ``S[:, cmd_slot:]`` the commands). Raises the error
+    for ``on_divergence="raise"``."""
+    from shipgnc.sim.simulator import Log, check_divergence
+
+    batch = setup.batch_shape
+    n_steps, every, dt = int(setup.n_steps), int(setup.log_every), float(setup.dt)
+    n_states, n_inputs = len(setup.model.states), int(setup.actuator.n)
+    log_steps = np.arange(0, n_steps + 1, every)
+    if n_steps % every:
+        log_steps = np.append(log_steps, n_steps)
+    status: dict = {"diverged": 0, "stopped_early": 0, "message": ""}
+    n_logged = log_steps.size
+    if event is not None:
+        k = event // 2
+        if event % 2 == 0:  # the command of sample k: samples before k are logged
+            n_logged = (k - 1) // every + 1
+            command = S[:, cmd_slot:cmd_slot + n_inputs].reshape(*batch, n_inputs)
+            error = check_divergence(setup, k * dt, command=command)
+        else:  # the state after step k: samples up to k are logged
+            n_logged = k // every + 1
+            t = k * dt
+            error = check_divergence(setup, t + dt,
+                                     S[:, state_slot:state_slot + n_states].reshape(*batch, n_states))
+        if error is None:
+            raise RuntimeError(f"compiled loop: divergence event {event} not confirmed by "
+                               "check_divergence")
+        if setup.on_divergence == "raise":
+            raise error
+        status.update(diverged=1, message=str(error))
+    data = {name: out[col, :n_logged].reshape(n_logged, *batch) for col, name in enumerate(signals)}
+    return Log(time=log_steps[:n_logged] * dt, data=data, signals=signals, status=status)
+
+
+# ----------------------------------------------------------------------------------------------
+# the boat: scalar twins of fossen3dof.derivatives and autopilot.step, and its kernel
+# ----------------------------------------------------------------------------------------------
+
+def _thruster(T_cmd, alpha_cmd, lower, upper, L_m):
+    """Applied input sat(cmd) of the static actuator and its force, eq. (5): (T, α, τ_u, τ_v, τ_r)."""
+    T = _clip(T_cmd, lower[0], upper[0])
+    alpha = _clip(alpha_cmd, lower[1], upper[1])
+    lateral = T * math.sin(alpha)
+    return T, alpha, T * math.cos(alpha), lateral, -L_m * lateral
 
 
 def _boat_rhs(c, s, su, sv, sr, tau_u, tau_v, tau_r, M11, M22, M33, X_u, Y_v, N_r, N_rr, k_munk):
@@ -311,8 +487,12 @@ def _ship_loop(k0, k1, n_steps, hold, log_every, dt, S, div_event, out, ctrl_mod
                   has_ref, ref_table, has_d, dist, mp, cp, lower, upper, act_lim, limits)
 
 
+# ----------------------------------------------------------------------------------------------
+# the boat twin's entry points
+# ----------------------------------------------------------------------------------------------
+
 def _load():
-    """Import numba and wrap the kernel (compiled, or loaded from the cache, on first call)."""
+    """Import numba and wrap the boat kernel (compiled, or loaded from the cache, on first call)."""
     global _KERNEL, prange, _wrap, _clip, _thruster, _sin_cos_shifted, _boat_rhs, _autopilot
     global _run_ship
     if _KERNEL is None:
@@ -320,41 +500,15 @@ def _load():
 
         # the kernel finds its helpers as module globals: rebind them to their compiled versions
         prange = numba.prange
-        # fused multiply-add and x/c → x·(1/c) only: NaN and inf keep their meaning (divergence
-        # guard); results move at round-off level, ≈20 % faster
-        options = {"cache": True, "error_model": "numpy", "fastmath": {"contract", "arcp"}}
-        scalar = numba.njit(**options)  # LLVM inlines them into the kernel
-        _wrap, _clip, _thruster = scalar(_py(_wrap)), scalar(_py(_clip)), scalar(_py(_thruster))
-        _sin_cos_shifted, _boat_rhs, _autopilot = (
-            scalar(_py(_sin_cos_shifted)), scalar(_py(_boat_rhs)), scalar(_py(_autopilot)))
-        _run_ship = numba.njit(**options)(_py(_run_ship))
-        _KERNEL = numba.njit(parallel=True, **options)(_ship_loop)
+        _wrap, _clip, _thruster = jit(_wrap), jit(_clip), jit(_thruster)
+        _sin_cos_shifted, _boat_rhs, _autopilot = jit(_sin_cos_shifted), jit(_boat_rhs), jit(_autopilot)
+        _run_ship = jit(_run_ship)
+        _KERNEL = jit(_ship_loop, parallel=True)
     return _KERNEL
 
 
-def _py(function):
-    """The plain Python function behind a (possibly already wrapped) numba dispatcher."""
-    return getattr(function, "py_func", function)
-
-
-def _numba_error() -> str | None:
-    """None if numba imports, else the reason (checked once per process)."""
-    global _NUMBA_CHECKED, _NUMBA_ERROR
-    if not _NUMBA_CHECKED:
-        _NUMBA_CHECKED = True
-        try:
-            import numba  # noqa: F401
-        except Exception as exc:  # ImportError, or a broken install (llvmlite mismatch, ...)
-            _NUMBA_ERROR = f"numba cannot be imported ({type(exc).__name__}: {exc})"
-    return _NUMBA_ERROR
-
-
-# ----------------------------------------------------------------------------------------------
-# public entry points
-# ----------------------------------------------------------------------------------------------
-
 def unsupported_reason(setup) -> str | None:
-    """None when the compiled loop covers ``setup``, else a short reason in words."""
+    """None when the boat's compiled loop covers ``setup``, else a short reason in words."""
     from shipgnc.control.heading_speed import HeadingSpeedAutopilot
     from shipgnc.control.open_loop import OpenLoopSchedule
     from shipgnc.environment.disturbance import ConstantDisturbance
@@ -396,16 +550,14 @@ def unsupported_reason(setup) -> str | None:
 
 
 def run(setup):
-    """Run ``setup`` in the compiled loop; returns the same :class:`Log` as ``run_numpy(setup)``."""
+    """Run ``setup`` in the boat's compiled loop; returns the same ``Log`` as ``run_numpy(setup)``."""
     from shipgnc.control.heading_speed import HeadingSpeedAutopilot
     from shipgnc.control.open_loop import OpenLoopSchedule
-    from shipgnc.sim.simulator import Log, check_divergence, log_signals
 
     reason = unsupported_reason(setup)
     if reason:
         raise ConfigError(f"compiled loop: {reason}")
     kernel = _load()
-    import numba
 
     model, ctrl, gd, dist, act = (setup.model, setup.controller, setup.guidance,
                                   setup.disturbance, setup.actuator)
@@ -446,72 +598,21 @@ def run(setup):
     limits = _owned(model.state_limits)
     act_lim = _inside_limits(lower, upper)
 
-    signals = log_signals(setup)
     names = [s.name for s in model.states]
     names += [f"{s.name}_cmd" for s in model.inputs] + [s.name for s in model.inputs]
     if gd is not None:
         names += ["psi_d", "u_d", "psi_error", "u_error"]
     if ctrl_mode == CTRL_AUTOPILOT:
         names += ["psi_r", "r_r"]
-    if names != list(signals):  # the kernel's column layout must match the numpy loop's log
-        raise RuntimeError(f"compiled loop: log layout {names} differs from {list(signals)}")
-    n_log = n_steps // every + 1 + (1 if n_steps % every else 0)
-    out = np.empty((len(names), n_log, n_ships))  # written in place: no copy afterwards
+    signals = log_layout(setup, names)
+    out = np.empty((len(names), log_length(setup), n_ships))  # written in place: no copy afterwards
     div_event = np.full(n_ships, -1, dtype=np.int64)
 
-    # small runs on one thread: a parallel region waits for every worker thread, which costs a
-    # scheduler tick when the other cores are busy
-    threads = max(1, min(numba.get_num_threads(), n_ships, n_ships * n_steps // MIN_THREAD_WORK))
-
     def call(k0: int, k1: int) -> None:
-        previous = numba.get_num_threads()
-        numba.set_num_threads(threads)  # local to the calling thread
-        try:
-            kernel(k0, k1, n_steps, hold, every, dt, S, div_event, out, ctrl_mode, cmd_table,
-                   has_ref, ref_table, has_d, d, mp, cp, lower, upper, act_lim, limits)
-        finally:
-            numba.set_num_threads(previous)
+        kernel(k0, k1, n_steps, hold, every, dt, S, div_event, out, ctrl_mode, cmd_table,
+               has_ref, ref_table, has_d, d, mp, cp, lower, upper, act_lim, limits)
 
-    n_chunks = PROGRESS_CHUNKS if setup.progress is not None else 1
-    bounds = np.linspace(0, n_steps + 1, min(n_chunks, n_steps + 1) + 1).round().astype(int)
-    if setup.progress is not None:
-        setup.progress(0, n_steps)
-    event = None  # first divergence: 2k = bad command at sample k, 2k + 1 = bad state after step k
-    for k0, k1 in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
-        start = S.copy()
-        call(k0, k1)
-        if (div_event >= 0).any():
-            # the numpy loop stops the whole batch at the first bad sample: replay this chunk up to
-            # it, so that S holds every ship's command of that sample or state after that step
-            event = int(div_event[div_event >= 0].min())
-            S[:] = start
-            div_event[:] = -1
-            call(k0, event // 2 + 1)
-            break
-        if setup.progress is not None:
-            setup.progress(k1 - 1, n_steps)
-
-    log_steps = np.arange(0, n_steps + 1, every)
-    if n_steps % every:
-        log_steps = np.append(log_steps, n_steps)
-    status: dict = {"diverged": 0, "stopped_early": 0, "message": ""}
-    n_logged = n_log
-    if event is not None:
-        k = event // 2
-        if event % 2 == 0:  # the command of sample k: samples before k are logged
-            n_logged = (k - 1) // every + 1
-            error = check_divergence(setup, k * dt, command=S[:, CMD:CMD + 2].reshape(*batch, 2))
-        else:  # the state after step k: samples up to k are logged
-            n_logged = k // every + 1
-            t = k * dt
-            error = check_divergence(setup, t + dt, S[:, X0:X0 + 6].reshape(*batch, 6))
-        if error is None:
-            raise RuntimeError(f"compiled loop: divergence event {event} not confirmed by "
-                               "check_divergence")
-        if setup.on_divergence == "raise":
-            raise error
-        status.update(diverged=1, message=str(error))
-
+    event = drive(setup, call, S, div_event)
     if ctrl_mode == CTRL_AUTOPILOT:  # leave the controller as the numpy loop would
         ctrl.z = S[:, Z].reshape(batch).copy()
         ctrl.z_u = S[:, ZU].reshape(batch).copy()
@@ -519,20 +620,13 @@ def run(setup):
         ctrl.reference_model.rate = S[:, R_R].reshape(batch).copy()
         ctrl._logged = {"psi_r": S[:, SIG].reshape(batch).copy(),
                         "r_r": S[:, SIG + 1].reshape(batch).copy()}
-    data = {name: out[col, :n_logged].reshape(n_logged, *batch) for col, name in enumerate(names)}
-    return Log(time=log_steps[:n_logged] * dt, data=data, signals=signals, status=status)
+    return make_log(setup, signals, out, S, event, state_slot=X0, cmd_slot=CMD)
 
 
 def _lookup(schedule, t: np.ndarray) -> np.ndarray:
     """``schedule(t)`` for many times at once: the rule of :meth:`PiecewiseConstant.index`."""
     idx = np.searchsorted(schedule.times, t + 1e-9 * np.maximum(1.0, np.abs(t)), side="right") - 1
     return _owned(schedule.values[idx])
-
-
-def _owned(values) -> np.ndarray:
-    """A fresh, writeable, C-ordered float64 copy: one kernel signature whatever the caller passes
-    (numba compiles read-only or strided arrays as other types)."""
-    return np.array(values, dtype=np.float64, order="C", copy=True)
 
 
 def _inside_limits(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:

@@ -9,8 +9,9 @@ between. The plant (and any actuator lag) is integrated with fixed-step RK4 or w
 ``scipy.integrate.solve_ivp`` over each ``dt``. The last sample is t_end itself.
 
 Batched: ``x0`` of shape ``(..., n)`` simulates every leading index as one ship, in one array
-operation per RK stage. A compiled (numba) twin of the loop serves large batches of the built-in
-boat; ``backend="numpy"`` forces this readable reference loop.
+operation per RK stage. Compiled (numba) twins of the loop serve large runs of the built-in boat
+(:mod:`shipgnc.sim.compiled`) and of document 000's Mariner (:mod:`shipgnc.sim.compiled_mariner`);
+``backend="numpy"`` forces this readable reference loop.
 """
 
 from __future__ import annotations
@@ -29,8 +30,13 @@ from shipgnc.sim.integrators import rk4_step, solve_ivp_step
 
 INTEGRATORS = ("rk4", "solve_ivp")
 BACKENDS = ("auto", "numpy", "compiled")
-#: batch size from which ``backend="auto"`` uses the compiled loop (compilation then pays off)
+#: ``backend="auto"`` uses a compiled twin from this batch size (compilation then pays off) ...
 COMPILED_MIN_BATCH = 64
+#: ... or from this much work, ships × steps (a long run of a few ships); setups no twin covers
+#: run in the numpy loop
+COMPILED_MIN_WORK = 200_000
+#: the compiled twins (modules of ``shipgnc.sim``), asked in this order
+COMPILED_TWINS = ("compiled", "compiled_mariner")
 #: most steps of one run, and most logged numbers (8 bytes each, 4 GB) of one result
 MAX_STEPS = 1e8
 MAX_LOGGED = 5e8
@@ -103,6 +109,10 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     progress : ``progress(k, n_steps)`` called about a hundred times per run.
     log_every : keep every n-th sample (large batches); the final sample is always kept.
     batch_dims : names of the batch dimensions (default ``("ship",)`` for one batch axis).
+    backend : ``"numpy"`` (this loop), ``"compiled"`` (a numba twin; ConfigError naming each twin's
+        reason when none covers the setup) or ``"auto"``: a twin that covers the setup when the
+        batch has ≥ :data:`COMPILED_MIN_BATCH` ships or the run ≥ :data:`COMPILED_MIN_WORK`
+        ship-steps, else this loop. Both give the same result to round-off.
 
     Returns an ``xarray.Dataset`` (see :mod:`shipgnc.sim.result`).
     """
@@ -113,16 +123,16 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
                       log_every=log_every)
     require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
     log = None
-    wants_compiled = backend == "compiled" or (
-        backend == "auto" and math.prod(setup.batch_shape) >= COMPILED_MIN_BATCH)
+    n_ships = math.prod(setup.batch_shape)
+    wants_compiled = backend == "compiled" or (backend == "auto" and (
+        n_ships >= COMPILED_MIN_BATCH or n_ships * setup.n_steps >= COMPILED_MIN_WORK))
     if wants_compiled:
-        from shipgnc.sim import compiled
-
-        reason = compiled.unsupported_reason(setup)
-        if backend == "compiled" and reason:
-            raise ConfigError(f"backend = 'compiled': {reason}; use backend='numpy'")
-        if not reason:
-            log = compiled.run(setup)
+        twin, reasons = _compiled_twin(setup)
+        if twin is not None:
+            log = twin.run(setup)
+        elif backend == "compiled":
+            raise ConfigError(f"backend = 'compiled': no compiled loop covers this run "
+                              f"({'; '.join(reasons)}); use backend='numpy'")
     if log is None:
         log = run_numpy(setup)
     from shipgnc.sim.result import build_dataset
@@ -130,6 +140,21 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     run_attrs = {"integrator": integrator, "dt": dt, "Ts": dt * setup.hold, "t_end": t_end,
                  "model": type(model).__name__, **(attrs or {})}
     return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
+
+
+def _compiled_twin(setup: SimSetup):
+    """The first compiled twin covering ``setup`` (a module with ``run``), or None and each twin's
+    reason for refusing it."""
+    import importlib
+
+    reasons = []
+    for name in COMPILED_TWINS:
+        twin = importlib.import_module(f"shipgnc.sim.{name}")
+        reason = twin.unsupported_reason(setup)
+        if not reason:
+            return twin, []
+        reasons.append(reason)
+    return None, reasons
 
 
 def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturbance, u0,

@@ -1,0 +1,332 @@
+"""The Mariner's compiled (numba) loop against the numpy reference loop (document 000).
+
+Every comparison runs the same setup, on fresh components, through ``simulate(...,
+backend="numpy")`` and ``backend="compiled"`` and requires the same variables, sample times and
+attributes, values equal to 1e-9 relative (round-off of the variable's scale absolute), the same
+divergence errors and the components left in the same state.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from shipgnc.actuators import Actuator
+from shipgnc.control.feedback_linearization import LOSFL, fl_lookahead, fl_paper
+from shipgnc.control.lqr import PathLQR, design_lqr
+from shipgnc.control.open_loop import OpenLoopSchedule
+from shipgnc.environment.current import CrossCurrent
+from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
+from shipgnc.environment.filtered_noise import SecondOrderNoise
+from shipgnc.errors import ConfigError, DivergenceError
+from shipgnc.guidance.path import WaypointPath
+from shipgnc.guidance.schedule import ReferenceSchedule
+from shipgnc.models.mariner import DOC_B_R, DOC_D_Y, MarinerDisturbance, MarinerWitOppe, rudder
+from shipgnc.sim import compiled_mariner, simulator
+from shipgnc.sim.simulator import _validate, simulate
+from shipgnc.units import NAUTICAL_MILE as NM
+
+pytest.importorskip("numba")
+
+RTOL = 1e-9
+M = MarinerWitOppe()
+U = M.params.U
+K_SI = design_lqr(M.params, R=1.0).K_si
+DOC_PATH = WaypointPath(np.array([[0, 0], [10, 0], [12, 4], [18, 12]]) * NM)
+#: legs of 300 m and 292 m, then a half-line: ships switch legs twice within 90 s
+SHORT_PATH = WaypointPath(np.array([[0.0, 0.0], [300.0, 0.0], [450.0, 250.0], [1500.0, 1200.0]]))
+#: three ships near SHORT_PATH: off to port, to starboard turning, behind and slower
+X0_SHORT = np.array([[0.0, -120.0, 0.0, U, 0.0],
+                     [40.0, 60.0, 0.4, 0.9 * U, 0.002],
+                     [-50.0, 10.0, -0.3, U, -0.003]])
+X0_DOC = np.array([[0.0, -1.5 * NM, 0.0, U, 0.0], [0.0, 0.5 * NM, 0.2, U, 0.0]])
+
+CONTROLLERS = {
+    "lqr": lambda path: PathLQR(K_SI, path, Ts=0.3, anti_windup=False),
+    "lqr_anti_windup": lambda path: PathLQR(K_SI, path, Ts=0.3, anti_windup=True),
+    "fl_paper": lambda path: fl_paper(M.params, path, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y),
+    "fl_lookahead": lambda path: fl_lookahead(M.params, path, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y),
+    "los_fl": lambda path: LOSFL(M.params, path, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y),
+}
+
+
+def waves():
+    return SecondOrderNoise(sigma=0.02 / 60**2, period=8.0, zeta=0.1)
+
+
+def doc_disturbance(path, **kw):
+    return MarinerDisturbance(b_r=DOC_B_R, current=CrossCurrent(DOC_D_Y, path, **kw), waves=waves())
+
+
+DISTURBANCES = {
+    "none": lambda path: None,
+    "constant": lambda path: ConstantDisturbance([[DOC_B_R, 0.1, -0.2], [0.0, 0.0, 0.0],
+                                                  [-DOC_B_R, 0.3, 0.0]]),
+    "doc": doc_disturbance,
+}
+
+
+def components(ctrl, dist, path, rate_mode="ramp"):
+    return lambda: {"controller": CONTROLLERS[ctrl](path) if ctrl else None,
+                    "disturbance": DISTURBANCES[dist](path),
+                    "actuator": rudder(M.params, rate_mode=rate_mode)}
+
+
+def both(x0, make, **kw):
+    """Run the numpy and the compiled loop on fresh components from ``make()``; returns the two
+    results and the two sets of components."""
+    results, parts = [], []
+    for backend in ("numpy", "compiled"):
+        part = make()
+        results.append(simulate(M, x0, backend=backend, **part, **kw))
+        parts.append(part)
+    return (*results, *parts)
+
+
+def assert_same(ref, got, rtol=RTOL):
+    assert list(got.data_vars) == list(ref.data_vars)
+    assert got.sizes == ref.sizes
+    np.testing.assert_array_equal(got.time.values, ref.time.values)
+    assert got.attrs == ref.attrs
+    for name in ref.data_vars:
+        assert got[name].dims == ref[name].dims
+        assert got[name].attrs == ref[name].attrs
+        values = ref[name].values
+        scale = float(np.nanmax(np.abs(values), initial=1.0))
+        np.testing.assert_allclose(got[name].values, values, rtol=rtol, atol=1e-12 * scale,
+                                   err_msg=name)
+
+
+def assert_same_end_state(numpy_parts, compiled_parts):
+    """The controller (active leg, e_I, last signal values) and the current's tracker as the numpy
+    loop leaves them."""
+    a, b = numpy_parts["controller"], compiled_parts["controller"]
+    if a is not None:
+        np.testing.assert_array_equal(b.tracker.leg, a.tracker.leg)
+        assert b.tracker.leg.dtype == a.tracker.leg.dtype
+        if isinstance(a, PathLQR):
+            np.testing.assert_allclose(b.e_I, a.e_I, rtol=RTOL)
+        assert list(b.signal_values()) == list(a.signal_values())
+        for name, value in a.signal_values().items():
+            np.testing.assert_allclose(b.signal_values()[name], value, rtol=RTOL, atol=1e-9,
+                                       err_msg=name)
+    a, b = numpy_parts["disturbance"], compiled_parts["disturbance"]
+    if isinstance(a, MarinerDisturbance) and a.current is not None:
+        np.testing.assert_array_equal(b.current.tracker.leg, a.current.tracker.leg)
+
+
+@pytest.mark.parametrize("rate_mode", ["ramp", "hold"])
+@pytest.mark.parametrize("dist", sorted(DISTURBANCES))
+@pytest.mark.parametrize("ctrl", sorted(CONTROLLERS))
+def test_controllers_disturbances_rate_modes(ctrl, dist, rate_mode):
+    # fl_paper's zero dynamics (+0.11 /s) amplify round-off: a short horizon only
+    t_end = 30.0 if ctrl == "fl_paper" else 90.0
+    ref, got, parts_np, parts_c = both(X0_SHORT, components(ctrl, dist, SHORT_PATH, rate_mode),
+                                       t_end=t_end, dt=0.3, seed=11)
+    assert_same(ref, got)
+    assert_same_end_state(parts_np, parts_c)
+    assert got.sizes["ship"] == 3
+    assert {"cross_track_error", "heading_error", "leg"} <= set(got.data_vars)
+    if ctrl != "fl_paper":
+        assert got.leg.values.max() == 2  # both leg switches happen within the horizon
+
+
+@pytest.mark.parametrize("ctrl", ["lqr", "lqr_anti_windup", "fl_lookahead", "los_fl"])
+def test_document_capture_saturates_the_rudder(ctrl):
+    # the document's 1.5 nm capture: the rate limit ramps the rudder; the LQR and FL commands
+    # saturate (anti-windup acts)
+    ref, got, parts_np, parts_c = both(X0_DOC, components(ctrl, "doc", DOC_PATH), t_end=120.0,
+                                       dt=0.3, seed=5)
+    assert_same(ref, got)
+    assert_same_end_state(parts_np, parts_c)
+    if ctrl != "los_fl":
+        assert np.isclose(np.abs(got.delta_cmd.values).max(), M.params.delta_max)
+    assert np.abs(np.diff(got.delta.values, axis=0)).max() <= M.params.delta_rate * 0.3 * (1 + 1e-12)
+
+
+def test_sample_time_log_every_progress_and_batch_shape():
+    # Ts = 3 dt, log_every = 4 and progress chunks that end inside control and logging periods; a
+    # (2, 2) batch of ships; the global current frame
+    x0 = np.concatenate([X0_SHORT, [[10.0, -30.0, 0.1, U, 0.0]]]).reshape(2, 2, 5)
+    calls = []
+
+    def make():
+        return {"controller": LOSFL(M.params, SHORT_PATH, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y,
+                                    current_frame="global"),
+                "disturbance": doc_disturbance(SHORT_PATH, frame="global"),
+                "actuator": rudder(M.params)}
+
+    ref, got, parts_np, parts_c = both(x0, make, t_end=90.0, dt=0.1, seed=2, log_every=4,
+                                       progress=lambda k, n: calls.append((k, n)))
+    assert_same(ref, got)
+    assert_same_end_state(parts_np, parts_c)
+    assert got.psi.shape == (900 // 4 + 1, 2, 2)
+    assert got.time.values[-1] == 90.0
+    assert (0, 900) in calls and calls[-1] == (900, 900)
+
+
+def test_several_leg_switches_in_one_sample():
+    x0 = np.array([[500.0, 400.0, 0.7, U, 0.0], [0.0, -20.0, 0.0, U, 0.0]])
+    ref, got, parts_np, parts_c = both(x0, components("lqr", "doc", SHORT_PATH), t_end=30.0,
+                                       dt=0.3, seed=0)
+    assert_same(ref, got)
+    assert_same_end_state(parts_np, parts_c)
+    assert got.leg.values[0].tolist() == [2.0, 0.0]
+
+
+def test_open_loop_turn_with_constant_rudder():
+    make = lambda: {"disturbance": doc_disturbance(DOC_PATH), "u0": [0.2],  # noqa: E731
+                    "actuator": rudder(M.params)}
+    ref, got, _, _ = both(X0_DOC, make, t_end=300.0, dt=0.3, seed=4)
+    assert_same(ref, got)
+    assert list(got.data_vars) == ["north", "east", "psi", "u", "r", "delta_cmd", "delta"]
+    assert np.all(got.delta.values == 0.2)
+
+
+def test_edge_sizes():
+    for x0, t_end in ((np.zeros((0, 5)), 3.0), (X0_DOC[0], 0.3)):
+        ref, got, _, _ = both(x0, components("lqr", "doc", DOC_PATH), t_end=t_end, dt=0.3, seed=1)
+        assert_same(ref, got)
+
+
+def test_same_seed_same_sea_and_the_generator_is_used_alike():
+    make = components("fl_lookahead", "doc", DOC_PATH)
+    generators = [np.random.default_rng(8), np.random.default_rng(8)]
+    results, parts = [], []
+    for backend, rng in zip(("numpy", "compiled"), generators, strict=True):
+        part = make()
+        results.append(simulate(M, X0_DOC, t_end=60.0, dt=0.3, seed=rng, backend=backend, **part))
+        parts.append(part)
+    assert_same(*results)
+    # the wave filters and the generators end in the same state: the next sample of the sea agrees
+    after = [p["disturbance"].waves(60.3) for p in parts]
+    np.testing.assert_array_equal(after[1], after[0])
+    assert generators[0].random() == generators[1].random()
+    # and the waves matter: another seed, another run
+    other = simulate(M, X0_DOC, t_end=60.0, dt=0.3, seed=9, backend="compiled", **make())
+    assert not np.allclose(other.r.values, results[1].r.values, rtol=1e-6, atol=0)
+
+
+def test_wave_chunks_and_progress_give_identical_results(monkeypatch):
+    make = components("lqr", "doc", SHORT_PATH)
+    plain = simulate(M, X0_SHORT, t_end=60.0, dt=0.3, seed=3, backend="compiled", **make())
+    monkeypatch.setattr(compiled_mariner, "WAVE_CHUNK", 100)  # 7 steps of 3 ships per kernel call
+    chunked = simulate(M, X0_SHORT, t_end=60.0, dt=0.3, seed=3, backend="compiled",
+                       progress=lambda k, n: None, **make())
+    for name in plain.data_vars:
+        np.testing.assert_array_equal(chunked[name].values, plain[name].values)
+
+
+def far_north():
+    """Ship (1,) starts 30 m short of the runaway limit |north| <= 1e8 m, heading north."""
+    x0 = X0_DOC[[0, 1, 0]].copy()
+    x0[1, :3] = [1e8 - 30.0, 0.0, 0.0]
+    return x0
+
+
+def toward_the_path():
+    """Ship (2,) starts 5 m to port heading 29° to starboard: once its cross-track error passes
+    ~2 m the FL law with k1 = 1e308 and a known b_r = 1e308 forms ν − f = −inf − (−inf), a NaN
+    rudder command (the other ships stay to port, where ν − f = +inf: a saturated command)."""
+    return np.array([[0.0, -120.0, 0.0, U, 0.0], [40.0, -60.0, 0.4, 0.9 * U, 0.002],
+                     [0.0, -5.0, 0.5, U, 0.0]])
+
+
+DIVERGING = {  # name: (x0, components, expected signal, ship)
+    "state": (far_north, components("lqr", "doc", DOC_PATH), "north", (1,)),
+    # b_r = 1 rad/s² spins ship (2,): its speed loss W r² drives u past −100 m/s at t = 11.7 s
+    "spin": (lambda: X0_SHORT, lambda: {
+        "controller": PathLQR(K_SI, SHORT_PATH, Ts=0.3),
+        "disturbance": ConstantDisturbance([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]),
+        "actuator": rudder(M.params)}, "u", (2,)),
+    "command": (toward_the_path, lambda: {
+        "controller": fl_paper(M.params, SHORT_PATH, Ts=0.3, k1=1e308, b_r=1e308),
+        "actuator": rudder(M.params, rate_mode="hold")}, "delta", (2,)),
+}
+
+
+@pytest.mark.parametrize("case", sorted(DIVERGING))
+def test_divergence_raises_the_same_error(case):
+    x0, make, signal, ship = DIVERGING[case]
+    errors = []
+    for backend in ("numpy", "compiled"):
+        with pytest.raises(DivergenceError) as info, np.errstate(all="ignore"):
+            simulate(M, x0(), t_end=120.0, dt=0.3, seed=1, backend=backend, **make())
+        errors.append(info.value)
+    ref, got = errors
+    assert str(got) == str(ref)
+    assert (got.time, got.state, got.index) == (ref.time, ref.state, ref.index)
+    assert got.value == pytest.approx(ref.value, rel=RTOL, nan_ok=True)
+    assert got.state == signal and got.index == ship and 0 < got.time < 120
+
+
+@pytest.mark.parametrize("case", sorted(DIVERGING))
+def test_divergence_stop_keeps_the_same_partial_result(case):
+    x0, make, _, _ = DIVERGING[case]
+    with np.errstate(all="ignore"):
+        ref, got, _, _ = both(x0(), make, t_end=120.0, dt=0.3, seed=1, on_divergence="stop",
+                              log_every=3, progress=lambda k, n: None)
+    assert got.attrs["diverged"] == 1 and got.attrs["message"].startswith("simulation diverged")
+    assert got.attrs["message"] == ref.attrs["message"]
+    assert_same(ref, got)
+    assert 0 < got.time.values[-1] < 120
+
+
+def setup_of(**kw):
+    base = dict(t_end=3.0, dt=0.3, controller=PathLQR(K_SI, DOC_PATH, Ts=0.3),
+                actuator=rudder(M.params), guidance=None, disturbance=None, u0=None,
+                integrator="rk4", method="RK45", rtol=1e-3, atol=1e-6, seed=None,
+                on_divergence="raise", observer=None, progress=None, log_every=1)
+    return _validate(M, X0_DOC, **{**base, **kw})
+
+
+def test_unsupported_reasons():
+    reason = compiled_mariner.unsupported_reason
+    assert reason(setup_of()) is None
+    assert reason(setup_of(disturbance=doc_disturbance(DOC_PATH), controller=None)) is None
+    cases = {
+        "GaussianForceNoise": {"disturbance": GaussianForceNoise([1e-4, 0.0, 0.0])},
+        "OpenLoopSchedule": {"controller": OpenLoopSchedule([0.0], [[0.1]])},
+        "guidance": {"guidance": ReferenceSchedule([0.0], [0.0], [U])},
+        "lag": {"actuator": Actuator([-0.6], [0.6], tau=[2.0], names=("delta",))},
+        "solve_ivp": {"integrator": "solve_ivp"},
+        "observer": {"observer": lambda t, x, c, u: None},
+        "do not fit": {"disturbance": ConstantDisturbance([[0.0, 0.0, 0.0]] * 4)},
+    }
+    for word, kw in cases.items():
+        text = reason(setup_of(**kw))
+        assert text and word in text, (word, text)
+    from shipgnc.models.fossen3dof import VectoredThrustBoat
+
+    boat = _validate(VectoredThrustBoat(), np.zeros(6), t_end=1.0, dt=0.05, controller=None,
+                     actuator=None, guidance=None, disturbance=None, u0=None, integrator="rk4",
+                     method="RK45", rtol=1e-3, atol=1e-6, seed=None, on_divergence="raise",
+                     observer=None, progress=None, log_every=1)
+    assert "MarinerWitOppe" in reason(boat)
+
+
+def test_compiled_backend_refuses_an_uncovered_mariner_setup():
+    with pytest.raises(ConfigError, match="GaussianForceNoise") as info:
+        simulate(M, X0_DOC, t_end=3.0, dt=0.3, controller=PathLQR(K_SI, DOC_PATH, Ts=0.3),
+                 disturbance=GaussianForceNoise([1e-4, 0.0, 0.0]), backend="compiled")
+    assert "backend='numpy'" in str(info.value)
+
+
+def test_auto_backend_picks_the_twin_by_batch_or_work(monkeypatch):
+    calls = []
+    run = compiled_mariner.run
+    monkeypatch.setattr(compiled_mariner, "run", lambda setup: calls.append(setup) or run(setup))
+    make = components("lqr", "doc", DOC_PATH)
+    simulate(M, X0_DOC, t_end=30.0, dt=0.3, seed=1, **make())  # 2 ships × 100 steps: numpy
+    assert calls == []
+    monkeypatch.setattr(simulator, "COMPILED_MIN_WORK", 200)
+    simulate(M, X0_DOC, t_end=30.0, dt=0.3, seed=1, **make())  # 200 ship-steps: compiled
+    assert len(calls) == 1
+    # not covered: the numpy loop, silently
+    simulate(M, X0_DOC, t_end=30.0, dt=0.3, seed=1, controller=PathLQR(K_SI, DOC_PATH, Ts=0.3),
+             disturbance=GaussianForceNoise([1e-4, 0.0, 0.0]))
+    assert len(calls) == 1
+    # a batch of COMPILED_MIN_BATCH ships: compiled, however short the run
+    x0 = np.repeat(X0_DOC[:1], simulator.COMPILED_MIN_BATCH, axis=0)
+    simulate(M, x0, t_end=0.6, dt=0.3, seed=1, **make())
+    assert len(calls) == 2
