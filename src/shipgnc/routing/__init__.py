@@ -1,0 +1,42 @@
+"""Time-optimal routing in a current (Zermelo's problem, spec 002).
+
+* :mod:`~shipgnc.routing.fields`: current fields v(x, t) (spec 002 §2.9.1), usable by the router and
+  as a ship's current in the simulation loop;
+* :mod:`~shipgnc.routing.pmp`: Pontryagin extremals, shooting, the batched global sweep (§2.4–2.6, 2.9.4);
+* :mod:`~shipgnc.routing.levelset` and :mod:`~shipgnc.routing.graph`: global checks (§2.9.2);
+* :mod:`~shipgnc.routing.obstacles`: polygons, vertex decomposition (§2.9.3);
+* :mod:`~shipgnc.routing.router`: :func:`solve_route`, the front door returning a
+  :class:`~shipgnc.routing.result.RouteResult`.
+
+Every public interface is SI: m, s, m/s, rad; NED positions (north, east); headings clockwise from north.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_LAZY = {
+    "UniformCurrent": "shipgnc.routing.fields",
+    "AffineCurrent": "shipgnc.routing.fields",
+    "RigidRotation": "shipgnc.routing.fields",
+    "RankineVortex": "shipgnc.routing.fields",
+    "LambOseenVortex": "shipgnc.routing.fields",
+    "SumField": "shipgnc.routing.fields",
+    "Modulated": "shipgnc.routing.fields",
+    "GriddedCurrent": "shipgnc.routing.fields",
+    "shear": "shipgnc.routing.fields",
+    "sample_field": "shipgnc.routing.fields",
+    "parse_field": "shipgnc.routing.field_spec",
+    "solve_route": "shipgnc.routing.router",
+    "RouteResult": "shipgnc.routing.result",
+    "Unreachable": "shipgnc.routing.result",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'shipgnc.routing' has no attribute {name!r}")

@@ -1,0 +1,498 @@
+"""Current fields v(x, t) in NED, SI (spec 002 §2.9.1).
+
+One protocol serves the router and the simulation loop:
+
+* ``velocity(t, north, east) -> (..., 2)``: the water's velocity over ground (v_N, v_E) [m/s];
+* ``jacobian(t, north, east) -> (..., 2, 2)``: J[i, j] = ∂v_i/∂x_j [1/s], used by the costate
+  equation (2.3) and the heading rate (2.5);
+* ``__call__(t, x)`` with ``x[..., 0]`` north and ``x[..., 1]`` east, plus ``per_stage = True`` and
+  ``reset``: the disturbance protocol of :mod:`shipgnc.environment.disturbance`, so the same object is a
+  ship's current, evaluated at every RK stage.
+
+``north`` and ``east`` broadcast against each other (leading batch axes); ``t`` is a scalar or broadcasts
+too. Positive ω and Γ turn clockwise on a north-up chart (positive about NED's down axis).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+
+__all__ = [
+    "AffineCurrent",
+    "CurrentField",
+    "FieldDomainError",
+    "GriddedCurrent",
+    "LambOseenVortex",
+    "Modulated",
+    "RankineVortex",
+    "RigidRotation",
+    "SumField",
+    "UniformCurrent",
+    "sample_field",
+    "shear",
+]
+
+
+class FieldDomainError(ConfigError):
+    """A gridded field was queried outside its grid (spec 002 F9); the message names point and extent."""
+
+
+def _finite(value, field: str) -> float:
+    require(isinstance(value, (int, float, np.floating, np.integer)) and math.isfinite(float(value)),
+            field, value, "must be a finite number")
+    return float(value)
+
+
+def _shape(t, north, east):
+    return np.broadcast_shapes(np.shape(t), np.shape(north), np.shape(east))
+
+
+class CurrentField:
+    """Base class: a steady or time-varying current field (see the module docstring)."""
+
+    per_stage = True
+    steady = True
+    #: ((north_min, north_max), (east_min, east_max)) for gridded data, else None
+    bounds: tuple[tuple[float, float], tuple[float, float]] | None = None
+
+    def velocity(self, t, north, east) -> np.ndarray:
+        raise NotImplementedError
+
+    def jacobian(self, t, north, east) -> np.ndarray:
+        raise NotImplementedError
+
+    def describe(self) -> str:
+        return type(self).__name__
+
+    # --- unchecked evaluation (used inside integrators that handle the domain themselves) ---
+    def _velocity(self, t, north, east) -> np.ndarray:
+        return self.velocity(t, north, east)
+
+    def _jacobian(self, t, north, east) -> np.ndarray:
+        return self.jacobian(t, north, east)
+
+    # --- disturbance protocol (shipgnc.environment.disturbance) ---
+    def reset(self, batch_shape=(), rng=None) -> None:
+        """Nothing to reset: a field is a pure function of (t, x)."""
+
+    def __call__(self, t, x) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        return self.velocity(t, x[..., 0], x[..., 1])
+
+    def __add__(self, other: CurrentField) -> SumField:
+        return SumField([self, other])
+
+    def max_speed(self, bounds, t=0.0, n: int = 81) -> float:
+        """Largest |v| [m/s] sampled on an n×n grid over ``bounds`` (a CFL and scale estimate)."""
+        (n0, n1), (e0, e1) = bounds
+        nn, ee = np.meshgrid(np.linspace(n0, n1, n), np.linspace(e0, e1, n), indexing="ij")
+        return float(np.max(np.linalg.norm(self._velocity(t, nn, ee), axis=-1)))
+
+
+@dataclass(frozen=True)
+class UniformCurrent(CurrentField):
+    """A uniform current c₀ = (north, east) [m/s] (spec 002 §2.9.1, section 2.10)."""
+
+    north: float = 0.0
+    east: float = 0.0
+
+    def __post_init__(self):
+        _finite(self.north, "current.north")
+        _finite(self.east, "current.east")
+
+    def velocity(self, t, north, east):
+        shape = _shape(t, north, east)
+        out = np.empty((*shape, 2))
+        out[..., 0], out[..., 1] = self.north, self.east
+        return out
+
+    def jacobian(self, t, north, east):
+        return np.zeros((*_shape(t, north, east), 2, 2))
+
+    def describe(self):
+        return f"uniform current ({self.north:.6g}, {self.east:.6g}) m/s"
+
+
+@dataclass(frozen=True)
+class AffineCurrent(CurrentField):
+    """v = v₀ + G (x − x_ref) (spec 002 §2.9.1); the document's shear is G = [[0, 0], [k, 0]] (§2.5)."""
+
+    v0: tuple[float, float] = (0.0, 0.0)
+    gradient: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
+    ref: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self):
+        for name, value in (("v0", self.v0), ("gradient", self.gradient), ("ref", self.ref)):
+            arr = np.asarray(value, dtype=float)
+            require(bool(np.all(np.isfinite(arr))), f"current.{name}", value, "must be finite")
+
+    def velocity(self, t, north, east):
+        shape = _shape(t, north, east)
+        g = np.asarray(self.gradient, dtype=float)
+        dn = np.broadcast_to(np.asarray(north, float) - self.ref[0], shape)
+        de = np.broadcast_to(np.asarray(east, float) - self.ref[1], shape)
+        return np.stack([self.v0[0] + g[0, 0] * dn + g[0, 1] * de,
+                         self.v0[1] + g[1, 0] * dn + g[1, 1] * de], axis=-1)
+
+    def jacobian(self, t, north, east):
+        return np.broadcast_to(np.asarray(self.gradient, float), (*_shape(t, north, east), 2, 2)).copy()
+
+    def describe(self):
+        g = np.asarray(self.gradient)
+        if np.allclose([g[0, 0], g[0, 1], g[1, 1], *self.v0], 0.0):
+            return f"shear v_E = k·(x_N − {self.ref[0]:g} m), k = {g[1, 0]:.6g} 1/s"
+        return f"affine current v0 = {tuple(self.v0)} m/s, G = {g.tolist()} 1/s"
+
+
+def shear(k: float, s: float = 0.0) -> AffineCurrent:
+    """The document's linear shear v = (0, k (x_N − s)) [k in 1/s, s in m] (spec 002 §2.5)."""
+    _finite(k, "shear.k")
+    return AffineCurrent((0.0, 0.0), ((0.0, 0.0), (float(k), 0.0)), (float(s), 0.0))
+
+
+@dataclass(frozen=True)
+class RigidRotation(CurrentField):
+    """Rigid rotation ω [rad/s] about ``centre`` (north, east) [m]: v = ω (−r_E, r_N), clockwise for ω > 0."""
+
+    omega: float
+    centre: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self):
+        _finite(self.omega, "rotation.omega")
+
+    def velocity(self, t, north, east):
+        shape = _shape(t, north, east)
+        rn = np.broadcast_to(np.asarray(north, float) - self.centre[0], shape)
+        re = np.broadcast_to(np.asarray(east, float) - self.centre[1], shape)
+        return np.stack([-self.omega * re, self.omega * rn], axis=-1)
+
+    def jacobian(self, t, north, east):
+        j = np.array([[0.0, -self.omega], [self.omega, 0.0]])
+        return np.broadcast_to(j, (*_shape(t, north, east), 2, 2)).copy()
+
+    def describe(self):
+        return f"rigid rotation ω = {self.omega:.6g} rad/s about {tuple(self.centre)} m"
+
+
+class _Vortex(CurrentField):
+    """Axisymmetric vortex v = f(q)·(−r_E, r_N), q = r², with tangential speed v_t = r f(q)."""
+
+    gamma: float
+    rc: float
+    centre: tuple[float, float]
+
+    def _check(self, name):
+        _finite(self.gamma, f"{name}.gamma")
+        require(_finite(self.rc, f"{name}.rc") > 0, f"{name}.rc", self.rc, "core radius must be > 0 m")
+
+    def _f(self, q):  # returns f(q), f'(q)
+        raise NotImplementedError
+
+    def _parts(self, t, north, east):
+        shape = _shape(t, north, east)
+        rn = np.broadcast_to(np.asarray(north, float) - self.centre[0], shape)
+        re = np.broadcast_to(np.asarray(east, float) - self.centre[1], shape)
+        return rn, re, *self._f(rn * rn + re * re)
+
+    def velocity(self, t, north, east):
+        rn, re, f, _ = self._parts(t, north, east)
+        return np.stack([-f * re, f * rn], axis=-1)
+
+    def jacobian(self, t, north, east):
+        rn, re, f, df = self._parts(t, north, east)
+        # v = f(q) a, a = (−r_E, r_N), ∇q = 2 (r_N, r_E):  J = f R + a ⊗ (2 f' r)
+        j = np.empty((*rn.shape, 2, 2))
+        j[..., 0, 0] = -re * 2 * df * rn
+        j[..., 0, 1] = -f - re * 2 * df * re
+        j[..., 1, 0] = f + rn * 2 * df * rn
+        j[..., 1, 1] = rn * 2 * df * re
+        return j
+
+    def tangential_speed(self, r):
+        r = np.asarray(r, dtype=float)
+        return r * self._f(r * r)[0]
+
+
+@dataclass(frozen=True)
+class LambOseenVortex(_Vortex):
+    """Lamb–Oseen vortex v_t = Γ/(2πr)·(1 − exp(−r²/r_c²)) [Γ in m²/s, r_c in m] (spec 002 §2.9.1)."""
+
+    gamma: float
+    rc: float
+    centre: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self):
+        self._check("lamb-oseen")
+
+    def _f(self, q):
+        c = self.rc**2
+        a = self.gamma / (2 * math.pi)
+        small = q < 1e-6 * c
+        qs = np.where(small, c, q)
+        e = np.exp(-qs / c)
+        f = np.where(small, (1 - q / (2 * c) + q * q / (6 * c * c)) / c, -np.expm1(-qs / c) / qs)
+        df = np.where(small, -1 / (2 * c * c) + q / (3 * c**3), e / (c * qs) + np.expm1(-qs / c) / qs**2)
+        return a * f, a * df
+
+    def describe(self):
+        return (f"Lamb–Oseen vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m "
+                f"at {tuple(self.centre)} m")
+
+
+@dataclass(frozen=True)
+class RankineVortex(_Vortex):
+    """Rankine vortex: v_t = Γr/(2πr_c²) inside r_c, Γ/(2πr) outside; its Jacobian jumps at r_c."""
+
+    gamma: float
+    rc: float
+    centre: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self):
+        self._check("rankine")
+
+    def _f(self, q):
+        c = self.rc**2
+        a = self.gamma / (2 * math.pi)
+        inside = q <= c
+        qs = np.where(inside, c, q)
+        return a * np.where(inside, 1 / c, 1 / qs), a * np.where(inside, 0.0, -1 / qs**2)
+
+    def describe(self):
+        return (f"Rankine vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m "
+                f"at {tuple(self.centre)} m")
+
+
+class SumField(CurrentField):
+    """The sum of several fields (spec 002 §2.9.1)."""
+
+    def __init__(self, fields):
+        flat = []
+        for f in fields:
+            require(isinstance(f, CurrentField), "field", f, "must be a CurrentField")
+            flat.extend(f.fields if isinstance(f, SumField) else [f])
+        require(len(flat) > 0, "field", fields, "a sum needs at least one field")
+        self.fields = tuple(flat)
+        self.steady = all(f.steady for f in flat)
+        boxes = [f.bounds for f in flat if f.bounds is not None]
+        if boxes:
+            self.bounds = ((max(b[0][0] for b in boxes), min(b[0][1] for b in boxes)),
+                           (max(b[1][0] for b in boxes), min(b[1][1] for b in boxes)))
+
+    def velocity(self, t, north, east):
+        return sum(f.velocity(t, north, east) for f in self.fields)
+
+    def jacobian(self, t, north, east):
+        return sum(f.jacobian(t, north, east) for f in self.fields)
+
+    def _velocity(self, t, north, east):
+        return sum(f._velocity(t, north, east) for f in self.fields)
+
+    def _jacobian(self, t, north, east):
+        return sum(f._jacobian(t, north, east) for f in self.fields)
+
+    def describe(self):
+        return " + ".join(f.describe() for f in self.fields)
+
+
+class Modulated(CurrentField):
+    """A field scaled in time: v(x, t) = m(t)·w(x), m(t) = mean + amplitude·cos(2πt/period + phase).
+
+    The tidal uniform current of spec 002 §2.9.5 is ``Modulated(UniformCurrent(0, c), 0, 1, T, φ)``; its
+    tidally modulated shear k(t) = k(1 + 0.5 sin(2πt/T)) is ``Modulated(shear(k), 1, 0.5, T, −π/2)``.
+    """
+
+    steady = False
+
+    def __init__(self, field: CurrentField, mean: float = 1.0, amplitude: float = 0.0,
+                 period: float = 12.42 * 3600.0, phase: float = 0.0):
+        require(isinstance(field, CurrentField), "field", field, "must be a CurrentField")
+        self.field = field
+        self.mean, self.amplitude = _finite(mean, "tide.mean"), _finite(amplitude, "tide.amplitude")
+        require(_finite(period, "tide.period") > 0, "tide.period", period, "must be > 0 s")
+        self.period, self.phase = float(period), _finite(phase, "tide.phase")
+        self.bounds = field.bounds
+
+    def factor(self, t):
+        w = 2 * np.pi / self.period
+        return self.mean + self.amplitude * np.cos(w * np.asarray(t, float) + self.phase)
+
+    def factor_integral(self, t0, t1):
+        """∫_{t0}^{t1} m(t) dt [s] (closed form)."""
+        w = 2 * np.pi / self.period
+        return (self.mean * (t1 - t0)
+                + self.amplitude / w * (np.sin(w * t1 + self.phase) - np.sin(w * t0 + self.phase)))
+
+    def velocity(self, t, north, east):
+        return np.asarray(self.factor(t))[..., None] * self.field.velocity(t, north, east)
+
+    def jacobian(self, t, north, east):
+        return np.asarray(self.factor(t))[..., None, None] * self.field.jacobian(t, north, east)
+
+    def _velocity(self, t, north, east):
+        return np.asarray(self.factor(t))[..., None] * self.field._velocity(t, north, east)
+
+    def _jacobian(self, t, north, east):
+        return np.asarray(self.factor(t))[..., None, None] * self.field._jacobian(t, north, east)
+
+    def describe(self):
+        return (f"({self.field.describe()}) × ({self.mean:g} + {self.amplitude:g}·cos(2πt/"
+                f"{self.period:g} s + {self.phase:g}))")
+
+
+class GriddedCurrent(CurrentField):
+    """Gridded data (spec 002 §2.9.1): an ``xarray.Dataset`` with ``current_north`` and ``current_east``
+    [m/s] on coordinates ``north`` and ``east`` [m], optionally ``time`` [s].
+
+    ``method="linear"`` interpolates bilinearly (exact for affine fields), ``"cubic"`` with a bicubic spline
+    (scipy's ``RectBivariateSpline``); the Jacobian is the derivative of the same interpolant. In time the
+    data is interpolated linearly. A query outside the grid raises :class:`FieldDomainError`, never
+    extrapolates (F9).
+    """
+
+    def __init__(self, dataset, method: str = "linear"):
+        require(method in ("linear", "cubic"), "field.method", method, "allowed: linear, cubic")
+        for name in ("current_north", "current_east"):
+            require(name in dataset.data_vars, "field.dataset", sorted(dataset.data_vars),
+                    f"needs a variable {name!r} [m/s]")
+        for name in ("north", "east"):
+            require(name in dataset.coords, "field.dataset", sorted(dataset.coords),
+                    f"needs a coordinate {name!r} [m]")
+        self.method = method
+        has_time = "time" in dataset.dims
+        order = (("time",) if has_time else ()) + ("north", "east")
+        vn = dataset["current_north"].transpose(*order).values.astype(float)
+        ve = dataset["current_east"].transpose(*order).values.astype(float)
+        self.n = np.asarray(dataset["north"].values, float)
+        self.e = np.asarray(dataset["east"].values, float)
+        for name, axis in (("north", self.n), ("east", self.e)):
+            require(axis.size >= (4 if method == "cubic" else 2) and bool(np.all(np.diff(axis) > 0)),
+                    f"field.{name}", f"{axis.size} values",
+                    "must increase strictly, at least 2 (4 for cubic)")
+        require(bool(np.all(np.isfinite(vn)) and np.all(np.isfinite(ve))), "field.current", "NaN/inf",
+                "gridded current values must be finite")
+        if has_time:
+            self.times = np.asarray(dataset["time"].values, float)
+            require(bool(np.all(np.diff(self.times) > 0)), "field.time", self.times.size,
+                    "must increase strictly")
+            self.steady = self.times.size == 1
+        else:
+            self.times = np.zeros(1)
+            vn, ve = vn[None], ve[None]
+        self.data = np.stack([vn, ve], axis=-1)  # (time, north, east, 2)
+        self.bounds = ((float(self.n[0]), float(self.n[-1])), (float(self.e[0]), float(self.e[-1])))
+        self._splines = None
+        if method == "cubic":
+            from scipy.interpolate import RectBivariateSpline
+
+            self._splines = [[RectBivariateSpline(self.n, self.e, self.data[k, :, :, c], kx=3, ky=3)
+                              for c in range(2)] for k in range(self.times.size)]
+
+    @classmethod
+    def from_netcdf(cls, path, method: str = "linear") -> GriddedCurrent:
+        import xarray as xr
+
+        try:
+            with xr.open_dataset(path) as ds:
+                ds.load()
+        except (OSError, ValueError) as exc:
+            raise ConfigError(f"field = {str(path)!r}: cannot read as NetCDF ({exc})") from None
+        return cls(ds, method)
+
+    def describe(self):
+        (n0, n1), (e0, e1) = self.bounds
+        return (f"gridded current ({self.method}) on N [{n0:g}, {n1:g}] m × E [{e0:g}, {e1:g}] m, "
+                f"{self.n.size}×{self.e.size} points")
+
+    def contains(self, north, east):
+        (n0, n1), (e0, e1) = self.bounds
+        north, east = np.asarray(north), np.asarray(east)
+        return (north >= n0) & (north <= n1) & (east >= e0) & (east <= e1)
+
+    def _check_domain(self, north, east):
+        inside = self.contains(north, east)
+        if not np.all(inside):
+            nn, ee = np.broadcast_arrays(np.asarray(north, float), np.asarray(east, float))
+            k = np.flatnonzero(~np.broadcast_to(inside, nn.shape))[0]
+            (n0, n1), (e0, e1) = self.bounds
+            raise FieldDomainError(
+                f"field query at (north, east) = ({nn.flat[k]:.6g}, {ee.flat[k]:.6g}) m: outside the gridded "
+                f"field's extent N [{n0:g}, {n1:g}] m × E [{e0:g}, {e1:g}] m (no extrapolation)")
+
+    def velocity(self, t, north, east):
+        self._check_domain(north, east)
+        return self._eval(t, north, east, deriv=False)
+
+    def jacobian(self, t, north, east):
+        self._check_domain(north, east)
+        return self._eval(t, north, east, deriv=True)
+
+    def _velocity(self, t, north, east):
+        return self._eval(t, north, east, deriv=False)
+
+    def _jacobian(self, t, north, east):
+        return self._eval(t, north, east, deriv=True)
+
+    def _eval(self, t, north, east, deriv):
+        shape = _shape(t, north, east)
+        (n0, n1), (e0, e1) = self.bounds
+        nn = np.clip(np.broadcast_to(np.asarray(north, float), shape), n0, n1).ravel()
+        ee = np.clip(np.broadcast_to(np.asarray(east, float), shape), e0, e1).ravel()
+        tt = np.broadcast_to(np.asarray(t, float), shape).ravel()
+        if self.times.size == 1:
+            out = self._slice(0, nn, ee, deriv)
+        else:
+            k = np.clip(np.searchsorted(self.times, tt, side="right") - 1, 0, self.times.size - 2)
+            w = np.clip((tt - self.times[k]) / (self.times[k + 1] - self.times[k]), 0.0, 1.0)
+            out = np.empty((nn.size, 2, 2) if deriv else (nn.size, 2))
+            for kk in np.unique(k):
+                m = k == kk
+                ww = w[m].reshape((-1,) + (1,) * (out.ndim - 1))
+                out[m] = ((1 - ww) * self._slice(kk, nn[m], ee[m], deriv)
+                          + ww * self._slice(kk + 1, nn[m], ee[m], deriv))
+        return out.reshape((*shape, 2, 2) if deriv else (*shape, 2))
+
+    def _slice(self, k, nn, ee, deriv):
+        if self._splines is not None:
+            sp = self._splines[k]
+            if not deriv:
+                return np.stack([sp[c].ev(nn, ee) for c in range(2)], axis=-1)
+            return np.stack([np.stack([sp[c].ev(nn, ee, dx=1), sp[c].ev(nn, ee, dy=1)], axis=-1)
+                             for c in range(2)], axis=-2)
+        i = np.clip(np.searchsorted(self.n, nn, side="right") - 1, 0, self.n.size - 2)
+        j = np.clip(np.searchsorted(self.e, ee, side="right") - 1, 0, self.e.size - 2)
+        hn, he = self.n[i + 1] - self.n[i], self.e[j + 1] - self.e[j]
+        a, b = ((nn - self.n[i]) / hn)[:, None], ((ee - self.e[j]) / he)[:, None]
+        d = self.data[k]
+        f00, f01, f10, f11 = d[i, j], d[i, j + 1], d[i + 1, j], d[i + 1, j + 1]
+        if not deriv:
+            return (1 - a) * (1 - b) * f00 + (1 - a) * b * f01 + a * (1 - b) * f10 + a * b * f11
+        dn = ((1 - b) * (f10 - f00) + b * (f11 - f01)) / hn[:, None]
+        de = ((1 - a) * (f01 - f00) + a * (f11 - f10)) / he[:, None]
+        return np.stack([dn, de], axis=-1)
+
+
+def sample_field(field: CurrentField, north, east, times=None):
+    """Sample a field on a grid as the ``xarray.Dataset`` that :class:`GriddedCurrent` reads."""
+    import xarray as xr
+
+    north, east = np.asarray(north, float), np.asarray(east, float)
+    nn, ee = np.meshgrid(north, east, indexing="ij")
+    attrs = {"units": "m/s"}
+    if times is None:
+        v = field.velocity(0.0, nn, ee)
+        dims = ("north", "east")
+        coords = {"north": ("north", north, {"units": "m"}), "east": ("east", east, {"units": "m"})}
+        data = {"current_north": (dims, v[..., 0], attrs), "current_east": (dims, v[..., 1], attrs)}
+    else:
+        times = np.asarray(times, float)
+        v = np.stack([field.velocity(t, nn, ee) for t in times])
+        dims = ("time", "north", "east")
+        coords = {"time": ("time", times, {"units": "s"}), "north": ("north", north, {"units": "m"}),
+                  "east": ("east", east, {"units": "m"})}
+        data = {"current_north": (dims, v[..., 0], attrs), "current_east": (dims, v[..., 1], attrs)}
+    return xr.Dataset(data, coords=coords)
