@@ -175,8 +175,13 @@ class CatamaranParams:
     def resistance_over_speed(self, V):
         """R(V)/V [N s/m], finite at V = 0 (0 for the continued fit; R's direction is −(u, v)/V)."""
         V = np.asarray(V, dtype=float)
-        safe = np.where(V > 0, V, 1.0)
-        return np.where(V > 0, self.resistance(safe) / safe, 0.0)
+        a0, a1, a2 = RK_COEFFS
+        with np.errstate(divide="ignore", invalid="ignore"):
+            fit = 2000.0 * (a0 / V + a1 + a2 * V)
+        if self.low_speed == "literal":
+            return np.where(V > 0, fit, 0.0)
+        rk_min = a0 + a1 * V_MIN_FIT + a2 * V_MIN_FIT**2
+        return np.where(V >= V_MIN_FIT, fit, (2000.0 * rk_min / V_MIN_FIT**2) * V)
 
     def top_speed(self) -> float:
         """Straight-running speed: 2 T_v = R(V), i.e. 2.536 V² − 8.436 V + (8.1 − T_v/1000) = 0."""
@@ -283,7 +288,7 @@ class Catamaran:
             X, Y, N = X + d[..., 0], Y + d[..., 1], N + d[..., 2]
         north_dot, east_dot = body_to_ned(x[..., PSI], x[..., U], x[..., V])
         if p.delta_row == "rate":
-            delta_dot = u[..., 0] + 0.0 * delta
+            delta_dot = np.broadcast_to(u[..., 0], delta.shape)
         else:
             delta_dot = (-delta + p.k_t * u[..., 0]) / p.T_t
         return np.stack([X / p.m_x, Y / p.m_y, N / p.J, north_dot, east_dot, x[..., R], delta_dot],

@@ -1,0 +1,415 @@
+"""The finite-state method (FSM) of document 004, general and for the catamaran's yaw rate.
+
+**General form** (spec 004 §4.5, eq. (12)–(15)). For an affine system ż = Φ(t, z) + B u and a
+smooth criterion J(z) with target J*, predict the free motion over a horizon h,
+
+    z̄ ≈ z + h Φ(t, z),   W ≈ I + h ∂Φ/∂z(t, z)                              (15)
+
+and require dJ/dt = (J* − J(z̄))/T_u along the controlled motion:
+
+    G u = f_J,   G = (∂J/∂z̄)ᵀ W B,   u = G⁺ f_J,   f_J = (J* − J(z̄))/T_u       (13)
+
+(G⁺ the Moore–Penrose pseudo-inverse: the minimum-norm control for several inputs).
+:func:`fsm_control` evaluates this on batched states with a central-difference (or supplied)
+Jacobian; :class:`FiniteStateController` wraps it as a controller for any model.
+
+**Yaw rate** (eq. (16)–(21)). With J = z̄₃ = ω̄ and δ a state driven by u = δ̇,
+
+    W₃₇ = h L T_v cos δ / J                                                  (19)
+    law (20):  u = (ω* − ω̄)/(T_u W₃₇),  ω̄ = ω + h Φ₃(z)
+    law (21):  u = (ω* − ω)/(T_u W₃₇)   (no velocity measurement needed)
+
+:class:`YawRateFSM` implements both with the guards of spec 004 §4.11.1: the feasibility check
+|ω*| ≤ ω_max, an optional clamp |δ| ≤ δ_max, an optional frozen 1/cos δ gain near 90°, and events
+(``omega_ref_above_max``, ``delta_clamped``, ``delta_reached_90``) recorded on the controller
+(``controller.events``) rather than a silent failure.
+
+**Actuator** (eq. (22)–(23)): with a thruster lag δ̇ = (−δ + k v_a)/T the command
+v_a = (δ + T u)/k (:func:`actuator_inverse`) makes δ̇ = u when T and k are right.
+
+**References** for the yaw rate: :class:`ConstantRate`, :class:`SineRate` and the heading
+capture (17) :class:`HeadingCapture`. Each is also a guidance object (reference ``r_ref``,
+tracking ``r``), so the simulator logs ω* and r − ω*; handed to the controller as ``omega_ref``
+it is evaluated at the time of every RK stage (needed for an exact switch at t*).
+
+The laws are stateless functions of (t, measured state, reference) — their "integral" is the
+physical δ — so they run in ``continuous`` mode (evaluated inside every RK stage, as the document
+does) or sampled every ``Ts`` with a hold.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+from shipgnc.frames import wrap_angle
+from shipgnc.models.base import Signal
+from shipgnc.models.catamaran import DELTA, PSI, Catamaran, R
+
+EVENT_KINDS = ("omega_ref_above_max", "delta_clamped", "delta_reached_90")
+
+
+# --- the general method ------------------------------------------------------------------------
+def numerical_jacobian(fun: Callable[[np.ndarray], np.ndarray], z: np.ndarray,
+                       rel_step: float = 1e-6) -> np.ndarray:
+    """Central-difference ∂fun/∂z for batched ``z`` (..., n) → (..., m, n)."""
+    z = np.asarray(z, dtype=float)
+    n = z.shape[-1]
+    step = rel_step * np.maximum(1.0, np.abs(z))  # (..., n)
+    eye = np.eye(n)
+    dz = eye * step[..., None, :]  # (..., n(pert), n)
+    plus = fun(z[..., None, :] + dz)  # (..., n(pert), m)
+    minus = fun(z[..., None, :] - dz)
+    return np.swapaxes((plus - minus) / (2.0 * step[..., :, None]), -1, -2)
+
+
+def fsm_control(phi: Callable, z: np.ndarray, B: np.ndarray, criterion: Callable, target, T_u: float,
+                h: float, *, jacobian: Callable | None = None,
+                criterion_gradient: Callable | None = None) -> np.ndarray:
+    """u = G⁺ (J* − J(z̄))/T_u of eq. (13) with the first-order prediction (15).
+
+    ``phi(z)`` is the free motion Φ (batched, (..., n)); ``B`` the input matrix (n, m) or
+    (..., n, m); ``criterion(z̄)`` returns (..., r); ``target`` broadcasts to (..., r);
+    ``jacobian(z)`` → (..., n, n) and ``criterion_gradient(z̄)`` → (..., r, n) default to central
+    differences. Returns u (..., m).
+    """
+    require(T_u > 0 and math.isfinite(T_u), "controller.T_u", T_u, "criterion time constant must be > 0 s")
+    require(h > 0 and math.isfinite(h), "controller.h", h, "prediction horizon must be > 0 s")
+    z = np.asarray(z, dtype=float)
+    n = z.shape[-1]
+    A = jacobian(z) if jacobian is not None else numerical_jacobian(phi, z)
+    z_bar = z + h * phi(z)
+    W = np.eye(n) + h * A
+    crit = np.asarray(criterion(z_bar), dtype=float)
+    grad = (criterion_gradient(z_bar) if criterion_gradient is not None
+            else numerical_jacobian(criterion, z_bar))
+    G = grad @ W @ B  # (..., r, m)
+    f_J = (np.asarray(target, dtype=float) - crit) / T_u
+    return (np.linalg.pinv(G) @ f_J[..., None])[..., 0]
+
+
+class FiniteStateController:
+    """The general FSM (13) + (15) for a model with an affine input, as a controller.
+
+    ``criterion(z̄)`` → (..., r); the target J* is the guidance reference (first r channels) or
+    ``target(t, x)``. Φ is the model's right-hand side at zero input; B = ∂f/∂u by differences
+    (the model must be affine in u). Continuous mode by default (``Ts=None``).
+    """
+
+    def __init__(self, model, criterion: Callable, *, T_u: float, h: float, target: Callable | None = None,
+                 jacobian: Callable | None = None, criterion_gradient: Callable | None = None,
+                 Ts: float | None = None):
+        require(isinstance(T_u, (int, float)) and T_u > 0, "controller.T_u", T_u, "must be > 0 s")
+        require(isinstance(h, (int, float)) and h > 0, "controller.h", h, "prediction horizon must be > 0 s")
+        self.model, self.criterion, self.T_u, self.h = model, criterion, float(T_u), float(h)
+        self.target, self.jacobian, self.criterion_gradient = target, jacobian, criterion_gradient
+        self.Ts = Ts
+        self.continuous = Ts is None
+        self.signals: tuple[Signal, ...] = ()
+        n_in = len(model.inputs)
+        n = len(model.states)
+        x0 = np.zeros(n)
+        u0 = np.zeros(n_in)
+        B = np.empty((n, n_in))
+        for j in range(n_in):
+            e = np.zeros(n_in)
+            e[j] = 1.0
+            B[:, j] = (model.derivatives(x0, u0 + e) - model.derivatives(x0, u0 - e)) / 2.0
+        self.B = B
+        self._zero_input = u0
+
+    def reset(self, batch_shape) -> None:
+        pass
+
+    def phi(self, z):
+        return self.model.derivatives(z, np.broadcast_to(self._zero_input, (*z.shape[:-1], self.B.shape[1])))
+
+    def law(self, t: float, x: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        target = self.target(t, x) if self.target is not None else reference
+        return fsm_control(self.phi, x, self.B, self.criterion, target, self.T_u, self.h,
+                           jacobian=self.jacobian, criterion_gradient=self.criterion_gradient)
+
+    def step(self, t, x, reference):
+        return self.law(t, x, reference)
+
+    def signal_values(self) -> dict[str, np.ndarray]:
+        return {}
+
+
+# --- actuator (22)–(23) -------------------------------------------------------------------------
+def actuator_inverse(delta, u, T: float, k: float):
+    """v_a = (δ + T u)/k (eq. (23)): the lag command that gives δ̇ = u for a lag (T, k)."""
+    return (np.asarray(delta) + T * np.asarray(u)) / k
+
+
+def thruster_lag_rate(delta, v_a, T: float, k: float):
+    """δ̇ = (−δ + k v_a)/T (eq. (22))."""
+    return (-np.asarray(delta) + k * np.asarray(v_a)) / T
+
+
+# --- yaw-rate references --------------------------------------------------------------------------
+class _RateReference:
+    """Base of the ω* sources: a guidance object with one reference ``r_ref`` (tracks ``r``)."""
+
+    references = (Signal("r_ref", "rad/s", "yaw-rate reference omega*", tracks="r"),)
+    outputs = ()
+
+    def __init__(self) -> None:
+        self._batch_shape: tuple[int, ...] = ()
+
+    def reset(self, batch_shape, model=None) -> None:
+        self._batch_shape = tuple(batch_shape)
+
+    def value(self, t: float, x: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def reference(self, t: float, x: np.ndarray) -> np.ndarray:
+        return np.broadcast_to(self.value(t, x), x.shape[:-1])[..., None].copy()
+
+    def output_values(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def finished(self):
+        return None
+
+
+class ConstantRate(_RateReference):
+    """ω*(t) = ``omega`` [rad/s] (from ``t_start``, 0 before); an array gives one value per ship."""
+
+    def __init__(self, omega: float, t_start: float = 0.0):
+        super().__init__()
+        value = np.asarray(omega, dtype=float) if not isinstance(omega, (str, bool)) else np.nan
+        require(bool(np.all(np.isfinite(value))) and np.ndim(value) <= 1, "omega_ref", omega,
+                "must be a finite yaw rate [rad/s] (or one per ship)")
+        self.omega = float(value) if np.ndim(value) == 0 else value
+        self.t_start = float(t_start)
+
+    def value(self, t, x):
+        return self.omega if t >= self.t_start else 0.0 * self.omega
+
+
+class SineRate(_RateReference):
+    """ω*(t) = A sin(2π t / period) (S6: A = 0.0072 rad/s, period t_f/4 = 375 s, reading C11)."""
+
+    def __init__(self, amplitude: float, period: float):
+        super().__init__()
+        require(math.isfinite(amplitude), "omega_ref.amplitude", amplitude, "must be finite")
+        require(math.isfinite(period) and period > 0, "omega_ref.period", period, "must be > 0 s")
+        self.amplitude, self.period = float(amplitude), float(period)
+
+    @classmethod
+    def document(cls, reading: str = "pi", t_f: float = 1500.0, amplitude: float = 0.0072) -> SineRate:
+        """Fig. 7's 0.0072 sin(8πt/t_f) (``reading="pi"``) or sin(8t/t_f) (``"literal"``)."""
+        require(reading in ("pi", "literal"), "omega_ref.reading", reading, "allowed: pi, literal")
+        return cls(amplitude, t_f / 4.0 if reading == "pi" else 2.0 * math.pi * t_f / 8.0)
+
+    def value(self, t, x):
+        return self.amplitude * math.sin(2.0 * math.pi * t / self.period)
+
+
+class HeadingCapture(_RateReference):
+    """Heading capture (17): ω* = ±ω_c until t* = t₀ + |wrap(K* − K(t₀))|/ω_c, then 0.
+
+    The sign of ω* is that of the wrapped difference K* − K(t₀) ∈ (−π, π] (C12); K(t₀) is latched
+    per ship at the first evaluation at t ≥ t₀ (or given as ``psi0``). ``ramp_s`` > 0 replaces the
+    jump at t* by a linear ramp over [t* − ramp/2, t* + ramp/2] (same area, so the same heading).
+    """
+
+    def __init__(self, psi_target: float, omega_c: float = 0.0022, *, t0: float = 0.0, psi0=None,
+                 ramp_s: float = 0.0):
+        super().__init__()
+        require(isinstance(psi_target, (int, float)) and math.isfinite(psi_target), "heading_target",
+                psi_target, "must be a finite heading [rad]")
+        require(isinstance(omega_c, (int, float)) and math.isfinite(omega_c) and omega_c > 0,
+                "omega_c", omega_c, "capture rate must be > 0 rad/s")
+        require(math.isfinite(t0) and t0 >= 0, "t0", t0, "must be >= 0 s")
+        require(math.isfinite(ramp_s) and ramp_s >= 0, "ramp_s", ramp_s, "must be >= 0 s")
+        self.psi_target, self.omega_c, self.t0, self.ramp_s = float(psi_target), float(omega_c), t0, ramp_s
+        self._psi0_given = None if psi0 is None else np.asarray(psi0, dtype=float)
+        self.psi0 = self._psi0_given
+
+    def reset(self, batch_shape, model=None) -> None:
+        super().reset(batch_shape)
+        self.psi0 = self._psi0_given
+
+    def _latch(self, t, x):
+        if self.psi0 is None and t >= self.t0:
+            self.psi0 = np.array(x[..., PSI], dtype=float, copy=True)
+
+    def switch_time(self):
+        """t* per ship (needs K(t₀): after the first evaluation or with ``psi0``)."""
+        if self.psi0 is None:
+            raise ConfigError("heading capture: K(t0) unknown before the first evaluation")
+        diff = wrap_angle(self.psi_target - self.psi0)
+        return self.t0 + np.abs(diff) / self.omega_c
+
+    def value(self, t, x):
+        self._latch(t, x)
+        if self.psi0 is None:
+            return np.zeros(x.shape[:-1])
+        diff = wrap_angle(self.psi_target - self.psi0)
+        t_star = self.t0 + np.abs(diff) / self.omega_c
+        if self.ramp_s > 0:
+            frac = np.clip((t_star + self.ramp_s / 2 - t) / self.ramp_s, 0.0, 1.0)
+        else:
+            frac = np.where(t < t_star, 1.0, 0.0)
+        return np.broadcast_to(np.sign(diff) * self.omega_c * frac, x.shape[:-1]).copy()
+
+
+def as_rate_reference(omega_ref) -> _RateReference | None:
+    """``None`` (use the guidance), a number (constant) or a reference object."""
+    if omega_ref is None or isinstance(omega_ref, _RateReference):
+        return omega_ref
+    if isinstance(omega_ref, (int, float, np.ndarray, list, tuple)) and not isinstance(omega_ref, bool):
+        return ConstantRate(float(omega_ref))
+    raise ConfigError(f"omega_ref = {omega_ref!r}: need a number [rad/s], ConstantRate, SineRate or "
+                      "HeadingCapture")
+
+
+# --- the yaw-rate laws -------------------------------------------------------------------------------
+def w37(params, delta, h: float):
+    """W₃₇ = h L T_v cos δ / J (eq. (19))."""
+    return h * params.L * params.T_v * np.cos(delta) / params.J
+
+
+def law20(model: Catamaran, x, omega_ref, T_u: float, h: float):
+    """u = (ω* − ω − h Φ₃)/(T_u W₃₇), eq. (20)."""
+    omega_bar = x[..., R] + h * model.yaw_acceleration(x)
+    return (omega_ref - omega_bar) / (T_u * w37(model.params, x[..., DELTA], h))
+
+
+def law21(model: Catamaran, x, omega_ref, T_u: float, h: float):
+    """u = (ω* − ω)/(T_u W₃₇), eq. (21): needs only L, J, T_v, ω and δ."""
+    return (omega_ref - x[..., R]) / (T_u * w37(model.params, x[..., DELTA], h))
+
+
+class YawRateFSM:
+    """Yaw-rate control by the FSM laws (20) or (21) for document 004's catamaran.
+
+    Parameters
+    ----------
+    model : the controller's model of the plant (nominal :class:`Catamaran`; only its parameters).
+    law : 20 or 21.
+    T_u, h : criterion time constant and prediction horizon [s] (``paper``: 0.1, 0.0625; ``si``:
+        2.5, 2.5; :func:`default_gains`).
+    omega_ref : a number, a reference object (:class:`ConstantRate`, :class:`SineRate`,
+        :class:`HeadingCapture`; evaluated at every RK stage) or ``None`` to use the guidance's
+        first reference channel (held over each step).
+    Ts : ``None`` (default) = continuous mode; a number = sample-and-hold every ``Ts`` s.
+    actuator : ``None`` (the input is δ̇) or ``(T_a, k_a)``: the command is v_a of (23) for a plant
+        with the thruster lag (22) (``delta_row="lag"``).
+    delta_max : optional clamp |δ| ≤ δ_max [rad] (no thruster rate pushing further out).
+    gain_freeze : optional angle [rad] beyond which cos δ in W₃₇ is frozen at cos(gain_freeze).
+    check_feasibility : compare |ω*| with ω_max of the controller's model (event, never an error).
+    """
+
+    reference_names = ()
+
+    def __init__(self, model: Catamaran, law: int = 21, *, T_u: float, h: float, omega_ref=None,
+                 Ts: float | None = None, actuator: tuple[float, float] | None = None,
+                 delta_max: float | None = None, gain_freeze: float | None = None,
+                 check_feasibility: bool = True):
+        require(isinstance(model, Catamaran), "controller.model", type(model).__name__,
+                "need a Catamaran (the controller's model of the plant)")
+        require(law in (20, 21, "20", "21"), "controller.law", law, "allowed: 20, 21")
+        for name, value in (("T_u", T_u), ("h", h)):
+            require(isinstance(value, (int, float)) and math.isfinite(value) and value > 0,
+                    f"controller.{name}", value, "must be a finite number > 0 s")
+        if Ts is not None:
+            require(isinstance(Ts, (int, float)) and math.isfinite(Ts) and Ts > 0, "controller.Ts", Ts,
+                    "must be > 0 s (or None for continuous mode)")
+        if actuator is not None:
+            T_a, k_a = actuator
+            require(math.isfinite(T_a) and T_a > 0, "controller.actuator.T", T_a, "must be > 0 s")
+            require(math.isfinite(k_a) and k_a != 0, "controller.actuator.k", k_a, "must be non-zero")
+        if delta_max is not None:
+            require(0 < delta_max <= math.pi / 2, "controller.delta_max", delta_max,
+                    "need 0 < delta_max <= pi/2 rad")
+        if gain_freeze is not None:
+            require(0 < gain_freeze < math.pi / 2, "controller.gain_freeze", gain_freeze,
+                    "need 0 < gain_freeze < pi/2 rad")
+        self.model = model if model.params.delta_row == "rate" else Catamaran(
+            model.params.with_(delta_row="rate"), model.preset_name)
+        self.law_number = int(law)
+        self.T_u, self.h = float(T_u), float(h)
+        self.omega_ref = as_rate_reference(omega_ref)
+        self.Ts = Ts
+        self.continuous = Ts is None
+        self.actuator = actuator
+        self.delta_max, self.gain_freeze = delta_max, gain_freeze
+        self.omega_max = None
+        if check_feasibility and model.params.coriolis == "printed":
+            from shipgnc.analysis.steady_turn import omega_max
+
+            self.omega_max = omega_max(self.model)
+        self.signals = (Signal("omega_ref", "rad/s", "yaw-rate reference used by the law"),
+                        Signal("fsm_u", "rad/s", "thruster rate asked by the law"))
+        self.events: list[dict] = []
+        self._last: dict[str, np.ndarray] = {}
+
+    def reset(self, batch_shape) -> None:
+        self.events = []
+        self._last = {}
+        if self.omega_ref is not None:
+            self.omega_ref.reset(batch_shape)
+
+    def _event(self, t: float, kind: str, message: str) -> None:
+        if all(e["kind"] != kind for e in self.events):
+            self.events.append({"time_s": float(t), "kind": kind, "message": message})
+
+    def law(self, t: float, x: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        if self.omega_ref is not None:
+            w_ref = self.omega_ref.value(t, x)
+        else:
+            require(reference.shape[-1] >= 1, "guidance", "none",
+                    "YawRateFSM without omega_ref needs a yaw-rate reference from the guidance")
+            w_ref = reference[..., 0]
+        if np.any(np.isnan(w_ref)):
+            raise ConfigError("omega_ref = nan: the yaw-rate reference must be finite")
+        if self.omega_max is not None and np.max(np.abs(w_ref)) > self.omega_max:
+            self._event(t, "omega_ref_above_max",
+                        f"|omega*| = {float(np.max(np.abs(w_ref))):.6g} rad/s exceeds omega_max = "
+                        f"{self.omega_max:.6g} rad/s: no steady turn with |delta| < 90°")
+        delta = x[..., DELTA]
+        delta_peak = float(np.max(np.abs(delta)))
+        if delta_peak >= math.pi / 2:
+            self._event(t, "delta_reached_90", f"|delta| reached 90° ({math.degrees(delta_peak):.2f}°): the "
+                        "FSM gain 1/cos(delta) is singular and the thruster keeps turning")
+        if self.gain_freeze is not None:  # W37 with cos(delta) frozen beyond gain_freeze
+            frozen = np.clip(delta, -self.gain_freeze, self.gain_freeze)
+            scale = np.cos(delta) / np.cos(frozen)
+        if self.law_number == 20:
+            u = law20(self.model, x, w_ref, self.T_u, self.h)
+        else:
+            u = law21(self.model, x, w_ref, self.T_u, self.h)
+        if self.gain_freeze is not None:
+            u = u * scale
+        if self.delta_max is not None:
+            outward = (np.abs(delta) >= self.delta_max) & (np.sign(u) == np.sign(delta))
+            if np.any(outward):
+                self._event(t, "delta_clamped", f"thruster angle held at the clamp |delta| = "
+                            f"{math.degrees(self.delta_max):.2f}°: the reference is not reached")
+            u = np.where(outward, 0.0, u)
+        self._last = {"omega_ref": w_ref, "fsm_u": u}
+        if self.actuator is not None:
+            T_a, k_a = self.actuator
+            return actuator_inverse(delta, u, T_a, k_a)[..., None]
+        return u[..., None]
+
+    def step(self, t, x, reference):
+        return self.law(t, x, reference)
+
+    def signal_values(self) -> dict[str, np.ndarray]:
+        return dict(self._last)
+
+
+def default_gains(preset_name: str) -> tuple[float, float]:
+    """(T_u, h) of the document (``paper``) or the consistent-unit tuning (``si``), spec 004 §4.4."""
+    from shipgnc.models.catamaran import FSM_GAINS
+
+    if preset_name not in FSM_GAINS:
+        raise ConfigError(f"vessel.preset = {preset_name!r}: unknown preset; allowed: {', '.join(FSM_GAINS)}")
+    return FSM_GAINS[preset_name]
