@@ -79,7 +79,7 @@ def test_compare_writes_figures_and_table(tmp_path):
     assert tuple(metrics) == COMPARED
     for name in ("result.nc", "metrics.json", "table.csv", "table.md", "fig3_tracks.png",
                  "fig4_heading.png", "fig5_rudder.png"):
-        assert (tmp_path / name).stat().st_size > 1000, name
+        assert (tmp_path / name).stat().st_size > 500, name
     # the printed gain, and the gain of the stated R = 1 (spec 000 §0.4 table)
     assert metrics["lqr_paper"]["lqr_gain"] == pytest.approx([3.4, 3.2, 1.0, 0.45])
     assert metrics["lqr"]["lqr_gain"] == pytest.approx([2.4455, 2.3244, 0.8788, 0.3162], abs=1e-4)

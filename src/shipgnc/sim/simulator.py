@@ -32,9 +32,10 @@ INTEGRATORS = ("rk4", "solve_ivp")
 BACKENDS = ("auto", "numpy", "compiled")
 #: ``backend="auto"`` uses a compiled twin from this batch size (compilation then pays off) ...
 COMPILED_MIN_BATCH = 64
-#: ... or from this much work, ships × steps (a long run of a few ships); setups no twin covers
-#: run in the numpy loop
-COMPILED_MIN_WORK = 200_000
+#: ... or from this much work, ships × steps (a long run of a few ships: the numpy loop needs
+#: ≈ 0.4 ms a step, a cached kernel ≈ 1 s to load, a cold one ≈ 10 s to compile once); setups no
+#: twin covers run in the numpy loop
+COMPILED_MIN_WORK = 20_000
 #: the compiled twins (modules of ``shipgnc.sim``), asked in this order
 COMPILED_TWINS = ("compiled", "compiled_mariner")
 #: most steps of one run, and most logged numbers (8 bytes each, 4 GB) of one result
