@@ -1,0 +1,223 @@
+"""Document 004's cases S1–S10 as plain builders, ready for ``simulate`` (spec 004 §4.7).
+
+Each builder returns a :class:`CatamaranCase` (or a dict of them keyed like the spec's metrics,
+e.g. ``{"law20": ..., "law21": ...}``) holding ``model, x0, actuator, controller, guidance,
+t_end, dt`` and, for heading runs, ``heading_target``. A runner calls::
+
+    case = turn()["law20"]
+    ds = simulate(case.model, case.x0, t_end=case.t_end, dt=case.dt, controller=case.controller,
+                  actuator=case.actuator, guidance=case.guidance, on_divergence="stop")
+    metrics = case.metrics(ds)          # spec 004 metrics, events included
+
+or simply ``ds = case.run()``. Common settings: u(0) = 4 m/s, everything else 0; RK4 with
+dt = 0.0625 s; t_f = 1500 s; gains per preset (``paper``: T_u = 0.1 s, h = 0.0625 s; ``si``:
+T_u = h = 2.5 s); the laws in continuous mode; preset ``si`` unless given.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from shipgnc.control.finite_state import (
+    ConstantRate,
+    HeadingCapture,
+    SineRate,
+    YawRateFSM,
+    default_gains,
+)
+from shipgnc.errors import require
+from shipgnc.models.catamaran import Catamaran
+
+DT = 0.0625
+T_END = 1500.0
+U0 = 4.0
+#: fixed thruster angle of S5 [rad]
+FIXED_ANGLE = 0.6
+
+
+@dataclass
+class CatamaranCase:
+    """Everything ``simulate`` needs for one run, plus what its metrics need."""
+
+    name: str
+    model: Catamaran
+    x0: np.ndarray
+    controller: object | None
+    guidance: object | None
+    t_end: float = T_END
+    dt: float = DT
+    actuator: object | None = None
+    heading_target: float | None = None
+    notes: dict = field(default_factory=dict)
+
+    def simulate_kwargs(self) -> dict:
+        return {"t_end": self.t_end, "dt": self.dt, "controller": self.controller, "actuator": self.actuator,
+                "guidance": self.guidance}
+
+    def run(self, **kwargs):
+        """``simulate`` this case (numpy loop, ``on_divergence="stop"``); events in ``attrs``."""
+        from shipgnc.analysis.catamaran_metrics import attach_events
+        from shipgnc.sim.simulator import simulate
+
+        options = {"backend": "numpy", "on_divergence": "stop", "attrs": {"case": self.name}, **kwargs}
+        ds = simulate(self.model, self.x0, **self.simulate_kwargs(), **options)
+        attach_events(ds, self.controller)
+        return ds
+
+    def metrics(self, ds) -> dict:
+        from shipgnc.analysis.catamaran_metrics import catamaran_metrics
+
+        return catamaran_metrics(ds, None, self.heading_target)
+
+
+def initial_state(u0: float = U0, delta0: float = 0.0, batch: int | None = None) -> np.ndarray:
+    x0 = np.array([u0, 0.0, 0.0, 0.0, 0.0, 0.0, delta0])
+    return x0 if batch is None else np.tile(x0, (batch, 1))
+
+
+def _gains(preset_name: str, T_u, h):
+    T_u0, h0 = default_gains(preset_name)
+    return (T_u0 if T_u is None else T_u), (h0 if h is None else h)
+
+
+def yaw_rate_case(name: str, preset_name: str = "si", law: int = 21, omega_ref=0.08, *, t_end: float = T_END,
+                  dt: float = DT, Ts: float | None = None, T_u: float | None = None, h: float | None = None,
+                  plant: dict | None = None, actuator_model: tuple[float, float] | None = None,
+                  batch: int | None = None, delta_max: float | None = None,
+                  **controller_options) -> CatamaranCase:
+    """A yaw-rate FSM run: plant ``preset_name`` (+ ``plant`` overrides), law (20)/(21) on the
+    nominal model, reference ``omega_ref`` (number, per-ship array or reference object)."""
+    T_u, h = _gains(preset_name, T_u, h)
+    plant_model = Catamaran.from_preset(preset_name, **(plant or {}))
+    nominal = Catamaran.from_preset(preset_name)
+    ref = omega_ref if not isinstance(omega_ref, (int, float, np.ndarray, list)) else ConstantRate(omega_ref)
+    ctrl = YawRateFSM(nominal, law, T_u=T_u, h=h, omega_ref=ref, Ts=Ts, actuator=actuator_model,
+                      delta_max=delta_max, **controller_options)
+    if batch is None and isinstance(ref, ConstantRate) and np.ndim(ref.omega) == 1:
+        batch = len(ref.omega)
+    return CatamaranCase(name, plant_model, initial_state(batch=batch), ctrl, ref, t_end, dt,
+                         notes={"preset": preset_name, "law": law, "T_u": T_u, "h": h})
+
+
+# --- S1–S10 -----------------------------------------------------------------------------------------
+def straight(preset_name: str = "si", t_end: float = 300.0) -> CatamaranCase:
+    """S1: straight run from 4 m/s with δ = 0 (no controller): the speed rises to 4.42306 m/s."""
+    return CatamaranCase("catamaran-straight", Catamaran.from_preset(preset_name), initial_state(), None,
+                         None, t_end, DT, notes={"preset": preset_name})
+
+
+def turn(preset_name: str = "si", omega: float = 0.08, t_end: float = T_END, dt: float = DT,
+         Ts: float | None = None) -> dict[str, CatamaranCase]:
+    """S3 ``catamaran-turn``: ω* = 0.08 rad/s with laws (20) and (21)."""
+    return {f"law{law}": yaw_rate_case(f"catamaran-turn/law{law}", preset_name, law, omega, t_end=t_end,
+                                       dt=dt, Ts=Ts) for law in (20, 21)}
+
+
+def steps(preset_name: str = "paper", t_end: float = T_END) -> dict[str, CatamaranCase]:
+    """S4 ``catamaran-steps``: ω* = 0.008 and 0.00072 with both laws (Figs. 1–3, 5–6)."""
+    return {f"law{law}@{w:g}": yaw_rate_case(f"catamaran-steps/law{law}@{w:g}", preset_name, law, w,
+                                             t_end=t_end)
+            for w in (0.008, 0.00072) for law in (20, 21)}
+
+
+def fixed_angle(preset_name: str = "paper", t_end: float = T_END) -> dict[str, CatamaranCase]:
+    """S5 ``catamaran-fixed-angle``: δ = 0.6 rad held (no controller), the FSM at the same steady
+    angle (ω* = the fixed run's steady r) and the document's pairing ω* = 0.00072 (C10)."""
+    from shipgnc.analysis.steady_turn import steady_state_at_angle
+
+    model = Catamaran.from_preset(preset_name)
+    same = steady_state_at_angle(model, FIXED_ANGLE).r
+    return {
+        "fixed": CatamaranCase("catamaran-fixed-angle/fixed", model, initial_state(delta0=FIXED_ANGLE), None,
+                               None, t_end, DT, notes={"preset": preset_name, "delta": FIXED_ANGLE}),
+        "law20_same_angle": yaw_rate_case("catamaran-fixed-angle/law20_same_angle", preset_name, 20, same,
+                                          t_end=t_end),
+        "law20@0.00072": yaw_rate_case("catamaran-fixed-angle/law20@0.00072", preset_name, 20, 0.00072,
+                                       t_end=t_end),
+    }
+
+
+def sine(preset_name: str = "si", law: int = 21, reading: str = "pi", t_end: float = T_END) -> CatamaranCase:
+    """S6 ``catamaran-sine``: ω* = 0.0072 sin(8πt/t_f) (reading C11; ``"literal"``: sin(8t/t_f))."""
+    return yaw_rate_case(f"catamaran-sine/law{law}", preset_name, law, SineRate.document(reading, T_END),
+                         t_end=t_end)
+
+
+def heading(preset_name: str = "si", law: int = 21, psi_target: float = 0.8, omega_c: float = 0.0022,
+            t_end: float | None = None, ramp_s: float = 0.0) -> CatamaranCase:
+    """S7 ``catamaran-heading``: heading capture (17) from K(0) = 0 to K*.
+
+    t_end: 1500 s for ω_c < 0.02 rad/s, else 600 s.
+    """
+    require(isinstance(psi_target, (int, float)) and math.isfinite(psi_target), "heading_target", psi_target,
+            "must be a finite heading [rad]")
+    t_end = t_end if t_end is not None else (T_END if omega_c < 0.02 else 600.0)
+    cap = HeadingCapture(psi_target, omega_c, ramp_s=ramp_s)
+    case = yaw_rate_case(f"catamaran-heading/law{law}", preset_name, law, cap, t_end=t_end)
+    case.heading_target = float(psi_target)
+    return case
+
+
+#: S8's true thruster (T_t [s], k_t) per run key; the controller assumes T_a = 2 s, k_a = 1
+ACTUATOR_RUNS = {"T2_k1": (2.0, 1.0), "T3_k1": (3.0, 1.0), "T1_k1": (1.0, 1.0), "T2_k0.8": (2.0, 0.8),
+                 "T2_k1.2": (2.0, 1.2)}
+
+
+def actuator(preset_name: str = "si", omega: float = 0.08, t_end: float = 600.0,
+             T_a: float = 2.0, k_a: float = 1.0) -> dict[str, CatamaranCase]:
+    """S8 ``catamaran-actuator``: law (21) through the inverse (23) on a plant with the lag (22)."""
+    cases = {"ideal": yaw_rate_case("catamaran-actuator/ideal", preset_name, 21, omega, t_end=t_end)}
+    for key, (T_t, k_t) in ACTUATOR_RUNS.items():
+        cases[key] = yaw_rate_case(f"catamaran-actuator/{key}", preset_name, 21, omega, t_end=t_end,
+                                   plant={"delta_row": "lag", "T_t": T_t, "k_t": k_t},
+                                   actuator_model=(T_a, k_a))
+    return cases
+
+
+def limit(preset_name: str = "paper", law: int = 21, omega: float = 0.081, t_end: float = T_END,
+          delta_max: float | None = None) -> CatamaranCase:
+    """S9: a reference at the feasibility limit (``paper`` law (21) fails from 0.081)."""
+    return yaw_rate_case(f"catamaran-limit/law{law}@{omega:g}", preset_name, law, omega, t_end=t_end,
+                         delta_max=delta_max)
+
+
+def robustness(preset_name: str = "si", n: int = 40, seed: int = 10, omega: float = 0.06,
+               t_end: float = T_END, law: int = 21) -> CatamaranCase:
+    """S10 / ``catamaran-montecarlo``: plant J uniform ±30 %, m_x and m_y uniform ±10 % each, the
+    controller nominal, law (21); one batched run (the ship axis) with per-ship plant parameters."""
+    require(isinstance(n, int) and n >= 1, "montecarlo.n", n, "need at least 1 draw")
+    rng = np.random.default_rng(seed)
+    J_f = rng.uniform(0.7, 1.3, n)
+    mx_f = rng.uniform(0.9, 1.1, n)
+    my_f = rng.uniform(0.9, 1.1, n)
+    case = yaw_rate_case(f"catamaran-montecarlo/{n}", preset_name, law, omega, t_end=t_end, batch=n,
+                         plant={"J_factor": J_f, "m_x_factor": mx_f, "m_y_factor": my_f})
+    case.notes.update({"seed": seed, "J_factor": J_f, "m_x_factor": mx_f, "m_y_factor": my_f})
+    return case
+
+
+def montecarlo(n: int = 1000, seed: int = 16, t_end: float = 300.0) -> CatamaranCase:
+    """Check 16: 1000 draws, ``si``, law (21), ω* = 0.06, 300 s."""
+    return robustness("si", n=n, seed=seed, t_end=t_end)
+
+
+#: scenario name → builder (spec 004 §4.7 names); each returns a case or a dict of cases
+SCENARIOS = {
+    "catamaran-turn": turn,
+    "catamaran-steps": steps,
+    "catamaran-fixed-angle": fixed_angle,
+    "catamaran-sine": lambda preset_name="si": {"law21": sine(preset_name, 21)},
+    "catamaran-heading": lambda preset_name="si": {"law21": heading(preset_name, 21)},
+    "catamaran-actuator": actuator,
+    "catamaran-montecarlo": lambda preset_name="si": {"montecarlo": montecarlo()},
+}
+
+
+def compare(preset_name: str = "si") -> dict[str, CatamaranCase]:
+    """``catamaran-compare``: FSM laws against the baselines on S3, S4 (ω* = 0.008) and S7."""
+    from shipgnc.control.catamaran_baselines import comparison_cases
+
+    return comparison_cases(preset_name)
