@@ -82,7 +82,7 @@ def yaw_rate_overshoot_pct(ds) -> float | None:
     rf = r[-1]
     if abs(rf) < R_NULL:
         return None
-    return 100.0 * max(0.0, float(np.max(np.sign(rf) * (r - rf)))) / abs(rf)
+    return float(100.0 * max(0.0, float(np.max(np.sign(rf) * (r - rf)))) / abs(rf))
 
 
 def delta_rate(ds) -> np.ndarray:
