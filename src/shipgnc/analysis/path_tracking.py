@@ -41,7 +41,8 @@ PATH_TRACKING_KEYS = ("settle_time_min", "overshoot_nm", "crosstrack_max_after_l
 
 def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reached_end) -> dict:
     """The metrics for every ship at once: arrays ``(time, ship)`` in SI → dict of ``(ship,)``
-    float arrays in the reported units (NaN where a figure does not exist; ``stable`` as bool).
+    float arrays in the reported units (NaN where a figure does not exist; ``stable`` as bool),
+    plus ``final_abs_crosstrack_nm``, the mean |y_r| over the last 10 min.
 
     ``reached_end``: bool per ship (or one bool), False when the run stopped early (divergence).
     Samples after a run stopped (NaN padding) are ignored.
@@ -97,6 +98,7 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
         "crosstrack_max_after_leg1_nm": max_after / NAUTICAL_MILE,
         "crosstrack_rms_after_leg1_nm": rms_after / NAUTICAL_MILE,
         "final_crosstrack_nm": final_mean(y) / NAUTICAL_MILE,
+        "final_abs_crosstrack_nm": final_mean(np.abs(y)) / NAUTICAL_MILE,
         "final_heading_error_deg": to_deg(final_mean(psi)),
         "final_rudder_deg": to_deg(final_mean(np.where(np.isfinite(d), d, 0.0))),
         "rudder_rms_deg": to_deg(rudder_rms),
@@ -127,7 +129,9 @@ def path_tracking_metrics(ds, *, delta_max: float, diverged: bool = False) -> di
 def montecarlo_summary(ds, *, delta_max: float, diverged: bool = False) -> dict:
     """Distribution of the path-tracking metrics over the ships of a batch result.
 
-    ``runs``; ``settled_fraction`` and ``stable_fraction``; median and 95th percentile of
+    ``runs``; ``settled_fraction`` and ``stable_fraction``; ``on_path_at_end_fraction``: runs whose
+    mean |y_r| over the last 10 min is inside the settling band (0.05 nm) — bounded is not
+    converged: a ship circling with its rudder hard over stays ``stable``; median and 95th percentile of
     ``settle_time_min`` (a ship that never settles counts as +∞, so a percentile it reaches is
     null) and of ``crosstrack_rms_after_leg1_nm`` (ships whose leg 1 never ends excluded).
     """
@@ -145,10 +149,12 @@ def montecarlo_summary(ds, *, delta_max: float, diverged: bool = False) -> dict:
         value = float(np.percentile(values, q, method="higher"))
         return value if math.isfinite(value) else None
 
+    on_path = arrays["final_abs_crosstrack_nm"] < SETTLE_BAND / NAUTICAL_MILE
     return {
         "runs": int(settle.size),
         "settled_fraction": float(np.isfinite(settle).mean()),
         "stable_fraction": float(arrays["stable"].mean()),
+        "on_path_at_end_fraction": float(on_path.mean()),
         "settle_time_min_median": pct(settle, 50),
         "settle_time_min_p95": pct(settle, 95),
         "crosstrack_rms_after_leg1_nm_median": pct(rms, 50),
