@@ -1,0 +1,336 @@
+"""The router's front door: :func:`solve_route` (spec 002 §2.4–2.9; failure modes §2.8).
+
+``method``:
+
+* ``"pmp"`` — the global sweep of extremals (2.9.4), each polished; the fastest is returned and every one is
+  listed with its status (F2, F3). A uniform steady current is solved in closed form with the explicit cone
+  test (F1, F1b).
+* ``"levelset"`` / ``"graph"`` — that global method (2.9.2) seeds a PMP polish; the polished extremal is
+  returned when it converges (``method = "pmp"``, the global method's time in ``global_check``), otherwise the
+  global method's own route. A graph's "unreachable" is confirmed by the sweep (F7).
+* ``"auto"`` — PMP plus a level-set global check; with obstacles, vertex decomposition (2.9.3).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+from shipgnc.routing.fields import CurrentField, FieldDomainError, UniformCurrent
+from shipgnc.routing.result import RouteResult
+
+METHODS = ("auto", "pmp", "levelset", "graph")
+TWO_PI = 2.0 * math.pi
+
+
+class _StraightPath:
+    """A constant-heading straight route (uniform currents)."""
+
+    def __init__(self, start, velocity, heading, t0, duration):
+        self.start, self.vel, self.psi = np.asarray(start, float), velocity, heading
+        self.t0, self.dur = t0, duration
+
+    def position(self, t):
+        tt = np.clip(np.asarray(t, float), self.t0, self.t0 + self.dur) - self.t0
+        return self.start + np.multiply.outer(tt, self.vel)
+
+    def heading(self, t):
+        return np.full(np.shape(t), self.psi)
+
+
+class _ChainPath:
+    """Extremals joined end to end (a route through obstacle vertices, 2.9.3)."""
+
+    def __init__(self, legs):
+        self.legs = legs
+
+    def _pick(self, t):
+        t = np.asarray(t, float)
+        ends = np.array([leg.t_end for leg in self.legs])
+        return np.clip(np.searchsorted(ends, t, side="left"), 0, len(self.legs) - 1)
+
+    def position(self, t):
+        t = np.asarray(t, float)
+        k = self._pick(t)
+        out = np.empty((*t.shape, 2))
+        for j, leg in enumerate(self.legs):
+            m = k == j
+            if np.any(m):
+                out[m] = leg.position(t[m])
+        return out
+
+    def heading(self, t):
+        t = np.asarray(t, float)
+        k = self._pick(t)
+        out = np.empty(t.shape)
+        for j, leg in enumerate(self.legs):
+            m = k == j
+            if np.any(m):
+                out[m] = leg.heading(t[m])
+        return out
+
+
+def _validate(fld, speed, start, target, t0, radius):
+    require(isinstance(fld, CurrentField), "field", type(fld).__name__, "must be a current field")
+    ok = isinstance(speed, (int, float, np.floating)) and math.isfinite(speed) and speed > 0
+    require(ok, "speed", speed, "ship speed through water must be a finite number > 0 m/s")
+    for name, p in (("start", start), ("target", target)):
+        arr = np.asarray(p, dtype=float)
+        require(arr.shape == (2,) and bool(np.all(np.isfinite(arr))), name, list(np.ravel(p)),
+                "must be a finite position (north, east) in m")
+    require(math.isfinite(t0), "t0", t0, "departure time must be finite")
+    require(math.isfinite(radius) and radius >= 0, "radius", radius, "target radius must be >= 0 m")
+    if fld.bounds is not None:
+        (n0, n1), (e0, e1) = fld.bounds
+        for name, p in (("start", start), ("target", target)):
+            if not (n0 <= p[0] <= n1 and e0 <= p[1] <= e1):
+                raise FieldDomainError(
+                    f"{name} = ({p[0]:.6g}, {p[1]:.6g}) m: outside the gridded field's extent "
+                    f"N [{n0:g}, {n1:g}] m × E [{e0:g}, {e1:g}] m")
+    v = fld.velocity(t0, start[0], start[1])
+    require(bool(np.all(np.isfinite(v))), "field", fld.describe(), "current at the start is not finite")
+
+
+def _ext_dict(ext, speed):
+    return {"time_s": float(ext.duration), "heading_start_deg": float(math.degrees(ext.theta0)),
+            "heading_end_deg": float(math.degrees(ext.heading_end)), "status": ext.status,
+            "conjugate_point_s": None if ext.conjugate_at is None else float(ext.conjugate_at - ext.t0)}
+
+
+def _from_extremal(res: RouteResult, ext, method="pmp"):
+    res.reachable = True
+    res.time_s, res.heading_start, res.heading_end = ext.duration, ext.theta0, ext.heading_end
+    res.miss_m, res.method, res.path = ext.miss, method, ext
+    return res
+
+
+def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0.0, method: str = "auto",
+                horizon: float | None = None, radius: float = 0.0, obstacles=None, n_angles: int = 1440,
+                n_steps: int | None = None, grid_spacing: float | None = None, directions: int = 80,
+                global_check: bool | None = None, domain=None) -> RouteResult:
+    """Time-optimal route from ``start`` to ``target`` (north, east) [m] at ``speed`` [m/s] through ``fld``.
+
+    Returns a :class:`~shipgnc.routing.result.RouteResult`; an unreachable target gives ``reachable=False``
+    with a worded ``reason`` (F1) rather than an exception. Bad input raises
+    :class:`~shipgnc.errors.ConfigError` naming the field (F10, Z-22). ``horizon`` [s] bounds the search
+    (default 4·|AB|/V); ``radius`` > 0 makes the target a disc (Z12); ``obstacles`` is a list of polygons
+    (sequences of (north, east) vertices in m, or shapely polygons) (2.9.3).
+    """
+    require(method in METHODS, "method", method, f"allowed: {', '.join(METHODS)}")
+    start = np.asarray(start, dtype=float)
+    target = np.asarray(target, dtype=float)
+    _validate(fld, speed, start, target, t0, radius)
+    res = RouteResult(False, start, target, float(speed), t0=float(t0), method=method, radius=float(radius),
+                      field=fld)
+    dist = float(np.hypot(*(target - start)))
+    if dist <= radius:  # F10: nothing to do
+        res.reachable, res.time_s, res.miss_m = True, 0.0, max(dist - radius, 0.0)
+        res.method = "pmp" if method == "auto" else method
+        res.notes.append("start and target coincide: t_f = 0 and an empty route (F10)")
+        return res
+    if horizon is None:
+        horizon = 4.0 * dist / speed
+    require(math.isfinite(horizon) and horizon > 0, "horizon", horizon, "must be a finite time > 0 s")
+    polys = None
+    if obstacles:
+        from shipgnc.routing.obstacles import as_polygons, check_endpoints
+
+        polys = as_polygons(obstacles)
+        check_endpoints(polys, start, target)
+
+    if method in ("auto", "pmp"):
+        if polys:
+            from shipgnc.routing.obstacles import route_around
+
+            route_around(res, polys, horizon=horizon, n_angles=n_angles)
+        else:
+            _pmp(res, horizon, n_angles, n_steps)
+        if method == "auto" and (global_check is None or global_check) and res.reachable:
+            _levelset_check(res, polys, grid_spacing, horizon, domain)
+        elif global_check and res.reachable:
+            _levelset_check(res, polys, grid_spacing, horizon, domain)
+        if not res.reachable and method == "auto" and not isinstance(fld, UniformCurrent):
+            _levelset_check(res, polys, grid_spacing, horizon, domain)
+        return res
+    if method == "levelset":
+        _levelset_primary(res, polys, grid_spacing, horizon, domain)
+        return res
+    _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles)
+    return res
+
+
+def _pmp(res: RouteResult, horizon, n_angles, n_steps):
+    from shipgnc.routing import pmp
+    from shipgnc.routing.closed_form import uniform_solution
+
+    fld, V, A, B = res.field, res.speed, res.start, res.target
+    if isinstance(fld, UniformCurrent) and res.radius == 0:
+        c = np.array([fld.north, fld.east])
+        sol = uniform_solution(V, c, A, B)
+        res.method = "pmp"
+        if not sol.reachable:
+            res.reason = f"target unreachable: {sol.reason}"
+            res.closest_approach_m, res.closest_time_s = sol.closest_approach, sol.closest_time
+            res.notes.append(f"closest approach {sol.closest_approach:.1f} m at t = "
+                             f"{sol.closest_time:.1f} s (F1)")
+            return res
+        e = np.array([math.cos(sol.heading), math.sin(sol.heading)])
+        res.reachable, res.time_s = True, sol.duration
+        res.heading_start = res.heading_end = sol.heading
+        res.miss_m = 0.0
+        res.path = _StraightPath(A, V * e + c, sol.heading, res.t0, sol.duration)
+        res.extremals = [{"time_s": sol.duration, "heading_start_deg": math.degrees(sol.heading),
+                          "heading_end_deg": math.degrees(sol.heading), "status": "global optimum",
+                          "conjugate_point_s": None}]
+        if sol.exit_time is not None:
+            res.notes.append(f"reachable only during a window: the target leaves the reachable set at "
+                             f"t = {sol.exit_time:.1f} s; a later arrival is infeasible (F1b)")
+        return res
+    sw = pmp.sweep(fld, V, A, B, t0=res.t0, horizon=horizon, n_angles=n_angles, n_steps=n_steps,
+                   radius=res.radius)
+    res.method = "pmp"
+    res.extremals = [_ext_dict(e, V) for e in sw.extremals]
+    if sw.n_inadmissible:
+        res.notes.append(f"{sw.n_inadmissible} of {sw.n_angles} initial headings inadmissible "
+                         "(V + e·v(A) ≤ 0) and skipped (F5)")
+    if sw.n_left_domain:
+        res.notes.append(f"{sw.n_left_domain} of {sw.n_angles} extremals left the gridded field's domain "
+                         f"{_extent(fld)} and were stopped there (F9)")
+    optimal = [e for e in sw.extremals if e.conjugate_at is None]
+    if not optimal:
+        res.closest_approach_m, res.closest_time_s = sw.closest_approach, sw.closest_time
+        extra = ""
+        if sw.n_left_domain:
+            extra = f"; {sw.n_left_domain} extremals left the gridded field's domain {_extent(fld)}"
+        res.reason = (f"target not reachable within T_max = {horizon:.0f} s ({horizon / 3600:.2f} h) in "
+                      f"{fld.describe()} at ship speed {V:.4f} m/s: closest approach "
+                      f"{sw.closest_approach:.1f} m at t = {sw.closest_time:.0f} s{extra}")
+        return res
+    _from_extremal(res, optimal[0])
+    if len(sw.extremals) > 1:
+        others = ", ".join(f"{e['time_s']:.0f} s" for e in res.extremals[1:])
+        res.notes.append(f"{len(sw.extremals)} extremals reach the target; the global optimum is returned, "
+                         f"others: {others} (F2)")
+    if not res.field.steady:
+        res.notes.append("time-varying current: H is not conserved, only H(t_f) = 0 holds (2.9.5)")
+    return res
+
+
+def _extent(fld):
+    if fld.bounds is None:
+        return ""
+    (n0, n1), (e0, e1) = fld.bounds
+    return f"N [{n0:g}, {n1:g}] m × E [{e0:g}, {e1:g}] m"
+
+
+def default_domain(fld, start, target, margin=None):
+    """A box holding A and B with a margin (F9): half of |AB| on every side, cut to a gridded extent."""
+    dist = float(np.hypot(*(np.asarray(target) - np.asarray(start))))
+    m = 0.5 * dist if margin is None else margin
+    n0, n1 = min(start[0], target[0]) - m, max(start[0], target[0]) + m
+    e0, e1 = min(start[1], target[1]) - m, max(start[1], target[1]) + m
+    if fld.bounds is not None:
+        (b0, b1), (c0, c1) = fld.bounds
+        n0, n1, e0, e1 = max(n0, b0), min(n1, b1), max(e0, c0), min(e1, c1)
+    return (n0, n1), (e0, e1)
+
+
+def _levelset_run(res, polys, grid_spacing, horizon, domain):
+    from shipgnc.routing.levelset import reachability
+
+    dom = domain if domain is not None else default_domain(res.field, res.start, res.target)
+    if grid_spacing is None:
+        size = max(dom[0][1] - dom[0][0], dom[1][1] - dom[1][0])
+        grid_spacing = size / 160.0
+    return reachability(res.field, res.speed, res.start, res.target, dom, grid_spacing, t0=res.t0,
+                        horizon=horizon, obstacles=polys)
+
+
+def _levelset_check(res, polys, grid_spacing, horizon, domain):
+    ls = _levelset_run(res, polys, grid_spacing, horizon, domain)
+    res.isochrones = ls
+    res.grid_spacing = ls.spacing
+    if ls.arrival is None:
+        if res.reachable:
+            res.notes.append(f"level set did not reach the target within {horizon:.0f} s")
+            res.global_check = {"method": "levelset", "time_s": None, "rel_diff": None}
+        else:
+            res.notes.append(f"level set confirms: not reached within {horizon:.0f} s; front's closest "
+                             f"approach {ls.closest_approach:.1f} m")
+        return
+    if res.reachable:
+        rel = (ls.arrival - res.time_s) / res.time_s
+        res.global_check = {"method": "levelset", "time_s": float(ls.arrival), "rel_diff": float(rel)}
+        if rel < -5e-3:
+            res.notes.append(f"level set arrives {-100 * rel:.2f} % earlier than the returned extremal: the "
+                             "sweep may have missed a route; refine n_angles or the horizon")
+    else:
+        res.notes.append(f"level set reaches the target at {ls.arrival:.0f} s although no extremal was "
+                         "polished")
+
+
+def _polish_from_seed(res, theta0, duration):
+    from shipgnc.routing import pmp
+
+    ext = pmp.shoot(res.field, res.speed, res.start, res.target, theta0, duration, t0=res.t0,
+                    radius=res.radius)
+    if ext is None:
+        return None
+    ext.conjugate_at = pmp.conjugate_time(res.field, res.speed, res.start, ext)
+    ext.status = "polished from the global seed" if ext.conjugate_at is None else "conjugate point"
+    return ext
+
+
+def _levelset_primary(res, polys, grid_spacing, horizon, domain):
+    ls = _levelset_run(res, polys, grid_spacing, horizon, domain)
+    res.isochrones, res.grid_spacing = ls, ls.spacing
+    if ls.arrival is None:
+        res.reason = (f"target not reachable within T_max = {horizon:.0f} s in {res.field.describe()} "
+                      f"at ship speed {res.speed:.4f} m/s: the reachability front's closest approach is "
+                      f"{ls.closest_approach:.1f} m")
+        res.closest_approach_m = ls.closest_approach
+        return
+    route = ls.route
+    ext = None if polys else _polish_from_seed(res, route.heading_start, ls.arrival)
+    if ext is not None and abs(ext.duration - ls.arrival) <= 0.05 * ls.arrival:
+        _from_extremal(res, ext, "pmp")
+        res.extremals = [_ext_dict(ext, res.speed)]
+        res.global_check = {"method": "levelset", "time_s": float(ls.arrival),
+                            "rel_diff": float((ls.arrival - ext.duration) / ext.duration)}
+        return
+    res.reachable, res.method, res.time_s = True, "levelset", float(ls.arrival)
+    res.heading_start, res.heading_end = route.heading_start, route.heading_end
+    res.miss_m, res.path = route.miss, route
+    res.notes.append("level-set route (not polished)")
+
+
+def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles):
+    from shipgnc.routing.graph import graph_route
+
+    dom = domain if domain is not None else default_domain(res.field, res.start, res.target)
+    if grid_spacing is None:
+        size = max(dom[0][1] - dom[0][0], dom[1][1] - dom[1][0])
+        grid_spacing = size / 200.0
+    g = graph_route(res.field, res.speed, res.start, res.target, dom, grid_spacing, directions=directions,
+                    t0=res.t0, obstacles=polys)
+    res.grid_spacing = g.spacing
+    if g.time_s is None:
+        res.notes.append(f"graph search ({directions} directions) found no route; a graph's 'unreachable' is "
+                         "not final and is checked by the PMP sweep (F7)")
+        _pmp(res, horizon, n_angles, None)
+        return
+    ext = None if polys else _polish_from_seed(res, g.heading_start, g.time_s)
+    if ext is not None and abs(ext.duration - g.time_s) <= 0.05 * g.time_s:
+        _from_extremal(res, ext, "pmp")
+        res.extremals = [_ext_dict(ext, res.speed)]
+        res.global_check = {"method": "graph", "time_s": float(g.time_s),
+                            "rel_diff": float((g.time_s - ext.duration) / ext.duration)}
+        return
+    res.reachable, res.method, res.time_s = True, "graph", float(g.time_s)
+    res.heading_start, res.heading_end, res.miss_m, res.path = g.heading_start, g.heading_end, g.miss, g
+    res.notes.append("graph route (a coarse seed, not polished) (F7)")
+
+
+__all__ = ["METHODS", "ConfigError", "default_domain", "solve_route"]
