@@ -131,7 +131,7 @@ def run_command(
         sc = load_scenario(scenario, set_ or [])
         if live and (sc.vessel.model != "vectored-thrust-boat" or sc.controllers is not None):
             raise ConfigError(f"--live: the live dashboard shows the vectored-thrust boat; scenario "
-                              f"{sc.name!r} ({sc.vessel.model}) writes comparison.png instead")
+                              f"{sc.name!r} ({sc.vessel.model}) writes its figures after the run")
         out_dir = out if out is not None else Path("runs") / sc.name
         observer = _live_observer(sc, realtime) if live else None
         with _progress(enabled=not live) as progress:
@@ -186,13 +186,9 @@ def _progress(enabled: bool):
 
 
 def _cell(value) -> str:
-    if isinstance(value, bool) or value is None:
-        return "—" if value is None else str(value)
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    if isinstance(value, list):
-        return ", ".join("—" if v is None else f"{v:.4g}" for v in value)
-    return str(value)
+    from shipgnc.scenarios.runner import metric_text
+
+    return metric_text(value, digits=6 if isinstance(value, float) else 4)
 
 
 def _print_metrics(name: str, metrics: dict) -> None:

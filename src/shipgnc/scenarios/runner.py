@@ -248,6 +248,10 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     compare = scenario.controllers is not None
     # one sea for every controller of a comparison, also when no seed is given (recorded)
     seed = sim.seed if sim.seed is not None else int(np.random.SeedSequence().generate_state(1)[0])
+    if scenario.vessel.model == "catamaran":
+        from shipgnc.scenarios import catamaran
+
+        return catamaran.run(scenario, seed=seed, progress=progress, on_divergence=on_divergence)
     results, all_metrics, setups = {}, {}, {}
     for name in scenario.variants:
         setup = build(scenario, name, seed=seed)
@@ -266,6 +270,12 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     first = next(iter(results))
     if not compare:
         return ScenarioRun(scenario, setups[first], results[first], all_metrics[first])
+    return ScenarioRun(scenario, setups[first], combine(results), all_metrics, setups)
+
+
+def combine(results: dict):
+    """Results by name → one Dataset with a ``controller`` dimension (shorter runs NaN-padded);
+    ``attrs["diverged"]`` if any diverged, with their messages."""
     import xarray as xr
 
     combined = xr.concat(list(results.values()), dim="controller", data_vars="all", join="outer",
@@ -275,7 +285,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     combined.attrs["diverged"] = int(bool(diverged))
     combined.attrs["message"] = "; ".join(f"{n}: {results[n].attrs['message']}" for n in diverged)
     combined.attrs.pop("controller", None)
-    return ScenarioRun(scenario, setups[first], combined, all_metrics, setups)
+    return combined
 
 
 def _vessel_attrs(model, scenario: Scenario) -> dict:
@@ -317,8 +327,10 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
     except OSError as exc:
         raise ConfigError(f"--out {str(out)!r}: cannot create the directory ({exc.strerror})") from None
     pending = None
+    job = figure_job(run, out) if figures else None
+    figures = job is not None
     if figures and figure_process is not None:
-        pending = figure_process.submit(render_figures, figure_job(run, out))
+        pending = figure_process.submit(render_figures, job)
     written = [save(run.result, out / "result.nc")]
     metrics_path = out / "metrics.json"
     metrics_path.write_text(metrics_json(run.metrics) + "\n", encoding="utf-8")
@@ -328,7 +340,7 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
     if pending is not None:
         written.extend(pending.result())
     elif figures:
-        written.extend(render_figures(figure_job(run, out)))
+        written.extend(render_figures(job))
     return written
 
 
@@ -342,6 +354,18 @@ def figure_job(run: ScenarioRun, out: Path):
     lower, upper = model.input_limits()
     limits = {s.name: (float(lower[i]), float(upper[i])) for i, s in enumerate(model.inputs)}
     names = list(run.setups) if run.setups is not None else list(run.scenario.variants)
+    if run.scenario.vessel.model == "catamaran":
+        if "controller" in run.result.dims:
+            runs = {n: run.result.sel(controller=n).dropna("time", how="all") for n in names}
+        else:
+            runs = {run.scenario.name: run.result}
+        if any("ship" in ds.dims for ds in runs.values()):
+            return None  # a batch: its metrics summarise it
+        target = getattr(run.setup.controller, "omega_ref", None)
+        options = {"builder": run.scenario.case.builder, "preset": run.scenario.vessel.preset,
+                   "heading_target": float(getattr(target, "psi_target", 0.0) or 0.0)}
+        return FigureJob(result=runs, out=out, title=run.scenario.name, kind="catamaran",
+                         options=options)
     if run.setup.path is not None:
         from shipgnc.viz import path_tracking as pt
 
@@ -382,8 +406,8 @@ def comparison_table(run: ScenarioRun) -> list[dict]:
         for key, value in metrics.items():
             if isinstance(value, (int, float)) or value is None:
                 row[key] = value
-            elif isinstance(value, (list, tuple)):  # e.g. a gain vector
-                row[key] = ", ".join(f"{v:.4g}" for v in value)
+            elif isinstance(value, (list, tuple)):  # a gain vector, a list of events
+                row[key] = metric_text(value)
         for key, value in doc.get(name, {}).items():
             row[f"document_{key}"] = value
         rows.append(row)
@@ -402,16 +426,30 @@ def write_table(rows: list[dict], out: Path) -> list[Path]:
         writer.writerows(rows)
 
     def cell(value) -> str:
-        if value is None:
-            return "—"
-        if isinstance(value, float):
-            return f"{value:.4g}"
-        return str(value)
+        return metric_text(value, digits=4)
 
     lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     lines += ["| " + " | ".join(cell(row.get(c)) for c in columns) + " |" for row in rows]
     md_path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return [csv_path, md_path]
+
+
+def metric_text(value, digits: int = 4) -> str:
+    """A metric as table text: numbers to ``digits`` significant digits, None as "—", a list of
+    numbers joined, a list of events (dicts with ``kind``) by kind ("none" if empty)."""
+    if value is None:
+        return "—"
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, float):
+        return f"{value:.{digits}g}"
+    if isinstance(value, (list, tuple)):
+        if not value:
+            return "none"
+        if all(isinstance(v, dict) for v in value):
+            return "; ".join(str(v.get("kind", v)) for v in value)
+        return ", ".join(metric_text(v, digits) for v in value)
+    return str(value)
 
 
 def metrics_json(metrics: dict) -> str:

@@ -97,6 +97,26 @@ class MarinerVesselConfig(Strict):
         return params
 
 
+class CatamaranVesselConfig(Strict):
+    """``vessel`` for document 004's twin-azimuth catamaran: parameter preset (spec 004 §4.4)."""
+
+    model: Literal["catamaran"]
+    preset: Literal["si", "paper"] = "si"
+
+
+CATAMARAN_BUILDERS = ("turn", "steps", "fixed-angle", "sine", "heading", "actuator", "montecarlo",
+                      "compare")
+
+
+class CatamaranCaseConfig(Strict):
+    """Document 004's case (spec 004 §4.7): a ``builder`` of :mod:`shipgnc.cases.catamaran` and its
+    keyword ``options`` (checked against the builder's signature when the scenario is built)."""
+
+    builder: Literal["turn", "steps", "fixed-angle", "sine", "heading", "actuator", "montecarlo",
+                     "compare"]
+    options: dict[str, Finite | int | bool | str | None] = Field(default_factory=dict)
+
+
 def _vessel_tag(value) -> str:
     if isinstance(value, dict):
         return value.get("model", "vectored-thrust-boat")
@@ -106,10 +126,11 @@ def _vessel_tag(value) -> str:
 Vessel = Annotated[
     Annotated[VesselConfig, Tag("vectored-thrust-boat")]
     | Annotated[CyberShipVesselConfig, Tag("cybership2")]
-    | Annotated[MarinerVesselConfig, Tag("mariner")],
+    | Annotated[MarinerVesselConfig, Tag("mariner")]
+    | Annotated[CatamaranVesselConfig, Tag("catamaran")],
     Discriminator(_vessel_tag, custom_error_type="vessel_model",
                   custom_error_message="unknown vessel model; allowed: vectored-thrust-boat, "
-                                       "cybership2, mariner"),
+                                       "cybership2, mariner, catamaran"),
 ]
 
 
@@ -419,7 +440,8 @@ DisturbanceConfig = Annotated[ConstantForceConfig | GaussianForceConfig | WavesC
 
 # --------------------------------------------------------------------------- scenario
 
-METRIC_SETS = ("stern-kick", "heading-steps", "waypoints", "course-quality", "path-tracking", "none")
+METRIC_SETS = ("stern-kick", "heading-steps", "waypoints", "course-quality", "path-tracking",
+               "catamaran", "none")
 
 
 class MonteCarloConfig(Strict):
@@ -456,7 +478,7 @@ class Scenario(Strict):
     description: str = ""
     document: str = ""
     metrics: Literal["stern-kick", "heading-steps", "waypoints", "course-quality", "path-tracking",
-                     "none"] = "none"
+                     "catamaran", "none"] = "none"
     vessel: Vessel = Field(default_factory=VesselConfig)
     actuator: ActuatorConfig = Field(default_factory=ActuatorConfig)
     simulation: SimulationConfig
@@ -466,6 +488,8 @@ class Scenario(Strict):
     disturbance: DisturbanceConfig | None = None
     quality: QualityConfig = Field(default_factory=QualityConfig)
     montecarlo: MonteCarloConfig | None = None
+    #: document 004's case (vessel model ``catamaran`` only)
+    case: CatamaranCaseConfig | None = None
     #: the document's own figures, by controller (shown beside ours in comparison tables)
     document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
 
@@ -476,6 +500,8 @@ class Scenario(Strict):
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
+        if self.vessel.model == "catamaran" or self.case is not None:
+            return self._consistent_catamaran()
         if (self.controller is None) == (self.controllers is None):
             raise ValueError("give either 'controller' or 'controllers' (a mapping name: controller)")
         if self.controllers is not None and not self.controllers:
@@ -528,6 +554,24 @@ class Scenario(Strict):
         if self.montecarlo is not None and vessel != "mariner":
             raise ValueError("montecarlo: batches of random initial states are built for vessel "
                              "model 'mariner' in this release")
+        return self
+
+
+    def _consistent_catamaran(self) -> Scenario:
+        if self.vessel.model != "catamaran":
+            raise ValueError(f"case: document 004's cases need vessel model 'catamaran', not "
+                             f"{self.vessel.model!r}")
+        if self.case is None:
+            raise ValueError("case: a catamaran scenario names a case builder (allowed: "
+                             f"{', '.join(CATAMARAN_BUILDERS)})")
+        for name in ("controller", "controllers", "guidance", "disturbance", "montecarlo"):
+            if getattr(self, name) is not None:
+                raise ValueError(f"{name}: a catamaran scenario's runs come from its case builder; "
+                                 "set them in case.options")
+        if self.actuator != ActuatorConfig():
+            raise ValueError("actuator: the catamaran's thruster is set in case.options")
+        if self.metrics not in ("catamaran", "none"):
+            raise ValueError(f"metrics = {self.metrics!r}: a catamaran scenario reports 'catamaran'")
         return self
 
 

@@ -28,6 +28,8 @@ class FigureJob:
     outline: tuple[float, float] = (2.0, 1.08)
     lever_arm: float = 1.0
     closeup: bool = False
+    #: document 004: the case builder, preset and heading target the figures depend on
+    options: dict | None = None
 
 
 def render_figures(job: FigureJob) -> list[Path]:
@@ -38,6 +40,8 @@ def render_figures(job: FigureJob) -> list[Path]:
 
     if job.kind in ("path-tracking", "montecarlo"):
         return _path_figures(job)
+    if job.kind == "catamaran":
+        return _catamaran_figures(job)
     if job.kind == "course-comparison":
         from shipgnc.units import to_deg
         from shipgnc.viz.comparison import course_comparison
@@ -68,3 +72,33 @@ def _path_figures(job: FigureJob) -> list[Path]:
             save_figure(pt.heading_figure(job.result), job.out / "fig4_heading.png"),
             save_figure(pt.rudder_figure(job.result, rudder_limit_deg=None if limit is None
                                          else float(to_deg(limit[1]))), job.out / "fig5_rudder.png")]
+
+
+def _catamaran_figures(job: FigureJob) -> list[Path]:
+    """Document 004's figures that belong to the run's case (``result``: Datasets by run key)."""
+    from shipgnc.models.catamaran import Catamaran
+    from shipgnc.viz import catamaran as cv
+    from shipgnc.viz.dashboard import save_figure
+
+    runs, opts = job.result, job.options or {}
+    builder, out = opts.get("builder"), job.out
+    first = next(iter(runs.values()))
+    figures = []
+    if builder == "turn":
+        figures.append((cv.fig_turn(runs.get("law21", first), f"{job.title}: turn"), "turn.png"))
+        figures.append((cv.fig_yaw_rate_laws(runs), "yaw_rate.png"))
+    elif builder == "steps":
+        model = Catamaran.from_preset(opts.get("preset", "si"))
+        key = next((k for k in runs if k.startswith("law20")), next(iter(runs)))
+        figures.append((cv.fig_phi3(runs[key], model), "fig1_phi3.png"))
+        figures.append((cv.fig_yaw_rate_laws(runs), "fig2_3_yaw_rate.png"))
+    elif builder == "fixed-angle":
+        figures.append((cv.fig_transients(runs), "fig4_5_transients.png"))
+    elif builder == "sine":
+        figures.append((cv.fig_sine(first), "fig7_sine.png"))
+    elif builder == "heading":
+        figures.append((cv.fig_heading(first, opts.get("heading_target", 0.0)), "fig8_heading.png"))
+    elif builder in ("actuator", "compare"):
+        rate_runs = {k: v for k, v in runs.items() if not k.startswith("S7")}
+        figures.append((cv.fig_yaw_rate_laws(rate_runs, t_max=None), "yaw_rate.png"))
+    return [save_figure(fig, out / name) for fig, name in figures]

@@ -1,0 +1,129 @@
+"""Document 004's scenarios: the case builders of :mod:`shipgnc.cases.catamaran` driven by a
+validated :class:`~shipgnc.scenarios.schema.Scenario` (spec 004 §4.7).
+
+A catamaran scenario names a ``case.builder`` and its ``case.options`` (the builder's keyword
+arguments, checked against its signature); ``vessel.preset``, ``simulation.t_end`` and
+``simulation.dt`` are handed to the builder where it takes them. A builder may return several runs
+(e.g. laws (20) and (21)); they share the result's ``controller`` dimension and the metrics are
+keyed by run.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+
+import numpy as np
+
+from shipgnc.errors import ConfigError
+from shipgnc.scenarios.schema import Scenario
+
+
+def _builders() -> dict:
+    from shipgnc.cases import catamaran as C
+
+    return {"turn": C.turn, "steps": C.steps, "fixed-angle": C.fixed_angle, "sine": C.sine,
+            "heading": C.heading, "actuator": C.actuator, "montecarlo": C.robustness,
+            "compare": _compare}
+
+
+def _compare(preset_name: str = "si", t_end: float = 600.0, t_end_rate: float = 300.0):
+    """FSM laws against the PI / LQR baselines on S3, S4 (``t_end_rate``) and S7 (``t_end``)
+    (spec 004 §4.11.3)."""
+    from shipgnc.control.catamaran_baselines import comparison_cases
+
+    return comparison_cases(preset_name, t_end_rate=min(t_end_rate, t_end), t_end_heading=t_end)
+
+
+def builder_options(name: str) -> dict[str, object]:
+    """The options a builder takes (name → default), for messages and ``shipgnc show``."""
+    signature = inspect.signature(_builders()[name])
+    return {p.name: p.default for p in signature.parameters.values() if p.name != "preset_name"}
+
+
+def cases(scenario: Scenario) -> dict:
+    """The runs of the scenario: run key → :class:`~shipgnc.cases.catamaran.CatamaranCase`."""
+    from shipgnc.cases.catamaran import DT, CatamaranCase
+
+    cfg, sim = scenario.case, scenario.simulation
+    build = _builders()[cfg.builder]
+    params = inspect.signature(build).parameters
+    allowed = builder_options(cfg.builder)
+    kwargs = {}
+    for key, value in cfg.options.items():
+        if key not in allowed:
+            raise ConfigError(f"case.options.{key}: not an option of builder {cfg.builder!r}; "
+                              f"allowed: {', '.join(allowed) or 'none'}")
+        default = allowed[key]
+        if isinstance(default, (int, float)) and not isinstance(default, bool):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ConfigError(f"case.options.{key} = {value!r}: must be a finite number")
+            if isinstance(default, int) and not isinstance(value, int):
+                raise ConfigError(f"case.options.{key} = {value!r}: must be a whole number")
+        kwargs[key] = value
+    if "preset_name" in params:
+        kwargs["preset_name"] = scenario.vessel.preset
+    elif scenario.vessel.preset != "si":
+        raise ConfigError(f"vessel.preset = {scenario.vessel.preset!r}: builder {cfg.builder!r} runs "
+                          "preset 'si' only")
+    if "t_end" in params and "t_end" not in kwargs:
+        kwargs["t_end"] = sim.t_end
+    if "dt" in params:
+        kwargs.setdefault("dt", sim.dt)
+    elif abs(sim.dt - DT) > 1e-12:
+        raise ConfigError(f"simulation.dt = {sim.dt!r}: builder {cfg.builder!r} integrates at "
+                          f"dt = {DT} s (spec 004 §4.7)")
+    built = build(**kwargs)
+    if isinstance(built, CatamaranCase):
+        law = getattr(built, "notes", {}).get("law")
+        built = {f"law{law}" if law else cfg.builder: built}
+    return built
+
+
+def run(scenario: Scenario, *, seed: int, progress=None, on_divergence: str = "raise"):
+    """Run every case of the scenario with the one loop; returns a
+    :class:`~shipgnc.scenarios.runner.ScenarioRun` (metrics keyed by run when there are several)."""
+    from shipgnc.analysis.catamaran_metrics import attach_events, catamaran_metrics, comparison_metrics
+    from shipgnc.scenarios.runner import ScenarioRun, Setup, combine
+    from shipgnc.sim.simulator import simulate
+
+    runs = cases(scenario)
+    results, metrics, setups = {}, {}, {}
+    several = len(runs) > 1
+    for key, case in runs.items():
+        ds = simulate(case.model, case.x0, **case.simulate_kwargs(), seed=seed, progress=progress,
+                      backend=scenario.simulation.backend,
+                      on_divergence="stop" if several else on_divergence,
+                      attrs={"scenario": scenario.name, "controller": key, "seed": seed,
+                             "vessel": "catamaran", "preset": scenario.vessel.preset})
+        attach_events(ds, case.controller)
+        if np.ndim(case.x0) > 1:
+            m = montecarlo_summary(ds, case)
+        elif scenario.case.builder == "compare":
+            m = {**catamaran_metrics(ds, case.controller, case.heading_target),
+                 **comparison_metrics(ds, case.heading_target)}
+        else:
+            m = catamaran_metrics(ds, case.controller, case.heading_target)
+        m["diverged"] = bool(ds.attrs.get("diverged", 0))
+        results[key], metrics[key] = ds, m
+        setups[key] = Setup(case.model, case.x0, case.actuator, case.controller, case.guidance, None)
+    first = next(iter(runs))
+    if not several:
+        return ScenarioRun(scenario, setups[first], results[first], metrics[first])
+    return ScenarioRun(scenario, setups[first], combine(results), metrics, setups)
+
+
+def montecarlo_summary(ds, case) -> dict:
+    """A batch (check 16 / S10): the spread of the final yaw rate and rudder over the ships."""
+    from shipgnc.analysis.catamaran_metrics import events, stable
+
+    r_end = np.asarray(ds["r"].values[-1], dtype=float)
+    delta_end = np.degrees(np.asarray(ds["delta"].values[-1], dtype=float))
+    target = getattr(getattr(case.controller, "omega_ref", None), "omega", None)
+    out = {"runs": int(r_end.size),
+           "final_yaw_rate_median_rad_s": float(np.median(r_end)),
+           "final_delta_deg_min": float(delta_end.min()), "final_delta_deg_max": float(delta_end.max()),
+           "stable": stable(ds, events(ds, case.controller))}
+    if target is not None:
+        out["final_yaw_rate_max_error_rad_s"] = float(np.max(np.abs(r_end - np.asarray(target))))
+    return out

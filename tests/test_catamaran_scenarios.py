@@ -1,0 +1,93 @@
+"""Document 004's built-in scenarios end to end (spec 004 §4.7): names, settings, metrics, files."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+from typer.testing import CliRunner
+
+from shipgnc.cli import app
+from shipgnc.errors import ConfigError
+from shipgnc.scenarios.registry import builtin_names, load_scenario
+from shipgnc.scenarios.runner import run_scenario
+
+NAMES = ("catamaran-turn", "catamaran-steps", "catamaran-fixed-angle", "catamaran-sine",
+         "catamaran-heading", "catamaran-actuator", "catamaran-compare", "catamaran-montecarlo")
+KEYS = ("final_yaw_rate_rad_s", "final_delta_deg", "final_speed_mps", "turning_diameter_m",
+        "yaw_rate_settling_s", "yaw_rate_overshoot_pct", "max_delta_rate_deg_s", "events", "stable")
+
+
+def test_every_scenario_is_built_in_and_shows():
+    assert set(NAMES) <= set(builtin_names())
+    for name in NAMES:
+        result = CliRunner().invoke(app, ["show", name])
+        assert result.exit_code == 0 and "builder:" in result.stdout, name
+
+
+def test_turn_reaches_the_commanded_yaw_rate(tmp_path):
+    """S3 with both laws: r → ω* = 0.08 rad/s (spec 004 check: the FSM makes r track ω*)."""
+    result = CliRunner().invoke(app, ["run", "catamaran-turn", "--set", "simulation.t_end=200",
+                                      "--out", str(tmp_path), "--json"])
+    assert result.exit_code == 0, result.stderr
+    metrics = json.loads(result.stdout)
+    assert tuple(metrics) == ("law20", "law21")
+    for name, m in metrics.items():
+        for key in KEYS:
+            assert key in m, (name, key)
+        assert m["final_yaw_rate_rad_s"] == pytest.approx(0.08, abs=1e-4), name
+        assert m["stable"] and m["events"] == []
+    for name in ("result.nc", "metrics.json", "table.md", "turn.png", "yaw_rate.png"):
+        assert (tmp_path / name).stat().st_size > 300, name
+    assert "law20" in (tmp_path / "table.md").read_text()
+
+
+def test_heading_capture_settles_on_the_target():
+    m = run_scenario("catamaran-heading", overrides=["case.options.omega_c=0.02",
+                                                     "simulation.t_end=300"]).metrics
+    assert abs(m["final_heading_error_rad"]) < 1e-3
+    assert m["stable"]
+
+
+def test_settings_reach_the_builder():
+    run = run_scenario("catamaran-turn", overrides=["case.options.omega=0.04", "simulation.t_end=120",
+                                                    "vessel.preset=paper"])
+    for m in run.metrics.values():
+        assert m["final_yaw_rate_rad_s"] == pytest.approx(0.04, abs=1e-4)
+    assert run.result.attrs["preset"] == "paper"
+    assert float(run.result.time[-1]) == pytest.approx(120.0)
+
+
+def test_montecarlo_is_one_batch():
+    run = run_scenario("catamaran-montecarlo", overrides=["case.options.n=50", "simulation.t_end=120"])
+    assert run.result.sizes["ship"] == 50
+    assert run.metrics["runs"] == 50
+    assert run.metrics["final_yaw_rate_max_error_rad_s"] < 1e-3  # every perturbed plant tracks ω*
+
+
+@pytest.mark.parametrize(("overrides", "words"), [
+    (["case.options.omegaa=0.1"], ["case.options.omegaa", "allowed", "omega"]),
+    (["case.options.omega=fast"], ["case.options.omega", "number"]),
+    (["case.builder=spin"], ["case.builder", "spin"]),
+    (["vessel.preset=navy"], ["vessel.preset", "navy"]),
+    (["controller={type: lqr}"], ["controller"]),
+    (["simulation.dt=0.1"], ["simulation.dt"]),
+])
+def test_bad_settings_name_the_field(overrides, words):
+    with pytest.raises(ConfigError) as info:
+        scenario = "catamaran-steps" if "simulation.dt=0.1" in overrides else "catamaran-turn"
+        run_scenario(scenario, overrides=overrides)
+    for word in words:
+        assert word in str(info.value), (word, str(info.value))
+
+
+def test_omega_beyond_the_limit_is_reported_not_silent():
+    """Spec 004 check 13 / §4.11.1: at the paper preset's feasibility limit law (21) fails with an
+    event and ``stable`` false instead of a silent wrong run."""
+    run = run_scenario("catamaran-turn", overrides=["vessel.preset=paper", "case.options.omega=0.2",
+                                                    "simulation.t_end=200"])
+    m = run.metrics["law21"]
+    assert not m["stable"] or m["events"]
+    assert math.isfinite(m["final_delta_deg"])
+    assert load_scenario("catamaran-turn").case.builder == "turn"
