@@ -211,6 +211,11 @@ def _print_metrics(name: str, metrics: dict) -> None:
     stdout.print(table)
 
 
+from shipgnc.cli_route import route as _route  # noqa: E402  (the route command, spec 002)
+
+app.command("route")(_route)
+
+
 def main() -> None:
     """Console-script entry point."""
     app()

@@ -172,8 +172,9 @@ def _solve(field, speed, start, thetas, t0, duration, dense=False, rtol=1e-11):
 class _Shooter:
     """Residual and Jacobian of x(t₀ + T; θ₀) − B (point) or x + R e(u) − B (disc, Z12) for least_squares."""
 
-    def __init__(self, field, speed, start, target, t0, radius=0.0, h=1e-6):
+    def __init__(self, field, speed, start, target, t0, radius=0.0, h=1e-6, rtol=1e-11):
         self.field, self.speed, self.start, self.t0 = field, speed, start, t0
+        self.rtol = rtol
         self.target, self.radius, self.h = np.asarray(target, float), float(radius), h
         self.cache: dict = {}
 
@@ -184,7 +185,7 @@ class _Shooter:
             if not dur > 0:
                 dur = 1e-9
             res = _solve(self.field, self.speed, self.start, [theta - self.h, theta, theta + self.h],
-                         self.t0, dur)
+                         self.t0, dur, rtol=self.rtol)
             y = res.y[:, -1].reshape(3, 4)
             if not res.success or not np.all(np.isfinite(y)):
                 y = np.full((3, 4), 1e12)
@@ -213,7 +214,7 @@ class _Shooter:
         return np.stack([d_theta, d_t], axis=-1)
 
 
-def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol_m=1.0):
+def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol_m=1.0, rtol=1e-11):
     """Polish one extremal from a guess (θ₀, t_f − t₀) with Levenberg–Marquardt (spec 002 §2.9.4).
 
     Returns an :class:`Extremal` or ``None`` when the solver fails, returns t_f ≤ 0 (F4), misses by more
@@ -221,12 +222,12 @@ def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol
     """
     from scipy.optimize import least_squares
 
-    sh = _Shooter(field, speed, np.asarray(start, float), target, t0, radius)
+    sh = _Shooter(field, speed, np.asarray(start, float), target, t0, radius, rtol=rtol)
     scale = max(float(np.hypot(*(np.asarray(target, float) - np.asarray(start, float)))), 1.0)
     try:
         sol = least_squares(sh.residual, [float(theta0), float(duration)], jac=sh.jacobian, method="lm",
                             x_scale=[1.0, max(float(duration), 1.0)], xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                            max_nfev=200)
+                            max_nfev=60)
     except (ValueError, FloatingPointError):
         return None
     theta, dur = float(sol.x[0]), float(sol.x[1])
@@ -235,13 +236,13 @@ def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol
     miss = float(np.hypot(*sol.fun))
     if miss > tol_m or miss > 1e-3 * scale + tol_m:
         return None
-    return finish_extremal(field, speed, start, target, theta, dur, t0, radius)
+    return finish_extremal(field, speed, start, target, theta, dur, t0, radius, rtol=rtol)
 
 
-def finish_extremal(field, speed, start, target, theta, dur, t0=0.0, radius=0.0):
+def finish_extremal(field, speed, start, target, theta, dur, t0=0.0, radius=0.0, rtol=1e-11):
     """Dense extremal with its costate scaled by (2.4); ``None`` if inadmissible or off a gridded domain."""
     theta = float(np.mod(theta, TWO_PI))
-    res = _solve(field, speed, start, [theta], t0, dur, dense=True)
+    res = _solve(field, speed, start, [theta], t0, dur, dense=True, rtol=rtol)
     y_end = res.y[:, -1]
     pe = y_end[2:] / math.hypot(y_end[2], y_end[3])
     vb = field._velocity(t0 + dur, y_end[0], y_end[1])
@@ -370,7 +371,18 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
     closest_t = float(best[0] * dt)
     candidates = _candidates(dist_tab, pos, th.size, speed * dt) if th.size > 2 else []
     extremals: list[Extremal] = []
-    for k, i in candidates[:max_candidates]:
+    seeds: list[tuple[int, int]] = []
+    dth = TWO_PI / n_angles
+    for k, i in candidates:
+        if len(seeds) >= max_candidates:
+            break
+        # one polish per basin: skip seeds next to an earlier seed or to a polished extremal
+        if any(abs(i - i2) <= 3 and abs(k - k2) <= 0.03 * k2 + 2 for k2, i2 in seeds):
+            continue
+        if any(abs(math.remainder(th[i] - o.theta0, TWO_PI)) <= 4 * dth
+               and abs(k * dt - o.duration) <= 0.03 * o.duration for o in extremals):
+            continue
+        seeds.append((k, i))
         ext = shoot(field, speed, start, target, th[i], k * dt, t0=t0, radius=radius)
         if ext is None or ext.duration > horizon * (1 + 1e-9):
             continue

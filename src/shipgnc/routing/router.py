@@ -139,6 +139,7 @@ def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0
 
         polys = as_polygons(obstacles)
         check_endpoints(polys, start, target)
+        res._obstacles = polys
 
     if method in ("auto", "pmp"):
         if polys:

@@ -1,0 +1,141 @@
+"""``shipgnc route``: time-optimal route in a current (spec 002 §2.9.6).
+
+    shipgnc route --start N,E --target N,E --speed V --field FIELD [--method auto|pmp|levelset|graph]
+                  [--obstacles FILE.geojson] [--units si|nautical] [--json] [--out DIR]
+
+SI by default; ``--units nautical`` reads positions in nm, speeds in kn, k and ω in 1/h, Γ in nm²/h and prints
+times in h beside s. JSON keys stay SI. Exit codes: 0 a route, 2 bad input, 3 unreachable (one-line reason on
+stderr, ``reachable: false`` in the JSON), 1 internal error.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from shipgnc.errors import ConfigError
+from shipgnc.units import KNOT, NAUTICAL_MILE
+
+
+def _pair(text: str, name: str, scale: float):
+    parts = text.split(",")
+    try:
+        vals = [float(p) for p in parts]
+    except ValueError:
+        vals = []
+    if len(vals) != 2 or not all(math.isfinite(v) for v in vals):
+        raise ConfigError(f"{name} = {text!r}: expected two finite numbers N,E")
+    return [vals[0] * scale, vals[1] * scale]
+
+
+def route(
+    start: Annotated[str, typer.Option("--start", help="Start N,E [m | nm].")],
+    target: Annotated[str, typer.Option("--target", help="Target N,E [m | nm].")],
+    speed: Annotated[float, typer.Option("--speed", help="Ship speed through water [m/s | kn].")],
+    field: Annotated[str, typer.Option("--field", help="Current: uniform:north=..,east=.. | shear:k=.. | "
+                                       "rotation:omega=..,north=..,east=.. | "
+                                       "lamb-oseen:gamma=..,rc=..,north=..,"
+                                       "east=.. | rankine:... ; '+' sums; or a NetCDF file.")],
+    method: Annotated[str, typer.Option("--method", help="auto | pmp | levelset | graph")] = "auto",
+    obstacles: Annotated[Path | None, typer.Option("--obstacles", help="GeoJSON polygons, [east, north] "
+                                                   "coordinates [m | nm].")] = None,
+    units: Annotated[str, typer.Option("--units", help="si | nautical")] = "si",
+    json_: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+    out: Annotated[Path | None, typer.Option("--out", help="Write route.png and route.json here.")] = None,
+    horizon: Annotated[float | None, typer.Option("--horizon", help="Search horizon [s | h] "
+                                                  "(default 4·|AB|/V).")] = None,
+    radius: Annotated[float, typer.Option("--radius", help="Target disc radius [m | nm].")] = 0.0,
+    depart: Annotated[float, typer.Option("--depart", help="Departure time t0 [s | h].")] = 0.0,
+    grid: Annotated[float | None, typer.Option("--grid",
+                                               help="Level-set / graph grid spacing [m | nm].")] = None,
+) -> None:
+    """Time-optimal route through a current field (Zermelo's problem)."""
+    from shipgnc.cli import friendly_errors, stderr, stdout
+
+    with friendly_errors():
+        from shipgnc.errors import require
+        from shipgnc.routing.field_spec import parse_field
+        from shipgnc.routing.router import METHODS, solve_route
+
+        require(units in ("si", "nautical"), "--units", units, "allowed: si, nautical")
+        require(method in METHODS, "--method", method, f"allowed: {', '.join(METHODS)}")
+        nautical = units == "nautical"
+        length = NAUTICAL_MILE if nautical else 1.0
+        vel = KNOT if nautical else 1.0
+        tscale = 3600.0 if nautical else 1.0
+        a = _pair(start, "--start", length)
+        b = _pair(target, "--target", length)
+        require(math.isfinite(speed) and speed > 0, "--speed", speed,
+                f"must be a finite speed > 0 {'kn' if nautical else 'm/s'}")
+        fld = parse_field(field, units)
+        polys = None
+        if obstacles is not None:
+            from shipgnc.routing.obstacles import load_geojson
+
+            polys = load_geojson(obstacles, units)
+        res = solve_route(fld, speed * vel, a, b, method=method, obstacles=polys, radius=radius * length,
+                          t0=depart * tscale, horizon=None if horizon is None else horizon * tscale,
+                          grid_spacing=None if grid is None else grid * length)
+        payload = res.to_json()
+        text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
+        if out is not None:
+            out.mkdir(parents=True, exist_ok=True)
+            (out / "route.json").write_text(text + "\n", encoding="utf-8")
+            from shipgnc.routing.figures import route_figure
+
+            route_figure(res, out / "route.png", nautical=nautical)
+            stderr.print(f"wrote route.json, route.png to {out}", soft_wrap=True)
+        if json_:
+            sys.stdout.write(text + "\n")
+        else:
+            _print(stdout, res, nautical)
+        if not res.reachable:
+            stderr.print(f"[bold red]unreachable:[/] {' '.join(str(res.reason).split())}", soft_wrap=True)
+            raise typer.Exit(3)
+
+
+def _jsonable(x):
+    import numpy as np
+
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    raise TypeError(type(x).__name__)
+
+
+def _print(console, res, nautical: bool) -> None:
+    from rich.table import Table
+
+    js = res.to_json()
+    table = Table(title="route", title_justify="left")
+    table.add_column("quantity", style="bold")
+    table.add_column("value", justify="right")
+    table.add_row("reachable", str(js["reachable"]))
+    if res.reachable:
+        t = js["time_s"]
+        table.add_row("t_f", f"{t:.2f} s = {t / 3600:.6f} h")
+        table.add_row("ETA", f"{res.t0 + t:.2f} s" + (f" = {(res.t0 + t) / 3600:.4f} h" if nautical else ""))
+        if js["heading_start_deg"] is not None:
+            table.add_row("u(t0)", f"{js['heading_start_deg']:.4f}°")
+            table.add_row("u(tf)", f"{js['heading_end_deg']:.4f}°")
+        table.add_row("miss", f"{js['miss_m']:.3g} m")
+    table.add_row("method", js["method"])
+    if res.grid_spacing:
+        g = res.grid_spacing
+        table.add_row("grid spacing", f"{g:.1f} m" + (f" = {g / NAUTICAL_MILE:.4f} nm" if nautical else ""))
+    if js["extremals"]:
+        table.add_row("extremals", ", ".join(f"{t:.1f} s" + (f" ({t / 3600:.4f} h)" if nautical else "")
+                                             for t in js["extremals"]))
+    gc = js["global_check"]
+    if gc:
+        val = "—" if gc["time_s"] is None else f"{gc['time_s']:.1f} s (rel. diff {gc['rel_diff']:+.2e})"
+        table.add_row(f"global check ({gc['method']})", val)
+    console.print(table)
+    for note in js["notes"]:
+        console.print(f"note: {note}", soft_wrap=True)
