@@ -8,11 +8,12 @@ time before the first leg switch.
 * ``settle_time_min``: first time after which |y_r| < 0.05 nm holds for the rest of leg 1
   (null if never);
 * ``overshoot_nm``: largest y_r of opposite sign to y_r(0) on leg 1, as a magnitude (0 if y_r
-  never crosses; null if y_r(0) = 0);
+  never crosses, and 0 for a start on the path line, |y_r(0)| < 1 mm);
 * ``crosstrack_max_after_leg1_nm``, ``crosstrack_rms_after_leg1_nm``: max |y_r| and RMS of y_r
   from the first switch to the end (null if leg 1 never ends);
 * ``final_crosstrack_nm``, ``final_heading_error_deg``, ``final_rudder_deg``: means over the last
-  10 min (signed);
+  10 min (signed; the heading error's is the circular mean, so a ship near ψ_r = ±180° reads
+  ±180°, not 0);
 * ``rudder_rms_deg``; ``saturation_fraction``: share of samples with |δ| at δ_max;
 * ``stable``: the run reached its end without the divergence guard and |y_r| stayed below
   max(3 nm, 2|y_r(0)|) (spec 000 §0.8, [A]).
@@ -32,6 +33,8 @@ SETTLE_BAND = 0.05 * NAUTICAL_MILE
 FINAL_WINDOW = 10.0 * MINUTE
 #: bound on |y_r| for ``stable`` [m]: max(3 nm, 2 |y_r(0)|)
 STABLE_BOUND = 3.0 * NAUTICAL_MILE
+#: |y_r(0)| below which a start counts as on the path line [m] (no side to overshoot to)
+ON_LINE = 1e-3
 
 PATH_TRACKING_KEYS = ("settle_time_min", "overshoot_nm", "crosstrack_max_after_leg1_nm",
                       "crosstrack_rms_after_leg1_nm", "final_crosstrack_nm",
@@ -67,9 +70,9 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
     settle = np.where(settled, t[np.minimum(settle_idx, n_t - 1)] / MINUTE, np.nan)
 
     y0 = y[0]
+    on_line = np.abs(y0) < ON_LINE
     opposite = np.where(leg1, -np.sign(y0) * y, -np.inf)
-    overshoot = np.maximum(opposite.max(axis=0), 0.0) / NAUTICAL_MILE
-    overshoot = np.where(y0 == 0, np.nan, overshoot)
+    overshoot = np.where(on_line, 0.0, np.maximum(opposite.max(axis=0), 0.0) / NAUTICAL_MILE)
 
     after = valid & (rows >= first_switch)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -99,7 +102,7 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
         "crosstrack_rms_after_leg1_nm": rms_after / NAUTICAL_MILE,
         "final_crosstrack_nm": final_mean(y) / NAUTICAL_MILE,
         "final_abs_crosstrack_nm": final_mean(np.abs(y)) / NAUTICAL_MILE,
-        "final_heading_error_deg": to_deg(final_mean(psi)),
+        "final_heading_error_deg": to_deg(np.arctan2(final_mean(np.sin(psi)), final_mean(np.cos(psi)))),
         "final_rudder_deg": to_deg(final_mean(np.where(np.isfinite(d), d, 0.0))),
         "rudder_rms_deg": to_deg(rudder_rms),
         "saturation_fraction": saturation,
@@ -133,15 +136,16 @@ def montecarlo_summary(ds, *, delta_max: float, diverged: bool = False) -> dict:
     mean |y_r| over the last 10 min is inside the settling band (0.05 nm) — bounded is not
     converged: a ship circling with its rudder hard over stays ``stable``; median and 95th percentile of
     ``settle_time_min`` (a ship that never settles counts as +∞, so a percentile it reaches is
-    null) and of ``crosstrack_rms_after_leg1_nm`` (ships whose leg 1 never ends excluded).
+    null) and of ``crosstrack_rms_after_leg1_nm`` (a ship that never finishes leg 1 counts as +∞
+    too: leaving them out would flatter a controller whose failures stay on leg 1).
     """
     arrays = path_tracking_arrays(ds["time"].values, _series(ds, "cross_track_error"),
                                   _series(ds, "heading_error"), _series(ds, "leg"),
                                   _series(ds, "delta"), delta_max=delta_max,
                                   reached_end=not diverged)
     settle = np.where(np.isnan(arrays["settle_time_min"]), np.inf, arrays["settle_time_min"])
-    rms = arrays["crosstrack_rms_after_leg1_nm"]
-    rms = rms[np.isfinite(rms)]
+    rms = np.where(np.isnan(arrays["crosstrack_rms_after_leg1_nm"]), np.inf,
+                   arrays["crosstrack_rms_after_leg1_nm"])
 
     def pct(values, q):
         if values.size == 0:

@@ -188,7 +188,8 @@ class OutputFL(_PathFL):
                          current_frame=current_frame)
         require(isinstance(lookahead, (int, float, np.floating)) and np.isfinite(lookahead)
                 and lookahead >= 0, "controller.lookahead", lookahead, "must be a finite length >= 0 m")
-        require(lookahead + self.r1 != 0 or self.r2 != 0, "controller.lookahead", lookahead,
+        require(abs(lookahead + self.r1) > 1e-6 * abs(self.r1) or self.r2 != 0, "controller.lookahead",
+                lookahead,
                 "l = -r1 (the pivot point) makes g = 0: the output has relative degree 3")
         for name, value in (("k1", k1), ("k2", k2)):
             require(isinstance(value, (int, float, np.floating)) and np.isfinite(value) and value > 0,

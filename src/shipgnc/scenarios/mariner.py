@@ -43,17 +43,20 @@ def mariner_path(g) -> WaypointPath:
 def controller(cfg, model, path: WaypointPath, scenario: Scenario):
     """Document 000's path controllers (spec 000 §0.4–0.5) with the scenario's settings."""
     from shipgnc.control import feedback_linearization as fl
-    from shipgnc.control.lqr import PathLQR, design_lqr, gain_to_si
+    from shipgnc.control.lqr import PAPER_Q, PAPER_R, PathLQR, design_lqr, gain_to_si
 
     p = model.params
     if cfg.type == "lqr":
-        K = gain_to_si(cfg.K_paper) if cfg.K_paper is not None else design_lqr(p, Q=cfg.Q, R=cfg.R).K_si
+        if cfg.K_paper is not None:
+            K = gain_to_si(cfg.K_paper)
+        else:
+            Q = PAPER_Q if cfg.Q is None else cfg.Q
+            K = design_lqr(p, Q=Q, R=PAPER_R if cfg.R is None else cfg.R).K_si
         return PathLQR(K, path, Ts=cfg.Ts, delta_max=p.delta_max, anti_windup=cfg.anti_windup)
     d = scenario.disturbance
     known = {}
     if cfg.knows_disturbance and d is not None:
-        known = {"b_r": d.b_r_rad_min2 / MINUTE**2, "d_y": d.d_y_nm_min * NAUTICAL_MILE / MINUTE,
-                 "current_frame": d.current_frame}
+        known = {"b_r": d.b_r, "d_y": d.d_y, "current_frame": d.current_frame}
     if cfg.type == "fl":
         return fl.OutputFL(p, path, Ts=cfg.Ts, lookahead=cfg.lookahead_nm * NAUTICAL_MILE,
                            k1=cfg.k1_per_min2 / MINUTE**2, k2=cfg.k2_per_min / MINUTE,
@@ -69,8 +72,8 @@ def disturbance(d, path: WaypointPath):
     from shipgnc.environment.filtered_noise import SecondOrderNoise
     from shipgnc.models.mariner import MarinerDisturbance
 
-    current = CrossCurrent(d.d_y_nm_min * NAUTICAL_MILE / MINUTE, path, frame=d.current_frame)
+    current = CrossCurrent(d.d_y, path, frame=d.current_frame)
     waves = None
     if d.wave_sigma_rad_min2 > 0:
         waves = SecondOrderNoise(d.wave_sigma_rad_min2 / MINUTE**2, d.wave_period, d.wave_zeta)
-    return MarinerDisturbance(d.b_r_rad_min2 / MINUTE**2, current=current, waves=waves)
+    return MarinerDisturbance(d.b_r, current=current, waves=waves)

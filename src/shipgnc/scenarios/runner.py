@@ -220,8 +220,11 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
         if lookahead is not None:  # output feedback linearisation: its zero dynamics (spec 000 §0.5)
             from shipgnc.control.feedback_linearization import zero_dynamics_pole
 
-            out["zero_dynamics_pole_per_min"] = zero_dynamics_pole(setup.model.params,
-                                                                   lookahead=lookahead)[0]
+            try:
+                out["zero_dynamics_pole_per_min"] = zero_dynamics_pole(setup.model.params,
+                                                                       lookahead=lookahead)[0]
+            except ConfigError:  # relative degree 3 (r1 + l = 0): no zero dynamics
+                out["zero_dynamics_pole_per_min"] = None
     else:
         out = {}
     out["diverged"] = diverged

@@ -26,6 +26,8 @@ from shipgnc.errors import ConfigError
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+OffsetNm = Annotated[float, Field(ge=-1000, le=1000, allow_inf_nan=False)]
+OffsetDeg = Annotated[float, Field(ge=-180, le=180, allow_inf_nan=False)]
 
 
 class Strict(BaseModel):
@@ -91,9 +93,25 @@ class MarinerVesselConfig(Strict):
     @field_validator("params_paper")
     @classmethod
     def _known_params(cls, params: dict[str, float]) -> dict[str, float]:
-        for key in params:
+        for key, value in params.items():
             if key not in MARINER_PARAM_NAMES:
                 raise ValueError(f"unknown parameter {key!r}; allowed: {', '.join(MARINER_PARAM_NAMES)}")
+            if abs(value) > 1e6:
+                raise ValueError(f"{key} = {value!r}: beyond ±1e6 in the document's units (its "
+                                 "coefficients are of order 1)")
+        from shipgnc.errors import ConfigError
+        from shipgnc.models.mariner import PAPER_UNITS, MarinerParams
+
+        try:
+            MarinerParams.from_paper_units(**params)
+        except ConfigError as exc:  # name the paper-unit value the user gave
+            field, _, rest = str(exc).partition(" = ")
+            name = field.rsplit(".", 1)[-1]
+            rule = rest.partition(": ")[2].strip()
+            given = params.get(name)
+            unit = PAPER_UNITS[name][0] if name in PAPER_UNITS else ""
+            message = f"{name} = {given!r} {unit}: {rule}" if given is not None else str(exc)
+            raise ValueError(message) from None
         return params
 
 
@@ -270,10 +288,17 @@ class PathLQRConfig(Strict):
 
     type: Literal["lqr"]
     Ts: Positive = 0.3
-    Q: tuple[NonNegative, NonNegative, NonNegative, NonNegative] = (0.1, 4.0, 0.0, 0.1)
-    R: Positive = 1.0
+    Q: tuple[NonNegative, NonNegative, NonNegative, NonNegative] | None = None
+    R: Positive | None = None
     K_paper: tuple[Finite, Finite, Finite, Finite] | None = None
     anti_windup: bool = False
+
+    @model_validator(mode="after")
+    def _gain_or_design(self) -> PathLQRConfig:
+        if self.K_paper is not None and (self.Q is not None or self.R is not None):
+            raise ValueError("give K_paper (a gain used as is) or Q and R (a design), not both "
+                             "(set Q and R to null to use K_paper)")
+        return self
 
 
 class OutputFLConfig(Strict):
@@ -376,6 +401,11 @@ class PathConfig(Strict):
         if self.reading == "text" and len(self.points_nm) < 3:
             raise ValueError("reading 'text' needs at least three points (the third leg starts at "
                              "the third)")
+        for a, b in itertools.pairwise(self.points_nm):
+            if a == b:
+                raise ValueError(f"points_nm: {list(a)} is repeated (a zero-length leg)")
+            if max(abs(v) for v in (*a, *b)) > 1e5:
+                raise ValueError(f"points_nm: {list(b)} is beyond ±1e5 nm")
         return self
 
 
@@ -430,9 +460,19 @@ class MarinerDisturbanceConfig(Strict):
     b_r_rad_min2: Finite = 0.1
     d_y_nm_min: Finite = 0.04
     current_frame: Literal["path", "global"] = "path"
-    wave_sigma_rad_min2: NonNegative = 0.0
-    wave_period: Positive = 8.0
-    wave_zeta: Positive = 0.1
+    wave_sigma_rad_min2: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
+    wave_period: Annotated[float, Field(ge=0.5, le=600, allow_inf_nan=False)] = 8.0
+    wave_zeta: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.1
+
+    @property
+    def b_r(self) -> float:
+        """b_r in SI [rad/s²]."""
+        return self.b_r_rad_min2 / 3600.0
+
+    @property
+    def d_y(self) -> float:
+        """d_y in SI [m/s]."""
+        return self.d_y_nm_min * 1852.0 / 60.0
 
 
 DisturbanceConfig = Annotated[ConstantForceConfig | GaussianForceConfig | WavesConfig
@@ -447,14 +487,15 @@ METRIC_SETS = ("stern-kick", "heading-steps", "waypoints", "course-quality", "pa
 class MonteCarloConfig(Strict):
     """A batch of ``runs`` ships in one simulation, each with its own initial offset and sea.
 
-    The initial state is ``simulation.initial_state`` plus a cross-track offset drawn uniformly
-    from ``east_offset_nm`` (added to east) and a heading offset drawn uniformly from
+    The initial state is ``simulation.initial_state`` plus an offset drawn uniformly from
+    ``east_offset_nm`` added to east (a cross-track offset under the caption and text readings,
+    whose first leg points north) and a heading offset drawn uniformly from
     ``heading_offset_deg``; each ship gets its own wave realisation (same ``simulation.seed``,
-    same batch)."""
+    same batch). The divergence guard stops the whole batch at the first ship that trips it."""
 
     runs: Annotated[int, Field(ge=1, le=100_000)] = 1000
-    east_offset_nm: tuple[Finite, Finite] = (-1.0, 1.0)
-    heading_offset_deg: tuple[Finite, Finite] = (-20.0, 20.0)
+    east_offset_nm: tuple[OffsetNm, OffsetNm] = (-1.0, 1.0)
+    heading_offset_deg: tuple[OffsetDeg, OffsetDeg] = (-20.0, 20.0)
 
     @model_validator(mode="after")
     def _ordered(self) -> MonteCarloConfig:
@@ -551,6 +592,14 @@ class Scenario(Strict):
         if vessel == "mariner" and self.simulation.initial_state.v != 0:
             raise ValueError("simulation.initial_state.v: the Mariner's sway is algebraic "
                              "(v = r1 r + r2 r^3); leave v at 0")
+        if self.metrics == "path-tracking":  # spec 000 §0.8: metrics on every sample (dt)
+            every = self.simulation.log_every
+            if self.montecarlo is None and every != 1:
+                raise ValueError(f"simulation.log_every = {every}: the path-tracking metrics of a "
+                                 "single run use every sample; keep 1")
+            if every * self.simulation.dt > 60.0:
+                raise ValueError(f"simulation.log_every = {every}: a batch's metrics need a sample "
+                                 f"at least every minute (log_every * dt <= 60 s)")
         if self.montecarlo is not None and vessel != "mariner":
             raise ValueError("montecarlo: batches of random initial states are built for vessel "
                              "model 'mariner' in this release")
