@@ -171,11 +171,12 @@ def test_montecarlo_batch(tmp_path):
     assert tuple(metrics) == ("lqr", "los_fl")
     for name, m in metrics.items():
         assert m["runs"] == 40
-        assert 0.0 <= m["settled_fraction"] <= 1.0 and m["stable_fraction"] == 1.0, name
+        assert 0.0 <= m["settled_fraction"] <= 1.0 and 0.0 <= m["stable_fraction"] <= 1.0, name
         assert 0.0 <= m["on_path_at_end_fraction"] <= 1.0
         for key in ("settle_time_min_median", "settle_time_min_p95",
                     "crosstrack_rms_after_leg1_nm_median", "crosstrack_rms_after_leg1_nm_p95"):
             assert key in m
+    assert metrics["los_fl"]["stable_fraction"] == 1.0  # LOS bounds the heading command
     assert (tmp_path / "montecarlo.png").stat().st_size > 10_000
     from shipgnc.sim.result import load
 
