@@ -91,3 +91,17 @@ def test_omega_beyond_the_limit_is_reported_not_silent():
     assert not m["stable"] or m["events"]
     assert math.isfinite(m["final_delta_deg"])
     assert load_scenario("catamaran-turn").case.builder == "turn"
+
+
+def test_vessel_options_change_plant_and_design():
+    """The sway-sign question of spec 004 §4.3 is a scenario setting. With the sign-consistent
+    Coriolis term the drag-only hull is directionally unstable (spec 004 C3): law (20) still holds
+    ω*, on the opposite thruster angle (counter-steering), unlike the printed sign's positive angle."""
+    base = ["simulation.t_end=300", "case.options.omega=0.04"]
+    printed = run_scenario("catamaran-turn", overrides=base).metrics["law20"]
+    consistent = run_scenario("catamaran-turn", overrides=[*base, "vessel.coriolis=consistent"])
+    law20 = consistent.metrics["law20"]
+    assert law20["final_yaw_rate_rad_s"] == pytest.approx(0.04, abs=1e-5)
+    assert printed["final_delta_deg"] > 0 > law20["final_delta_deg"]
+    with pytest.raises(ConfigError, match="vessel.params.J_zzz"):
+        run_scenario("catamaran-turn", overrides=["vessel.params={J_zzz: 1.0}"])

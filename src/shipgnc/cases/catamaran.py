@@ -11,7 +11,9 @@ t_end, dt`` and, for heading runs, ``heading_target``. A runner calls::
 
 or simply ``ds = case.run()``. Common settings: u(0) = 4 m/s, everything else 0; RK4 with
 dt = 0.0625 s; t_f = 1500 s; gains per preset (``paper``: T_u = 0.1 s, h = 0.0625 s; ``si``:
-T_u = h = 2.5 s); the laws in continuous mode; preset ``si`` unless given.
+T_u = h = 2.5 s); the laws in continuous mode; preset ``si`` unless given. ``vessel`` (a dict of
+:class:`~shipgnc.models.catamaran.CatamaranParams` overrides, e.g. ``{"coriolis": "consistent"}``)
+changes the catamaran itself — plant and the controller's model alike — for every builder.
 """
 
 from __future__ import annotations
@@ -86,13 +88,14 @@ def _gains(preset_name: str, T_u, h):
 def yaw_rate_case(name: str, preset_name: str = "si", law: int = 21, omega_ref=0.08, *, t_end: float = T_END,
                   dt: float = DT, Ts: float | None = None, T_u: float | None = None, h: float | None = None,
                   plant: dict | None = None, actuator_model: tuple[float, float] | None = None,
-                  batch: int | None = None, delta_max: float | None = None,
+                  batch: int | None = None, delta_max: float | None = None, vessel: dict | None = None,
                   **controller_options) -> CatamaranCase:
-    """A yaw-rate FSM run: plant ``preset_name`` (+ ``plant`` overrides), law (20)/(21) on the
-    nominal model, reference ``omega_ref`` (number, per-ship array or reference object)."""
+    """A yaw-rate FSM run: plant ``preset_name`` (+ ``vessel`` and ``plant`` overrides), law (20)/(21)
+    on the nominal model (``preset_name`` + ``vessel``), reference ``omega_ref`` (number, per-ship
+    array or reference object)."""
     T_u, h = _gains(preset_name, T_u, h)
-    plant_model = Catamaran.from_preset(preset_name, **(plant or {}))
-    nominal = Catamaran.from_preset(preset_name)
+    plant_model = Catamaran.from_preset(preset_name, **{**(vessel or {}), **(plant or {})})
+    nominal = Catamaran.from_preset(preset_name, **(vessel or {}))
     ref = omega_ref if not isinstance(omega_ref, (int, float, np.ndarray, list)) else ConstantRate(omega_ref)
     ctrl = YawRateFSM(nominal, law, T_u=T_u, h=h, omega_ref=ref, Ts=Ts, actuator=actuator_model,
                       delta_max=delta_max, **controller_options)
@@ -103,51 +106,54 @@ def yaw_rate_case(name: str, preset_name: str = "si", law: int = 21, omega_ref=0
 
 
 # --- S1–S10 -----------------------------------------------------------------------------------------
-def straight(preset_name: str = "si", t_end: float = 300.0) -> CatamaranCase:
+def straight(preset_name: str = "si", t_end: float = 300.0, vessel: dict | None = None) -> CatamaranCase:
     """S1: straight run from 4 m/s with δ = 0 (no controller): the speed rises to 4.42306 m/s."""
-    return CatamaranCase("catamaran-straight", Catamaran.from_preset(preset_name), initial_state(), None,
-                         None, t_end, DT, notes={"preset": preset_name})
+    return CatamaranCase("catamaran-straight", Catamaran.from_preset(preset_name, **(vessel or {})),
+                         initial_state(), None, None, t_end, DT, notes={"preset": preset_name})
 
 
 def turn(preset_name: str = "si", omega: float = 0.08, t_end: float = T_END, dt: float = DT,
-         Ts: float | None = None) -> dict[str, CatamaranCase]:
+         Ts: float | None = None, vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """S3 ``catamaran-turn``: ω* = 0.08 rad/s with laws (20) and (21)."""
     return {f"law{law}": yaw_rate_case(f"catamaran-turn/law{law}", preset_name, law, omega, t_end=t_end,
-                                       dt=dt, Ts=Ts) for law in (20, 21)}
+                                       dt=dt, Ts=Ts, vessel=vessel) for law in (20, 21)}
 
 
-def steps(preset_name: str = "paper", t_end: float = T_END) -> dict[str, CatamaranCase]:
+def steps(preset_name: str = "paper", t_end: float = T_END,
+          vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """S4 ``catamaran-steps``: ω* = 0.008 and 0.00072 with both laws (Figs. 1–3, 5–6)."""
     return {f"law{law}@{w:g}": yaw_rate_case(f"catamaran-steps/law{law}@{w:g}", preset_name, law, w,
-                                             t_end=t_end)
+                                             t_end=t_end, vessel=vessel)
             for w in (0.008, 0.00072) for law in (20, 21)}
 
 
-def fixed_angle(preset_name: str = "paper", t_end: float = T_END) -> dict[str, CatamaranCase]:
+def fixed_angle(preset_name: str = "paper", t_end: float = T_END,
+                vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """S5 ``catamaran-fixed-angle``: δ = 0.6 rad held (no controller), the FSM at the same steady
     angle (ω* = the fixed run's steady r) and the document's pairing ω* = 0.00072 (C10)."""
     from shipgnc.analysis.steady_turn import steady_state_at_angle
 
-    model = Catamaran.from_preset(preset_name)
+    model = Catamaran.from_preset(preset_name, **(vessel or {}))
     same = steady_state_at_angle(model, FIXED_ANGLE).r
     return {
         "fixed": CatamaranCase("catamaran-fixed-angle/fixed", model, initial_state(delta0=FIXED_ANGLE), None,
                                None, t_end, DT, notes={"preset": preset_name, "delta": FIXED_ANGLE}),
         "law20_same_angle": yaw_rate_case("catamaran-fixed-angle/law20_same_angle", preset_name, 20, same,
-                                          t_end=t_end),
+                                          t_end=t_end, vessel=vessel),
         "law20@0.00072": yaw_rate_case("catamaran-fixed-angle/law20@0.00072", preset_name, 20, 0.00072,
-                                       t_end=t_end),
+                                       t_end=t_end, vessel=vessel),
     }
 
 
-def sine(preset_name: str = "si", law: int = 21, reading: str = "pi", t_end: float = T_END) -> CatamaranCase:
+def sine(preset_name: str = "si", law: int = 21, reading: str = "pi", t_end: float = T_END,
+         vessel: dict | None = None) -> CatamaranCase:
     """S6 ``catamaran-sine``: ω* = 0.0072 sin(8πt/t_f) (reading C11; ``"literal"``: sin(8t/t_f))."""
     return yaw_rate_case(f"catamaran-sine/law{law}", preset_name, law, SineRate.document(reading, T_END),
-                         t_end=t_end)
+                         t_end=t_end, vessel=vessel)
 
 
 def heading(preset_name: str = "si", law: int = 21, psi_target: float = 0.8, omega_c: float = 0.0022,
-            t_end: float | None = None, ramp_s: float = 0.0) -> CatamaranCase:
+            t_end: float | None = None, ramp_s: float = 0.0, vessel: dict | None = None) -> CatamaranCase:
     """S7 ``catamaran-heading``: heading capture (17) from K(0) = 0 to K*.
 
     t_end: 1500 s for ω_c < 0.02 rad/s, else 600 s.
@@ -156,7 +162,7 @@ def heading(preset_name: str = "si", law: int = 21, psi_target: float = 0.8, ome
             "must be a finite heading [rad]")
     t_end = t_end if t_end is not None else (T_END if omega_c < 0.02 else 600.0)
     cap = HeadingCapture(psi_target, omega_c, ramp_s=ramp_s)
-    case = yaw_rate_case(f"catamaran-heading/law{law}", preset_name, law, cap, t_end=t_end)
+    case = yaw_rate_case(f"catamaran-heading/law{law}", preset_name, law, cap, t_end=t_end, vessel=vessel)
     case.heading_target = float(psi_target)
     return case
 
@@ -167,25 +173,26 @@ ACTUATOR_RUNS = {"T2_k1": (2.0, 1.0), "T3_k1": (3.0, 1.0), "T1_k1": (1.0, 1.0), 
 
 
 def actuator(preset_name: str = "si", omega: float = 0.08, t_end: float = 600.0,
-             T_a: float = 2.0, k_a: float = 1.0) -> dict[str, CatamaranCase]:
+             T_a: float = 2.0, k_a: float = 1.0, vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """S8 ``catamaran-actuator``: law (21) through the inverse (23) on a plant with the lag (22)."""
-    cases = {"ideal": yaw_rate_case("catamaran-actuator/ideal", preset_name, 21, omega, t_end=t_end)}
+    cases = {"ideal": yaw_rate_case("catamaran-actuator/ideal", preset_name, 21, omega, t_end=t_end,
+                                    vessel=vessel)}
     for key, (T_t, k_t) in ACTUATOR_RUNS.items():
         cases[key] = yaw_rate_case(f"catamaran-actuator/{key}", preset_name, 21, omega, t_end=t_end,
                                    plant={"delta_row": "lag", "T_t": T_t, "k_t": k_t},
-                                   actuator_model=(T_a, k_a))
+                                   actuator_model=(T_a, k_a), vessel=vessel)
     return cases
 
 
 def limit(preset_name: str = "paper", law: int = 21, omega: float = 0.081, t_end: float = T_END,
-          delta_max: float | None = None) -> CatamaranCase:
+          delta_max: float | None = None, vessel: dict | None = None) -> CatamaranCase:
     """S9: a reference at the feasibility limit (``paper`` law (21) fails from 0.081)."""
     return yaw_rate_case(f"catamaran-limit/law{law}@{omega:g}", preset_name, law, omega, t_end=t_end,
-                         delta_max=delta_max)
+                         delta_max=delta_max, vessel=vessel)
 
 
 def robustness(preset_name: str = "si", n: int = 40, seed: int = 10, omega: float = 0.06,
-               t_end: float = T_END, law: int = 21) -> CatamaranCase:
+               t_end: float = T_END, law: int = 21, vessel: dict | None = None) -> CatamaranCase:
     """S10 / ``catamaran-montecarlo``: plant J uniform ±30 %, m_x and m_y uniform ±10 % each, the
     controller nominal, law (21); one batched run (the ship axis) with per-ship plant parameters."""
     require(isinstance(n, int) and n >= 1, "montecarlo.n", n, "need at least 1 draw")
@@ -194,7 +201,7 @@ def robustness(preset_name: str = "si", n: int = 40, seed: int = 10, omega: floa
     mx_f = rng.uniform(0.9, 1.1, n)
     my_f = rng.uniform(0.9, 1.1, n)
     case = yaw_rate_case(f"catamaran-montecarlo/{n}", preset_name, law, omega, t_end=t_end, batch=n,
-                         plant={"J_factor": J_f, "m_x_factor": mx_f, "m_y_factor": my_f})
+                         plant={"J_factor": J_f, "m_x_factor": mx_f, "m_y_factor": my_f}, vessel=vessel)
     case.notes.update({"seed": seed, "J_factor": J_f, "m_x_factor": mx_f, "m_y_factor": my_f})
     return case
 
@@ -216,8 +223,8 @@ SCENARIOS = {
 }
 
 
-def compare(preset_name: str = "si") -> dict[str, CatamaranCase]:
+def compare(preset_name: str = "si", vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """``catamaran-compare``: FSM laws against the baselines on S3, S4 (ω* = 0.008) and S7."""
     from shipgnc.control.catamaran_baselines import comparison_cases
 
-    return comparison_cases(preset_name)
+    return comparison_cases(preset_name, vessel=vessel)

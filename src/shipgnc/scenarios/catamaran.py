@@ -27,18 +27,21 @@ def _builders() -> dict:
             "compare": _compare}
 
 
-def _compare(preset_name: str = "si", t_end: float = 600.0, t_end_rate: float = 300.0):
+def _compare(preset_name: str = "si", t_end: float = 600.0, t_end_rate: float = 300.0,
+             vessel: dict | None = None):
     """FSM laws against the PI / LQR baselines on S3, S4 (``t_end_rate``) and S7 (``t_end``)
     (spec 004 §4.11.3)."""
     from shipgnc.control.catamaran_baselines import comparison_cases
 
-    return comparison_cases(preset_name, t_end_rate=min(t_end_rate, t_end), t_end_heading=t_end)
+    return comparison_cases(preset_name, t_end_rate=min(t_end_rate, t_end), t_end_heading=t_end,
+                            vessel=vessel)
 
 
 def builder_options(name: str) -> dict[str, object]:
     """The options a builder takes (name → default), for messages and ``shipgnc show``."""
     signature = inspect.signature(_builders()[name])
-    return {p.name: p.default for p in signature.parameters.values() if p.name != "preset_name"}
+    return {p.name: p.default for p in signature.parameters.values()
+            if p.name not in ("preset_name", "vessel")}
 
 
 def cases(scenario: Scenario) -> dict:
@@ -66,6 +69,12 @@ def cases(scenario: Scenario) -> dict:
     elif scenario.vessel.preset != "si":
         raise ConfigError(f"vessel.preset = {scenario.vessel.preset!r}: builder {cfg.builder!r} runs "
                           "preset 'si' only")
+    overrides = scenario.vessel.overrides()
+    if overrides:
+        from shipgnc.models.catamaran import preset
+
+        preset(scenario.vessel.preset, **overrides)  # unknown names and bad values fail here, once
+        kwargs["vessel"] = overrides
     if "t_end" in params and "t_end" not in kwargs:
         kwargs["t_end"] = sim.t_end
     if "dt" in params:

@@ -120,6 +120,21 @@ class CatamaranVesselConfig(Strict):
 
     model: Literal["catamaran"]
     preset: Literal["si", "paper"] = "si"
+    #: sway Coriolis sign of the printed model, or the consistent one (spec 004 §4.3)
+    coriolis: Literal["printed", "consistent"] = "printed"
+    #: resistance below V_m: the quadratic continuation, or the literal fit (spec 004 §4.3)
+    low_speed: Literal["continued", "literal"] = "continued"
+    #: other :class:`CatamaranParams` overrides (SI), e.g. ``{J_zz: 4.0e6, T_v: 18000}``
+    params: dict[str, Finite] = Field(default_factory=dict)
+
+    def overrides(self) -> dict:
+        """Parameter overrides of the preset (the defaults left out)."""
+        out = dict(self.params)
+        if self.coriolis != "printed":
+            out["coriolis"] = self.coriolis
+        if self.low_speed != "continued":
+            out["low_speed"] = self.low_speed
+        return out
 
 
 CATAMARAN_BUILDERS = ("turn", "steps", "fixed-angle", "sine", "heading", "actuator", "montecarlo",
