@@ -292,3 +292,18 @@ def test_heading_schedule_and_constant_heading_legs(document):
     assert plan.headings.shape == (4,) and plan.times.shape == (5,)
     ds = document.to_dataset(51)
     assert ds.heading.attrs["units"] == "rad" and ds.sizes["time"] == 51
+
+
+def test_f3_determinant_with_xdot_misfires_in_a_time_varying_current():
+    """Spec F3's det[∂x/∂θ₀, ẋ] changes sign in the tidal uniform current (2.9.5) where V + e·c(t) = 0, though
+    neighbouring extremals never focus (a uniform current: ∂x/∂θ₀ = V t e⊥ ≠ 0). The router uses
+    det[∂x/∂θ₀, p/|p|], equal up to the positive factor ẋ·p for steady fields."""
+    tide = Modulated(UniformCurrent(0.0, KNOT), 0.0, 1.0, 12.42 * H, 0.0)
+    ext = pmp.shoot(tide, V, A, B, math.radians(302.355), 6.95 * H)
+    assert pmp.conjugate_time(tide, V, A, ext) is None
+    t = np.linspace(0.05, 1.0, 400) * ext.duration
+    e = np.array([math.cos(ext.theta0), math.sin(ext.theta0)])
+    xdot = V * e + tide.velocity(t, 0.0, 0.0)
+    dxdth = V * np.multiply.outer(t, [-e[1], e[0]])
+    det = dxdth[:, 0] * xdot[:, 1] - dxdth[:, 1] * xdot[:, 0]
+    assert np.any(np.sign(det) != np.sign(det[0]))

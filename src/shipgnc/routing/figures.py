@@ -68,3 +68,91 @@ def route_figure(res, path, nautical: bool = True, extra_text: str | None = None
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def document_figures(out_dir) -> list:
+    """The figures of docs/002_zermelo_routing.md (``python -m shipgnc.routing.figures docs/figures``).
+
+    zermelo-paper.png: the document's case (PMP with the level-set check at 0.04 nm, hourly isochrones)
+    and the document's numbers beside ours; zermelo-vortex.png: the three extremals of F2;
+    zermelo-shoal.png: the shear plus the square shoal of 2.9.3(b).
+    """
+    import math
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from shipgnc.routing import pmp
+    from shipgnc.routing.closed_form import straight_course
+    from shipgnc.routing.fields import LambOseenVortex, shear
+    from shipgnc.routing.router import solve_route
+
+    nm, h = NAUTICAL_MILE, 3600.0
+    V = 0.5 * nm / h
+    A, B = np.array([-1.86, 3.66]) * nm, np.zeros(2)
+    dom = ((-2.5 * nm, 2.0 * nm), (-1.0 * nm, 6.0 * nm))
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    # --- the document's case
+    res = solve_route(shear(-0.5 / h), V, A, B, method="auto", horizon=30 * h, grid_spacing=0.04 * nm,
+                      domain=dom)
+    js = res.to_json()
+    sc = straight_course(shear(-0.5 / h), V, A, B)
+    gc = js["global_check"]
+    text = "\n".join([
+        "quantity           document   ours",
+        f"alpha = u_f - 180  30°        {js['heading_end_deg'] - 180:.4f}°",
+        f"u(0)               345°       {js['heading_start_deg']:.4f}°",
+        f"u(t_f)             210°       {js['heading_end_deg']:.4f}°",
+        f"t_f                10.93 h    {js['time_h']:.6f} h",
+        f"straight, still    8.21 h     {float(np.hypot(*A)) / V / h:.6f} h",
+        f"straight in shear  impossible infeasible {100 * sc.infeasible[0][1]:.2f} % of AB",
+        f"level set 0.04 nm  —          {gc['time_s'] / h:.6f} h ({gc['rel_diff']:+.1e})",
+    ])
+    written.append(route_figure(res, out / "zermelo-paper.png", nautical=True, extra_text=text))
+    # --- F2: three extremals around a Lamb–Oseen vortex
+    fld = LambOseenVortex(2 * nm**2 / h, 0.5 * nm, (-0.93 * nm, 1.83 * nm))
+    sw = pmp.sweep(fld, V, A, B, horizon=30 * h)
+    fig, ax = plt.subplots(figsize=(7, 6.5))
+    gn, ge = np.meshgrid(np.linspace(-3.5, 1.5, 21) * nm, np.linspace(-1, 5.5, 23) * nm, indexing="ij")
+    v = fld.velocity(0.0, gn, ge)
+    ax.quiver(ge / nm, gn / nm, v[..., 1], v[..., 0], color="0.6", width=0.003)
+    for ext, color in zip(sw.extremals, ("tab:blue", "tab:orange", "tab:red"), strict=False):
+        _, y = ext.sample(800)
+        label = f"{ext.duration / h:.6f} h: {ext.status}"
+        ax.plot(y[:, 1] / nm, y[:, 0] / nm, color=color, lw=2, label=label)
+        if ext.conjugate_at is not None:
+            xc = ext.position(ext.conjugate_at)
+            ax.plot(xc[1] / nm, xc[0] / nm, "*", color=color, ms=12)
+    ax.plot(A[1] / nm, A[0] / nm, "o", color="tab:red")
+    ax.plot(0, 0, "ks")
+    ax.set_aspect("equal")
+    ax.set_xlabel("east [nm]")
+    ax.set_ylabel("north [nm]")
+    ax.set_title("F2: Lamb–Oseen vortex (Γ = 2 nm²/h, r_c = 0.5 nm) at the midpoint of AB", fontsize=9)
+    ax.legend(fontsize=7, loc="upper right")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / "zermelo-vortex.png", dpi=120)
+    plt.close(fig)
+    written.append(out / "zermelo-vortex.png")
+    # --- the document's shear plus a square shoal (2.9.3 b)
+    shoal = np.array([(0.3, 3.6), (0.3, 4.2), (0.9, 4.2), (0.9, 3.6)]) * nm
+    res = solve_route(shear(-0.5 / h), V, A, B, method="auto", obstacles=[shoal], horizon=30 * h,
+                      n_angles=720, grid_spacing=0.04 * nm, domain=dom)
+    gc = res.global_check or {}
+    text = (f"via (0.9, 4.2) nm: {res.time_s / h:.6f} h (spec 11.031160 h)\n"
+            f"level set 0.04 nm, shoal frozen: {gc.get('time_s', math.nan) / h:.6f} h")
+    written.append(route_figure(res, out / "zermelo-shoal.png", nautical=True, extra_text=text))
+    return written
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    for p in document_figures(sys.argv[1] if len(sys.argv) > 1 else "docs/figures"):
+        print(p)
