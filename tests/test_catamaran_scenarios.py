@@ -103,5 +103,5 @@ def test_vessel_options_change_plant_and_design():
     law20 = consistent.metrics["law20"]
     assert law20["final_yaw_rate_rad_s"] == pytest.approx(0.04, abs=1e-5)
     assert printed["final_delta_deg"] > 0 > law20["final_delta_deg"]
-    with pytest.raises(ConfigError, match="vessel.params.J_zzz"):
+    with pytest.raises(ConfigError, match=r"vessel\.params\.J_zzz"):
         run_scenario("catamaran-turn", overrides=["vessel.params={J_zzz: 1.0}"])
