@@ -100,9 +100,10 @@ def test_netcdf_field(tmp_path):
     path = tmp_path / "c.nc"
     ds.to_netcdf(path)
     r = invoke("--start", "-1000,0", "--target", "1000,0", "--speed", "1", "--field", str(path),
-               "--method", "pmp", "--json")
+               "--method", "graph", "--grid", "100", "--json")
     assert r.exit_code == 0, r.stderr
     js = json.loads(r.stdout)
+    assert js["method"] == "pmp" and js["global_check"]["method"] == "graph"  # graph seed, PMP polish
     assert js["time_s"] == pytest.approx(2000 / np.sqrt(1 - 0.01), rel=1e-7)
     r = invoke("--start", "-5000,0", "--target", "1000,0", "--speed", "1", "--field", str(path), "--json")
     assert r.exit_code == 2 and "outside the gridded field" in r.stderr

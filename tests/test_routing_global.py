@@ -191,3 +191,16 @@ def test_z22_domain_not_holding_the_route():
     assert not r.reachable or r.time_s / H > DOC_H
     text = (r.reason or "") + " ".join(r.notes)
     assert "domain" in text and "N [-5556, 926] m" in text
+
+
+def test_levelset_method_seeds_a_pmp_polish():
+    r = solve_route(shear(K), V, A, B, method="levelset", grid_spacing=0.08 * NM, domain=DOMAIN)
+    assert r.method == "pmp" and r.time_s / H == pytest.approx(DOC_H, rel=1e-9)
+    gc = r.global_check
+    assert gc["method"] == "levelset" and 0 < gc["rel_diff"] < 1e-3 and r.grid_spacing == 0.08 * NM
+
+
+def test_f4_negative_times_are_rejected():
+    # a solver started on the time-reversed extremal must not return t_f < 0
+    ext = pmp.shoot(shear(K), V, A, B, math.radians(300.0), -4.6 * H)
+    assert ext is None or ext.duration > 0

@@ -414,7 +414,7 @@ def _candidates(dist_tab, pos, n, step_len):
     p = pos[1:-1]
     gap = np.maximum(np.hypot(*np.moveaxis(p - np.roll(p, 1, axis=1), -1, 0)),
                      np.hypot(*np.moveaxis(p - np.roll(p, -1, axis=1), -1, 0)))
-    ok = is_min & (inner <= 3.0 * (gap + step_len))
+    ok = is_min & (inner <= 1.0 * (gap + step_len))
     k, i = np.nonzero(ok)
     order = np.argsort(inner[k, i])
     return [(int(k[j]) + 1, int(i[j])) for j in order]
