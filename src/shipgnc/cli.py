@@ -148,7 +148,10 @@ def run_command(
         if observer is not None and not observer.closed:
             stderr.print("close the live window to exit")
             observer.finish(block=True)
-        if run.result.attrs.get("diverged"):
+        if run.route is not None and not run.metrics.get("reachable"):
+            stderr.print(f"[bold red]unreachable:[/] {run.metrics.get('reason', '')}", soft_wrap=True)
+            raise typer.Exit(3)
+        if run.result is not None and run.result.attrs.get("diverged"):
             message = run.result.attrs.get("message") or "the simulation diverged"
             stderr.print(f"[bold red]error:[/] {message}", soft_wrap=True)
             raise typer.Exit(3)

@@ -264,3 +264,43 @@ class LOSFL(_PathFL):
         nu = -self.kp * e - self.kd * (k["r"] - psi_d_dot)
         raw = (nu + self.H_N(k["r"]) - self.b_r) / self.c
         return self._finish(raw, k, los_heading=psi_d)
+
+
+class HeadingFL:
+    """Heading autopilot for the Mariner: the exact feedback linearisation of the yaw loop of
+    ``los_fl`` (spec 000 §0.5) on a heading reference [ψ_d, r_d] from guidance::
+
+        e = wrap(ψ − ψ_d),  ν = −k_p e − k_d (r − r_d),  δ = (ν + H_N(r) − b_r)/c
+
+    SI gains ``kp`` [1/s²] = 1/60², ``kd`` [1/s] = 2/60 by default (the ``los_fl`` loop); ``b_r``
+    known [rad/s²]. Used to sail an optimal route's heading programme (spec 002 §2.9.6).
+    """
+
+    continuous = False
+    reference_names = ("psi_d", "r_d")
+    signals = ()
+
+    def __init__(self, params, *, Ts: float, kp: float = KP_PAPER / MINUTE**2,
+                 kd: float = KD_PAPER / MINUTE, delta_max: float = DELTA_MAX, b_r: float = 0.0):
+        check_controller_args(Ts, delta_max)
+        for name, value in (("kp", kp), ("kd", kd), ("b_r", b_r)):
+            require(isinstance(value, (int, float, np.floating)) and np.isfinite(value)
+                    and (value > 0 or name == "b_r"), f"controller.{name}", value,
+                    "must be a finite number" + (" > 0" if name != "b_r" else ""))
+        self.a, self.b, self.c = (plant_coefficient(params, k) for k in ("a", "b", "c"))
+        self.Ts, self.kp, self.kd = float(Ts), float(kp), float(kd)
+        self.delta_max, self.b_r = float(delta_max), float(b_r)
+
+    def reset(self, batch_shape) -> None:
+        pass
+
+    def signal_values(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        x = np.asarray(measurement, dtype=float)
+        psi, r = x[..., I_PSI], x[..., I_R]
+        e = wrap_angle(psi - reference[..., 0])
+        nu = -self.kp * e - self.kd * (r - reference[..., 1])
+        raw = (nu + self.a * r + self.b * r**3 - self.b_r) / self.c
+        return np.clip(raw, -self.delta_max, self.delta_max)[..., None]

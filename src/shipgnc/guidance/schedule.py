@@ -68,3 +68,40 @@ class CourseSchedule:
 
     def finished(self):
         return None
+
+
+class HeadingProfile:
+    """A continuous heading programme ψ_d(t) from a callable (e.g. an optimal route's heading,
+    spec 002 §2.9.6): references ``[psi_d, r_d]`` with r_d = dψ_d/dt by a central difference over
+    ``rate_step`` seconds (a piecewise-constant programme gives r_d = 0 away from its jumps)."""
+
+    references = (
+        Signal("psi_d", "rad", "desired heading", angle=True, tracks="psi"),
+        Signal("r_d", "rad/s", "rate of the desired heading"),
+    )
+    outputs = ()
+
+    def __init__(self, heading, *, rate_step: float = 1.0):
+        if not callable(heading):
+            from shipgnc.errors import ConfigError
+
+            raise ConfigError(f"guidance.heading: need a callable psi_d(t), got {type(heading).__name__}")
+        self.heading = heading
+        self.rate_step = float(rate_step)
+        self._batch_shape: tuple[int, ...] = ()
+
+    def reset(self, batch_shape, model=None) -> None:
+        self._batch_shape = tuple(batch_shape)
+
+    def reference(self, t: float, x: np.ndarray) -> np.ndarray:
+        h = self.rate_step
+        psi = float(self.heading(t))
+        step = np.angle(np.exp(1j * (float(self.heading(t + h)) - float(self.heading(max(t - h, 0.0))))))
+        rate = step / (t + h - max(t - h, 0.0))
+        return np.broadcast_to(np.array([psi, rate]), (*self._batch_shape, 2)).copy()
+
+    def output_values(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def finished(self):
+        return None

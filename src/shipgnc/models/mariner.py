@@ -252,15 +252,20 @@ class MarinerDisturbance:
     ``b_r`` [rad/s²] constant yaw acceleration; ``current`` a
     :class:`~shipgnc.environment.current.CrossCurrent` (d_y across the active leg, or along east)
     or None; ``waves`` a :class:`~shipgnc.environment.filtered_noise.SecondOrderNoise` added to ṙ
-    or None. Sampled at each step's start and held over the step (``per_stage = False``).
+    or None; or any current field with ``__call__(t, x) -> (..., 2)`` (e.g. a
+    :mod:`shipgnc.routing.fields` field, evaluated per RK stage).
     """
-
-    per_stage = False
 
     def __init__(self, b_r: float = 0.0, current=None, waves=None):
         require(isinstance(b_r, (int, float)) and math.isfinite(b_r), "disturbance.b_r", b_r,
                 "must be a finite yaw acceleration in rad/s^2")
         self.b_r, self.current, self.waves = float(b_r), current, waves
+
+    @property
+    def per_stage(self) -> bool:
+        """Evaluated at every RK stage when the current is a field of position and time (a route's
+        current, spec 002); else sampled at each step's start and held."""
+        return bool(getattr(self.current, "per_stage", False)) and self.waves is None
 
     def reset(self, batch_shape, rng: np.random.Generator) -> None:
         self._shape = tuple(batch_shape)

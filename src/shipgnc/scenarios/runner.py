@@ -53,6 +53,9 @@ class ScenarioRun:
     result: object  # xarray.Dataset
     metrics: dict
     setups: dict | None = None
+    #: document 002: the solved route and the sailed runs by label
+    route: object = None
+    sailed: dict | None = None
 
 
 def _boat(scenario: Scenario):
@@ -250,7 +253,12 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     sim = scenario.simulation
     compare = scenario.controllers is not None
     # one sea for every controller of a comparison, also when no seed is given (recorded)
-    seed = sim.seed if sim.seed is not None else int(np.random.SeedSequence().generate_state(1)[0])
+    seed = sim.seed if sim is not None and sim.seed is not None else int(
+        np.random.SeedSequence().generate_state(1)[0])
+    if scenario.route is not None:
+        from shipgnc.scenarios import routing
+
+        return routing.run(scenario, seed=seed)
     if scenario.vessel.model == "catamaran":
         from shipgnc.scenarios import catamaran
 
@@ -329,6 +337,13 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise ConfigError(f"--out {str(out)!r}: cannot create the directory ({exc.strerror})") from None
+    if run.route is not None:
+        from shipgnc.scenarios import routing
+
+        written = [] if run.result is None else [save(run.result, out / "result.nc")]
+        (out / "metrics.json").write_text(metrics_json(run.metrics) + "\n", encoding="utf-8")
+        written.append(out / "metrics.json")
+        return written + (routing.write_figures(run, out) if figures else [])
     pending = None
     job = figure_job(run, out) if figures else None
     figures = job is not None
@@ -462,6 +477,8 @@ def metrics_json(metrics: dict) -> str:
             return None
         if isinstance(value, (list, tuple)):
             return [clean(v) for v in value]
+        if isinstance(value, dict):
+            return {k: clean(v) for k, v in value.items()}
         if isinstance(value, np.generic):
             return clean(value.item())
         return value

@@ -495,6 +495,37 @@ DisturbanceConfig = Annotated[ConstantForceConfig | GaussianForceConfig | WavesC
 
 # --------------------------------------------------------------------------- scenario
 
+class RouteConfig(Strict):
+    """Document 002's routing problem (spec 002): as ``shipgnc route`` takes it. With ``units:
+    nautical`` positions and ``radius``/``grid`` are in nm, ``speed`` in kn, ``horizon``/``depart``
+    in h and the FIELD parameters as the route command reads them (k, ω in 1/h, Γ in nm²/h);
+    ``obstacles``: polygons of [north, east] vertices in the same length unit."""
+
+    units: Literal["si", "nautical"] = "si"
+    start: tuple[Finite, Finite]
+    target: tuple[Finite, Finite]
+    speed: Positive
+    field: Annotated[str, Field(min_length=1)]
+    method: Literal["auto", "pmp", "levelset", "graph"] = "auto"
+    obstacles: list[Annotated[list[tuple[Finite, Finite]], Field(min_length=3)]] = Field(default_factory=list)
+    radius: NonNegative = 0.0
+    depart: NonNegative = 0.0
+    horizon: Positive | None = None
+    grid: Positive | None = None
+
+
+class SailConfig(Strict):
+    """The route sailed by a ship (spec 002 §2.9.6): the Mariner of document 000 (route speed = its
+    straight-running speed U = 15 kn) steered by a heading autopilot along the optimal heading
+    programme and along ``legs`` constant-heading legs, through the same current field."""
+
+    vessel: Literal["mariner"] = "mariner"
+    legs: Annotated[int, Field(ge=1, le=50)] = 4
+    dt: Positive = 0.3
+    #: run this long past the optimal arrival time (fraction of it) to find the closest approach
+    margin: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.2
+
+
 METRIC_SETS = ("stern-kick", "heading-steps", "waypoints", "course-quality", "path-tracking",
                "catamaran", "none")
 
@@ -534,10 +565,10 @@ class Scenario(Strict):
     description: str = ""
     document: str = ""
     metrics: Literal["stern-kick", "heading-steps", "waypoints", "course-quality", "path-tracking",
-                     "catamaran", "none"] = "none"
+                     "catamaran", "route", "none"] = "none"
     vessel: Vessel = Field(default_factory=VesselConfig)
     actuator: ActuatorConfig = Field(default_factory=ActuatorConfig)
-    simulation: SimulationConfig
+    simulation: SimulationConfig | None = None
     controller: ControllerConfig | None = None
     controllers: dict[Annotated[str, Field(pattern=r"^[A-Za-z0-9_]+$")], ControllerConfig] | None = None
     guidance: GuidanceConfig | None = None
@@ -546,6 +577,9 @@ class Scenario(Strict):
     montecarlo: MonteCarloConfig | None = None
     #: document 004's case (vessel model ``catamaran`` only)
     case: CatamaranCaseConfig | None = None
+    #: document 002's routing problem, and optionally a ship sailing the route
+    route: RouteConfig | None = None
+    sail: SailConfig | None = None
     #: the document's own figures, by controller (shown beside ours in comparison tables)
     document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
 
@@ -556,6 +590,10 @@ class Scenario(Strict):
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
+        if self.route is not None or self.sail is not None:
+            return self._consistent_route()
+        if self.simulation is None:
+            raise ValueError("simulation: required field is missing (dt, t_end, ...)")
         if self.vessel.model == "catamaran" or self.case is not None:
             return self._consistent_catamaran()
         if (self.controller is None) == (self.controllers is None):
@@ -620,6 +658,21 @@ class Scenario(Strict):
                              "model 'mariner' in this release")
         return self
 
+
+    def _consistent_route(self) -> Scenario:
+        if self.route is None:
+            raise ValueError("sail: needs a route section (the route to sail)")
+        for name in ("controller", "controllers", "guidance", "disturbance", "montecarlo", "case"):
+            if getattr(self, name) is not None:
+                raise ValueError(f"{name}: a route scenario takes its route from the route section "
+                                 "(and its ship from sail)")
+        if self.metrics not in ("route", "none"):
+            raise ValueError(f"metrics = {self.metrics!r}: a route scenario reports 'route'")
+        if self.route.units == "nautical" and self.sail is not None and abs(self.route.speed - 15.0) > 1e-9:
+            raise ValueError(f"route.speed = {self.route.speed!r} kn: the sailing Mariner runs at its "
+                             "straight-running speed U = 15 kn; scale the route (speed and current "
+                             "by the same factor) to sail it")
+        return self
 
     def _consistent_catamaran(self) -> Scenario:
         if self.vessel.model != "catamaran":
