@@ -127,7 +127,13 @@ def write_figures(run, out) -> list:
     from shipgnc.routing.figures import route_figure
 
     nautical = run.scenario.route.units == "nautical"
-    written = [route_figure(run.route, out / "route.png", nautical=nautical)]
+    document = run.scenario.document_figures.get("route", {})
+    text = None
+    if document:  # the document's numbers beside ours, on the figure
+        rows = [f"{key:<18} {value:>10.4g} {run.metrics.get(key) or float('nan'):>12.6g}"
+                for key, value in document.items()]
+        text = "\n".join([f"{'':<18} {'document':>10} {'shipgnc':>12}", *rows])
+    written = [route_figure(run.route, out / "route.png", nautical=nautical, extra_text=text)]
     if run.sailed:
         written.append(_sail_figure(run, out / "sail.png", nautical))
     return [p for p in written if p is not None]
