@@ -111,5 +111,14 @@ def set_path(data: dict, key: str, value: object) -> None:
 
 
 def scenario_yaml(scenario: Scenario) -> str:
-    """The scenario as YAML (what ``shipgnc show`` prints)."""
-    return yaml.safe_dump(scenario.model_dump(mode="json", exclude_none=True), sort_keys=False)
+    """The scenario as YAML (what ``shipgnc show`` prints): every field that acts on this
+    scenario, with its value or default; sections that cannot change its run are left out
+    (``actuator`` beyond the boat, ``quality`` beyond document 003's index, ``vessel`` of a route)."""
+    data = scenario.model_dump(mode="json", exclude_none=True)
+    if scenario.route is not None:
+        data.pop("vessel", None)
+    if scenario.route is not None or scenario.vessel.model != "vectored-thrust-boat":
+        data.pop("actuator", None)
+    if scenario.metrics != "course-quality":
+        data.pop("quality", None)
+    return yaml.safe_dump(data, sort_keys=False)
