@@ -62,3 +62,33 @@ def test_unreachable_target_exits_3():
     assert result.exit_code == 3
     assert "unreachable" in result.stderr
     assert json.loads(result.stdout)["reachable"] is False
+
+
+def test_a_wall_is_gone_round_not_through(tmp_path):
+    """A 10 km wall across a 1 km route in still water: the detour past its ends (≈ 10.23 km) is the
+    route; no method may sail through the wall, and a level set that leaks says so."""
+    from shipgnc.routing.fields import UniformCurrent
+    from shipgnc.routing.router import solve_route
+
+    wall = [[(400.0, -5000.0), (400.0, 5000.0), (600.0, 5000.0), (600.0, -5000.0)]]
+    detour = 2 * math.hypot(400.0, 5000.0) + 200.0
+    field = UniformCurrent(0.0, 0.0)
+    for method in ("auto", "graph"):
+        res = solve_route(field, 1.0, (0.0, 0.0), (1000.0, 0.0), method=method, obstacles=wall,
+                          horizon=20_000.0, grid_spacing=100.0)
+        assert res.reachable, method
+        assert res.time_s >= detour * (1 - 1e-6)
+        assert res.time_s == pytest.approx(detour, rel=0.02)  # a graph route on a 100 m grid
+    res = solve_route(field, 1.0, (0.0, 0.0), (1000.0, 0.0), method="levelset", obstacles=wall,
+                      horizon=20_000.0, grid_spacing=100.0)
+    assert not res.reachable or res.time_s >= detour * (1 - 1e-6)
+    if not res.reachable:
+        assert "obstacle" in res.reason
+
+
+def test_too_fine_a_grid_is_refused_before_allocating():
+    result = CliRunner().invoke(app, ["route", "--units", "nautical", "--start", "0,0", "--target", "1,0",
+                                      "--speed", "1", "--field", "uniform:north=0,east=0", "--method",
+                                      "levelset", "--grid", "1e-9"])
+    assert result.exit_code == 2
+    assert "grid_spacing" in result.stderr and "coarser" in result.stderr

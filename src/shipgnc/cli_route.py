@@ -34,25 +34,25 @@ def _pair(text: str, name: str, scale: float):
 
 
 def route(
-    start: Annotated[str, typer.Option("--start", help="Start N,E [m | nm].")],
-    target: Annotated[str, typer.Option("--target", help="Target N,E [m | nm].")],
-    speed: Annotated[float, typer.Option("--speed", help="Ship speed through water [m/s | kn].")],
+    start: Annotated[str, typer.Option("--start", help="Start N,E \\[m | nm].")],
+    target: Annotated[str, typer.Option("--target", help="Target N,E \\[m | nm].")],
+    speed: Annotated[float, typer.Option("--speed", help="Ship speed through water \\[m/s | kn].")],
     field: Annotated[str, typer.Option("--field", help="Current: uniform:north=..,east=.. | shear:k=.. | "
                                        "rotation:omega=..,north=..,east=.. | "
                                        "lamb-oseen:gamma=..,rc=..,north=..,"
                                        "east=.. | rankine:... ; '+' sums; or a NetCDF file.")],
     method: Annotated[str, typer.Option("--method", help="auto | pmp | levelset | graph")] = "auto",
     obstacles: Annotated[Path | None, typer.Option("--obstacles", help="GeoJSON polygons, [east, north] "
-                                                   "coordinates [m | nm].")] = None,
+                                                   "coordinates \\[m | nm].")] = None,
     units: Annotated[str, typer.Option("--units", help="si | nautical")] = "si",
     json_: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
     out: Annotated[Path | None, typer.Option("--out", help="Write route.png and route.json here.")] = None,
-    horizon: Annotated[float | None, typer.Option("--horizon", help="Search horizon [s | h] "
+    horizon: Annotated[float | None, typer.Option("--horizon", help="Search horizon \\[s | h] "
                                                   "(default 4·|AB|/V).")] = None,
-    radius: Annotated[float, typer.Option("--radius", help="Target disc radius [m | nm].")] = 0.0,
-    depart: Annotated[float, typer.Option("--depart", help="Departure time t0 [s | h].")] = 0.0,
+    radius: Annotated[float, typer.Option("--radius", help="Target disc radius \\[m | nm].")] = 0.0,
+    depart: Annotated[float, typer.Option("--depart", help="Departure time t0 \\[s | h].")] = 0.0,
     grid: Annotated[float | None, typer.Option("--grid",
-                                               help="Level-set / graph grid spacing [m | nm].")] = None,
+                                               help="Level-set / graph grid spacing \\[m | nm].")] = None,
 ) -> None:
     """Time-optimal route through a current field (Zermelo's problem)."""
     from shipgnc.cli import friendly_errors, stderr, stdout

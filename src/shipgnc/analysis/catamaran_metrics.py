@@ -32,8 +32,17 @@ def _final(ds, name: str) -> float:
     return float(_series(ds, name)[-1])
 
 
+#: a settled stretch shorter than this share of the run does not show a steady state
+MIN_SETTLED_SHARE = 0.1
+
+
 def settling_time(t, y, final: float | None = None, band: float = 0.02) -> float | None:
-    """First time after which ``y`` stays within ±band·|final| of ``final`` (default y[-1])."""
+    """First time after which ``y`` stays within ±band·|final| of ``final`` (default y[-1]).
+
+    None when it never does, or when the settled stretch is shorter than
+    :data:`MIN_SETTLED_SHARE` of the run (with ``final = y[-1]`` the last sample is always
+    "settled": a run too short to reach a steady state must not report one).
+    """
     y = np.asarray(y, dtype=float)
     t = np.asarray(t, dtype=float)
     final = float(y[-1]) if final is None else final
@@ -42,7 +51,9 @@ def settling_time(t, y, final: float | None = None, band: float = 0.02) -> float
     if outside.size == 0:
         return float(t[0])
     k = outside[-1] + 1
-    return float(t[k]) if k < t.size else None
+    if k >= t.size or t[-1] - t[k] < MIN_SETTLED_SHARE * (t[-1] - t[0]):
+        return None
+    return float(t[k])
 
 
 def final_yaw_rate_rad_s(ds) -> float:

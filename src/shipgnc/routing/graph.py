@@ -86,6 +86,11 @@ def graph_route(field, speed, start, target, domain, spacing, *, directions=80, 
 
     start, target = np.asarray(start, float), np.asarray(target, float)
     (n0, n1), (e0, e1) = domain
+    require(isinstance(spacing, (int, float)) and math.isfinite(spacing) and spacing > 0, "grid_spacing",
+            spacing, "must be a finite length > 0 m")
+    cells = ((n1 - n0) / spacing + 2) * ((e1 - e0) / spacing + 2)
+    require(cells * directions <= 30_000_000, "grid_spacing", spacing,
+            f"gives about {cells:.3g} cells × {directions} directions; coarsen the grid")
     north = target[0] + spacing * np.arange(math.floor((n0 - target[0]) / spacing),
                                             math.ceil((n1 - target[0]) / spacing) + 1)
     east = target[1] + spacing * np.arange(math.floor((e0 - target[1]) / spacing),

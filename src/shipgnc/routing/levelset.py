@@ -226,6 +226,9 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     for name, p in (("start", start), ("target", target)):
         require(n0 <= p[0] <= n1 and e0 <= p[1] <= e1, name, p.tolist(),
                 f"must lie in the level-set domain N [{n0:g}, {n1:g}] × E [{e0:g}, {e1:g}] m")
+    cells = ((n1 - n0) / spacing + 2) * ((e1 - e0) / spacing + 2)
+    require(cells <= 4_000_000, "grid_spacing", spacing,
+            f"gives about {cells:.3g} cells over the domain; use a coarser grid (at most 4e6 cells)")
     north, east = _axis(target[0], n0, n1, spacing), _axis(target[1], e0, e1, spacing)
     if field.bounds is not None:
         (b0, b1), (c0, c1) = field.bounds

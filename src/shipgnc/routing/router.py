@@ -152,7 +152,12 @@ def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0
             _levelset_check(res, polys, grid_spacing, horizon, domain)
         elif global_check and res.reachable:
             _levelset_check(res, polys, grid_spacing, horizon, domain)
-        if not res.reachable and method == "auto" and not isinstance(fld, UniformCurrent):
+        if not res.reachable and method == "auto" and polys:
+            # a detour past several vertices: the obstacle-aware graph search decides (2.9.3, F7)
+            res.notes.append("no collision-free extremal or one-vertex chain: graph search around the "
+                             "obstacles")
+            _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles)
+        elif not res.reachable and method == "auto" and not isinstance(fld, UniformCurrent):
             _levelset_check(res, polys, grid_spacing, horizon, domain)
         return res
     if method == "levelset":
@@ -226,12 +231,17 @@ def _extent(fld):
     return f"N [{n0:g}, {n1:g}] m × E [{e0:g}, {e1:g}] m"
 
 
-def default_domain(fld, start, target, margin=None):
-    """A box holding A and B with a margin (F9): half of |AB| on every side, cut to a gridded extent."""
+def default_domain(fld, start, target, margin=None, obstacles=None):
+    """A box holding A and B with a margin (F9): half of |AB| on every side, grown to hold the
+    obstacles with the same margin (a detour goes round them), cut to a gridded extent."""
     dist = float(np.hypot(*(np.asarray(target) - np.asarray(start))))
     m = 0.5 * dist if margin is None else margin
     n0, n1 = min(start[0], target[0]) - m, max(start[0], target[0]) + m
     e0, e1 = min(start[1], target[1]) - m, max(start[1], target[1]) + m
+    for poly in obstacles or ():
+        b_n0, b_e0, b_n1, b_e1 = poly.bounds  # shapely: (minx, miny, maxx, maxy) = (N, E, N, E)
+        n0, n1 = min(n0, b_n0 - m), max(n1, b_n1 + m)
+        e0, e1 = min(e0, b_e0 - m), max(e1, b_e1 + m)
     if fld.bounds is not None:
         (b0, b1), (c0, c1) = fld.bounds
         n0, n1, e0, e1 = max(n0, b0), min(n1, b1), max(e0, c0), min(e1, c1)
@@ -241,7 +251,8 @@ def default_domain(fld, start, target, margin=None):
 def _levelset_run(res, polys, grid_spacing, horizon, domain):
     from shipgnc.routing.levelset import reachability
 
-    dom = domain if domain is not None else default_domain(res.field, res.start, res.target)
+    dom = domain if domain is not None else default_domain(res.field, res.start, res.target,
+                                                           obstacles=polys)
     if grid_spacing is None:
         size = max(dom[0][1] - dom[0][0], dom[1][1] - dom[1][0])
         grid_spacing = size / 160.0
@@ -261,6 +272,10 @@ def _levelset_check(res, polys, grid_spacing, horizon, domain):
             res.notes.append(f"level set confirms: not reached within {horizon:.0f} s; front's closest "
                              f"approach {ls.closest_approach:.1f} m")
         return
+    if polys and ls.route is not None and _leaks(ls.route, polys, ls.arrival, res.t0):
+        res.notes.append("level-set check discarded: its front crossed an obstacle (refine the grid)")
+        res.global_check = {"method": "levelset", "time_s": None, "rel_diff": None}
+        return
     if res.reachable:
         rel = (ls.arrival - res.time_s) / res.time_s
         res.global_check = {"method": "levelset", "time_s": float(ls.arrival), "rel_diff": float(rel)}
@@ -270,6 +285,15 @@ def _levelset_check(res, polys, grid_spacing, horizon, domain):
     else:
         res.notes.append(f"level set reaches the target at {ls.arrival:.0f} s although no extremal was "
                          "polished")
+
+
+def _leaks(route, polys, arrival, t0) -> bool:
+    """Does a recovered level-set route pass through an obstacle? (The frozen cells slow the front
+    down but a thin wall does not stop the level-set equation, whose φ falls everywhere.)"""
+    from shipgnc.routing.obstacles import path_hits
+
+    t = np.linspace(t0, t0 + arrival, 2001)
+    return path_hits(polys, np.asarray(route.position(t), dtype=float).reshape(-1, 2))
 
 
 def _polish_from_seed(res, theta0, duration):
@@ -294,6 +318,10 @@ def _levelset_primary(res, polys, grid_spacing, horizon, domain):
         res.closest_approach_m = ls.closest_approach
         return
     route = ls.route
+    if polys and _leaks(route, polys, ls.arrival, res.t0):
+        res.reason = ("the level-set front crossed an obstacle (a wall a few grid cells thick does not "
+                      "stop it): no trustworthy route; refine --grid or use --method graph")
+        return
     ext = None if polys else _polish_from_seed(res, route.heading_start, ls.arrival)
     if ext is not None and abs(ext.duration - ls.arrival) <= 0.05 * ls.arrival:
         _from_extremal(res, ext, "pmp")
@@ -310,7 +338,8 @@ def _levelset_primary(res, polys, grid_spacing, horizon, domain):
 def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles):
     from shipgnc.routing.graph import graph_route
 
-    dom = domain if domain is not None else default_domain(res.field, res.start, res.target)
+    dom = domain if domain is not None else default_domain(res.field, res.start, res.target,
+                                                           obstacles=polys)
     if grid_spacing is None:
         size = max(dom[0][1] - dom[0][0], dom[1][1] - dom[1][0])
         grid_spacing = size / 200.0
@@ -320,7 +349,17 @@ def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angl
     if g.time_s is None:
         res.notes.append(f"graph search ({directions} directions) found no route; a graph's 'unreachable' is "
                          "not final and is checked by the PMP sweep (F7)")
-        _pmp(res, horizon, n_angles, None)
+        if polys:  # the sweep must honour the obstacles too
+            from shipgnc.routing.obstacles import route_around
+
+            route_around(res, polys, horizon=horizon, n_angles=n_angles)
+        else:
+            _pmp(res, horizon, n_angles, None)
+        if not res.reachable and not res.reason:
+            res.reason = (f"no route found within T_max = {horizon:.0f} s by the graph search "
+                          f"({directions} directions, {g.spacing:.1f} m grid) or the extremal sweep")
+        if not res.reachable:
+            res.method = "graph"
         return
     ext = None if polys else _polish_from_seed(res, g.heading_start, g.time_s)
     if ext is not None and abs(ext.duration - g.time_s) <= 0.05 * g.time_s:
