@@ -3,6 +3,8 @@
     shipgnc list                          built-in scenarios
     shipgnc show NAME_OR_YAML [--set ..]  the scenario as validated YAML
     shipgnc run NAME_OR_YAML [--out DIR] [--set k=v ...] [--json] [--live]
+    shipgnc route --start N,E --target N,E --speed V --field FIELD   (document 002)
+    shipgnc sweep NAME_OR_YAML [--grid k=v1,v2 ...] [--mc N] [--workers local|dask]
 
 Bad input ends with a one-line ``error: ...`` on stderr and a non-zero exit code (2: bad input,
 3: the simulation diverged, 1: an internal error); never a traceback (set ``SHIPGNC_DEBUG=1`` to
@@ -217,6 +219,10 @@ def _print_metrics(name: str, metrics: dict) -> None:
 from shipgnc.cli_route import route as _route  # noqa: E402  (the route command, spec 002)
 
 app.command("route")(_route)
+
+from shipgnc.cli_sweep import sweep as _sweep  # noqa: E402  (studies, here or on dask)
+
+app.command("sweep")(_sweep)
 
 
 def main() -> None:

@@ -36,6 +36,7 @@ import numpy as np
 from scipy import integrate
 
 from shipgnc.errors import ConfigError, require
+from shipgnc.sim.streams import is_generator
 from shipgnc.units import G
 
 __all__ = [
@@ -554,8 +555,8 @@ class WaveRealisation:
         """
         require(isinstance(spectrum, WaveSpectrum), "waves.spectrum", type(spectrum).__name__,
                 "must be a WaveSpectrum")
-        require(isinstance(rng, np.random.Generator), "waves.rng", type(rng).__name__,
-                "must be a numpy.random.Generator (e.g. numpy.random.default_rng(seed))")
+        require(is_generator(rng), "waves.rng", type(rng).__name__,
+                "must be a numpy.random.Generator (e.g. numpy.random.default_rng(seed)) or MemberStreams")
         n = n_components
         require(isinstance(n, (int, np.integer)) and not isinstance(n, bool) and n >= 1,
                 "waves.n_components", n, "must be an integer >= 1")

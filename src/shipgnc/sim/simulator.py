@@ -27,9 +27,10 @@ from shipgnc.errors import ConfigError, DivergenceError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import Signal, names
 from shipgnc.sim.integrators import rk4_step, solve_ivp_step
+from shipgnc.sim.streams import MemberStreams, is_generator
 
 INTEGRATORS = ("rk4", "solve_ivp")
-BACKENDS = ("auto", "numpy", "compiled")
+BACKENDS = ("auto", "numpy", "compiled", "compiled-or-numpy")
 #: ``backend="auto"`` uses a compiled twin from this batch size (compilation then pays off) ...
 COMPILED_MIN_BATCH = 64
 #: ... or from this much work, ships × steps (a long run of a few ships: the numpy loop needs
@@ -111,9 +112,12 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     log_every : keep every n-th sample (large batches); the final sample is always kept.
     batch_dims : names of the batch dimensions (default ``("ship",)`` for one batch axis).
     backend : ``"numpy"`` (this loop), ``"compiled"`` (a numba twin; ConfigError naming each twin's
-        reason when none covers the setup) or ``"auto"``: a twin that covers the setup when the
+        reason when none covers the setup), ``"auto"``: a twin that covers the setup when the
         batch has ≥ :data:`COMPILED_MIN_BATCH` ships or the run ≥ :data:`COMPILED_MIN_WORK`
-        ship-steps, else this loop. Both give the same result to round-off.
+        ship-steps, else this loop, or ``"compiled-or-numpy"``: a twin whenever one covers the
+        setup, whatever the batch size (a study's chunks of any size then take the same path).
+        Both give the same result to round-off; each gives a ship the same result to the bit
+        whatever the batch it shares.
 
     Returns an ``xarray.Dataset`` (see :mod:`shipgnc.sim.result`).
     """
@@ -125,7 +129,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
     log = None
     n_ships = math.prod(setup.batch_shape)
-    wants_compiled = backend == "compiled" or (backend == "auto" and (
+    wants_compiled = backend in ("compiled", "compiled-or-numpy") or (backend == "auto" and (
         n_ships >= COMPILED_MIN_BATCH or n_ships * setup.n_steps >= COMPILED_MIN_WORK))
     if wants_compiled:
         twin, reasons = _compiled_twin(setup)
@@ -220,10 +224,13 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
         require(bool(np.all(actuator.tau[limited] > 0)), "actuator.rate",
                 actuator.rate.tolist(), "a continuous controller needs a lag (tau > 0) on "
                 "every rate-limited channel")
-    if seed is not None and not isinstance(seed, np.random.Generator):
+    if seed is not None and not is_generator(seed):
         require(isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and seed >= 0,
-                "seed", seed, "must be a non-negative integer or a numpy Generator")
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+                "seed", seed, "must be a non-negative integer, a numpy Generator or MemberStreams")
+    if isinstance(seed, MemberStreams):
+        require(x0.shape[:-1] == (len(seed),), "seed", f"{len(seed)} member streams",
+                f"need one stream per ship of the batch {x0.shape[:-1]}")
+    rng = seed if is_generator(seed) else np.random.default_rng(seed)
     return SimSetup(model=model, x0=x0, t_end=float(t_end), dt=float(dt), n_steps=n_steps,
                     hold=hold, controller=controller, actuator=actuator, guidance=guidance,
                     disturbance=disturbance, integrator=integrator,

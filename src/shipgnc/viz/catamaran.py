@@ -11,20 +11,12 @@ from pathlib import Path
 
 import numpy as np
 
-from shipgnc.viz.style import COLORS, DPI, LABEL_SIZE, LEGEND, REFERENCE, SMALL_SIZE, TICK_SIZE
+from shipgnc.viz.style import COLORS, DPI, LABEL_SIZE, LEGEND, REFERENCE, new_figure
 
 STATE_ORDER = ("u", "v", "r", "north", "east", "psi", "delta")
 
 
-def _figure(nrows=1, ncols=1, size=SMALL_SIZE, **kw):
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=size, layout="constrained")
-    axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
-    for ax in axes.flat:
-        ax.tick_params(labelsize=TICK_SIZE)
-        ax.grid(True, linewidth=0.4, alpha=0.5)
-    return fig, axes
+_figure = new_figure
 
 
 def _states(ds) -> np.ndarray:

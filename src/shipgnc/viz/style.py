@@ -61,6 +61,19 @@ TICK_SIZE = 8
 TITLE_SIZE = 12
 
 
+def new_figure(nrows=1, ncols=1, size=SMALL_SIZE, **kw):
+    """A constrained-layout ``matplotlib.figure.Figure`` (no pyplot: no window, no global registry)
+    with an ``(nrows, ncols)`` array of gridded axes in the shared tick style."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=size, layout="constrained")
+    axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
+    for ax in axes.flat:
+        ax.tick_params(labelsize=TICK_SIZE)
+        ax.grid(True, linewidth=0.4, alpha=0.5)
+    return fig, axes
+
+
 def to_deg(angle):
     """Radians → degrees, for display only (floats and arrays)."""
     return np.degrees(angle)

@@ -1,0 +1,128 @@
+"""``shipgnc sweep``: a gain sweep and Monte Carlo study of a scenario, here or on dask.
+
+    shipgnc sweep SCENARIO [--grid KEY=V1,V2,...]... [--mc N] [--seed S]
+                  [--perturb FIELD=normal:SIGMA | FIELD=uniform:LOW,HIGH]... [--set KEY=VALUE]...
+                  [--workers local|dask] [--scheduler tcp://HOST:PORT] [--chunk-size M]
+                  [--series] [--out DIR]
+
+Writes ``sweep.nc`` (or ``sweep.zarr`` for a large study with the ``[dist]`` extra),
+``summary.csv`` / ``summary.md`` (median, p5, p95 of each metric per grid point) and ``sweep.png``
+(each metric against the first grid key with the members' spread). Exit codes as ``shipgnc run``:
+2 bad input (one line naming what was wrong), 1 internal error.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+
+def sweep(
+    scenario: Annotated[str, typer.Argument(help="Built-in scenario name or a YAML file.")],
+    grid: Annotated[list[str] | None, typer.Option(
+        "--grid", help="KEY=V1,V2,... a scenario field and its values (repeatable: the product).")] = None,
+    mc: Annotated[int, typer.Option("--mc", help="Monte Carlo members per grid point.")] = 1,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the members' streams.")] = 0,
+    perturb: Annotated[list[str] | None, typer.Option(
+        "--perturb", help="FIELD=normal:SIGMA or FIELD=uniform:LOW,HIGH, an initial-state offset per "
+                          "member (north, east [m], psi_deg [deg], u, v [m/s], r_deg_s [deg/s]).")] = None,
+    set_: Annotated[list[str] | None, typer.Option(
+        "--set", help="KEY=VALUE applied to every point (repeatable).")] = None,
+    workers: Annotated[str, typer.Option("--workers", help="local | dask (a LocalCluster).")] = "local",
+    scheduler: Annotated[str | None, typer.Option(
+        "--scheduler", help="Address of a running dask scheduler, tcp://HOST:PORT.")] = None,
+    chunk_size: Annotated[int, typer.Option("--chunk-size", help="Members per task.")] = 1000,
+    series: Annotated[bool, typer.Option("--series", help="Keep every member's time series.")] = False,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Output directory "
+                                             "[default: runs/sweep-<scenario>].")] = None,
+    figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write sweep.png.")] = True,
+) -> None:
+    """Sweep a scenario over a grid of settings and a Monte Carlo of seeded members."""
+    from shipgnc.cli import friendly_errors, stderr
+
+    with friendly_errors():
+        from shipgnc.errors import ConfigError
+        from shipgnc.study.spec import Perturbation, Study, parse_grid
+
+        if mc < 1:
+            raise ConfigError(f"--mc {mc}: must be an integer >= 1")
+        if chunk_size < 1:
+            raise ConfigError(f"--chunk-size {chunk_size}: must be an integer >= 1")
+        study = Study(scenario, grid=tuple(parse_grid(g) for g in grid or []), members=mc, seed=seed,
+                      perturb=tuple(Perturbation.parse(p) for p in perturb or []),
+                      overrides=tuple(set_ or []), series=series)
+        out_dir = out if out is not None else Path("runs") / f"sweep-{Path(scenario).stem}"
+        run = _run_with_progress(study, workers, scheduler, chunk_size)
+        written = write_study(run.dataset, out_dir, figures=figures)
+        _print_summary(run)
+        stderr.print(f"{run.chunks} chunks on {run.workers} in {run.seconds:.1f} s; wrote "
+                     f"{', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
+
+
+def _run_with_progress(study, workers, scheduler, chunk_size):
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from shipgnc.cli import stderr
+    from shipgnc.study.execute import run_study
+
+    with Progress(TextColumn("chunks"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                  console=stderr, transient=True, disable=not stderr.is_terminal) as bar:
+        task = bar.add_task("chunks", total=None)
+
+        def update(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        return run_study(study, workers=workers, scheduler=scheduler, chunk_size=chunk_size,
+                         on_chunk=update)
+
+
+def write_study(ds, out: Path, *, figures: bool = True) -> list[Path]:
+    """The study's Dataset, summary table and figure in ``out``."""
+    from shipgnc.errors import ConfigError
+    from shipgnc.scenarios.runner import write_table
+    from shipgnc.study.summary import save_dataset, spread_figure, summary_rows
+
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"--out {str(out)!r}: cannot create the directory ({exc.strerror})") from None
+    written = [save_dataset(ds, out)]
+    csv_path, md_path = write_table(summary_rows(ds), out)
+    written += [csv_path.rename(out / "summary.csv"), md_path.rename(out / "summary.md")]
+    if figures:
+        written.append(spread_figure(ds, out / "sweep.png"))
+    return written
+
+
+def _print_summary(run, max_columns: int = 8) -> None:
+    """One row per metric, one column per grid point: the median and [p5, p95] of the members."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from shipgnc.cli import stdout
+    from shipgnc.scenarios.runner import metric_text
+
+    def metric_text4(value) -> str:
+        return metric_text(value, digits=4)
+    from shipgnc.study.summary import summary_rows
+
+    ds = run.dataset
+    rows = summary_rows(ds)
+    suffixes = ("_median", "_p5", "_p95", "_missing")
+    cell_keys = [k for k in rows[0] if not k.endswith(suffixes)]
+    metrics = [k.removesuffix("_median") for k in rows[0] if k.endswith("_median")]
+    shown = rows[:max_columns]
+    title = f"{ds.attrs['scenario']}: median [p5, p95] over {ds.attrs['members']} members"
+    if len(rows) > len(shown):
+        title += f" (first {len(shown)} of {len(rows)} points; all in summary.csv)"
+    table = Table(title=escape(title), title_justify="left")
+    table.add_column("metric", style="bold")
+    for row in shown:
+        label = ", ".join(f"{k.rsplit('.', 1)[-1]}={metric_text4(row[k])}" for k in cell_keys) or "all"
+        table.add_column(escape(label), justify="right")
+    for m in metrics:
+        table.add_row(m, *(escape(f"{metric_text4(r[f'{m}_median'])} [{metric_text4(r[f'{m}_p5'])}, "
+                                  f"{metric_text4(r[f'{m}_p95'])}]") for r in shown))
+    stdout.print(table)

@@ -1,0 +1,138 @@
+"""One chunk of a study: a slice of members at one grid point, run as one batch.
+
+A chunk is the unit of work a backend hands out (thousands of ships per task, not one task per
+ship). :func:`run_chunk` is a pure function of the study and the chunk: it builds the scenario of
+the grid point, stacks the members' initial states, gives each member its own random stream, runs
+the one simulation loop once for the whole slice and scores every member with the scenario's
+metrics. The result depends on the members' indices only, not on the slice they came in.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from shipgnc.errors import ConfigError
+from shipgnc.models.base import names
+from shipgnc.sim.streams import MemberStreams
+from shipgnc.study.spec import PERTURBABLE, Study
+
+
+@dataclass(frozen=True)
+class Chunk:
+    """Members ``start .. stop-1`` of grid point ``point`` (an index into ``Study.points``),
+    controller ``variant`` (None: the scenario's only one)."""
+
+    point: int
+    start: int
+    stop: int
+    variant: str | None = None
+
+    @property
+    def size(self) -> int:
+        return self.stop - self.start
+
+
+def plan_chunks(study: Study, variants: list[str] | None, chunk_size: int) -> list[Chunk]:
+    """Every chunk of the study, grid point by grid point, at most ``chunk_size`` members each."""
+    if not isinstance(chunk_size, (int, np.integer)) or isinstance(chunk_size, bool) or chunk_size < 1:
+        raise ConfigError(f"--chunk-size {chunk_size!r}: must be an integer >= 1")
+    out = []
+    for p in range(len(study.points)):
+        for variant in variants or [None]:
+            for start in range(0, study.members, chunk_size):
+                out.append(Chunk(p, start, min(start + chunk_size, study.members), variant))
+    return out
+
+
+def check_sweepable(scenario) -> None:
+    """Refuse the scenarios whose runs do not go through the generic loop of one batch."""
+    if scenario.route is not None:
+        raise ConfigError(f"scenario {scenario.name!r} is a routing problem (document 002): "
+                          "sweep a simulation scenario")
+    if scenario.vessel.model == "catamaran":
+        raise ConfigError(f"scenario {scenario.name!r}: the catamaran's cases run through their "
+                          "own builders and are not sweepable yet")
+    if scenario.montecarlo is not None:
+        raise ConfigError(f"scenario {scenario.name!r} has its own montecarlo section; sweep the "
+                          "single-run scenario with --mc and --perturb instead")
+
+
+def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> np.ndarray:
+    """x0 of each member of the chunk: the scenario's x0 plus the member's own offsets."""
+    state_names = names(model.states)
+    batch = np.tile(np.asarray(x0, dtype=float), (chunk.size, 1))
+    for p in study.perturb:
+        state, scale = PERTURBABLE[p.field]
+        if state not in state_names:
+            raise ConfigError(f"--perturb {p.field}: this vessel has no state {state!r} "
+                              f"(states: {', '.join(state_names)})")
+    for row, member in enumerate(range(chunk.start, chunk.stop)):
+        rng = np.random.default_rng(study.member_streams(member)[0])
+        for p in study.perturb:
+            state, scale = PERTURBABLE[p.field]
+            batch[row, state_names.index(state)] += scale * p.draw(rng)
+    return batch
+
+
+def numeric_metrics(metrics: dict) -> dict[str, float]:
+    """The scalar figures of a metrics dict as floats (None → NaN; lists and events left out)."""
+    out = {}
+    for key, value in metrics.items():
+        if isinstance(value, bool):
+            out[key] = float(value)
+        elif isinstance(value, (int, float, np.integer, np.floating)):
+            out[key] = float(value)
+        elif value is None:
+            out[key] = math.nan
+    return out
+
+
+def _simulate(setup, scenario, x0, streams, backend: str):
+    from shipgnc.sim.simulator import simulate
+
+    sim = scenario.simulation
+    return simulate(setup.model, x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
+                    actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
+                    u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
+                    atol=sim.atol, seed=streams, log_every=sim.log_every, backend=backend,
+                    on_divergence="stop", batch_dims=("member",))
+
+
+def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
+    """Run one chunk; an ``xarray.Dataset`` with a ``member`` dimension: every scalar metric, and
+    with ``study.series`` every time series.
+
+    The batch runs in one call of the loop. If a member diverges (which stops a batch), the chunk
+    is run again member by member, so that every member's figures are its own run's whatever
+    chunk it shares (a diverged member is flagged ``diverged = 1`` with its figures up to then).
+    """
+    import xarray as xr
+
+    from shipgnc.scenarios.runner import build, compute_metrics
+
+    scenario = study.scenario_at(study.points[chunk.point])
+    check_sweepable(scenario)
+    setup = build(scenario, chunk.variant, seed=study.seed)
+    x0 = member_initial_states(study, setup.x0, setup.model, chunk)
+    seeds = [study.member_streams(m)[1] for m in range(chunk.start, chunk.stop)]
+    result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend)
+    if result.attrs.get("diverged", 0):
+        singles = [_simulate(setup, scenario, x0[i:i + 1], MemberStreams(seeds[i:i + 1]), backend)
+                   for i in range(chunk.size)]
+        members = [r.isel(member=0) for r in singles]
+    else:
+        members = [result.isel(member=i) for i in range(chunk.size)]
+    rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
+    keys = list(dict.fromkeys(k for row in rows for k in row))
+    data = {k: ("member", np.array([row.get(k, math.nan) for row in rows])) for k in keys}
+    out = xr.Dataset(data, coords={"member": np.arange(chunk.start, chunk.stop)})
+    if study.series:
+        series = result if not result.attrs.get("diverged", 0) else xr.concat(
+            singles, dim="member", join="outer")
+        series = series.assign_coords(member=np.arange(chunk.start, chunk.stop))
+        series.attrs = {}
+        out = xr.merge([out, series.rename({k: f"series_{k}" for k in series.data_vars})])
+    return out

@@ -1,0 +1,158 @@
+"""Run a study's chunks here or on a dask cluster, and put them together into one Dataset.
+
+Three ways, one result to the bit: ``workers="local"`` runs the chunks one after another in this
+process; ``workers="dask"`` starts a :class:`dask.distributed.LocalCluster` (one single-threaded
+worker process per core); ``scheduler="tcp://HOST:PORT"`` sends them to a running dask cluster.
+dask reschedules the chunks of a worker that dies, and a chunk is a pure function of the study, so
+a lost worker costs time, not members.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from shipgnc.errors import ConfigError
+from shipgnc.study.chunk import Chunk, check_sweepable, plan_chunks, run_chunk
+from shipgnc.study.spec import Study
+
+WORKERS = ("local", "dask")
+#: members per chunk by default: large enough that a task is thousands of ship-runs, small enough
+#: that its time series (≈ 15 signals × samples × 8 bytes per member) stay in memory
+DEFAULT_CHUNK_SIZE = 1000
+#: seconds to wait for a dask scheduler before calling it unreachable
+CONNECT_TIMEOUT_S = 5
+
+
+@dataclass
+class StudyRun:
+    """A finished study: the Dataset and how it ran (kept out of the Dataset, which depends on
+    the study alone)."""
+
+    dataset: object  # xarray.Dataset
+    chunks: int
+    workers: str
+    seconds: float
+
+
+def variants_of(study: Study) -> list[str] | None:
+    """The controller variants (a ``controller`` dimension) of a comparison scenario, else None;
+    every grid point is loaded here, so a bad grid key or value fails before any work starts."""
+    variants = None
+    for point in study.points:
+        scenario = study.scenario_at(point)
+        check_sweepable(scenario)
+        if scenario.controllers is not None:
+            names = list(scenario.controllers)
+            if variants is not None and names != variants:
+                raise ConfigError(f"--grid: the controllers change across the grid ({variants} vs {names})")
+            variants = names
+    return variants
+
+
+def connect(scheduler: str | None, workers: str):
+    """A dask ``Client``: to ``scheduler`` if given, else to a new LocalCluster sized to the machine."""
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise ConfigError("dask is not installed: pip install 'shipgnc[dist]' to run on dask") from None
+    if scheduler is not None:
+        try:
+            return Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise ConfigError(f"--scheduler {scheduler!r}: cannot reach a dask scheduler within "
+                              f"{CONNECT_TIMEOUT_S} s ({reason})") from None
+    cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                           dashboard_address=None)
+    return Client(cluster)
+
+
+def run_chunks(study: Study, chunks: list[Chunk], *, client=None,
+               on_chunk: Callable[[int, int], None] | None = None) -> list:
+    """The chunks' Datasets in chunk order; ``on_chunk(done, total)`` after each finished chunk."""
+    total = len(chunks)
+    if client is None:
+        out = []
+        for i, chunk in enumerate(chunks):
+            out.append(run_chunk(study, chunk))
+            if on_chunk is not None:
+                on_chunk(i + 1, total)
+        return out
+    from dask.distributed import as_completed
+
+    futures = [client.submit(run_chunk, study, chunk, pure=False, retries=1) for chunk in chunks]
+    index = {f.key: i for i, f in enumerate(futures)}
+    results: list = [None] * total
+    for done, future in enumerate(as_completed(futures), start=1):
+        results[index[future.key]] = future.result()
+        if on_chunk is not None:
+            on_chunk(done, total)
+    return results
+
+
+def assemble(study: Study, chunks: list[Chunk], parts: list, variants: list[str] | None):
+    """One Dataset: dimensions (*grid keys, [controller], member), coordinates labelled."""
+    import xarray as xr
+
+    by_cell: dict[tuple, list] = {}
+    for chunk, part in zip(chunks, parts, strict=True):
+        by_cell.setdefault((chunk.point, chunk.variant), []).append(part)
+    cells = {key: xr.concat(ps, dim="member", join="outer") for key, ps in by_cell.items()}
+    points = []
+    for p in range(len(study.points)):
+        if variants is None:
+            points.append(cells[(p, None)])
+        else:
+            points.append(xr.concat([cells[(p, v)] for v in variants], dim="controller", join="outer")
+                          .assign_coords(controller=variants))
+    if study.grid:
+        nested = np.empty(study.shape, dtype=object)
+        for i, ds in enumerate(points):
+            nested[np.unravel_index(i, study.shape)] = ds
+        ds = xr.combine_nested(nested.tolist(), concat_dim=list(study.dims), join="outer",
+                               combine_attrs="drop")
+        ds = ds.assign_coords({key: list(values) for key, values in study.grid})
+        ds = ds.transpose(*study.dims, ...)
+    else:
+        ds = points[0]
+    ds.attrs = {"scenario": study.scenario, "seed": int(study.seed), "members": int(study.members),
+                "grid": "; ".join(f"{k}={','.join(map(str, v))}" for k, v in study.grid),
+                "perturb": "; ".join(str(p) for p in study.perturb),
+                "overrides": "; ".join(study.overrides),
+                "streams": "member i: SeedSequence(seed).spawn(members)[i] (offsets, disturbances)"}
+    return ds
+
+
+def run_study(study: Study, *, workers: str = "local", scheduler: str | None = None,
+              chunk_size: int = DEFAULT_CHUNK_SIZE, client=None,
+              on_chunk: Callable[[int, int], None] | None = None) -> StudyRun:
+    """Run ``study`` and return its Dataset (see :func:`assemble`).
+
+    ``workers``: ``"local"`` or ``"dask"`` (a new LocalCluster); ``scheduler``: an existing dask
+    cluster's address (implies dask); ``client``: an existing ``dask.distributed.Client`` (tests).
+    """
+    import time
+
+    if workers not in WORKERS:
+        raise ConfigError(f"--workers {workers!r}: allowed: {', '.join(WORKERS)}")
+    variants = variants_of(study)
+    chunks = plan_chunks(study, variants, chunk_size)
+    start = time.perf_counter()
+    owned = None
+    if client is None and (workers == "dask" or scheduler is not None):
+        client = owned = connect(scheduler, workers)
+    try:
+        parts = run_chunks(study, chunks, client=client, on_chunk=on_chunk)
+    finally:
+        if owned is not None:
+            cluster = getattr(owned, "cluster", None)
+            owned.close()
+            if cluster is not None and scheduler is None:
+                cluster.close()
+    ds = assemble(study, chunks, parts, variants)
+    how = "local" if client is None else ("scheduler " + scheduler if scheduler else "dask")
+    return StudyRun(ds, len(chunks), how, time.perf_counter() - start)

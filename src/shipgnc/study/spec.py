@@ -1,0 +1,154 @@
+"""What a study is: a scenario, a grid of overrides, a Monte Carlo of seeded members.
+
+A study is the product of its grids (each grid key is a scenario field, as in ``--set``) times
+``members`` Monte Carlo members. Member *i* has its own random streams,
+``SeedSequence(seed).spawn(members)[i]``, split in two children: one draws the member's initial
+state offsets (:class:`Perturbation`), the other feeds the scenario's random disturbances
+(:class:`~shipgnc.sim.streams.MemberStreams`). So a member's result depends on ``seed`` and *i*
+only, never on how the study is chunked or where a chunk runs; and member *i* meets the same sea
+and the same offsets at every grid point (common random numbers: differences between grid points
+are the grid's, not the dice's).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+from shipgnc.scenarios.registry import load_scenario, parse_override
+from shipgnc.scenarios.schema import Scenario
+from shipgnc.units import deg
+
+#: initial-state fields a member may be offset in, with the conversion of the offset to SI
+PERTURBABLE = {"north": ("north", 1.0), "east": ("east", 1.0), "psi_deg": ("psi", deg(1.0)),
+               "u": ("u", 1.0), "v": ("v", 1.0), "r_deg_s": ("r", deg(1.0))}
+DISTRIBUTIONS = ("normal", "uniform")
+
+
+@dataclass(frozen=True)
+class Perturbation:
+    """An offset of one initial-state field per member: ``normal:SIGMA`` (zero mean) or
+    ``uniform:LOW,HIGH``, in the field's unit (``psi_deg`` in degrees, ``north`` in metres, ...)."""
+
+    field: str
+    kind: str
+    low: float  # normal: 0; uniform: lower bound
+    high: float  # normal: sigma; uniform: upper bound
+
+    @classmethod
+    def parse(cls, text: str) -> Perturbation:
+        """``"psi_deg=uniform:-30,30"`` or ``"north=normal:5"``."""
+        field, sep, rule = text.partition("=")
+        field = field.strip().removeprefix("initial_state.")
+        if not sep or field not in PERTURBABLE:
+            raise ConfigError(f"--perturb {text!r}: expected FIELD=normal:SIGMA or FIELD=uniform:LOW,HIGH "
+                              f"with FIELD one of {', '.join(PERTURBABLE)}")
+        kind, _, args = rule.partition(":")
+        kind = kind.strip()
+        if kind not in DISTRIBUTIONS:
+            raise ConfigError(f"--perturb {text!r}: distribution {kind!r} unknown; allowed: "
+                              f"{', '.join(DISTRIBUTIONS)}")
+        try:
+            numbers = [float(a) for a in args.split(",")]
+        except ValueError:
+            raise ConfigError(f"--perturb {text!r}: {args!r} is not a list of numbers") from None
+        if not all(math.isfinite(v) for v in numbers):
+            raise ConfigError(f"--perturb {text!r}: values must be finite")
+        if kind == "normal":
+            if len(numbers) != 1 or numbers[0] < 0:
+                raise ConfigError(f"--perturb {text!r}: normal takes one standard deviation >= 0")
+            return cls(field, kind, 0.0, numbers[0])
+        if len(numbers) != 2 or numbers[0] > numbers[1]:
+            raise ConfigError(f"--perturb {text!r}: uniform takes LOW,HIGH with LOW <= HIGH")
+        return cls(field, kind, numbers[0], numbers[1])
+
+    def draw(self, rng: np.random.Generator) -> float:
+        if self.kind == "normal":
+            return float(rng.normal(0.0, self.high))
+        return float(rng.uniform(self.low, self.high))
+
+    def __str__(self) -> str:
+        args = f"{self.high:g}" if self.kind == "normal" else f"{self.low:g},{self.high:g}"
+        return f"{self.field}={self.kind}:{args}"
+
+
+def parse_grid(text: str) -> tuple[str, tuple]:
+    """``"controller.omega=0.5,1,2"`` → ``("controller.omega", (0.5, 1, 2))`` (values read as YAML)."""
+    key, sep, values = text.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise ConfigError(f"--grid {text!r}: expected KEY=V1,V2,... with a dotted scenario key, "
+                          f"e.g. controller.omega=0.5,1.0")
+    items = [v.strip() for v in values.split(",") if v.strip()]
+    if not items:
+        raise ConfigError(f"--grid {text!r}: the grid of {key!r} is empty; give at least one value")
+    parsed = tuple(parse_override(f"{key}={v}")[1] for v in items)
+    for value in parsed:
+        if not isinstance(value, (int, float, str)) or isinstance(value, bool):
+            raise ConfigError(f"--grid {key}: value {value!r} is not a number or a name")
+    if len(set(parsed)) != len(parsed):
+        raise ConfigError(f"--grid {key}: repeated values in {list(parsed)}")
+    return key, parsed
+
+
+@dataclass(frozen=True)
+class Study:
+    """A sweep of ``scenario`` over the product of ``grid`` times ``members`` seeded members.
+
+    ``grid``: ordered (key, values) pairs; ``overrides``: ``--set`` items applied first;
+    ``series``: keep every member's full time series in the result (memory: members × samples).
+    """
+
+    scenario: str
+    grid: tuple[tuple[str, tuple], ...] = ()
+    members: int = 1
+    seed: int = 0
+    perturb: tuple[Perturbation, ...] = ()
+    overrides: tuple[str, ...] = ()
+    series: bool = False
+
+    def __post_init__(self) -> None:
+        require(isinstance(self.members, (int, np.integer)) and not isinstance(self.members, bool)
+                and self.members >= 1, "--mc", self.members, "must be an integer >= 1")
+        require(isinstance(self.seed, (int, np.integer)) and not isinstance(self.seed, bool)
+                and self.seed >= 0, "--seed", self.seed, "must be an integer >= 0")
+        keys = [k for k, _ in self.grid]
+        repeated = sorted({k for k in keys if keys.count(k) > 1})
+        require(not repeated, "--grid", ", ".join(repeated), "each key may be gridded once")
+        for key, values in self.grid:
+            require(len(values) >= 1, f"--grid {key}", "[]", "needs at least one value")
+        fields = [p.field for p in self.perturb]
+        require(len(set(fields)) == len(fields), "--perturb", ", ".join(fields),
+                "each field may be perturbed once")
+
+    @property
+    def dims(self) -> tuple[str, ...]:
+        return tuple(k for k, _ in self.grid)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(v) for _, v in self.grid)
+
+    @property
+    def points(self) -> list[tuple]:
+        """Every grid point (a tuple of values, in grid-key order; ``[()]`` without a grid)."""
+        return list(itertools.product(*(v for _, v in self.grid)))
+
+    def scenario_at(self, point: tuple) -> Scenario:
+        """The validated scenario of one grid point."""
+        extra = [f"{k}={v}" for (k, _), v in zip(self.grid, point, strict=True)]
+        try:
+            return load_scenario(self.scenario, [*self.overrides, *extra])
+        except ConfigError as exc:
+            where = ", ".join(extra)
+            raise ConfigError(f"{exc} (at grid point {where})" if where else str(exc)) from None
+
+    def member_streams(self, member: int) -> tuple[np.random.SeedSequence, np.random.SeedSequence]:
+        """Member ``member``'s two streams (initial offsets, disturbances):
+        ``SeedSequence(seed).spawn(members)[member].spawn(2)``, built directly from the spawn key
+        so that no chunk needs the others."""
+        return tuple(np.random.SeedSequence(int(self.seed), spawn_key=(int(member), j)) for j in (0, 1))
