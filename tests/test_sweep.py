@@ -67,7 +67,7 @@ def test_local_cluster_gives_the_same_bits(local_result, cluster):
 
 def test_a_killed_worker_costs_no_member(local_result, cluster):
     """One worker dies mid-sweep; dask reschedules its chunk and the result is unchanged."""
-    cl, client = cluster
+    _, client = cluster
     slow = small_study(overrides=("simulation.t_end=40", NOISY))
     reference = run_study(slow, chunk_size=2).dataset
     killed = []
