@@ -300,11 +300,48 @@ def check_divergence(setup: SimSetup, t: float, x: np.ndarray | None = None,
     return DivergenceError(message, time=t, state=signal.name, value=value, index=idx[:-1])
 
 
+def advance_plant(setup: SimSetup, t0: float, x: np.ndarray, lag: np.ndarray | None, plan,
+                  command: np.ndarray, ref: np.ndarray, d_held) -> tuple[np.ndarray, np.ndarray | None]:
+    """The plant (and the actuator lag states) from t0 to t0 + dt under one step's input ``plan``
+    (:meth:`Actuator.begin_step`): RK4 or ``solve_ivp``. A continuous controller's law is evaluated
+    in every stage; a held disturbance sample ``d_held`` is used unless the disturbance is
+    ``per_stage``. Returns (x, lag); NaN when the adaptive solver gives up (a divergence)."""
+    model, act, ctrl, dist = setup.model, setup.actuator, setup.controller, setup.disturbance
+    n, dt = x.shape[-1], setup.dt
+    continuous = bool(getattr(ctrl, "continuous", False))
+
+    def rhs(t: float, z: np.ndarray) -> np.ndarray:
+        xs = z[..., :n]
+        lag_s = z[..., n:] if lag is not None else None
+        if continuous:
+            cmd = ctrl.law(t, xs, ref)
+            u = act.saturate(cmd) if lag_s is None else np.where(act.tau > 0, lag_s, act.saturate(cmd))
+        else:
+            cmd = command
+            u = act.input_at(plan, (t - t0) / dt, lag_s)
+        d = dist(t, xs) if (dist is not None and dist.per_stage) else d_held
+        xdot = model.derivatives(xs, u, d)
+        if lag_s is None:
+            return xdot
+        return np.concatenate([xdot, act.lag_derivative(cmd, lag_s)], axis=-1)
+
+    z = x if lag is None else np.concatenate([x, lag], axis=-1)
+    with np.errstate(all="ignore"):
+        if setup.integrator == "rk4":
+            z = rk4_step(rhs, t0, z, dt)
+        else:
+            try:
+                z = solve_ivp_step(rhs, t0, z, dt, **setup.solver_options)
+            except (FloatingPointError, ValueError, OverflowError):
+                z = np.full_like(z, np.nan)  # the solver gave up: report it as a divergence
+    return z[..., :n], (z[..., n:] if lag is not None else None)
+
+
 def run_numpy(setup: SimSetup) -> Log:
     """The reference loop in plain numpy (readable; batched over ships)."""
     model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller, setup.guidance,
                                   setup.disturbance)
-    batch, n = setup.batch_shape, setup.x0.shape[-1]
+    batch = setup.batch_shape
     dt = setup.dt
     continuous = bool(getattr(ctrl, "continuous", False))
     if ctrl is not None:
@@ -330,24 +367,6 @@ def run_numpy(setup: SimSetup) -> Log:
     status: dict = {"diverged": 0, "stopped_early": 0, "message": ""}
     n_logged = 0
     progress_every = max(1, setup.n_steps // 100)
-
-    def rhs_factory(t0: float, plan, ref_now, d_now):
-        def rhs(t: float, z: np.ndarray) -> np.ndarray:
-            xs = z[..., :n]
-            lag_s = z[..., n:] if lag is not None else None
-            if continuous:
-                cmd = ctrl.law(t, xs, ref_now)
-                u = act.saturate(cmd) if lag_s is None else np.where(act.tau > 0, lag_s,
-                                                                       act.saturate(cmd))
-            else:
-                cmd = command
-                u = act.input_at(plan, (t - t0) / dt, lag_s)
-            d = dist(t, xs) if (dist is not None and dist.per_stage) else d_now
-            xdot = model.derivatives(xs, u, d)
-            if lag_s is None:
-                return xdot
-            return np.concatenate([xdot, act.lag_derivative(cmd, lag_s)], axis=-1)
-        return rhs
 
     for k in range(setup.n_steps + 1):
         t = k * dt
@@ -399,19 +418,7 @@ def run_numpy(setup: SimSetup) -> Log:
             setup.progress(k, setup.n_steps)
         if last or all_done:
             break
-        z = x if lag is None else np.concatenate([x, lag], axis=-1)
-        rhs = rhs_factory(t, plan, ref, held_d)
-        with np.errstate(all="ignore"):
-            if setup.integrator == "rk4":
-                z = rk4_step(rhs, t, z, dt)
-            else:
-                try:
-                    z = solve_ivp_step(rhs, t, z, dt, **setup.solver_options)
-                except (FloatingPointError, ValueError, OverflowError):
-                    z = np.full_like(z, np.nan)  # the solver gave up: report it as a divergence
-        x = z[..., :n]
-        if lag is not None:
-            lag = z[..., n:]
+        x, lag = advance_plant(setup, t, x, lag, plan, command, ref, held_d)
         applied = act.input_at(plan, 1.0, lag)
         error = check_divergence(setup, t + dt, x)
         if error is not None:

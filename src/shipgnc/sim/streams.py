@@ -27,7 +27,8 @@ def member_seeds(seed: int, n_members: int) -> list[np.random.SeedSequence]:
 class MemberStreams:
     """A batch of generators, one per member; draws have the member axis first.
 
-    ``streams[i]`` is member *i*'s :class:`numpy.random.Generator`. ``standard_normal(shape)`` with
+    ``streams[i]`` is member *i*'s :class:`numpy.random.Generator` (from a seed, a ``SeedSequence``
+    or a generator, used as it is). ``standard_normal(shape)`` with
     ``shape = (n_members, *rest)`` returns member *i*'s ``standard_normal(rest)`` in row *i*; same for
     ``random`` and ``uniform``. A shape without the member axis first is refused (it would mix the
     streams).

@@ -1,0 +1,47 @@
+"""Reinforcement-learning environments (``pip install "shipgnc[rl]"``): shipgnc scenarios as
+``gymnasium`` environments, registered under ``shipgnc/...`` ids when this module is imported.
+
+    import gymnasium as gym
+    import shipgnc.rl  # registers the ids
+
+    env = gym.make("shipgnc/BoatHeading-v0")
+    envs = gym.make_vec("shipgnc/BoatHeading-v0", num_envs=1000, vectorization_mode="vector_entry_point")
+
+| id | scenario | initial offsets per reset |
+|---|---|---|
+| ``shipgnc/BoatHeading-v0`` | ``boat-autopilot`` (document 001: heading steps) | heading ±30° |
+| ``shipgnc/BoatLOS-v0`` | ``boat-los`` (waypoints with LOS references) | none |
+| ``shipgnc/CyberShipCourse-v0`` | ``cybership-calm`` (document 003, reward −J) | none |
+| ``shipgnc/CyberShipWaves-v0`` | ``cybership-waves`` (seeded sea per episode) | none |
+| ``shipgnc/Ship-v0`` | any: ``gym.make("shipgnc/Ship-v0", scenario=..., perturb=[...])`` | as given |
+"""
+
+from __future__ import annotations
+
+try:
+    import gymnasium as gym
+except ImportError as exc:  # pragma: no cover - the [rl] extra is missing
+    raise ImportError("shipgnc.rl needs gymnasium: pip install 'shipgnc[rl]'") from exc
+
+from shipgnc.rl.env import ShipEnv, ShipVectorEnv
+
+ENVIRONMENTS = {
+    "shipgnc/BoatHeading-v0": {"scenario": "boat-autopilot", "perturb": ("psi_deg=uniform:-30,30",)},
+    "shipgnc/BoatLOS-v0": {"scenario": "boat-los"},
+    "shipgnc/CyberShipCourse-v0": {"scenario": "cybership-calm"},
+    "shipgnc/CyberShipWaves-v0": {"scenario": "cybership-waves"},
+    "shipgnc/Ship-v0": {},
+}
+
+
+def register() -> None:
+    """Register every id of :data:`ENVIRONMENTS` (again: a no-op)."""
+    for env_id, kwargs in ENVIRONMENTS.items():
+        if env_id not in gym.registry:
+            gym.register(env_id, entry_point="shipgnc.rl.env:ShipEnv",
+                         vector_entry_point="shipgnc.rl.env:ShipVectorEnv", kwargs=dict(kwargs))
+
+
+register()
+
+__all__ = ["ENVIRONMENTS", "ShipEnv", "ShipVectorEnv", "register"]

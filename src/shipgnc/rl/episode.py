@@ -1,0 +1,180 @@
+"""A scenario as a batch of episodes an agent steps: the engine behind :mod:`shipgnc.rl`.
+
+The agent takes the controller's place in the one loop: every control period ``Ts`` (the
+scenario's controller sample time) it sees the state, the guidance references and the tracking
+errors, and returns a command; the actuator (saturation, rate limit, lag), the plant and the
+disturbance advance exactly as in :func:`shipgnc.sim.simulator.simulate` (same
+:func:`~shipgnc.sim.simulator.advance_plant`, same sample timing), so a classical controller used
+as the policy earns the negative of the scenario's own metric.
+
+**Reward** — the per-sample term of the scenario's metric, summed over the samples of the control
+period (the final sample t_end included in the last step):
+
+* ``heading-steps`` (spec 001 §1.10): r = −Σ e_ψ² [rad²]; an episode's return is −N·mse, so
+  ``heading_rmse_deg`` = deg(√(−return / N)) with N the number of samples;
+* ``course-quality`` (document 003, eq. 2): r = −Σ (Δψ² + λ δ²); the return is −J;
+* ``waypoints`` (spec 001 §1.10): r = −Σ e² with e the LOS cross-track error [m], over the samples
+  the metric counts (along-track distance past the capture distance on their own leg).
+
+Each member of the batch has its own random stream (:class:`~shipgnc.sim.streams.MemberStreams`):
+its initial-state offsets (``perturb``) are drawn first, then its disturbance.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+from shipgnc.frames import wrap_angle
+from shipgnc.models.base import names
+from shipgnc.sim.simulator import _validate, advance_plant
+from shipgnc.sim.streams import MemberStreams
+from shipgnc.study.spec import PERTURBABLE, Perturbation
+
+REWARDS = ("heading-steps", "course-quality", "waypoints")
+
+
+class BatchedEpisode:
+    """``batch`` episodes of ``scenario`` stepped together (the batch axis is the member axis)."""
+
+    def __init__(self, scenario, batch: int = 1, perturb=()):
+        from shipgnc.scenarios.registry import load_scenario
+        from shipgnc.scenarios.runner import build
+
+        self.scenario = load_scenario(scenario) if isinstance(scenario, str) else scenario
+        sc = self.scenario
+        if sc.route is not None or sc.vessel.model in ("catamaran", "mariner"):
+            raise ConfigError(f"scenario {sc.name!r}: an environment needs a vessel stepped by the generic "
+                              "loop with guidance (the vectored-thrust boat or CyberShip II)")
+        if sc.metrics not in REWARDS:
+            raise ConfigError(f"scenario {sc.name!r}: metric set {sc.metrics!r} has no per-sample "
+                              f"reward; environments take a scenario whose metrics are one of "
+                              f"{', '.join(REWARDS)}")
+        require(isinstance(batch, (int, np.integer)) and batch >= 1, "num_envs", batch, "must be >= 1")
+        self.perturb = tuple(p if isinstance(p, Perturbation) else Perturbation.parse(p) for p in perturb)
+        setup = build(sc)
+        if setup.guidance is None:
+            raise ConfigError(f"scenario {sc.name!r}: no guidance, so no reference to reward tracking")
+        self.batch = int(batch)
+        self.model, self.actuator, self.guidance = setup.model, setup.actuator, setup.guidance
+        self.disturbance = setup.disturbance
+        cfg = next(iter(sc.variants.values()))
+        x0 = np.tile(np.asarray(setup.x0, dtype=float), (self.batch, 1))
+        sim = sc.simulation
+        self.sim = _validate(self.model, x0, t_end=sim.t_end, dt=sim.dt, controller=None,
+                             actuator=self.actuator, guidance=None, disturbance=self.disturbance,
+                             u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
+                             atol=sim.atol, seed=None, on_divergence="stop", observer=None,
+                             progress=None, log_every=1)
+        self.hold = max(1, round(float(getattr(cfg, "Ts", sim.dt)) / sim.dt))
+        self.dt = sim.dt
+        self.n_steps = self.sim.n_steps
+        self.lam = float(sc.quality.lam) if sc.metrics == "course-quality" else 0.0
+        state_names = names(self.model.states)
+        for p in self.perturb:
+            state, _ = PERTURBABLE[p.field]
+            if state not in state_names:
+                raise ConfigError(f"perturb {p.field}: this vessel has no state {state!r}")
+        self._angle = np.array([s.angle for s in self.model.states], dtype=bool)
+        self._ref_angle = np.array([s.angle for s in self.guidance.references], dtype=bool)
+        self._tracked = [(state_names.index(s.tracks), i, s.angle)
+                         for i, s in enumerate(self.guidance.references) if s.tracks]
+        self._psi_error = next(n for n, (j, _, _) in enumerate(self._tracked) if state_names[j] == "psi")
+        self._i_delta = names(self.model.inputs).index("delta") if self.lam else None
+        lower, upper = self.model.input_limits()
+        self.action_low, self.action_high = np.asarray(lower, float), np.asarray(upper, float)
+        self.observation_names = ([*state_names, *(s.name for s in self.guidance.references),
+                                   *(f"{state_names[j]}_error" for j, _, _ in self._tracked)])
+
+    # -- episode ---------------------------------------------------------------------------
+    def reset(self, seeds) -> np.ndarray:
+        """Start every member's episode; ``seeds``: one generator, ``SeedSequence`` or int per member
+        (a generator is drawn from as it is, so an environment's stream goes on across episodes)."""
+        streams = MemberStreams(seeds)
+        require(len(streams) == self.batch, "seeds", len(streams), f"need {self.batch}")
+        x = self.sim.x0.copy()
+        state_names = names(self.model.states)
+        for i, rng in enumerate(streams.streams):
+            for p in self.perturb:
+                state, scale = PERTURBABLE[p.field]
+                x[i, state_names.index(state)] += scale * p.draw(rng)
+        self.x = x
+        self.t = 0.0
+        self.k = 0
+        self.guidance.reset((self.batch,), self.model)
+        if self.disturbance is not None:
+            self.disturbance.reset((self.batch,), streams)
+        self.command = np.broadcast_to(self.sim.u0, (self.batch, self.actuator.n)).copy()
+        self.applied = self.actuator.initial(self.command)
+        self.lag = self.applied.copy() if self.actuator.has_lag else None
+        self.ref = self.guidance.reference(0.0, self.x)
+        self.done = np.zeros(self.batch, dtype=bool)
+        self.diverged = np.zeros(self.batch, dtype=bool)
+        return self.observation()
+
+    def observation(self) -> np.ndarray:
+        x = np.where(self._angle, wrap_angle(self.x), self.x)
+        ref = np.where(self._ref_angle, wrap_angle(self.ref), self.ref)
+        return np.concatenate([x, ref, self.errors()], axis=-1)
+
+    def errors(self) -> np.ndarray:
+        cols = []
+        for j, i, angle in self._tracked:
+            e = self.x[..., j] - self.ref[..., i]
+            cols.append(wrap_angle(e) if angle else e)
+        return np.stack(cols, axis=-1) if cols else np.zeros((self.batch, 0))
+
+    def sample_cost(self) -> np.ndarray:
+        """The metric's term at the current sample (per member)."""
+        metric = self.scenario.metrics
+        if metric == "waypoints":  # the metric's samples: along-track >= capture distance on their leg
+            out = self.guidance.output_values()
+            captured = out["along_track"] >= self.scenario.guidance.capture_distance
+            return np.where(captured, out["cross_track_error"] ** 2, 0.0)
+        cost = self.errors()[..., self._psi_error] ** 2
+        if metric == "course-quality":
+            cost = cost + self.lam * self.applied_now[..., self._i_delta] ** 2
+        return cost
+
+    def step(self, action: np.ndarray):
+        """Hold ``action`` (shape ``(batch, n_inputs)``) over one control period; returns
+        (observation, reward, terminated, truncated). Members already done stay frozen (reward 0)."""
+        action = np.asarray(action, dtype=float).reshape(self.batch, self.actuator.n)
+        if not np.all(np.isfinite(action)):
+            raise ConfigError(f"action {action.tolist()}: must be finite")
+        self.command = np.where(self.done[:, None], self.command, action)
+        reward = np.zeros(self.batch)
+        live = ~self.done
+        for _ in range(self.hold):
+            plan = self.actuator.begin_step(self.applied, self.command, self.dt)
+            self.applied_now = self.actuator.input_at(plan, 0.0, self.lag)
+            reward -= np.where(live, self.sample_cost(), 0.0)
+            d = (self.disturbance(self.t, self.x) if self.disturbance is not None
+                 and not self.disturbance.per_stage else None)
+            x, lag = advance_plant(self.sim, self.t, self.x, self.lag, plan, self.command, self.ref, d)
+            applied = self.actuator.input_at(plan, 1.0, lag)
+            bad = ~np.all(np.isfinite(x) & (np.abs(x) <= np.asarray(self.model.state_limits)), axis=-1)
+            self.diverged |= bad & live
+            keep = (~live | bad)[:, None]
+            self.x = np.where(keep, self.x, x)
+            self.applied = np.where(keep, self.applied, applied)
+            if lag is not None:
+                self.lag = np.where(keep, self.lag, lag)
+            live = live & ~bad
+            self.k += 1
+            self.t = self.k * self.dt
+            if self.k >= self.n_steps:
+                break
+        truncated = self.k >= self.n_steps
+        if self.k % self.hold == 0:  # a control instant: the guidance's next reference
+            self.ref = self.guidance.reference(self.t, self.x)
+        finished = self.guidance.finished()
+        finished = np.zeros(self.batch, bool) if finished is None else np.asarray(finished, bool)
+        final = live & (finished | truncated)
+        if final.any():  # the loop's last sample (t_end, or the guidance's end) counts too
+            self.applied_now = self.applied
+            reward -= np.where(final, self.sample_cost(), 0.0)
+        terminated = self.done | self.diverged | finished
+        truncated_now = np.full(self.batch, truncated) & ~terminated
+        self.done = terminated | truncated_now
+        return self.observation(), reward, terminated, truncated_now

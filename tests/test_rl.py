@@ -1,0 +1,132 @@
+"""``shipgnc.rl``: gymnasium environments over the scenarios (issue: gymnasium environment).
+
+The reward is the scenario's own metric sample by sample, so the scenario's controller used as the
+policy must earn exactly the metric that ``shipgnc run`` reports; the vectorised env must equal N
+single envs step for step."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import shipgnc.rl  # noqa: F401  (registers the ids)
+from shipgnc.errors import ConfigError
+from shipgnc.rl import ENVIRONMENTS, ShipEnv, ShipVectorEnv
+from shipgnc.scenarios.registry import load_scenario
+from shipgnc.scenarios.runner import build, run_scenario
+
+
+@pytest.mark.parametrize("env_id", ["shipgnc/BoatHeading-v0", "shipgnc/BoatLOS-v0",
+                                    "shipgnc/CyberShipWaves-v0"])
+def test_check_env_passes(env_id):
+    check_env(gym.make(env_id).unwrapped, skip_render_check=True)
+
+
+def test_every_id_is_registered():
+    for env_id in ENVIRONMENTS:
+        assert env_id in gym.registry
+
+
+def test_spaces_come_from_the_model_and_the_actuator():
+    env = gym.make("shipgnc/BoatHeading-v0").unwrapped
+    assert env.observation_names == ["north", "east", "psi", "u", "v", "r", "psi_d", "u_d",
+                                     "psi_error", "u_error"]
+    assert env.action_space.low.tolist() == pytest.approx([0.0, -np.pi / 4])  # spec 001: 0-200 N, ±45°
+    assert env.action_space.high.tolist() == pytest.approx([200.0, np.pi / 4])
+
+
+def _episode_with_controller(env, controller, seed=0):
+    _, info = env.reset(seed=seed)
+    controller.reset((1,))
+    total, done = 0.0, False
+    while not done:
+        u = controller.step(info["t"], info["state"][None], info["reference"][None])[0]
+        _, reward, terminated, truncated, info = env.step(u)
+        total += reward
+        done = terminated or truncated
+    return total, info
+
+
+def test_autopilot_as_policy_earns_the_scenario_heading_rmse():
+    """Return = −Σ e_ψ² over the N samples of the run: heading_rmse_deg = deg √(−return/N)."""
+    scenario = load_scenario("boat-autopilot")
+    run = run_scenario(scenario)
+    env = ShipEnv("boat-autopilot")
+    total, _ = _episode_with_controller(env, build(scenario).controller)
+    n = run.result.sizes["time"]
+    assert np.degrees(np.sqrt(-total / n)) == pytest.approx(run.metrics["heading_rmse_deg"], rel=1e-12)
+
+
+def test_course_pd_as_policy_earns_minus_J():
+    """Document 003's quality index (eq. 2) as the return: −J of the PD autopilot, calm water."""
+    scenario = load_scenario("cybership-calm")
+    run = run_scenario(scenario)
+    env = gym.make("shipgnc/CyberShipCourse-v0").unwrapped
+    total, _ = _episode_with_controller(env, build(scenario, "pd").controller)
+    assert -total == pytest.approx(run.metrics["pd"]["J"], rel=1e-12)
+
+
+def test_los_episode_terminates_at_the_last_waypoint():
+    scenario = load_scenario("boat-los")
+    run = run_scenario(scenario)
+    env = gym.make("shipgnc/BoatLOS-v0").unwrapped
+    total, info = _episode_with_controller(env, build(scenario).controller)
+    assert info["t"] == pytest.approx(run.metrics["completion_time_s"], abs=scenario.simulation.dt)
+    captured = int((run.result.along_track >= scenario.guidance.capture_distance).sum())
+    assert np.sqrt(-total / captured) == pytest.approx(run.metrics["crosstrack_rms_m"], rel=1e-9)
+
+
+def test_vector_env_equals_single_envs_step_for_step():
+    n, seed = 4, 7
+    vec = gym.make_vec("shipgnc/BoatHeading-v0", num_envs=n, vectorization_mode="vector_entry_point")
+    singles = [gym.make("shipgnc/BoatHeading-v0").unwrapped for _ in range(n)]
+    obs_v, _ = vec.reset(seed=seed)
+    obs_s = np.stack([env.reset(seed=seed + i)[0] for i, env in enumerate(singles)])
+    np.testing.assert_array_equal(obs_v, obs_s)
+    assert len(np.unique(obs_v[:, 2])) == n  # each its own initial heading offset
+    rng = np.random.default_rng(0)
+    done = np.zeros(n, bool)
+    for _ in range(60):
+        actions = rng.uniform(vec.single_action_space.low, vec.single_action_space.high, (n, 2))
+        obs_v, r_v, term_v, trunc_v, _ = vec.step(actions)
+        for i, env in enumerate(singles):
+            if done[i]:
+                continue
+            o, r, term, trunc, _ = env.step(actions[i])
+            np.testing.assert_array_equal(obs_v[i], o)
+            assert r_v[i] == r and term_v[i] == term and trunc_v[i] == trunc
+            done[i] = term or trunc
+
+
+def test_vector_env_runs_a_batch_to_the_end():
+    envs = ShipVectorEnv(num_envs=64, scenario="boat-autopilot", perturb=("psi_deg=uniform:-30,30",))
+    envs.reset(seed=3)
+    steps = 0
+    while True:
+        _, reward, terminated, truncated, _ = envs.step(np.tile([100.0, 0.0], (64, 1)))
+        steps += 1
+        if np.all(terminated | truncated):
+            break
+    assert np.all(truncated) and steps == 1400  # 70 s at Ts = 0.05 s
+    assert np.all(reward <= 0)
+
+
+def test_same_seed_same_episode_and_seas_differ_by_seed():
+    env = gym.make("shipgnc/CyberShipWaves-v0").unwrapped
+    action = np.array([env.action_space.high[0], 0.05])
+
+    def roll(seed):
+        env.reset(seed=seed)
+        return np.array([env.step(action)[0] for _ in range(50)])
+
+    np.testing.assert_array_equal(roll(5), roll(5))
+    assert not np.array_equal(roll(5), roll(6))
+
+
+def test_scenarios_without_a_reward_are_refused():
+    with pytest.raises(ConfigError, match="no per-sample reward"):
+        ShipEnv("boat-stern-kick")
+    with pytest.raises(ConfigError, match="needs a vessel"):
+        ShipEnv("mariner-lqr")
