@@ -40,7 +40,8 @@ def local_result():
 
 @pytest.fixture(scope="module")
 def cluster():
-    distributed = pytest.importorskip("dask.distributed")
+    from dask import distributed
+
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cl, distributed.Client(cl) as client:
         yield cl, client
@@ -142,7 +143,6 @@ def test_summary_quantiles_are_those_of_the_members(local_result):
 
 
 def test_large_study_goes_to_zarr(tmp_path, monkeypatch, local_result):
-    pytest.importorskip("zarr")
     monkeypatch.setattr(summary, "ZARR_MIN_BYTES", 0)
     path = summary.save_dataset(local_result, tmp_path)
     assert path.name == "sweep.zarr"

@@ -74,20 +74,20 @@ def _si(name: str) -> float:
 class MarinerParams:
     """Parameters of the de Wit–Oppe model (defaults: the document's Mariner; SI throughout).
 
-    ==========  ================  ==================  =================  =======================
-    field       paper value       paper unit          SI value           SI unit
-    ==========  ================  ==================  =================  =======================
-    a           1.084             1/min               0.018067           1/s
-    b           0.62              min                 37.2               s  (multiplies r³)
-    c           3.553             1/min² (A2)         9.869e-4           1/s²  (δ in rad)
-    r1          −0.0375           nm/rad              −69.45             m/rad
-    r2          0                 nm·min²/rad³        0                  m·s²/rad³
-    f           0.86              1/min               0.014333           1/s
-    W           0.067             nm/rad²             124.08             m/rad²
-    S           0.215             nm/min²             0.11061            m/s²
-    delta_max   35° = 0.6109      rad                 0.6109             rad
-    delta_rate  228°/min (3.8°/s) rad/min             0.06632            rad/s
-    ==========  ================  ==================  =================  =======================
+    ==========  ==================  ==================  =================  =======================
+    field       paper value         paper unit          SI value           SI unit
+    ==========  ==================  ==================  =================  =======================
+    a           1.084               1/min               0.018067           1/s
+    b           0.62                min                 37.2               s  (multiplies r³)
+    c           3.553               1/min² (A2)         9.869e-4           1/s²  (δ in rad)
+    r1          −0.0375             nm/rad              −69.45             m/rad
+    r2          0                   nm·min²/rad³        0                  m·s²/rad³
+    f           0.86                1/min               0.014333           1/s
+    W           0.067               nm/rad²             124.08             m/rad²
+    S           0.215               nm/min²             0.11061            m/s²
+    delta_max   35° = 0.6109        rad                 0.6109             rad
+    delta_rate  228°/min (3.8°/s)   rad/min             0.06632            rad/s
+    ==========  ==================  ==================  =================  =======================
 
     Straight-running speed U = S/f = 0.25 nm/min = 7.7167 m/s (15 kn). The rudder limits feed
     :func:`rudder` and :meth:`MarinerWitOppe.input_limits`; the model itself does not clip δ.

@@ -1,19 +1,20 @@
 """Reinforcement-learning environments (``pip install "shipgnc[rl]"``): shipgnc scenarios as
-``gymnasium`` environments, registered under ``shipgnc/...`` ids when this module is imported.
+``gymnasium`` environments, registered under ``shipgnc/...`` ids when this module is imported::
 
     import gymnasium as gym
     import shipgnc.rl  # registers the ids
 
     env = gym.make("shipgnc/BoatHeading-v0")
-    envs = gym.make_vec("shipgnc/BoatHeading-v0", num_envs=1000, vectorization_mode="vector_entry_point")
+    envs = gym.make_vec("shipgnc/BoatHeading-v0", num_envs=1000,
+                        vectorization_mode="vector_entry_point")
 
-| id | scenario | initial offsets per reset |
-|---|---|---|
-| ``shipgnc/BoatHeading-v0`` | ``boat-autopilot`` (document 001: heading steps) | heading ±30° |
-| ``shipgnc/BoatLOS-v0`` | ``boat-los`` (waypoints with LOS references) | none |
-| ``shipgnc/CyberShipCourse-v0`` | ``cybership-calm`` (document 003, reward −J) | none |
-| ``shipgnc/CyberShipWaves-v0`` | ``cybership-waves`` (seeded sea per episode) | none |
-| ``shipgnc/Ship-v0`` | any: ``gym.make("shipgnc/Ship-v0", scenario=..., perturb=[...])`` | as given |
+Registered ids (scenario; initial offsets drawn at each reset):
+
+* ``shipgnc/BoatHeading-v0``: ``boat-autopilot`` (document 001, heading steps); heading ±30°;
+* ``shipgnc/BoatLOS-v0``: ``boat-los`` (waypoints with LOS references);
+* ``shipgnc/CyberShipCourse-v0``: ``cybership-calm`` (document 003; the return is −J);
+* ``shipgnc/CyberShipWaves-v0``: ``cybership-waves`` (a seeded sea per episode);
+* ``shipgnc/Ship-v0``: any scenario, ``gym.make("shipgnc/Ship-v0", scenario=..., perturb=[...])``.
 """
 
 from __future__ import annotations

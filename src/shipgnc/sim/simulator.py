@@ -119,7 +119,10 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         Both give the same result to round-off; each gives a ship the same result to the bit
         whatever the batch it shares.
 
-    Returns an ``xarray.Dataset`` (see :mod:`shipgnc.sim.result`).
+    Returns
+    -------
+    xarray.Dataset
+        See :mod:`shipgnc.sim.result`.
     """
     setup = _validate(model, x0, t_end=t_end, dt=dt, controller=controller, actuator=actuator,
                       guidance=guidance, disturbance=disturbance, u0=u0, integrator=integrator,
