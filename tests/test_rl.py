@@ -18,6 +18,7 @@ from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build, run_scenario
 
 
+@pytest.mark.filterwarnings("ignore:.*(symmetric and normalized|infinity).*:UserWarning")
 @pytest.mark.parametrize("env_id", ["shipgnc/BoatHeading-v0", "shipgnc/BoatLOS-v0",
                                     "shipgnc/CyberShipWaves-v0"])
 def test_check_env_passes(env_id):
