@@ -36,7 +36,7 @@ def test_site_builds_without_warnings(tmp_path):
         assert (tmp_path / "site" / f"{page}.html").stat().st_size > 5000
 
 
-@pytest.mark.parametrize("blocks", _pages_with_examples())
+@pytest.mark.parametrize("blocks", list(_pages_with_examples()))
 def test_page_examples_run(blocks, tmp_path, monkeypatch):
     """A page's Python blocks run in order in one namespace, as a reader would paste them."""
     monkeypatch.chdir(tmp_path)

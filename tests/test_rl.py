@@ -131,3 +131,23 @@ def test_scenarios_without_a_reward_are_refused():
         ShipEnv("boat-stern-kick")
     with pytest.raises(ConfigError, match="needs a vessel"):
         ShipEnv("mariner-lqr")
+
+
+def test_hold_mode_rudder_earns_the_spec_J():
+    """With the rudder slewed per step (``rudder_rate_mode: hold``) the PD's J is 265.89 (spec 003
+    hold-mode value). The last sample's rudder is the policy's last action held, where the loop
+    asks the controller once more, so the return is −J up to one sample's change of the command:
+    δ² there is ≈ 7e-5 rad² of J ≈ 266, and one sample changes δ by ≈ 0.1 % (δ ≈ −0.0084 rad,
+    slewing ~6e-6 rad per sample), so the gap is ≲ 1e-9 relative; 1e-6 leaves room."""
+    scenario = load_scenario("cybership-calm", ["vessel.rudder_rate_mode=hold"])
+    run = run_scenario(scenario)
+    total, _ = _episode_with_controller(ShipEnv(scenario), build(scenario, "pd").controller)
+    assert -total == pytest.approx(run.metrics["pd"]["J"], rel=1e-6)
+    assert -total == pytest.approx(265.89, abs=0.01)
+
+
+def test_vector_env_refuses_a_batch_coupling_integrator():
+    scenario = load_scenario("boat-autopilot", ["simulation.integrator=solve_ivp"])
+    ShipEnv(scenario)  # one ship: the adaptive integrator is fine
+    with pytest.raises(ConfigError, match="vectorised environment needs 'rk4'"):
+        ShipVectorEnv(num_envs=2, scenario=scenario)

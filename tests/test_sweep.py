@@ -13,9 +13,10 @@ import xarray as xr
 from typer.testing import CliRunner
 
 from shipgnc.cli import app
-from shipgnc.errors import ConfigError
+from shipgnc.errors import ConfigError, ShipGNCWarning
 from shipgnc.study import summary
-from shipgnc.study.execute import run_study
+from shipgnc.study.chunk import plan_chunks, run_chunk
+from shipgnc.study.execute import assemble, run_study
 from shipgnc.study.spec import Perturbation, Study, parse_grid
 
 runner = CliRunner()
@@ -157,6 +158,8 @@ def test_large_study_goes_to_zarr(tmp_path, monkeypatch, local_result):
     (["--grid", "controller.omega=1", "--grid", "controller.omega=2"], "gridded once"),
     (["--perturb", "psi=normal:1"], "FIELD one of"),
     (["--workers", "spark"], "--workers 'spark'"),
+    (["--grid", "simulation.seed=1,2"], "--grid simulation.seed: not in a study"),
+    (["--set", "simulation.backend=numpy"], "--set simulation.backend: not in a study"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, expected, tmp_path):
     res = runner.invoke(app, ["sweep", "boat-autopilot", *args, "--out", str(tmp_path)])
@@ -179,3 +182,111 @@ def test_unsweepable_scenarios_are_refused():
         run_study(Study("zermelo-paper"))
     with pytest.raises(ConfigError, match="own montecarlo section"):
         run_study(Study("mariner-montecarlo"))
+
+
+def test_grid_numbers_in_exponent_notation_are_numbers():
+    """YAML 1.1 reads ``1e-1`` (no dot) as a string; a grid value must be the number."""
+    assert parse_grid("controller.omega=1e-1,2E0,0.5") == ("controller.omega", (0.1, 2.0, 0.5))
+
+
+def test_products_on_the_path_do_not_depend_on_the_batch():
+    """The wave filter's Φx + Ln (spec 000 A11) and the LQR's K·x (document 000 eq. 13) for one
+    member are the same bits alone and in a batch of 300 (a BLAS product is not: its summation
+    order follows the array sizes)."""
+    from shipgnc.control.lqr import PathLQR
+    from shipgnc.environment.filtered_noise import SecondOrderNoise
+    from shipgnc.scenarios.registry import load_scenario
+    from shipgnc.scenarios.runner import build
+    from shipgnc.sim.streams import MemberStreams, member_seeds
+
+    seeds = member_seeds(3, 300)
+    noise = SecondOrderNoise(sigma=0.5, period=8.0, zeta=0.1)
+    times = np.arange(0.0, 30.0, 0.3)
+    batch = noise.sequence(times, (300,), MemberStreams(seeds))
+    for i in (0, 7, 299):
+        alone = noise.sequence(times, (1,), MemberStreams(seeds[i:i + 1]))
+        np.testing.assert_array_equal(batch[:, i], alone[:, 0])
+    setup = build(load_scenario("mariner-lqr"))
+    assert isinstance(setup.controller, PathLQR)
+    x = np.tile(setup.x0, (300, 1)) + np.random.default_rng(0).normal(0.0, 50.0, (300, setup.x0.size))
+    setup.controller.reset((300,))
+    many = setup.controller.step(0.0, x, None)
+    for i in (0, 7, 299):
+        setup.controller.reset((1,))
+        np.testing.assert_array_equal(setup.controller.step(0.0, x[i:i + 1], None)[0], many[i])
+
+
+def test_mariner_with_wave_noise_chunks_to_the_bit():
+    """Document 000's Mariner with narrow-band wave noise: the same members in chunks of 3 and 1."""
+    study = Study("mariner-lqr", members=3, seed=4, overrides=(
+        "simulation.t_end=600", "disturbance.wave_sigma_rad_min2=0.5"),
+        perturb=(Perturbation.parse("psi_deg=normal:10"),))
+    a = run_study(study, chunk_size=3).dataset
+    b = run_study(study, chunk_size=1).dataset
+    xr.testing.assert_identical(a, b)
+    assert len(np.unique(a["final_crosstrack_nm"].values)) == 3
+
+
+def test_route_series_do_not_depend_on_the_chunk():
+    """A member that completes its route early keeps sailing until its batch is done, and the batch
+    ends on a step that depends on its members: each member's series is its log grid (every 7th
+    step) up to its own completion, plus the completion sample, NaN elsewhere, so the time series
+    are the same in chunks of 4 and of 1."""
+    study = Study("boat-los", members=4, seed=1, series=True,
+                  perturb=(Perturbation.parse("east=uniform:-20,0"),),
+                  overrides=("simulation.log_every=7",))
+    a = run_study(study, chunk_size=4).dataset
+    b = run_study(study, chunk_size=1).dataset
+    xr.testing.assert_identical(a, b)
+    done = a["completion_time_s"].values
+    assert np.all(np.isfinite(done)) and len(np.unique(done)) == 4
+    step = np.rint(a.time.values / 0.05).astype(int)
+    for m, t_done in enumerate(done):
+        north = a["series_north"].sel(member=m).values
+        on_grid = (step % 7 == 0) & (a.time.values <= t_done)
+        assert np.all(np.isfinite(north[on_grid])) and np.isfinite(north[a.time.values == t_done]).all()
+        assert np.all(np.isnan(north[a.time.values > t_done]))
+        assert np.all(np.isnan(north[~on_grid & (a.time.values != t_done)]))
+
+
+def test_solve_ivp_is_refused_in_a_study():
+    with pytest.raises(ConfigError, match="needs 'rk4'"):
+        run_study(Study("boat-autopilot", overrides=("simulation.integrator=solve_ivp",)))
+
+
+def test_a_field_the_vessel_lacks_fails_before_any_work():
+    with pytest.raises(ConfigError, match="--perturb v: the MarinerWitOppe has no state 'v'"):
+        run_study(Study("mariner-lqr", perturb=(Perturbation.parse("v=normal:1"),)))
+
+
+def test_an_offset_beyond_the_model_range_names_the_member_on_dask(cluster):
+    """A member pushed past the model's range is a one-line ConfigError, returned by the worker,
+    not a worker traceback retried."""
+    _, client = cluster
+    study = small_study(perturb=(Perturbation.parse("u=uniform:60,70"),))
+    start = time.monotonic()
+    with pytest.raises(ConfigError, match=r"--perturb u: member \d+ starts at u = 6\d.* \|u\| <= 50"):
+        run_study(study, chunk_size=4, client=client)
+    assert time.monotonic() - start < 30
+
+
+def test_chunks_from_different_loops_are_flagged():
+    """A worker without numba runs the numpy loop: the study warns that its members agree to
+    round-off only, and the Dataset says which loops ran."""
+    study = small_study(grid=(), members=4, overrides=("simulation.t_end=15",))  # no noise: compiled
+    chunks = plan_chunks(study, None, 2)
+    parts = [run_chunk(study, c) for c in chunks]
+    assert {p.attrs["backend"] for p in parts} == {"compiled"}
+    parts[1] = run_chunk(study, chunks[1], backend="numpy")
+    with pytest.warns(ShipGNCWarning, match="different loops"):
+        ds = assemble(study, chunks, parts, None)
+    assert ds.attrs["backend"] == "compiled, numpy"
+
+
+def test_a_run_table_in_the_output_directory_is_kept(tmp_path, local_result):
+    from shipgnc.cli_sweep import write_study
+
+    (tmp_path / "table.csv").write_text("a run's comparison\n")
+    write_study(local_result, tmp_path, figures=False)
+    assert (tmp_path / "table.csv").read_text() == "a run's comparison\n"
+    assert (tmp_path / "summary.csv").exists() and (tmp_path / "summary.md").exists()

@@ -13,6 +13,7 @@ Writes ``sweep.nc`` (or ``sweep.zarr`` for a large study with the ``[dist]`` ext
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -40,10 +41,12 @@ def sweep(
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write sweep.png.")] = True,
 ) -> None:
     """Sweep a scenario over a grid of settings and a Monte Carlo of seeded members."""
+    from rich.markup import escape
+
     from shipgnc.cli import friendly_errors, stderr
 
     with friendly_errors():
-        from shipgnc.errors import ConfigError
+        from shipgnc.errors import ConfigError, ShipGNCWarning
         from shipgnc.study.spec import Perturbation, Study, parse_grid
 
         if mc < 1:
@@ -54,7 +57,15 @@ def sweep(
                       perturb=tuple(Perturbation.parse(p) for p in perturb or []),
                       overrides=tuple(set_ or []), series=series)
         out_dir = out if out is not None else Path("runs") / f"sweep-{Path(scenario).stem}"
-        run = _run_with_progress(study, workers, scheduler, chunk_size)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ShipGNCWarning)
+            run = _run_with_progress(study, workers, scheduler, chunk_size)
+        for warning in caught:
+            if issubclass(warning.category, ShipGNCWarning):
+                stderr.print(f"[yellow]warning:[/] {escape(str(warning.message))}", soft_wrap=True)
+            else:
+                warnings.warn_explicit(warning.message, warning.category, warning.filename,
+                                       warning.lineno)
         written = write_study(run.dataset, out_dir, figures=figures)
         _print_summary(run)
         stderr.print(f"{run.chunks} chunks on {run.workers} in {run.seconds:.1f} s; wrote "
@@ -89,8 +100,7 @@ def write_study(ds, out: Path, *, figures: bool = True) -> list[Path]:
     except OSError as exc:
         raise ConfigError(f"--out {str(out)!r}: cannot create the directory ({exc.strerror})") from None
     written = [save_dataset(ds, out)]
-    csv_path, md_path = write_table(summary_rows(ds), out)
-    written += [csv_path.rename(out / "summary.csv"), md_path.rename(out / "summary.md")]
+    written += write_table(summary_rows(ds), out, stem="summary")
     if figures:
         written.append(spread_figure(ds, out / "sweep.png"))
     return written

@@ -33,6 +33,11 @@ class DivergenceError(ShipGNCError, FloatingPointError):
         self.index = index
 
 
+class ShipGNCWarning(UserWarning):
+    """A result that is sound but weaker than asked (e.g. a study whose chunks ran on different
+    loops agrees to round-off, not to the bit); the command line prints it as a one-line warning."""
+
+
 def require(condition: bool, field: str, value: object, rule: str) -> None:
     """Raise :class:`ConfigError` ``"<field> = <value>: <rule>"`` unless ``condition`` holds."""
     if not condition:

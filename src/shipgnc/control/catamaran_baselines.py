@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from shipgnc.batchmath import row_dot
 from shipgnc.control.finite_state import HeadingCapture, as_rate_reference, default_gains
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
@@ -100,7 +101,7 @@ class HeadingLQR:
         psi_ref, r_ref = self.heading_reference(t, x)
         err = np.stack([x[..., V], x[..., R] - r_ref, wrap_angle(x[..., PSI] - psi_ref), x[..., DELTA]], -1)
         self._last = {"psi_ref": psi_ref}
-        return -(err @ self.K)[..., None]
+        return -row_dot(err, self.K)[..., None]
 
     step = law
 

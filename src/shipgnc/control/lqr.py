@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from shipgnc.batchmath import row_dot
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.guidance.path import LegTracker, WaypointPath
@@ -255,7 +256,7 @@ class PathLQR:
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
         xs = self.state(measurement)
         y_r, psi_r = xs[..., 0], xs[..., 1]
-        raw = -(xs @ self.K)
+        raw = -row_dot(xs, self.K)
         delta = np.clip(raw, -self.delta_max, self.delta_max)
         integrate = np.ones(raw.shape, dtype=bool)
         if self.anti_windup:

@@ -23,6 +23,7 @@ import math
 import numpy as np
 import scipy.linalg
 
+from shipgnc.batchmath import matvec
 from shipgnc.errors import require
 
 
@@ -75,7 +76,7 @@ class SecondOrderNoise:
         if self._t is not None and t > self._t:
             phi, L = self.transition(t - self._t)
             n = self._rng.standard_normal(self._x.shape)
-            self._x = self._x @ phi.T + n @ L.T
+            self._x = matvec(phi, self._x) + matvec(L, n)
         self._t = t
         return self._x[..., 1]
 

@@ -14,7 +14,9 @@ Registered ids (scenario; initial offsets drawn at each reset):
 * ``shipgnc/BoatLOS-v0``: ``boat-los`` (waypoints with LOS references);
 * ``shipgnc/CyberShipCourse-v0``: ``cybership-calm`` (document 003; the return is −J);
 * ``shipgnc/CyberShipWaves-v0``: ``cybership-waves`` (a seeded sea per episode);
-* ``shipgnc/Ship-v0``: any scenario, ``gym.make("shipgnc/Ship-v0", scenario=..., perturb=[...])``.
+* ``shipgnc/Ship-v0``: ``gym.make("shipgnc/Ship-v0", scenario=..., perturb=[...])`` for a boat or
+  CyberShip II scenario with guidance and metric set ``heading-steps``, ``waypoints`` or
+  ``course-quality`` (the others have no per-sample reward: ConfigError).
 """
 
 from __future__ import annotations

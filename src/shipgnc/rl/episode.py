@@ -29,6 +29,7 @@ from shipgnc.frames import wrap_angle
 from shipgnc.models.base import names
 from shipgnc.sim.simulator import _validate, advance_plant
 from shipgnc.sim.streams import MemberStreams
+from shipgnc.study.chunk import check_perturbable
 from shipgnc.study.spec import PERTURBABLE, Perturbation
 
 REWARDS = ("heading-steps", "course-quality", "waypoints")
@@ -51,6 +52,10 @@ class BatchedEpisode:
                               f"reward; environments take a scenario whose metrics are one of "
                               f"{', '.join(REWARDS)}")
         require(isinstance(batch, (int, np.integer)) and batch >= 1, "num_envs", batch, "must be >= 1")
+        if batch > 1 and sc.simulation.integrator != "rk4":
+            raise ConfigError(f"simulation.integrator = {sc.simulation.integrator!r}: a vectorised "
+                              "environment needs 'rk4' (solve_ivp picks one step size for the whole "
+                              "batch, so the members would not step as single environments)")
         self.perturb = tuple(p if isinstance(p, Perturbation) else Perturbation.parse(p) for p in perturb)
         setup = build(sc)
         if setup.guidance is None:
@@ -71,10 +76,7 @@ class BatchedEpisode:
         self.n_steps = self.sim.n_steps
         self.lam = float(sc.quality.lam) if sc.metrics == "course-quality" else 0.0
         state_names = names(self.model.states)
-        for p in self.perturb:
-            state, _ = PERTURBABLE[p.field]
-            if state not in state_names:
-                raise ConfigError(f"perturb {p.field}: this vessel has no state {state!r}")
+        check_perturbable(self.perturb, self.model, flag="perturb")
         self._angle = np.array([s.angle for s in self.model.states], dtype=bool)
         self._ref_angle = np.array([s.angle for s in self.guidance.references], dtype=bool)
         self._tracked = [(state_names.index(s.tracks), i, s.angle)
@@ -171,8 +173,10 @@ class BatchedEpisode:
         finished = self.guidance.finished()
         finished = np.zeros(self.batch, bool) if finished is None else np.asarray(finished, bool)
         final = live & (finished | truncated)
-        if final.any():  # the loop's last sample (t_end, or the guidance's end) counts too
-            self.applied_now = self.applied
+        if final.any():  # the loop's last sample (t_end, or the guidance's end) counts too,
+            # with the input the loop logs there: the held command's plan at its start
+            plan = self.actuator.begin_step(self.applied, self.command, self.dt)
+            self.applied_now = self.actuator.input_at(plan, 0.0, self.lag)
             reward -= np.where(final, self.sample_cost(), 0.0)
         terminated = self.done | self.diverged | finished
         truncated_now = np.full(self.batch, truncated) & ~terminated

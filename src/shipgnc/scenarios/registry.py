@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from importlib import resources
 from pathlib import Path
 
@@ -11,6 +12,8 @@ from shipgnc.errors import ConfigError
 from shipgnc.scenarios.schema import Scenario, validate
 
 BUILTIN_PACKAGE = "shipgnc.scenarios.builtin"
+#: a decimal number, exponent allowed (YAML 1.1 leaves ``1e-1`` a string)
+NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
 
 def _builtin_files() -> dict[str, object]:
@@ -82,6 +85,8 @@ def parse_override(item: str) -> tuple[str, object]:
         value = yaml.safe_load(text)
     except yaml.YAMLError:
         value = text
+    if isinstance(value, str) and NUMBER.fullmatch(value.strip()):
+        value = float(value)  # YAML 1.1 reads 1e-1 (no dot) as a string
     return key, value
 
 

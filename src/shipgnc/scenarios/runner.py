@@ -432,12 +432,12 @@ def comparison_table(run: ScenarioRun) -> list[dict]:
     return rows
 
 
-def write_table(rows: list[dict], out: Path) -> list[Path]:
-    """``table.csv`` and ``table.md`` of the comparison rows."""
+def write_table(rows: list[dict], out: Path, stem: str = "table") -> list[Path]:
+    """``<stem>.csv`` and ``<stem>.md`` of the rows (default ``table``: a run's comparison)."""
     import csv
 
     columns = list(dict.fromkeys(k for row in rows for k in row))
-    csv_path, md_path = out / "table.csv", out / "table.md"
+    csv_path, md_path = out / f"{stem}.csv", out / f"{stem}.md"
     with csv_path.open("w", newline="", encoding="utf-8") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns)
         writer.writeheader()

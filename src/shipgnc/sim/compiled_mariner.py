@@ -39,7 +39,6 @@ whose zero dynamics amplify any round-off by e^{t/9 s}):
 * sin ψ, cos ψ of the RK4 stages from one libm call per step (angle addition,
   :func:`~shipgnc.sim.compiled._sin_cos_shifted`);
 * r³ = r·r·r (numpy's ``r**3`` calls ``pow``: within an ulp);
-* PathLQR's K·x summed left to right (numpy's ``@`` leaves the order to BLAS);
 * the legs' cos, sin (path frame, current) are computed once per run by numpy, not per sample;
 * LLVM may fuse multiply-adds and turn x/c into x·(1/c) (``fastmath={"contract", "arcp"}``);
   a fused product does not overflow by itself, so where numpy forms inf − inf = NaN from two

@@ -116,8 +116,9 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         batch has ≥ :data:`COMPILED_MIN_BATCH` ships or the run ≥ :data:`COMPILED_MIN_WORK`
         ship-steps, else this loop, or ``"compiled-or-numpy"``: a twin whenever one covers the
         setup, whatever the batch size (a study's chunks of any size then take the same path).
-        Both give the same result to round-off; each gives a ship the same result to the bit
-        whatever the batch it shares.
+        Both give the same result to round-off; with ``"rk4"`` each gives a ship the same result
+        to the bit whatever the batch it shares (``"solve_ivp"`` controls one step size for the
+        whole batch, so there the batch's other ships move the steps).
 
     Returns
     -------
@@ -130,14 +131,14 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
                       on_divergence=on_divergence, observer=observer, progress=progress,
                       log_every=log_every)
     require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
-    log = None
+    log, ran_on = None, "numpy"
     n_ships = math.prod(setup.batch_shape)
     wants_compiled = backend in ("compiled", "compiled-or-numpy") or (backend == "auto" and (
         n_ships >= COMPILED_MIN_BATCH or n_ships * setup.n_steps >= COMPILED_MIN_WORK))
     if wants_compiled:
         twin, reasons = _compiled_twin(setup)
         if twin is not None:
-            log = twin.run(setup)
+            log, ran_on = twin.run(setup), twin.__name__.rsplit(".", 1)[-1]
         elif backend == "compiled":
             raise ConfigError(f"backend = 'compiled': no compiled loop covers this run "
                               f"({'; '.join(reasons)}); use backend='numpy'")
@@ -145,7 +146,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         log = run_numpy(setup)
     from shipgnc.sim.result import build_dataset
 
-    run_attrs = {"integrator": integrator, "dt": dt, "Ts": dt * setup.hold, "t_end": t_end,
+    run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold, "t_end": t_end,
                  "model": type(model).__name__, **(attrs or {})}
     return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
 

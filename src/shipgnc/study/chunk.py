@@ -48,7 +48,8 @@ def plan_chunks(study: Study, variants: list[str] | None, chunk_size: int) -> li
 
 
 def check_sweepable(scenario) -> None:
-    """Refuse the scenarios whose runs do not go through the generic loop of one batch."""
+    """Refuse the scenarios whose runs do not go through the generic loop of one batch, and the
+    integrator whose result depends on the batch."""
     if scenario.route is not None:
         raise ConfigError(f"scenario {scenario.name!r} is a routing problem (document 002): "
                           "sweep a simulation scenario")
@@ -58,22 +59,42 @@ def check_sweepable(scenario) -> None:
     if scenario.montecarlo is not None:
         raise ConfigError(f"scenario {scenario.name!r} has its own montecarlo section; sweep the "
                           "single-run scenario with --mc and --perturb instead")
+    if scenario.simulation.integrator != "rk4":
+        raise ConfigError(f"simulation.integrator = {scenario.simulation.integrator!r}: a study needs "
+                          "'rk4' (solve_ivp picks one step size for the whole batch, so a member's "
+                          "result would depend on the chunk it shares)")
+
+
+def check_perturbable(perturb, model, flag: str = "--perturb") -> None:
+    """Every perturbed field must be a state of ``model``."""
+    state_names = names(model.states)
+    for p in perturb:
+        state, _ = PERTURBABLE[p.field]
+        if state not in state_names:
+            raise ConfigError(f"{flag} {p.field}: the {type(model).__name__} has no state "
+                              f"{state!r} (states: {', '.join(state_names)})")
 
 
 def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> np.ndarray:
-    """x0 of each member of the chunk: the scenario's x0 plus the member's own offsets."""
+    """x0 of each member of the chunk: the scenario's x0 plus the member's own offsets; a member
+    pushed beyond the model's state range is a ConfigError naming the member and the field."""
     state_names = names(model.states)
     batch = np.tile(np.asarray(x0, dtype=float), (chunk.size, 1))
-    for p in study.perturb:
-        state, scale = PERTURBABLE[p.field]
-        if state not in state_names:
-            raise ConfigError(f"--perturb {p.field}: this vessel has no state {state!r} "
-                              f"(states: {', '.join(state_names)})")
     for row, member in enumerate(range(chunk.start, chunk.stop)):
         rng = np.random.default_rng(study.member_streams(member)[0])
         for p in study.perturb:
             state, scale = PERTURBABLE[p.field]
             batch[row, state_names.index(state)] += scale * p.draw(rng)
+    limits = np.asarray(model.state_limits, dtype=float)
+    outside = np.argwhere(np.abs(batch) > limits)
+    if outside.size:
+        row, i = (int(v) for v in outside[0])
+        s = model.states[i]
+        field = next((p.field for p in study.perturb if PERTURBABLE[p.field][0] == s.name),
+                     f"initial_state.{s.name}")
+        raise ConfigError(f"--perturb {field}: member {chunk.start + row} starts at {s.name} = "
+                          f"{batch[row, i]:g} {s.unit}, beyond the model's range |{s.name}| <= "
+                          f"{limits[i]:g} {s.unit}; narrow the distribution")
     return batch
 
 
@@ -90,24 +111,59 @@ def numeric_metrics(metrics: dict) -> dict[str, float]:
     return out
 
 
-def _simulate(setup, scenario, x0, streams, backend: str):
+def _simulate(setup, scenario, x0, streams, backend: str, log_every: int):
     from shipgnc.sim.simulator import simulate
 
     sim = scenario.simulation
     return simulate(setup.model, x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
                     actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
                     u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
-                    atol=sim.atol, seed=streams, log_every=sim.log_every, backend=backend,
+                    atol=sim.atol, seed=streams, log_every=log_every, backend=backend,
                     on_divergence="stop", batch_dims=("member",))
+
+
+def ends_early(setup) -> bool:
+    """Whether the guidance can finish (a route's last waypoint), which ends a batch early."""
+    if setup.guidance is None:
+        return False
+    setup.guidance.reset((1,), setup.model)
+    return setup.guidance.finished() is not None
+
+
+def on_log_grid(times, scenario) -> np.ndarray:
+    """Which ``times`` are on the scenario's log grid (step k with k % log_every == 0, or the last)."""
+    sim = scenario.simulation
+    k = np.rint(np.asarray(times) / sim.dt).astype(np.int64)
+    return (k % sim.log_every == 0) | (k == round(sim.t_end / sim.dt))
+
+
+def route_series(series, scenario, done_at: np.ndarray):
+    """Each member's series on the log grid up to its own completion ``done_at`` (NaN: never),
+    plus its completion sample; NaN elsewhere. Times no member keeps are dropped."""
+    import xarray as xr
+
+    t = series.time.values
+    grid = on_log_grid(t, scenario)[:, None]
+    limit = np.nan_to_num(done_at, nan=np.inf)[None, :]
+    keep = (grid | (t[:, None] == limit)) & (t[:, None] <= limit)
+    mask = xr.DataArray(keep, dims=("time", "member"), coords={"time": series.time,
+                                                                "member": series.member})
+    return series.where(mask).isel(time=np.flatnonzero(keep.any(axis=1)))
 
 
 def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """Run one chunk; an ``xarray.Dataset`` with a ``member`` dimension: every scalar metric, and
-    with ``study.series`` every time series.
+    with ``study.series`` every time series; ``attrs["backend"]`` says which loop ran it.
 
     The batch runs in one call of the loop. If a member diverges (which stops a batch), the chunk
     is run again member by member, so that every member's figures are its own run's whatever
     chunk it shares (a diverged member is flagged ``diverged = 1`` with its figures up to then).
+
+    A route (guidance that finishes) ends a batch when its last member completes; the others keep
+    sailing until then. So a member's series are NaN after its own completion
+    (``completion_time_s``), and such a batch is logged at every step (its metrics are computed
+    on every step, its series thinned to the log grid plus each member's completion sample), as
+    the step a batch ends on depends on the batch.
     """
     import xarray as xr
 
@@ -118,21 +174,27 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     setup = build(scenario, chunk.variant, seed=study.seed)
     x0 = member_initial_states(study, setup.x0, setup.model, chunk)
     seeds = [study.member_streams(m)[1] for m in range(chunk.start, chunk.stop)]
-    result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend)
+    log_every = 1 if ends_early(setup) else scenario.simulation.log_every
+    result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend, log_every)
     if result.attrs.get("diverged", 0):
-        singles = [_simulate(setup, scenario, x0[i:i + 1], MemberStreams(seeds[i:i + 1]), backend)
-                   for i in range(chunk.size)]
-        members = [r.isel(member=0) for r in singles]
+        runs = [_simulate(setup, scenario, x0[i:i + 1], MemberStreams(seeds[i:i + 1]), backend,
+                          log_every) for i in range(chunk.size)]
+        ran_on = {r.attrs.get("backend") for r in runs}
+        members = [r.isel(member=0) for r in runs]
+        result = xr.concat(runs, dim="member", join="outer")
     else:
+        ran_on = {result.attrs.get("backend")}
         members = [result.isel(member=i) for i in range(chunk.size)]
     rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
     keys = list(dict.fromkeys(k for row in rows for k in row))
     data = {k: ("member", np.array([row.get(k, math.nan) for row in rows])) for k in keys}
-    out = xr.Dataset(data, coords={"member": np.arange(chunk.start, chunk.stop)})
+    out = xr.Dataset(data, coords={"member": np.arange(chunk.start, chunk.stop)},
+                     attrs={"backend": ", ".join(sorted(str(b) for b in ran_on))})
     if study.series:
-        series = result if not result.attrs.get("diverged", 0) else xr.concat(
-            singles, dim="member", join="outer")
-        series = series.assign_coords(member=np.arange(chunk.start, chunk.stop))
+        series = result.assign_coords(member=np.arange(chunk.start, chunk.stop))
         series.attrs = {}
-        out = xr.merge([out, series.rename({k: f"series_{k}" for k in series.data_vars})])
+        if "completion_time_s" in out:
+            series = route_series(series, scenario, out.completion_time_s.values)
+        out = xr.merge([out, series.rename({k: f"series_{k}" for k in series.data_vars})],
+                       combine_attrs="override")
     return out

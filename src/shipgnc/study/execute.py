@@ -9,14 +9,16 @@ a lost worker costs time, not members.
 
 from __future__ import annotations
 
+import logging
 import os
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from shipgnc.errors import ConfigError
-from shipgnc.study.chunk import Chunk, check_sweepable, plan_chunks, run_chunk
+from shipgnc.errors import ConfigError, ShipGNCWarning
+from shipgnc.study.chunk import Chunk, check_perturbable, check_sweepable, plan_chunks, run_chunk
 from shipgnc.study.spec import Study
 
 WORKERS = ("local", "dask")
@@ -40,11 +42,15 @@ class StudyRun:
 
 def variants_of(study: Study) -> list[str] | None:
     """The controller variants (a ``controller`` dimension) of a comparison scenario, else None;
-    every grid point is loaded here, so a bad grid key or value fails before any work starts."""
+    every grid point is loaded here, so a bad grid key or value, an unsweepable scenario or a
+    ``--perturb`` field the vessel does not have fails before any work starts."""
+    from shipgnc.scenarios.runner import VESSELS
+
     variants = None
     for point in study.points:
         scenario = study.scenario_at(point)
         check_sweepable(scenario)
+        check_perturbable(study.perturb, VESSELS[scenario.vessel.model](scenario)[0])
         if scenario.controllers is not None:
             names = list(scenario.controllers)
             if variants is not None and names != variants:
@@ -67,7 +73,7 @@ def connect(scheduler: str | None, workers: str):
             raise ConfigError(f"--scheduler {scheduler!r}: cannot reach a dask scheduler within "
                               f"{CONNECT_TIMEOUT_S} s ({reason})") from None
     cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                           dashboard_address=None)
+                           dashboard_address=None, silence_logs=logging.ERROR)
     return Client(cluster)
 
 
@@ -84,14 +90,28 @@ def run_chunks(study: Study, chunks: list[Chunk], *, client=None,
         return out
     from dask.distributed import as_completed
 
-    futures = [client.submit(run_chunk, study, chunk, pure=False, retries=1) for chunk in chunks]
+    futures = [client.submit(chunk_task, study, chunk, pure=False) for chunk in chunks]
     index = {f.key: i for i, f in enumerate(futures)}
     results: list = [None] * total
     for done, future in enumerate(as_completed(futures), start=1):
-        results[index[future.key]] = future.result()
+        part = future.result()
+        if isinstance(part, ConfigError):
+            client.cancel(futures)
+            raise part
+        results[index[future.key]] = part
         if on_chunk is not None:
             on_chunk(done, total)
     return results
+
+
+def chunk_task(study: Study, chunk: Chunk):
+    """A chunk on a dask worker: its Dataset, or the ConfigError it met *returned*, so that bad
+    input ends the study with its one-line message instead of a worker traceback and retries
+    (a worker that dies is another matter: dask reschedules its chunks)."""
+    try:
+        return run_chunk(study, chunk)
+    except ConfigError as exc:
+        return exc
 
 
 def assemble(study: Study, chunks: list[Chunk], parts: list, variants: list[str] | None):
@@ -102,6 +122,11 @@ def assemble(study: Study, chunks: list[Chunk], parts: list, variants: list[str]
     for chunk, part in zip(chunks, parts, strict=True):
         by_cell.setdefault((chunk.point, chunk.variant), []).append(part)
     cells = {key: xr.concat(ps, dim="member", join="outer") for key, ps in by_cell.items()}
+    backends = sorted({b for part in parts for b in part.attrs.get("backend", "").split(", ") if b})
+    if len(backends) > 1:
+        warnings.warn(f"the study's chunks ran on different loops ({', '.join(backends)}; a worker "
+                      "without numba runs the numpy loop): members agree to round-off, not to the "
+                      "bit; install shipgnc's numba on every worker", ShipGNCWarning, stacklevel=2)
     points = []
     for p in range(len(study.points)):
         if variants is None:
@@ -122,7 +147,7 @@ def assemble(study: Study, chunks: list[Chunk], parts: list, variants: list[str]
     ds.attrs = {"scenario": study.scenario, "seed": int(study.seed), "members": int(study.members),
                 "grid": "; ".join(f"{k}={','.join(map(str, v))}" for k, v in study.grid),
                 "perturb": "; ".join(str(p) for p in study.perturb),
-                "overrides": "; ".join(study.overrides),
+                "overrides": "; ".join(study.overrides), "backend": ", ".join(backends),
                 "streams": "member i: SeedSequence(seed).spawn(members)[i] (offsets, disturbances)"}
     return ds
 

@@ -27,6 +27,13 @@ from shipgnc.units import deg
 PERTURBABLE = {"north": ("north", 1.0), "east": ("east", 1.0), "psi_deg": ("psi", deg(1.0)),
                "u": ("u", 1.0), "v": ("v", 1.0), "r_deg_s": ("r", deg(1.0))}
 DISTRIBUTIONS = ("normal", "uniform")
+#: scenario fields a study sets itself, which --grid and --set may not
+STUDY_OWNED = {
+    "simulation.seed": "member i's random streams come from --seed "
+                       "(SeedSequence(seed).spawn(members)[i]); give --seed instead",
+    "simulation.backend": "a study runs every chunk on the compiled loop where one covers the "
+                          "setup, else on numpy, so that chunks agree to the bit",
+}
 
 
 @dataclass(frozen=True)
@@ -121,6 +128,10 @@ class Study:
         require(not repeated, "--grid", ", ".join(repeated), "each key may be gridded once")
         for key, values in self.grid:
             require(len(values) >= 1, f"--grid {key}", "[]", "needs at least one value")
+        for flag, key in [*(("--grid", k) for k in keys),
+                          *(("--set", o.partition("=")[0].strip()) for o in self.overrides)]:
+            if key in STUDY_OWNED:
+                raise ConfigError(f"{flag} {key}: not in a study: {STUDY_OWNED[key]}")
         fields = [p.field for p in self.perturb]
         require(len(set(fields)) == len(fields), "--perturb", ", ".join(fields),
                 "each field may be perturbed once")

@@ -1,0 +1,28 @@
+"""Per-member linear algebra whose bits do not depend on the batch around the member.
+
+``x @ M`` on a batch hands the sum to BLAS, which picks its blocking (and so the order of the
+additions) from the array sizes: the same ship can come out a last bit different in a batch of 3
+and in a batch of 1000. A study must give each member the same result however it is chunked
+(issue 8), so the small products on the simulation path are written here as sums in a fixed
+left-to-right order, elementwise over the batch.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def row_dot(x, weights) -> np.ndarray:
+    """Σ_j x[..., j]·w[j], summed left to right: ``x @ w`` for a weight vector, shape ``x.shape[:-1]``."""
+    x = np.asarray(x, dtype=float)
+    w = np.asarray(weights, dtype=float)
+    total = x[..., 0] * w[0]
+    for j in range(1, w.shape[0]):
+        total = total + x[..., j] * w[j]
+    return total
+
+
+def matvec(matrix, x) -> np.ndarray:
+    """(M x) for every member: ``x @ M.T`` with a fixed summation order, shape ``x.shape``."""
+    M = np.asarray(matrix, dtype=float)
+    return np.stack([row_dot(x, M[i]) for i in range(M.shape[0])], axis=-1)
