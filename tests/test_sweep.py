@@ -116,6 +116,7 @@ def test_waves_are_drawn_per_member():
     a = run_study(study, chunk_size=3).dataset
     b = run_study(study, chunk_size=1).dataset
     xr.testing.assert_identical(a, b)
+    assert a.attrs["backend"] == "numpy+wave_kernel"  # the loop, and the wave loads' compiled kernel
     assert a["J"].dims == ("controller", "member")
     assert len(np.unique(a["J"].sel(controller="pd").values)) == 3
 
@@ -159,6 +160,7 @@ def test_large_study_goes_to_zarr(tmp_path, monkeypatch, local_result):
     (["--perturb", "psi=normal:1"], "FIELD one of"),
     (["--workers", "spark"], "--workers 'spark'"),
     (["--grid", "simulation.seed=1,2"], "--grid simulation.seed: not in a study"),
+    (["--set", "simulation={seed: 2}"], "SeedSequence(seed).spawn(members)[i]); give --seed"),
     (["--set", "simulation.backend=numpy"], "--set simulation.backend: not in a study"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, expected, tmp_path):
@@ -187,6 +189,7 @@ def test_unsweepable_scenarios_are_refused():
 def test_grid_numbers_in_exponent_notation_are_numbers():
     """YAML 1.1 reads ``1e-1`` (no dot) as a string; a grid value must be the number."""
     assert parse_grid("controller.omega=1e-1,2E0,0.5") == ("controller.omega", (0.1, 2.0, 0.5))
+    assert parse_grid("vessel.preset='1e5'") == ("vessel.preset", ("1e5",))  # quoted: a name
 
 
 def test_products_on_the_path_do_not_depend_on_the_batch():
@@ -247,6 +250,12 @@ def test_route_series_do_not_depend_on_the_chunk():
         assert np.all(np.isfinite(north[on_grid])) and np.isfinite(north[a.time.values == t_done]).all()
         assert np.all(np.isnan(north[a.time.values > t_done]))
         assert np.all(np.isnan(north[~on_grid & (a.time.values != t_done)]))
+    # the same without the route's metrics (no completion_time_s): the guidance's completion times
+    unscored = Study(study.scenario, members=4, seed=1, series=True, perturb=study.perturb,
+                     overrides=(*study.overrides, "metrics=none"))
+    c = run_study(unscored, chunk_size=4).dataset
+    xr.testing.assert_identical(c, run_study(unscored, chunk_size=1).dataset)
+    xr.testing.assert_identical(c["series_north"], a["series_north"])
 
 
 def test_solve_ivp_is_refused_in_a_study():
@@ -260,14 +269,29 @@ def test_a_field_the_vessel_lacks_fails_before_any_work():
 
 
 def test_an_offset_beyond_the_model_range_names_the_member_on_dask(cluster):
-    """A member pushed past the model's range is a one-line ConfigError, returned by the worker,
-    not a worker traceback retried."""
+    """A member a normal offset pushes past the model's range (|u| <= 50 m/s for the boat) is a
+    one-line ConfigError, returned by the worker, not a worker traceback retried."""
     _, client = cluster
-    study = small_study(perturb=(Perturbation.parse("u=uniform:60,70"),))
+    study = small_study(perturb=(Perturbation.parse("u=normal:200"),))
     start = time.monotonic()
-    with pytest.raises(ConfigError, match=r"--perturb u: member \d+ starts at u = 6\d.* \|u\| <= 50"):
+    with pytest.raises(ConfigError, match=r"--perturb u=normal:200: member \d+ would start at "
+                                          r"u = -?\d.* m/s, beyond the model's range \|u\| <= 50 m/s"):
         run_study(study, chunk_size=4, client=client)
     assert time.monotonic() - start < 30
+
+
+@pytest.mark.parametrize("rule, expected", [
+    ("u=uniform:60,70", r"u = 60 m/s, beyond the model's range \|u\| <= 50 m/s"),
+    ("r_deg_s=uniform:0,3000", r"r_deg_s = 3000 deg/s, beyond the model's range \|r_deg_s\| <= 2864.79 deg/s"),
+])
+def test_a_uniform_offset_beyond_the_range_is_refused_before_any_work(rule, expected):
+    with pytest.raises(ConfigError, match=f"--perturb {rule}: members would start at {expected}"):
+        run_study(small_study(perturb=(Perturbation.parse(rule),)))
+
+
+def test_study_owned_fields_are_refused_inside_a_mapping_too():
+    with pytest.raises(ConfigError, match=r"--set simulation\.seed: not in a study"):
+        Study("boat-autopilot", overrides=("simulation={dt: 0.05, seed: 3}",))
 
 
 def test_chunks_from_different_loops_are_flagged():

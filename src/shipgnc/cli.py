@@ -56,7 +56,10 @@ def friendly_errors():
 
 
 def _one_line(exc: BaseException) -> str:
-    return " ".join(str(exc).split())
+    """The message on one line, rich markup escaped (``spawn(n)[i]`` is text, not a style)."""
+    from rich.markup import escape
+
+    return escape(" ".join(str(exc).split()))
 
 
 def _version(value: bool) -> None:

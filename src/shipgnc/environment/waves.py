@@ -826,6 +826,13 @@ class FroudeKrylovWaveLoads:
                                 self.spreading is None)
         return out.reshape(*self._batch, 3)
 
+    def evaluator(self) -> str:
+        """Which code evaluates the loads: ``"wave_kernel"`` (numba) or ``"numpy"``; they agree to
+        round-off, not to the bit, so a run records it (``attrs["backend"]``)."""
+        from shipgnc.environment import wave_kernel
+
+        return "numpy" if self.backend == "numpy" or not wave_kernel.available() else "wave_kernel"
+
     def _compiled_ok(self) -> bool:
         if self._flat is None:
             from shipgnc.environment import wave_kernel

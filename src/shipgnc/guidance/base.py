@@ -3,7 +3,9 @@
 ``references`` are the signals handed to the controller; one with ``tracks="<state>"`` makes the
 simulator log ``<state>_error`` (wrapped when the signal is an angle). ``outputs`` are extra
 signals logged each sample (cross-track error, leg index, ...). ``finished()`` returns, per ship,
-whether the task is complete; the run stops when every ship is done.
+whether the task is complete; the run stops when every ship is done. A guidance that can finish
+also keeps ``completion_time`` (per ship, the sample time it finished, NaN before), which a study
+needs to end each member's series at its own completion.
 """
 
 from __future__ import annotations

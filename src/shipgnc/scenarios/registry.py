@@ -85,8 +85,8 @@ def parse_override(item: str) -> tuple[str, object]:
         value = yaml.safe_load(text)
     except yaml.YAMLError:
         value = text
-    if isinstance(value, str) and NUMBER.fullmatch(value.strip()):
-        value = float(value)  # YAML 1.1 reads 1e-1 (no dot) as a string
+    if isinstance(value, str) and NUMBER.fullmatch(text.strip()):
+        value = float(value)  # YAML 1.1 reads 1e-1 (no dot) as a string; "1e-1" stays one
     return key, value
 
 

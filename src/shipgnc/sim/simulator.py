@@ -123,7 +123,9 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     Returns
     -------
     xarray.Dataset
-        See :mod:`shipgnc.sim.result`.
+        See :mod:`shipgnc.sim.result`; ``attrs["backend"]`` names the loop that ran (``numpy``,
+        ``compiled``, ``compiled_mariner``), with ``+wave_kernel`` / ``+numpy`` when a disturbance
+        has a compiled twin of its own (the wave loads of document 003).
     """
     setup = _validate(model, x0, t_end=t_end, dt=dt, controller=controller, actuator=actuator,
                       guidance=guidance, disturbance=disturbance, u0=u0, integrator=integrator,
@@ -146,8 +148,11 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         log = run_numpy(setup)
     from shipgnc.sim.result import build_dataset
 
-    run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold, "t_end": t_end,
-                 "model": type(model).__name__, **(attrs or {})}
+    evaluator = getattr(disturbance, "evaluator", None)  # a disturbance with a compiled twin
+    if evaluator is not None:
+        ran_on = f"{ran_on}+{evaluator()}"
+    run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold,
+                 "t_end": t_end, "model": type(model).__name__, **(attrs or {})}
     return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
 
 

@@ -17,7 +17,7 @@ import numpy as np
 from shipgnc.errors import ConfigError
 from shipgnc.models.base import names
 from shipgnc.sim.streams import MemberStreams
-from shipgnc.study.spec import PERTURBABLE, Study
+from shipgnc.study.spec import PERTURB_UNITS, PERTURBABLE, Study
 
 
 @dataclass(frozen=True)
@@ -65,14 +65,30 @@ def check_sweepable(scenario) -> None:
                           "result would depend on the chunk it shares)")
 
 
-def check_perturbable(perturb, model, flag: str = "--perturb") -> None:
-    """Every perturbed field must be a state of ``model``."""
+def check_perturbable(perturb, model, x0=None, flag: str = "--perturb") -> None:
+    """Every perturbed field must be a state of ``model``; with the scenario's ``x0``, a uniform
+    offset must keep every member inside the model's state range (checked before any work)."""
     state_names = names(model.states)
+    limits = np.asarray(model.state_limits, dtype=float)
     for p in perturb:
-        state, _ = PERTURBABLE[p.field]
+        state, scale = PERTURBABLE[p.field]
         if state not in state_names:
             raise ConfigError(f"{flag} {p.field}: the {type(model).__name__} has no state "
                               f"{state!r} (states: {', '.join(state_names)})")
+        if x0 is not None and p.kind == "uniform":
+            i = state_names.index(state)
+            for bound in (p.low, p.high):
+                _check_range(f"{flag} {p}", "members", p.field, float(x0[i]) + scale * bound,
+                             limits[i], scale)
+
+
+def _check_range(what: str, who: str, field: str, value: float, limit: float, scale: float) -> None:
+    """A start ``value`` [SI] beyond ``limit`` is a ConfigError in the field's own unit."""
+    if abs(value) > limit:
+        unit = PERTURB_UNITS[field]
+        raise ConfigError(f"{what}: {who} would start at {field} = {value / scale:g} {unit}, beyond "
+                          f"the model's range |{field}| <= {limit / scale:g} {unit}; narrow the "
+                          "distribution")
 
 
 def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> np.ndarray:
@@ -86,15 +102,14 @@ def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> 
             state, scale = PERTURBABLE[p.field]
             batch[row, state_names.index(state)] += scale * p.draw(rng)
     limits = np.asarray(model.state_limits, dtype=float)
-    outside = np.argwhere(np.abs(batch) > limits)
-    if outside.size:
-        row, i = (int(v) for v in outside[0])
-        s = model.states[i]
-        field = next((p.field for p in study.perturb if PERTURBABLE[p.field][0] == s.name),
-                     f"initial_state.{s.name}")
-        raise ConfigError(f"--perturb {field}: member {chunk.start + row} starts at {s.name} = "
-                          f"{batch[row, i]:g} {s.unit}, beyond the model's range |{s.name}| <= "
-                          f"{limits[i]:g} {s.unit}; narrow the distribution")
+    for p in study.perturb:
+        state, scale = PERTURBABLE[p.field]
+        i = state_names.index(state)
+        outside = np.flatnonzero(np.abs(batch[:, i]) > limits[i])
+        if outside.size:
+            row = int(outside[0])
+            _check_range(f"--perturb {p}", f"member {chunk.start + row}", p.field, batch[row, i],
+                         limits[i], scale)
     return batch
 
 
@@ -151,19 +166,39 @@ def route_series(series, scenario, done_at: np.ndarray):
     return series.where(mask).isel(time=np.flatnonzero(keep.any(axis=1)))
 
 
+def _run_batch(setup, scenario, x0, seeds, backend: str, route: bool):
+    """One loop call for ``x0``'s members: the result and, for a route, each member's completion
+    time (NaN: not completed). A route batch is logged at every step (see :func:`run_chunk`)."""
+    try:
+        result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend,
+                           1 if route else scenario.simulation.log_every)
+    except ConfigError as exc:
+        if route and str(exc).startswith("log size"):
+            raise ConfigError(f"{exc} (a route study logs every step of a chunk, so that each "
+                              f"member's completion is logged: lower --chunk-size)") from None
+        raise
+    if not route:
+        return result, None
+    done_at = getattr(setup.guidance, "completion_time", None)
+    if done_at is None:
+        raise ConfigError(f"guidance {type(setup.guidance).__name__} can finish but keeps no "
+                          "completion_time; a study cannot end its members' series")
+    return result, np.asarray(done_at, dtype=float).reshape(-1).round(9)
+
+
 def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """Run one chunk; an ``xarray.Dataset`` with a ``member`` dimension: every scalar metric, and
-    with ``study.series`` every time series; ``attrs["backend"]`` says which loop ran it.
+    with ``study.series`` every time series; ``attrs["backend"]`` says which code ran it.
 
     The batch runs in one call of the loop. If a member diverges (which stops a batch), the chunk
     is run again member by member, so that every member's figures are its own run's whatever
     chunk it shares (a diverged member is flagged ``diverged = 1`` with its figures up to then).
 
-    A route (guidance that finishes) ends a batch when its last member completes; the others keep
-    sailing until then. So a member's series are NaN after its own completion
-    (``completion_time_s``), and such a batch is logged at every step (its metrics are computed
-    on every step, its series thinned to the log grid plus each member's completion sample), as
-    the step a batch ends on depends on the batch.
+    A route (guidance that finishes at its last waypoint) ends a batch when its last member
+    completes; the others keep sailing until then, and the step the batch ends on depends on its
+    members. So a route batch is logged at every step, its metrics are computed there, and each
+    member's series is thinned to the log grid up to its own completion plus its completion
+    sample (NaN elsewhere).
     """
     import xarray as xr
 
@@ -174,14 +209,15 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     setup = build(scenario, chunk.variant, seed=study.seed)
     x0 = member_initial_states(study, setup.x0, setup.model, chunk)
     seeds = [study.member_streams(m)[1] for m in range(chunk.start, chunk.stop)]
-    log_every = 1 if ends_early(setup) else scenario.simulation.log_every
-    result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend, log_every)
+    route = ends_early(setup)
+    result, done_at = _run_batch(setup, scenario, x0, seeds, backend, route)
     if result.attrs.get("diverged", 0):
-        runs = [_simulate(setup, scenario, x0[i:i + 1], MemberStreams(seeds[i:i + 1]), backend,
-                          log_every) for i in range(chunk.size)]
-        ran_on = {r.attrs.get("backend") for r in runs}
-        members = [r.isel(member=0) for r in runs]
-        result = xr.concat(runs, dim="member", join="outer")
+        runs = [_run_batch(setup, scenario, x0[i:i + 1], seeds[i:i + 1], backend, route)
+                for i in range(chunk.size)]
+        ran_on = {r.attrs.get("backend") for r, _ in runs}
+        members = [r.isel(member=0) for r, _ in runs]
+        result = xr.concat([r for r, _ in runs], dim="member", join="outer")
+        done_at = np.concatenate([d for _, d in runs]) if route else None
     else:
         ran_on = {result.attrs.get("backend")}
         members = [result.isel(member=i) for i in range(chunk.size)]
@@ -193,8 +229,8 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     if study.series:
         series = result.assign_coords(member=np.arange(chunk.start, chunk.stop))
         series.attrs = {}
-        if "completion_time_s" in out:
-            series = route_series(series, scenario, out.completion_time_s.values)
+        if route:
+            series = route_series(series, scenario, done_at)
         out = xr.merge([out, series.rename({k: f"series_{k}" for k in series.data_vars})],
                        combine_attrs="override")
     return out

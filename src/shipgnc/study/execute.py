@@ -44,13 +44,14 @@ def variants_of(study: Study) -> list[str] | None:
     """The controller variants (a ``controller`` dimension) of a comparison scenario, else None;
     every grid point is loaded here, so a bad grid key or value, an unsweepable scenario or a
     ``--perturb`` field the vessel does not have fails before any work starts."""
-    from shipgnc.scenarios.runner import VESSELS
+    from shipgnc.scenarios.runner import VESSELS, initial_states
 
     variants = None
     for point in study.points:
         scenario = study.scenario_at(point)
         check_sweepable(scenario)
-        check_perturbable(study.perturb, VESSELS[scenario.vessel.model](scenario)[0])
+        check_perturbable(study.perturb, VESSELS[scenario.vessel.model](scenario)[0],
+                          initial_states(scenario, study.seed))
         if scenario.controllers is not None:
             names = list(scenario.controllers)
             if variants is not None and names != variants:
@@ -90,7 +91,9 @@ def run_chunks(study: Study, chunks: list[Chunk], *, client=None,
         return out
     from dask.distributed import as_completed
 
-    futures = [client.submit(chunk_task, study, chunk, pure=False) for chunk in chunks]
+    # retries: one more try for a chunk that raised (e.g. a race on numba's cache); bad input
+    # is returned, not raised, so it is not retried
+    futures = [client.submit(chunk_task, study, chunk, pure=False, retries=1) for chunk in chunks]
     index = {f.key: i for i, f in enumerate(futures)}
     results: list = [None] * total
     for done, future in enumerate(as_completed(futures), start=1):
@@ -106,7 +109,7 @@ def run_chunks(study: Study, chunks: list[Chunk], *, client=None,
 
 def chunk_task(study: Study, chunk: Chunk):
     """A chunk on a dask worker: its Dataset, or the ConfigError it met *returned*, so that bad
-    input ends the study with its one-line message instead of a worker traceback and retries
+    input ends the study with its one-line message instead of a worker traceback and a retry
     (a worker that dies is another matter: dask reschedules its chunks)."""
     try:
         return run_chunk(study, chunk)

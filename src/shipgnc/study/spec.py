@@ -26,6 +26,8 @@ from shipgnc.units import deg
 #: initial-state fields a member may be offset in, with the conversion of the offset to SI
 PERTURBABLE = {"north": ("north", 1.0), "east": ("east", 1.0), "psi_deg": ("psi", deg(1.0)),
                "u": ("u", 1.0), "v": ("v", 1.0), "r_deg_s": ("r", deg(1.0))}
+#: the unit an offset of each field is given in (and reported in)
+PERTURB_UNITS = {"north": "m", "east": "m", "psi_deg": "deg", "u": "m/s", "v": "m/s", "r_deg_s": "deg/s"}
 DISTRIBUTIONS = ("normal", "uniform")
 #: scenario fields a study sets itself, which --grid and --set may not
 STUDY_OWNED = {
@@ -102,6 +104,18 @@ def parse_grid(text: str) -> tuple[str, tuple]:
     return key, parsed
 
 
+def _set_keys(item: str) -> list[str]:
+    """The dotted keys an override sets: ``a.b=1`` → ``[a.b]``; ``a={b: 1, c: {d: 2}}`` →
+    ``[a, a.b, a.c, a.c.d]``."""
+    def walk(key, value):
+        yield key
+        if isinstance(value, dict):
+            for k, v in value.items():
+                yield from walk(f"{key}.{k}", v)
+
+    return list(walk(*parse_override(item)))
+
+
 @dataclass(frozen=True)
 class Study:
     """A sweep of ``scenario`` over the product of ``grid`` times ``members`` seeded members.
@@ -129,7 +143,7 @@ class Study:
         for key, values in self.grid:
             require(len(values) >= 1, f"--grid {key}", "[]", "needs at least one value")
         for flag, key in [*(("--grid", k) for k in keys),
-                          *(("--set", o.partition("=")[0].strip()) for o in self.overrides)]:
+                          *(("--set", k) for o in self.overrides for k in _set_keys(o))]:
             if key in STUDY_OWNED:
                 raise ConfigError(f"{flag} {key}: not in a study: {STUDY_OWNED[key]}")
         fields = [p.field for p in self.perturb]
