@@ -816,13 +816,14 @@ class FroudeKrylovWaveLoads:
         Evaluated by the compiled twin (:mod:`shipgnc.environment.wave_kernel`) when numba is
         available and ``backend`` allows it, else by :meth:`loads_numpy` (the reference).
         """
-        if self.backend == "numpy" or not self._compiled_ok():
+        self._require_reset()
+        if self.evaluator() == "numpy":
             return self.loads_numpy(t, x)
         from shipgnc.environment import wave_kernel
 
         north, east, psi = (np.ascontiguousarray(np.broadcast_to(a, self._batch).reshape(-1),
                                                  dtype=float) for a in self._state(x))
-        out = wave_kernel.loads(t, north, east, psi, self._flat, self.length, self.beam,
+        out = wave_kernel.loads(t, north, east, psi, self._flat_arrays(), self.length, self.beam,
                                 self.spreading is None)
         return out.reshape(*self._batch, 3)
 
@@ -833,12 +834,9 @@ class FroudeKrylovWaveLoads:
 
         return "numpy" if self.backend == "numpy" or not wave_kernel.available() else "wave_kernel"
 
-    def _compiled_ok(self) -> bool:
+    def _flat_arrays(self) -> dict[str, np.ndarray]:
+        """The sea's per-component arrays as (ships, components) rows for the kernel (made once)."""
         if self._flat is None:
-            from shipgnc.environment import wave_kernel
-
-            if not wave_kernel.available():
-                return False
             r = self._require_reset()
             n = r.omega.shape[-1]
             chi = np.broadcast_to(self.direction if self.spreading is None else r.direction,
@@ -853,7 +851,7 @@ class FroudeKrylovWaveLoads:
                           "half_kL": flat(self._half_kL), "half_kB": flat(self._half_kB),
                           "chi": flat(chi), "wX": flat(self._weights[0]),
                           "wY": flat(self._weights[1]), "wN": flat(self._weights[2])}
-        return True
+        return self._flat
 
     def loads_numpy(self, t: float, x: np.ndarray) -> np.ndarray:
         """The reference numpy form of :meth:`__call__`."""
