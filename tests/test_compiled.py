@@ -16,15 +16,12 @@ from shipgnc.actuators import Actuator
 from shipgnc.control.heading_speed import HeadingSpeedAutopilot
 from shipgnc.control.open_loop import OpenLoopSchedule
 from shipgnc.environment.disturbance import ConstantDisturbance
-from shipgnc.errors import ConfigError, DivergenceError
+from shipgnc.errors import DivergenceError
 from shipgnc.guidance.los import LOSGuidance
 from shipgnc.guidance.path import WaypointPath
 from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.fossen3dof import VectoredThrustBoat
-from shipgnc.sim import compiled
 from shipgnc.sim.simulator import _validate, simulate
-
-pytest.importorskip("numba")
 
 RTOL, ATOL = 1e-9, 1e-12
 BOAT = VectoredThrustBoat()
@@ -238,17 +235,14 @@ def setup_of(**kw):
 
 
 def test_unsupported_reasons():
-    assert compiled.unsupported_reason(setup_of(controller=autopilot(),
-                                                guidance=heading_steps())) is None
+    from shipgnc.sim import compose
+
+    assert compose.unsupported_reason(setup_of(controller=autopilot(),
+                                               guidance=heading_steps())) is None
     los = LOSGuidance(WaypointPath([[0, 0], [60, 0], [60, 60]]), lookahead=8.0, speed=1.5)
-    reason = compiled.unsupported_reason(setup_of(controller=autopilot(), guidance=los))
-    assert reason and "LOSGuidance" in reason
-    reason = compiled.unsupported_reason(setup_of(observer=lambda t, x, c, u: None))
+    assert compose.unsupported_reason(setup_of(controller=autopilot(), guidance=los)) is None
+    assert compose.unsupported_reason(setup_of(actuator=Actuator.for_model(BOAT, rate=[50, 1]))) is None
+    reason = compose.unsupported_reason(setup_of(observer=lambda t, x, c, u: None))
     assert reason and "observer" in reason
-    reason = compiled.unsupported_reason(setup_of(actuator=Actuator.for_model(BOAT, rate=[50, 1])))
-    assert reason and "rate" in reason
-    reason = compiled.unsupported_reason(setup_of(integrator="solve_ivp"))
+    reason = compose.unsupported_reason(setup_of(integrator="solve_ivp"))
     assert reason and "solve_ivp" in reason
-    with pytest.raises(ConfigError, match="LOSGuidance"):
-        simulate(BOAT, np.zeros(6), controller=autopilot(), guidance=los, t_end=1, dt=0.05,
-                 backend="compiled")

@@ -17,6 +17,7 @@ Reference ``[psi_d, u_d]``; measurement: the boat's state ``[north, east, psi, u
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +25,7 @@ import numpy as np
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
 from shipgnc.guidance.reference import HeadingReferenceModel
+from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
 from shipgnc.models.fossen3dof import BoatParams, allocate_thrust
 
@@ -98,3 +100,56 @@ class HeadingSpeedAutopilot:
 
     def signal_values(self) -> dict[str, np.ndarray]:
         return self._logged
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`step` for the composed loop (:func:`heading_speed_step`); per-ship state
+        ``[z, z_u, psi_r, r_r, started]``."""
+        p, g, ref = self.params, self.gains, self.reference_model
+        params = flat(p.M33, p.N_r, p.N_rr, p.X_u, p.L_m, p.alpha_max, p.T_min, p.T_max, g.Kp,
+                      g.Kd, g.Ki, g.Kpu, g.Kiu, ref.omega, ref.zeta, self.Ts,
+                      float(self.yaw_feedforward))
+        state = np.zeros((*batch_shape, 5))
+        state[..., 0], state[..., 1] = self.z, self.z_u
+        if ref.psi is not None:
+            state[..., 2], state[..., 3], state[..., 4] = ref.psi, ref.rate, 1.0
+
+        def restore(z: np.ndarray) -> None:
+            z = z.reshape(*batch_shape, 5)
+            self.z, self.z_u = z[..., 0].copy(), z[..., 1].copy()
+            if np.all(z[..., 4] > 0):
+                ref.psi, ref.rate = z[..., 2].copy(), z[..., 3].copy()
+
+        return Kernel(heading_speed_step, params, state, restore=restore)
+
+
+@kernel_function
+def heading_speed_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`HeadingSpeedAutopilot.step` for one ship, operation for operation."""
+    M33, N_r, N_rr, X_u, L_m, alpha_max, T_min, T_max = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+    Kp, Kd, Ki, Kpu, Kiu, w, zeta, Ts, yaw_ff = p[8], p[9], p[10], p[11], p[12], p[13], p[14], p[15], p[16]
+    psi, su, sr = x[2], x[3], x[5]
+    psi_d, u_d = ref[0], ref[1]
+    if z[4] == 0.0:  # the reference model starts at the measured heading, ψ̇_r = 0
+        z[2], z[3], z[4] = psi, 0.0, 1.0
+    psi_r, r_r = z[2], z[3]
+    acc = w * w * wrap(psi_d - psi_r) - 2.0 * zeta * w * r_r
+    e = wrap(psi - psi_r)
+    damping_ff = -N_r * r_r
+    if yaw_ff != 0.0:
+        damping_ff = damping_ff - N_rr * abs(r_r) * r_r
+    tau_r = M33 * acc + damping_ff - Kp * e - Kd * (sr - r_r) - Ki * z[0]
+    speed_error = u_d - su
+    tau_u = -X_u * u_d + Kpu * speed_error + Kiu * z[1]
+    if not (tau_u > 0.0 or tau_u != tau_u):  # np.maximum(0.0, tau_u), NaN kept
+        tau_u = 0.0
+    lateral = -tau_r / L_m
+    thrust = math.hypot(tau_u, lateral)
+    alpha = math.atan2(lateral, tau_u)
+    if abs(alpha) <= alpha_max:
+        z[0] = z[0] + Ts * e
+    if thrust >= T_min and thrust <= T_max:
+        z[1] = z[1] + Ts * speed_error
+    sig[0], sig[1] = psi_r, r_r
+    z[2] = psi_r + Ts * r_r
+    z[3] = r_r + Ts * acc
+    cmd[0], cmd[1] = thrust, alpha

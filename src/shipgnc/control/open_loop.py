@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from shipgnc.errors import require
+from shipgnc.kernels import Kernel, kernel_function, schedule_params, schedule_row
 from shipgnc.timeseries import PiecewiseConstant
 
 
@@ -37,3 +38,17 @@ class OpenLoopSchedule:
 
     def signal_values(self) -> dict[str, np.ndarray]:
         return {}
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`step` for the composed loop (:func:`schedule_step`)."""
+        return Kernel(schedule_step, schedule_params(self.schedule))
+
+
+@kernel_function
+def schedule_step(t, x, ref, z, p, cmd, sig):
+    """The schedule's row at ``t`` (``p`` from :func:`~shipgnc.kernels.schedule_params`)."""
+    n = int(p[0])
+    m = cmd.shape[0]
+    row = schedule_row(p[1:1 + n], t)
+    for j in range(m):
+        cmd[j] = p[1 + n + row * m + j]

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from shipgnc.errors import require
+from shipgnc.kernels import Kernel, flat, kernel_function
 
 
 class ConstantDisturbance:
@@ -30,6 +31,10 @@ class ConstantDisturbance:
 
     def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
         return np.broadcast_to(self.values, self._shape)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """The values per ship as the kernel's state (:func:`copy_state`)."""
+        return Kernel(copy_state, state=np.broadcast_to(self.values, self._shape))
 
 
 class GaussianForceNoise:
@@ -55,3 +60,28 @@ class GaussianForceNoise:
     def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
         assert self._rng is not None, "reset() must be called before sampling"
         return self.mean + self.std * self._rng.standard_normal(self._shape)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """mean + std·w with w drawn in numpy, step by step as :meth:`__call__` draws it."""
+        rng, shape, n = self._rng, self._shape, self.std.size
+
+        def table(k0: int, k1: int) -> np.ndarray:
+            draws = np.stack([rng.standard_normal(shape) for _ in range(k1 - k0)])
+            return draws.reshape(k1 - k0, -1, n)
+
+        return Kernel(gaussian_sample, flat(n, self.mean, self.std), table=table, n_table=n)
+
+
+@kernel_function
+def copy_state(t, x, z, p, w, d):
+    """d = the ship's constant values."""
+    for j in range(d.shape[0]):
+        d[j] = z[j]
+
+
+@kernel_function
+def gaussian_sample(t, x, z, p, w, d):
+    """d = mean + std·w, ``p`` = [n, mean (n), std (n)]."""
+    n = int(p[0])
+    for j in range(n):
+        d[j] = p[1 + j] + p[1 + n + j] * w[j]

@@ -22,11 +22,14 @@ leg. Batched: each ship has its own leg index.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
 from shipgnc.guidance.path import WaypointPath
+from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal, state_index
 
 
@@ -102,6 +105,66 @@ class LOSGuidance:
     def finished(self) -> np.ndarray:
         return self._done
 
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`reference` for the composed loop (:func:`los_reference`); per-ship state
+        ``[leg, done, e_int, t_last (NaN before the first sample), completion_time]``."""
+        path = self.path
+        params = flat(self._i_north, self._i_east, path.n_legs, self.lookahead,
+                      self.integral_gain, self.speed, self.switch_radius, path.waypoints[:-1, 0],
+                      path.waypoints[:-1, 1], path.leg_lengths, path.leg_angles)
+        state = np.stack([self.leg, self._done, self.e_int,
+                          np.full(batch_shape, np.nan if self._t_last is None else self._t_last),
+                          self.completion_time], axis=-1)
+
+        def restore(z: np.ndarray) -> None:
+            z = z.reshape(*batch_shape, 5)
+            self.leg = z[..., 0].astype(int)
+            self._done = z[..., 1] > 0
+            self.e_int = z[..., 2].copy()
+            t_last = z.reshape(-1, 5)[0, 3] if z.size else np.nan
+            self._t_last = None if np.isnan(t_last) else float(t_last)
+            self.completion_time = z[..., 4].copy()
+
+        return Kernel(los_reference, params, state, restore=restore)
+
     def waypoints_reached(self) -> np.ndarray:
         """Waypoints after the start whose leg was completed (switch or end of the last leg)."""
         return self.leg + self._done.astype(int)
+
+
+@kernel_function
+def los_reference(t, x, z, p, ref, out):
+    """One :meth:`LOSGuidance.reference` for one ship, operation for operation."""
+    n_legs = int(p[2])
+    D, sigma, speed, R_sw = p[3], p[4], p[5], p[6]
+    north, east = x[int(p[0])], x[int(p[1])]
+    o_n, o_e = p[7:7 + n_legs], p[7 + n_legs:7 + 2 * n_legs]
+    lengths, angles = p[7 + 2 * n_legs:7 + 3 * n_legs], p[7 + 3 * n_legs:7 + 4 * n_legs]
+    leg = int(z[0])
+    last = n_legs - 1
+    s, e = _project(north, east, o_n[leg], o_e[leg], angles[leg])
+    if leg < last and s >= lengths[leg] - R_sw:
+        leg += 1
+        s, e = _project(north, east, o_n[leg], o_e[leg], angles[leg])
+        z[2] = 0.0
+    if leg == last and s >= lengths[last] and z[1] == 0.0:
+        z[4] = t
+        z[1] = 1.0
+    if sigma > 0 and not math.isnan(z[3]):
+        h = t - z[3]
+        q = e + sigma * z[2]
+        z[2] = z[2] + h * D * e / (q * q + D * D)
+    z[3] = t
+    z[0] = leg
+    ref[0] = wrap(angles[leg] - math.atan((e + sigma * z[2]) / D))
+    ref[1] = speed
+    out[0], out[1], out[2] = e, s, float(leg)
+    return z[1] != 0.0
+
+
+@kernel_function
+def _project(north, east, origin_north, origin_east, angle):
+    """:func:`shipgnc.frames.path_frame` for one point: (along-track s, cross-track e)."""
+    dn, de = north - origin_north, east - origin_east
+    c, s = math.cos(angle), math.sin(angle)
+    return dn * c + de * s, -dn * s + de * c

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from shipgnc.kernels import Kernel, kernel_function, schedule_params, schedule_row
 from shipgnc.models.base import Signal
 from shipgnc.timeseries import PiecewiseConstant
 
@@ -30,6 +31,10 @@ class ReferenceSchedule:
 
     def reset(self, batch_shape, model=None) -> None:
         self._batch_shape = tuple(batch_shape)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`reference` for the composed loop (:func:`schedule_reference`)."""
+        return Kernel(schedule_reference, schedule_params(self.schedule))
 
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
         value = self.schedule(t)
@@ -58,6 +63,10 @@ class CourseSchedule:
 
     def reset(self, batch_shape, model=None) -> None:
         self._batch_shape = tuple(batch_shape)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`reference` for the composed loop (:func:`schedule_reference`)."""
+        return Kernel(schedule_reference, schedule_params(self.schedule))
 
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
         value = self.schedule(t)
@@ -105,3 +114,15 @@ class HeadingProfile:
 
     def finished(self):
         return None
+
+
+@kernel_function
+def schedule_reference(t, x, z, p, ref, out):
+    """The set-points' row at ``t`` (``p`` from :func:`~shipgnc.kernels.schedule_params`); never
+    finished."""
+    n = int(p[0])
+    m = ref.shape[0]
+    row = schedule_row(p[1:1 + n], t)
+    for j in range(m):
+        ref[j] = p[1 + n + row * m + j]
+    return False

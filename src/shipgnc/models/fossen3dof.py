@@ -26,6 +26,7 @@ import numpy as np
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
+from shipgnc.kernels import Kernel, flat, kernel_function
 from shipgnc.models.base import Signal
 from shipgnc.units import G
 
@@ -235,3 +236,28 @@ class VectoredThrustBoat:
         r_dot = (tau_r + p.munk_coefficient * su * sv + p.N_r * sr
                  + p.N_rr * np.abs(sr) * sr) / p.M33
         return np.stack([north_dot, east_dot, sr, u_dot, v_dot, r_dot], axis=-1)
+
+    def kernel(self) -> Kernel:
+        """:meth:`derivatives` for the composed loop (:func:`boat_rhs`)."""
+        p = self.params
+        return Kernel(boat_rhs, flat(p.M11, p.M22, p.M33, p.X_u, p.Y_v, p.N_r, p.N_rr,
+                                     p.munk_coefficient, p.L_m))
+
+
+@kernel_function
+def boat_rhs(x, u, d, p, xdot):
+    """ẋ of eq. (1)–(5), (9)–(11') for one ship: :meth:`VectoredThrustBoat.derivatives`, operation
+    for operation; ``p`` = [M11, M22, M33, X_u, Y_v, N_r, N_rr, k_Munk, L_m]."""
+    M11, M22, M33, X_u, Y_v, N_r, N_rr, k_munk, L_m = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8]
+    su, sv, sr = x[3], x[4], x[5]
+    lateral = u[0] * math.sin(u[1])
+    tau_u = u[0] * math.cos(u[1]) + d[0]
+    tau_v = lateral + d[1]
+    tau_r = -L_m * lateral + d[2]
+    c, s = math.cos(x[2]), math.sin(x[2])
+    xdot[0] = c * su - s * sv
+    xdot[1] = s * su + c * sv
+    xdot[2] = sr
+    xdot[3] = (tau_u + M22 * sv * sr + X_u * su) / M11
+    xdot[4] = (tau_v - M11 * su * sr + Y_v * sv) / M22
+    xdot[5] = (tau_r + k_munk * su * sv + N_r * sr + N_rr * abs(sr) * sr) / M33

@@ -439,13 +439,13 @@ def run(setup):
             values = np.stack([noise(k * dt) for k in range(k0, k1)]).reshape(k1 - k0, n_ships)
             waves = _owned(values.T)
 
-    def call(k0: int, k1: int) -> None:
+    def call(k0: int, k1: int, k_last: int) -> None:  # the Mariner's path controllers never finish
         kernel(k0, k1, n_steps, hold, every, dt, S, div_event, out, ctrl_mode, cp, legs, base,
                current_mode, current_legs, current_table, int(noise is not None), waves, mp,
                act_p, limits)
 
     n_chunks = 1 if noise is None else max(1, math.ceil(n_ships * (n_steps + 1) / WAVE_CHUNK))
-    event = drive(setup, call, S, div_event, n_chunks=n_chunks, prepare=prepare)
+    event, _ = drive(setup, call, S, div_event, n_chunks=n_chunks, prepare=prepare)
 
     # leave the components as the numpy loop would
     if ctrl is not None:

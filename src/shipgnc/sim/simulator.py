@@ -9,9 +9,10 @@ between. The plant (and any actuator lag) is integrated with fixed-step RK4 or w
 ``scipy.integrate.solve_ivp`` over each ``dt``. The last sample is t_end itself.
 
 Batched: ``x0`` of shape ``(..., n)`` simulates every leading index as one ship, in one array
-operation per RK stage. Compiled (numba) twins of the loop serve large runs of the built-in boat
-(:mod:`shipgnc.sim.compiled`) and of document 000's Mariner (:mod:`shipgnc.sim.compiled_mariner`);
-``backend="numpy"`` forces this readable reference loop.
+operation per RK stage. The same loop compiled: :mod:`shipgnc.sim.compose` composes the kernels of
+the components (:mod:`shipgnc.kernels`) into one numba loop for any combination whose components
+all have one; document 000's Mariner still has a whole-loop twin
+(:mod:`shipgnc.sim.compiled_mariner`); ``backend="numpy"`` forces this readable reference loop.
 """
 
 from __future__ import annotations
@@ -37,8 +38,10 @@ COMPILED_MIN_BATCH = 64
 #: ≈ 0.4 ms a step, a cached kernel ≈ 1 s to load, a cold one ≈ 10 s to compile once); setups no
 #: twin covers run in the numpy loop
 COMPILED_MIN_WORK = 20_000
-#: the compiled twins (modules of ``shipgnc.sim``), asked in this order
-COMPILED_TWINS = ("compiled", "compiled_mariner")
+#: the compiled loops (modules of ``shipgnc.sim``), asked in this order, and the name each
+#: records in ``attrs["backend"]``: the composed loop of components with kernels, and the
+#: Mariner's whole-loop twin
+COMPILED_TWINS = {"compose": "compiled", "compiled_mariner": "compiled_mariner"}
 #: most steps of one run, and most logged numbers (8 bytes each, 4 GB) of one result
 MAX_STEPS = 1e8
 MAX_LOGGED = 5e8
@@ -140,7 +143,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     if wants_compiled:
         twin, reasons = _compiled_twin(setup)
         if twin is not None:
-            log, ran_on = twin.run(setup), twin.__name__.rsplit(".", 1)[-1]
+            log, ran_on = twin.run(setup), COMPILED_TWINS[twin.__name__.rsplit(".", 1)[-1]]
         elif backend == "compiled":
             raise ConfigError(f"backend = 'compiled': no compiled loop covers this run "
                               f"({'; '.join(reasons)}); use backend='numpy'")

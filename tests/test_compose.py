@@ -1,0 +1,212 @@
+"""The composed compiled loop (DESIGN "Speed by composition"): each component's kernel equals its
+numpy form, and combinations no whole-loop twin ever covered run compiled and equal the numpy loop
+(1e-9 relative or 1e-12 absolute, the promise of ``simulate``'s ``backend``)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from shipgnc.actuators import Actuator
+from shipgnc.control.heading_speed import HeadingSpeedAutopilot
+from shipgnc.control.open_loop import OpenLoopSchedule
+from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
+from shipgnc.errors import ConfigError
+from shipgnc.guidance.los import LOSGuidance
+from shipgnc.guidance.path import WaypointPath
+from shipgnc.guidance.schedule import ReferenceSchedule
+from shipgnc.models.base import Signal
+from shipgnc.models.fossen3dof import VectoredThrustBoat
+from shipgnc.sim import compose
+from shipgnc.sim.simulator import simulate
+
+RTOL, ATOL = 1e-9, 1e-12
+BOAT = VectoredThrustBoat()
+SQUARE = WaypointPath([[0, 0], [40, 0], [40, 40], [0, 40]])
+
+
+def fleet(n=24, seed=5):
+    rng = np.random.default_rng(seed)
+    x0 = np.zeros((n, 6))
+    x0[:, 0:2] = rng.uniform(-10, 10, (n, 2))
+    x0[:, 2] = rng.uniform(-3, 3, n)
+    x0[:, 3] = rng.uniform(0, 2, n)
+    return x0
+
+
+def assert_same(ref, got):
+    assert list(got.data_vars) == list(ref.data_vars)
+    np.testing.assert_array_equal(got.time.values, ref.time.values)
+    assert got.attrs["backend"] == "compiled" and ref.attrs["backend"] == "numpy"
+    for name in ref.data_vars:
+        np.testing.assert_allclose(got[name].values, ref[name].values, rtol=RTOL, atol=ATOL,
+                                   err_msg=name)
+
+
+def both(make, x0=None, **kw):
+    x0 = fleet() if x0 is None else x0
+    return [simulate(BOAT, x0, backend=backend, **make(), **kw) for backend in ("numpy", "compiled")]
+
+
+# ----------------------------------------------------------------------------------------------
+# each component's kernel against its numpy form, one ship at a time
+# ----------------------------------------------------------------------------------------------
+
+def test_model_kernel_equals_derivatives():
+    rng = np.random.default_rng(0)
+    kernel = BOAT.kernel()
+    for _ in range(50):
+        x, u, d = rng.normal(size=6) * [50, 50, 4, 2, 1, 1], rng.normal(size=2), rng.normal(size=3)
+        xdot = np.empty(6)
+        kernel.function(x, u, d, kernel.params, xdot)
+        np.testing.assert_allclose(xdot, BOAT.derivatives(x, u, d), rtol=1e-13, atol=1e-15)
+        kernel.function(x, u, np.zeros(3), kernel.params, xdot)  # zero d is no disturbance
+        np.testing.assert_allclose(xdot, BOAT.derivatives(x, u, None), rtol=1e-13, atol=1e-15)
+
+
+def test_controller_kernel_equals_step():
+    x0 = fleet(8)
+    ref = np.tile([0.7, 1.5], (8, 1))
+    numpy_ap, kernel_ap = HeadingSpeedAutopilot(BOAT.params), HeadingSpeedAutopilot(BOAT.params)
+    numpy_ap.reset((8,))
+    kernel_ap.reset((8,))
+    kernel = kernel_ap.kernel((8,))
+    z = kernel.state_for(8)
+    for k in range(20):
+        x = x0 + 0.01 * k
+        expected = numpy_ap.step(k * 0.05, x, ref)
+        for i in range(8):
+            cmd, sig = np.empty(2), np.empty(2)
+            kernel.function(k * 0.05, x[i], ref[i], z[i], kernel.params, cmd, sig)
+            np.testing.assert_allclose(cmd, expected[i], rtol=1e-13)
+            np.testing.assert_allclose(sig, [numpy_ap.signal_values()["psi_r"][i],
+                                             numpy_ap.signal_values()["r_r"][i]], rtol=1e-13)
+    kernel.restore(z)
+    np.testing.assert_allclose(kernel_ap.z, numpy_ap.z, rtol=1e-13)
+
+
+def test_guidance_kernel_equals_reference():
+    los = LOSGuidance(SQUARE, lookahead=6.0, speed=1.2, switch_radius=2.0, integral_gain=0.3)
+    los.reset((5,), BOAT)
+    kernel = los.kernel((5,))
+    z = kernel.state_for(5)
+    rng = np.random.default_rng(2)
+    for k in range(60):
+        x = np.zeros((5, 6))
+        x[:, :2] = rng.uniform(-5, 45, (5, 2))
+        expected = los.reference(0.1 * k, x)
+        for i in range(5):
+            ref, out = np.empty(2), np.empty(3)
+            done = kernel.function(0.1 * k, x[i], z[i], kernel.params, ref, out)
+            np.testing.assert_allclose(ref, expected[i], rtol=1e-13, atol=1e-15)
+            assert out[2] == los.leg[i] and done == los.finished()[i]
+
+
+def test_schedule_kernels_switch_on_the_same_sample():
+    """PiecewiseConstant's 1e-9 tolerance: a switch at 5 s fires at t = 100·0.05 s."""
+    steps = ReferenceSchedule([0, 5, 10], [0.0, 0.5, -0.5], [1.0, 2.0, 3.0])
+    kernel = steps.kernel(())
+    for t in (0.0, 4.99, 100 * 0.05, 5.0 - 1e-12, 9.999999999999, 10.0, 1e6):
+        ref = np.empty(2)
+        kernel.function(t, np.zeros(6), np.zeros(0), kernel.params, ref, np.zeros(0))
+        np.testing.assert_array_equal(ref, steps.schedule(t))
+
+
+# ----------------------------------------------------------------------------------------------
+# combinations: the composed loop against the numpy loop
+# ----------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("integral_gain", [0.0, 0.4])
+def test_los_route_ends_when_every_ship_has_finished(integral_gain):
+    def make():
+        return {"controller": HeadingSpeedAutopilot(BOAT.params),
+                "guidance": LOSGuidance(SQUARE, lookahead=6.0, speed=1.5, switch_radius=1.0,
+                                        integral_gain=integral_gain)}
+
+    ref, got = both(make, t_end=400.0, dt=0.05, log_every=8)
+    assert_same(ref, got)
+    assert ref.time.values[-1] < 400.0  # stopped at the last ship's completion, off the log grid
+    assert round(ref.time.values[-1] / 0.05) % 8 != 0
+
+
+def test_los_completion_state_is_left_as_numpy_leaves_it():
+    guides = []
+
+    def make():
+        guides.append(LOSGuidance(SQUARE, lookahead=6.0, speed=1.5))
+        return {"controller": HeadingSpeedAutopilot(BOAT.params), "guidance": guides[-1]}
+
+    both(make, t_end=400.0, dt=0.05)
+    np.testing.assert_allclose(guides[1].completion_time, guides[0].completion_time)
+    np.testing.assert_array_equal(guides[1].waypoints_reached(), guides[0].waypoints_reached())
+
+
+@pytest.mark.parametrize("rate_mode", ["ramp", "hold"])
+def test_rate_limited_actuator(rate_mode):
+    def make():
+        act = Actuator.for_model(BOAT, rate=[40.0, math.radians(20)], rate_mode=rate_mode)
+        return {"controller": HeadingSpeedAutopilot(BOAT.params), "actuator": act,
+                "guidance": ReferenceSchedule([0, 10], np.radians([0, 60]), [1.5, 1.0])}
+
+    assert_same(*both(make, t_end=30.0, dt=0.05, log_every=3))
+
+
+def test_actuator_lag_and_a_slower_controller():
+    def make():
+        act = Actuator.for_model(BOAT, rate=[np.inf, math.radians(30)], tau=[0.5, 0.2])
+        return {"controller": HeadingSpeedAutopilot(BOAT.params, Ts=0.2), "actuator": act,
+                "guidance": ReferenceSchedule([0, 10], np.radians([0, 60]), [1.5, 1.0])}
+
+    assert_same(*both(make, t_end=30.0, dt=0.05))
+
+
+def test_seeded_noise_gives_the_same_sea():
+    def make():
+        return {"controller": HeadingSpeedAutopilot(BOAT.params),
+                "guidance": ReferenceSchedule([0], [0.3], [1.5]),
+                "disturbance": GaussianForceNoise([5.0, 5.0, 2.0], mean=[0.0, 3.0, 0.0])}
+
+    assert_same(*both(make, t_end=20.0, dt=0.05, seed=11))
+
+
+def test_constant_disturbance_per_ship():
+    forces = np.linspace(-20, 20, 24)[:, None] * [1.0, 0.5, 0.1]
+
+    def make():
+        return {"controller": OpenLoopSchedule([0, 5], [[100, 0], [100, 0.3]]),
+                "disturbance": ConstantDisturbance(forces)}
+
+    assert_same(*both(make, t_end=15.0, dt=0.05))
+
+
+def test_a_combination_is_compiled_once():
+    before = len(compose._LOOPS)
+    for _ in range(2):
+        simulate(BOAT, fleet(3), controller=OpenLoopSchedule([0], [[50, 0.1]]), t_end=1.0,
+                 dt=0.05, backend="compiled")
+    assert len(compose._LOOPS) - before <= 1
+
+
+class _Toy:
+    """A model without a kernel: runs in numpy, and the compiled backend names it."""
+
+    states = (Signal("north", "m"), Signal("east", "m"), Signal("psi", "rad", angle=True))
+    inputs = (Signal("a", "1"),)
+    disturbances = ()
+    state_limits = (1e6, 1e6, 1e6)
+    params = None
+
+    def input_limits(self):
+        return np.array([-1.0]), np.array([1.0])
+
+    def derivatives(self, x, u, d=None):
+        return np.stack([np.cos(x[..., 2]), np.sin(x[..., 2]), u[..., 0]], axis=-1)
+
+
+def test_a_component_without_kernel_falls_back_and_is_named():
+    result = simulate(_Toy(), np.zeros((100, 3)), t_end=1.0, dt=0.1, u0=[0.1])
+    assert result.attrs["backend"] == "numpy"
+    with pytest.raises(ConfigError, match="model _Toy has no kernel"):
+        simulate(_Toy(), np.zeros(3), t_end=1.0, dt=0.1, backend="compiled")
