@@ -17,11 +17,13 @@ Logged values: the command and the applied input at each sample instant.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from shipgnc.errors import ConfigError, require
+from shipgnc.kernels import clip, kernel_function
 
 
 def _per_channel(value, n: int, field: str, default: float) -> np.ndarray:
@@ -137,3 +139,54 @@ class Actuator:
         tau = np.where(self.tau > 0, self.tau, 1.0)
         rate = np.clip((target - lag_state) / tau, -self.rate, self.rate)
         return np.where(self.tau > 0, rate, 0.0)
+
+    def kernel_params(self) -> np.ndarray:
+        """``[lower, upper, rate, tau]`` (n each): the parameters of the kernels below."""
+        return np.concatenate([self.lower, self.upper, self.rate, self.tau]).astype(np.float64)
+
+
+# ----------------------------------------------------------------------------------------------
+# kernels of the composed loop (shipgnc.sim.compose): one ship, p = Actuator.kernel_params()
+# ----------------------------------------------------------------------------------------------
+
+@kernel_function
+def plan_kernel(applied, cmd, pa, h, rate_limited, hold_mode, start, end):
+    """:meth:`Actuator.begin_step` for one ship: the step's input runs from ``start`` to ``end``."""
+    n = cmd.shape[0]
+    for j in range(n):
+        target = clip(cmd[j], pa[j], pa[n + j])
+        if not rate_limited:
+            start[j] = target
+            end[j] = target
+            continue
+        rate = pa[2 * n + j]
+        e = applied[j] + clip(target - applied[j], -rate * h, rate * h)
+        end[j] = e
+        start[j] = e if (hold_mode or not math.isfinite(rate)) else applied[j]
+
+
+@kernel_function
+def input_at_kernel(start, end, theta, lag, pa, has_lag, rate_limited, u):
+    """:meth:`Actuator.input_at`: the applied input at fraction ``theta`` of the step."""
+    n = u.shape[0]
+    for j in range(n):
+        if has_lag and pa[3 * n + j] > 0:
+            u[j] = lag[j]
+        elif theta == 1.0 or not rate_limited:
+            u[j] = end[j]
+        else:
+            u[j] = start[j] + theta * (end[j] - start[j])
+
+
+@kernel_function
+def lag_rate_kernel(cmd, lag, pa, out):
+    """:meth:`Actuator.lag_derivative`: ȧ = clip((sat(cmd) − a)/τ, −rate, rate) on lag channels."""
+    n = cmd.shape[0]
+    for j in range(n):
+        tau = pa[3 * n + j]
+        if tau > 0:
+            target = clip(cmd[j], pa[j], pa[n + j])
+            rate = pa[2 * n + j]
+            out[j] = clip((target - lag[j]) / tau, -rate, rate)
+        else:
+            out[j] = 0.0

@@ -14,8 +14,8 @@ per-ship state, mutated in place; every array is a 1-D float64 slice of one ship
 * model       ``rhs(x, u, d, p, xdot)`` — writes ẋ; ``d`` is zeros when the run has no
   disturbance, so a model's kernel treats zero ``d`` exactly as ``d=None``;
 * controller  ``step(t, x, ref, z, p, cmd, sig)`` — sampled every Ts; writes the command and the
-  logged signals ``sig``; ``continuous`` controllers ``law(t, x, ref, z, p, cmd, sig)`` called in
-  every RK4 stage and at the samples (``z`` then read-only);
+  logged signals ``sig``; a ``continuous`` controller's kernel has the same signature and is
+  called at the samples (``sig`` logged) and in every RK4 stage (``sig`` a scratch array there);
 * guidance    ``reference(t, x, z, p, ref, out) -> finished`` — writes the references and the
   logged outputs, returns True once the ship's task is complete;
 * disturbance ``sample(t, x, z, p, w, d)`` — writes ``d``; ``w`` is the step's row of a table the

@@ -24,15 +24,24 @@ first component without a kernel; ``simulate`` then runs the numpy loop.
 
 from __future__ import annotations
 
+import hashlib
+import importlib
+import inspect
 import math
+import os
+import sys
+from pathlib import Path
 
 import numba
 import numpy as np
 
+from shipgnc.actuators import Actuator
 from shipgnc.errors import ConfigError
-from shipgnc.kernels import JIT_OPTIONS, Kernel, NotCompiled, clip, kernel_function, wrap
+from shipgnc.kernels import Kernel, NotCompiled, kernel_function
 
 _LOOPS: dict = {}
+#: the loop's body (read as source, never imported)
+TEMPLATE = Path(__file__).with_name("loop_template.py")
 
 
 @kernel_function
@@ -55,53 +64,6 @@ def _no_disturbance(t, x, z, p, w, d):
     pass
 
 
-# ----------------------------------------------------------------------------------------------
-# the actuator (shipgnc.actuators.Actuator), per ship; p = [lower, upper, rate, tau] (n each)
-# ----------------------------------------------------------------------------------------------
-
-@kernel_function
-def _plan(applied, cmd, pa, h, rate_limited, hold_mode, start, end):
-    """:meth:`Actuator.begin_step` for one ship: the step's input runs from ``start`` to ``end``."""
-    n = cmd.shape[0]
-    for j in range(n):
-        target = clip(cmd[j], pa[j], pa[n + j])
-        if not rate_limited:
-            start[j] = target
-            end[j] = target
-            continue
-        rate = pa[2 * n + j]
-        e = applied[j] + clip(target - applied[j], -rate * h, rate * h)
-        end[j] = e
-        start[j] = e if (hold_mode or not math.isfinite(rate)) else applied[j]
-
-
-@kernel_function
-def _input_at(start, end, theta, lag, pa, has_lag, rate_limited, u):
-    """:meth:`Actuator.input_at`: the applied input at fraction ``theta`` of the step."""
-    n = u.shape[0]
-    for j in range(n):
-        if has_lag and pa[3 * n + j] > 0:
-            u[j] = lag[j]
-        elif theta == 1.0 or not rate_limited:
-            u[j] = end[j]
-        else:
-            u[j] = start[j] + theta * (end[j] - start[j])
-
-
-@kernel_function
-def _lag_rate(cmd, lag, pa, out):
-    """:meth:`Actuator.lag_derivative`: ȧ = clip((sat(cmd) − a)/τ, −rate, rate) on lag channels."""
-    n = cmd.shape[0]
-    for j in range(n):
-        tau = pa[3 * n + j]
-        if tau > 0:
-            target = clip(cmd[j], pa[j], pa[n + j])
-            rate = pa[2 * n + j]
-            out[j] = clip((target - lag[j]) / tau, -rate, rate)
-        else:
-            out[j] = 0.0
-
-
 def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, *, nx: int, nu: int, nd: int, nref: int,
              nout: int, nsig: int, nerr: int, nzc: int, nzg: int, nzd: int, has_ctrl: bool,
              continuous: bool, has_guid: bool, has_dist: bool, per_stage: bool, has_lag: bool,
@@ -114,151 +76,93 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, *, nx: int, nu: int, nd: int, 
     return _LOOPS[key]
 
 
-def _generate(model_fn, ctrl_fn, guid_fn, dist_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc, nzg,
-              nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-              hold_mode):
+def _generate(*key):
+    """The combination's loop: from a module written to the disk cache and compiled with numba's
+    cache (loaded in ≈ 0.1 s by later processes) when every kernel is importable by name; else
+    compiled in memory, once per process (a kernel defined in a script or a notebook)."""
+    functions = key[:4]
+    importable = all(_importable(fn) for fn in functions)
+    source = _source(*key, imports=importable)
+    path = _cache_file(source, functions) if importable else None
+    if path is not None:  # importable by name: numba's cache rebuilds the loop's module by name
+        if str(path.parent) not in sys.path:
+            sys.path.append(str(path.parent))
+        return importlib.import_module(path.stem).loop
+    namespace = dict(zip(("model_fn", "ctrl_fn", "guid_fn", "dist_fn"), functions, strict=True))
+    exec(compile(source.replace("CACHE = True", "CACHE = False"), "<shipgnc composed loop>",
+                 "exec"), namespace)
+    return namespace["loop"]
+
+
+def _importable(fn) -> bool:
+    py = getattr(fn, "py_func", fn)
+    try:
+        return getattr(importlib.import_module(py.__module__), py.__qualname__) is fn
+    except (ImportError, AttributeError):
+        return False
+
+
+def cache_dir() -> Path:
+    """Where composed loops are written: ``$SHIPGNC_CACHE_DIR``, else ``$XDG_CACHE_HOME/shipgnc``
+    or ``~/.cache/shipgnc`` (subfolder ``loops``)."""
+    root = os.environ.get("SHIPGNC_CACHE_DIR") or Path(
+        os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "shipgnc"
+    return Path(root) / "loops"
+
+
+def _cache_file(source: str, functions) -> Path | None:
+    """The module file of ``source`` in :func:`cache_dir`, named by a hash of it, of the files that
+    define its kernels and of the numba version (an edited kernel gets a new file); written once,
+    atomically (concurrent processes may race to write the same file). None if not writable."""
+    digest = hashlib.sha256(source.encode())
+    files = {inspect.getsourcefile(getattr(fn, "py_func", fn)) for fn in functions}
+    files |= {__file__, str(TEMPLATE), inspect.getsourcefile(kernel_function),
+              inspect.getsourcefile(Actuator)}
+    for name in sorted(f for f in files if f):
+        digest.update(Path(name).read_bytes())
+    digest.update(numba.__version__.encode())
+    path = cache_dir() / f"shipgnc_loop_{digest.hexdigest()[:24]}.py"
+    try:
+        if not path.exists():
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_suffix(f".{os.getpid()}.tmp")
+            tmp.write_text(source)
+            os.replace(tmp, path)
+    except OSError:
+        return None
+    return path
+
+
+def _source(model_fn, ctrl_fn, guid_fn, dist_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc, nzg,
+            nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
+            hold_mode, *, imports: bool):
+    """Source of the combination's module: constants, the components' kernels, the loop body."""
     nl = nu if has_lag else 0
-    nz = nx + nl
     lay = row_layout(nx, nl, nu, nref, nout, nsig, nd, nzc, nzg, nzd)
-    o_x, o_lag, o_app, o_cmd, o_ref = lay["x"], lay["lag"], lay["applied"], lay["cmd"], lay["ref"]
-    o_out, o_sig, o_d, o_done = lay["out"], lay["sig"], lay["d"], lay["done"]
-    o_zc, o_zg, o_zd = lay["zc"], lay["zg"], lay["zd"]
-    # columns of the log (the order of simulator.log_signals)
-    c_cmd, c_app, c_ref = nx, nx + nu, nx + 2 * nu
-    c_err = c_ref + nref
-    c_out = c_err + nerr
-    c_sig = c_out + nout
-
-    def loop(k0, k1, k_last, hold, every, dt, S, W, pm, pa, pc, pg, pd, limits, err,
-             out, event, done_at):
-        n_ships = S.shape[0]
-        for i in numba.prange(n_ships):
-            row = S[i]
-            x = row[o_x:o_x + nx]
-            lag = row[o_lag:o_lag + nl]
-            applied = row[o_app:o_app + nu]
-            cmd = row[o_cmd:o_cmd + nu]
-            ref = row[o_ref:o_ref + nref]
-            gout = row[o_out:o_out + nout]
-            sig = row[o_sig:o_sig + nsig]
-            d = row[o_d:o_d + nd]
-            zci = row[o_zc:o_zc + nzc]
-            zgi = row[o_zg:o_zg + nzg]
-            zdi = row[o_zd:o_zd + nzd]
-            start = np.empty(nu)
-            end = np.empty(nu)
-            u = np.empty(nu)
-            cs = np.empty(nu)
-            sig_s = np.empty(nsig)
-            zs = np.empty(nz)
-            zn = np.empty(nz)
-            ks = np.empty(nz)
-            acc = np.empty(nz)
-            xdot = np.empty(nx)
-            ic = k0 % hold
-            il = k0 % every
-            s = (k0 + every - 1) // every
-            for k in range(k0, k1):
-                t = k * dt
-                if ic == 0:
-                    if has_guid:
-                        if guid_fn(t, x, zgi, pg, ref, gout):
-                            row[o_done] = 1.0
-                    if has_ctrl:
-                        ctrl_fn(t, x, ref, zci, pc, cmd, sig)
-                        bad = False
-                        for j in range(nu):
-                            if not math.isfinite(cmd[j]):
-                                bad = True
-                        if bad:
-                            event[i] = 2 * k
-                            break
-                _plan(applied, cmd, pa, dt, rate_limited, hold_mode, start, end)
-                _input_at(start, end, 0.0, lag, pa, has_lag, rate_limited, u)
-                if has_dist and not per_stage:
-                    dist_fn(t, x, zdi, pd, W[k - k0, i], d)
-                if row[o_done] != 0.0 and done_at[i] < 0:
-                    done_at[i] = k
-                if il == 0 or k == k_last:
-                    for j in range(nx):
-                        out[j, s, i] = x[j]
-                    for j in range(nu):
-                        out[c_cmd + j, s, i] = cmd[j]
-                        out[c_app + j, s, i] = u[j]
-                    for j in range(nref):
-                        out[c_ref + j, s, i] = ref[j]
-                    for j in range(nerr):
-                        e = x[err[j, 0]] - ref[err[j, 1]]
-                        out[c_err + j, s, i] = wrap(e) if err[j, 2] else e
-                    for j in range(nout):
-                        out[c_out + j, s, i] = gout[j]
-                    for j in range(nsig):
-                        out[c_sig + j, s, i] = sig[j]
-                    s += 1
-                if k == k_last:
-                    break
-                # classic RK4 (sim.integrators.rk4_step) of z = [x, lag]
-                for stage in range(4):
-                    if stage == 0:
-                        theta = 0.0
-                        for j in range(nz):
-                            zs[j] = x[j] if j < nx else lag[j - nx]
-                    else:
-                        theta = 1.0 if stage == 3 else 0.5
-                        step = dt if stage == 3 else 0.5 * dt
-                        for j in range(nz):
-                            zs[j] = (x[j] if j < nx else lag[j - nx]) + step * ks[j]
-                    ts = t + theta * dt
-                    xs = zs[:nx]
-                    lag_s = zs[nx:]
-                    if continuous:
-                        ctrl_fn(ts, xs, ref, zci, pc, cs, sig_s)
-                        for j in range(nu):
-                            if has_lag and pa[3 * nu + j] > 0:
-                                u[j] = lag_s[j]
-                            else:
-                                u[j] = clip(cs[j], pa[j], pa[nu + j])
-                    else:
-                        _input_at(start, end, theta, lag_s, pa, has_lag, rate_limited, u)
-                    if has_dist and per_stage:
-                        dist_fn(ts, xs, zdi, pd, W[k - k0, i], d)
-                    model_fn(xs, u, d, pm, xdot)
-                    for j in range(nx):
-                        ks[j] = xdot[j]
-                    if has_lag:
-                        _lag_rate(cs if continuous else cmd, lag_s, pa, ks[nx:])
-                    if stage == 0:
-                        for j in range(nz):
-                            acc[j] = ks[j]
-                    elif stage < 3:
-                        for j in range(nz):
-                            acc[j] = acc[j] + 2.0 * ks[j]
-                    else:
-                        for j in range(nz):
-                            acc[j] = acc[j] + ks[j]
-                sixth = dt / 6.0
-                for j in range(nz):
-                    zn[j] = (x[j] if j < nx else lag[j - nx]) + sixth * acc[j]
-                for j in range(nx):
-                    x[j] = zn[j]
-                for j in range(nl):
-                    lag[j] = zn[nx + j]
-                _input_at(start, end, 1.0, lag, pa, has_lag, rate_limited, applied)
-                ok = True
-                for j in range(nx):
-                    if not abs(x[j]) <= limits[j]:
-                        ok = False
-                if not ok:
-                    event[i] = 2 * k + 1
-                    break
-                ic += 1
-                if ic == hold:
-                    ic = 0
-                il += 1
-                if il == every:
-                    il = 0
-
-    return numba.njit(parallel=True, **{**JIT_OPTIONS, "cache": False})(loop)
+    constants = {
+        "nx": nx, "nu": nu, "nd": nd, "nref": nref, "nout": nout, "nsig": nsig, "nerr": nerr,
+        "nzc": nzc, "nzg": nzg, "nzd": nzd, "nl": nl, "nz": nx + nl,
+        "has_ctrl": has_ctrl, "continuous": continuous, "has_guid": has_guid,
+        "has_dist": has_dist, "per_stage": per_stage, "has_lag": has_lag,
+        "rate_limited": rate_limited, "hold_mode": hold_mode,
+        **{f"o_{name}": lay[key] for name, key in (
+            ("x", "x"), ("lag", "lag"), ("app", "applied"), ("cmd", "cmd"), ("ref", "ref"),
+            ("out", "out"), ("sig", "sig"), ("d", "d"), ("done", "done"), ("zc", "zc"),
+            ("zg", "zg"), ("zd", "zd"))},
+        # columns of the log (the order of simulator.log_signals)
+        "c_cmd": nx, "c_app": nx + nu, "c_ref": nx + 2 * nu, "c_err": nx + 2 * nu + nref,
+        "c_out": nx + 2 * nu + nref + nerr, "c_sig": nx + 2 * nu + nref + nerr + nout,
+    }
+    lines = ["# generated by shipgnc.sim.compose: the loop of one combination of components",
+             "CACHE = True"]
+    for alias, fn in (("model_fn", model_fn), ("ctrl_fn", ctrl_fn), ("guid_fn", guid_fn),
+                      ("dist_fn", dist_fn)):
+        py = getattr(fn, "py_func", fn)
+        if imports:
+            lines.append(f"from {py.__module__} import {py.__qualname__} as {alias}")
+    lines += [f"{name} = {value!r}" for name, value in constants.items()]
+    return ("\n".join(lines) + "\n" + TEMPLATE.read_text()
+            + '\nloop = numba.njit(parallel=True, **{**JIT_OPTIONS, "cache": CACHE})(loop)\n')
 
 
 # ----------------------------------------------------------------------------------------------
@@ -285,8 +189,6 @@ def unsupported_reason(setup) -> str | None:
         reason = why() if callable(why) else None
         if reason:
             return f"{role} {type(component).__name__}: {reason}"
-    if getattr(setup.controller, "continuous", False) and getattr(setup.controller, "signals", ()):
-        return f"controller {type(setup.controller).__name__}: a continuous law's signals are not compiled"
     return None
 
 
@@ -359,7 +261,7 @@ def run(setup):
     event_at = np.full(n, -1, dtype=np.int64)
     done_at = np.full(n, -1, dtype=np.int64) if gd is not None else None
     params = [np.ascontiguousarray(k.params, dtype=np.float64) for k in (km, kc_, kg_, kd_)]
-    pa = np.concatenate([act.lower, act.upper, act.rate, act.tau]).astype(np.float64)
+    pa = act.kernel_params()
     limits = np.asarray(model.state_limits, dtype=np.float64)
     table = {"W": np.zeros((1, n, 0))}
 
