@@ -26,3 +26,20 @@ def matvec(matrix, x) -> np.ndarray:
     """(M x) for every member: ``x @ M.T`` with a fixed summation order, shape ``x.shape``."""
     M = np.asarray(matrix, dtype=float)
     return np.stack([row_dot(x, M[i]) for i in range(M.shape[0])], axis=-1)
+
+
+def time_sum(values) -> np.ndarray:
+    """Σ over the time axis of ``(time, member)`` values, added in time order for every member
+    (a running sum): its bits depend neither on how many members share the array (numpy's ``sum``
+    adds a single column pairwise but a wide array row by row) nor on zeros padding the end of a
+    member's series (a route member that finished before its batch)."""
+    values = np.asarray(values, dtype=float)
+    if values.shape[0] == 0:
+        return np.zeros(values.shape[1:])
+    return np.cumsum(values, axis=0)[-1]
+
+
+def time_mean(values) -> np.ndarray:
+    """Mean over the time axis of ``(time, member)`` values, member by member (see :func:`time_sum`)."""
+    values = np.asarray(values, dtype=float)
+    return time_sum(values) / values.shape[0]

@@ -1,8 +1,12 @@
-"""Scenario metrics computed from a result Dataset (one ship), as spec 001 §1.9–1.10 defines them.
+"""Scenario metrics computed from a result Dataset, as spec 001 §1.9–1.10 and spec 003 §3.8 define
+them.
 
-Every function takes a single-ship ``xarray.Dataset`` (see :mod:`shipgnc.sim.result`) and returns a
-dict of plain Python numbers (``None`` where a figure does not exist, e.g. a run that never settles).
-A metric's name carries the unit it is reported in.
+Each metric set is computed once, for every ship of a batch at once: ``*_arrays`` functions take
+the logged series as arrays ``(time, ship)`` and return a dict of ``(ship,)`` arrays (NaN where a
+figure does not exist), so that a study scores a chunk of members in one pass. The single-ship
+functions (``*_metrics``) take a one-ship ``xarray.Dataset`` (see :mod:`shipgnc.sim.result`) and
+return the same figures as plain Python numbers (``None`` where a figure does not exist, e.g. a run
+that never settles). A metric's name carries the unit it is reported in.
 """
 
 from __future__ import annotations
@@ -12,6 +16,7 @@ import math
 
 import numpy as np
 
+from shipgnc.batchmath import time_mean, time_sum
 from shipgnc.frames import path_frame, wrap_angle
 from shipgnc.units import to_deg
 
@@ -83,6 +88,55 @@ def stern_kick_metrics(ds) -> dict:
     }
 
 
+def series(ds, name: str) -> np.ndarray:
+    """The logged variable ``name`` as a float array ``(time, ship)`` (one column for one ship)."""
+    values = np.asarray(ds[name].values, dtype=float)
+    return values.reshape(values.shape[0], -1)
+
+
+def _scalar(value, kind=float):
+    """A figure of a one-ship array as a plain number (``None`` where it does not exist)."""
+    value = float(value)
+    return kind(value) if math.isfinite(value) else None
+
+
+def heading_step_arrays(t, psi_error, psi_d, alpha, thrust, thrust_cmd, u, step_times,
+                        tolerance_deg: float = 2.0) -> dict:
+    """The heading-step figures of :func:`heading_step_metrics` for every ship: arrays
+    ``(time, ship)`` in SI → ``(ship,)`` arrays (``settling_times_s``: ``(step, ship)``)."""
+    t = np.asarray(t, dtype=float)
+    err = to_deg(psi_error)
+    bounds = [*step_times, t[-1] + 1.0]
+    settling, overshoot = [], []
+    for t_k, t_next in itertools.pairwise(bounds):
+        window = (t >= t_k - 1e-9) & (t < t_next - 1e-9)
+        if not window.any():
+            continue
+        e_w, t_w = err[window], t[window]
+        bad = np.abs(e_w) > tolerance_deg
+        after_last_bad = e_w.shape[0] - bad[::-1].argmax(axis=0)  # index after the last bad sample
+        settle_at = t_w[np.minimum(after_last_bad, t_w.size - 1)] - t_k
+        settling.append(np.where(~bad.any(axis=0), 0.0,
+                                 np.where(after_last_bad < t_w.size, settle_at, np.nan)))
+        earlier = np.flatnonzero(t < t_k - 1e-9)
+        before = psi_d[earlier[-1]] if earlier.size else psi_d[0]
+        direction = np.sign(wrap_angle(psi_d[window][0] - before))
+        overshoot.append(np.maximum(0.0, np.max(direction * e_w, axis=0)))
+    n_ships = err.shape[1]
+    steps = np.array(settling).reshape(-1, n_ships)
+    settle = (np.max(steps, axis=0) if steps.shape[0] else np.full(n_ships, np.nan))  # NaN if any
+    return {
+        "heading_rmse_deg": np.sqrt(time_mean(err**2)),
+        "settling_time_s": settle,
+        "overshoot_deg": np.max(np.array(overshoot), axis=0) if overshoot else np.zeros(n_ships),
+        "max_thruster_angle_deg": to_deg(np.abs(alpha).max(axis=0)),
+        "max_thrust_n": thrust.max(axis=0),
+        "settling_times_s": steps,
+        "max_thrust_cmd_n": thrust_cmd.max(axis=0),
+        "final_speed_mps": u[-1],
+    }
+
+
 def heading_step_metrics(ds, step_times, tolerance_deg: float = 2.0) -> dict:
     """Metrics of heading-step tracking (spec 001 §1.10), with e_ψ = wrap(ψ − ψ_d).
 
@@ -92,36 +146,37 @@ def heading_step_metrics(ds, step_times, tolerance_deg: float = 2.0) -> dict:
     the largest max(0, sign(Δψ_d)·e_ψ) after a step. ``max_thruster_angle_deg`` and
     ``max_thrust_n`` use the applied input; ``max_thrust_cmd_n`` the command.
     """
-    t = ds.time.values
-    err = to_deg(ds.psi_error.values)
-    psi_d = ds.psi_d.values
-    bounds = [*step_times, t[-1] + 1.0]
-    settling, overshoot = [], []
-    for t_k, t_next in itertools.pairwise(bounds):
-        window = (t >= t_k - 1e-9) & (t < t_next - 1e-9)
-        if not window.any():
-            continue
-        e_w, t_w = err[window], t[window]
-        bad = np.flatnonzero(np.abs(e_w) > tolerance_deg)
-        if bad.size == 0:
-            settling.append(0.0)
-        elif bad[-1] + 1 < t_w.size:
-            settling.append(float(t_w[bad[-1] + 1] - t_k))
-        else:
-            settling.append(None)
-        before = psi_d[np.flatnonzero(t < t_k - 1e-9)[-1]] if (t < t_k - 1e-9).any() else psi_d[0]
-        direction = np.sign(wrap_angle(psi_d[window][0] - before))
-        overshoot.append(float(max(0.0, np.max(direction * e_w))))
-    settle = None if any(s is None for s in settling) or not settling else max(settling)
+    a = heading_step_arrays(ds.time.values, series(ds, "psi_error"), series(ds, "psi_d"),
+                            series(ds, "alpha"), series(ds, "T"), series(ds, "T_cmd"),
+                            series(ds, "u"), step_times, tolerance_deg)
+    out = {key: _scalar(value[0]) for key, value in a.items() if key != "settling_times_s"}
+    out["settling_times_s"] = [_scalar(v) for v in a["settling_times_s"][:, 0]]
+    out["overshoot_deg"] = float(a["overshoot_deg"][0])
+    return {key: out[key] for key in a}
+
+
+def waypoint_arrays(t, leg, along, cross, alpha, leg_lengths, capture_distance: float = 20.0) -> dict:
+    """The waypoint figures of :func:`waypoint_metrics` for every ship: arrays ``(time, ship)`` →
+    ``(ship,)`` arrays; each ship's samples after its own completion are left out."""
+    t = np.asarray(t, dtype=float)
+    leg = np.asarray(leg).astype(int)
+    last = len(leg_lengths) - 1
+    done = (leg == last) & (along >= leg_lengths[last])
+    any_done = done.any(axis=0)
+    end = np.where(any_done, done.argmax(axis=0) + 1, t.size)  # samples kept, per ship
+    keep = np.arange(t.size)[:, None] < end
+    captured = keep & (along >= capture_distance)
+    n_captured = captured.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rms = np.sqrt(time_sum(np.where(captured, cross**2, 0.0)) / n_captured)
+    peak = np.max(np.where(captured, np.abs(cross), -np.inf), axis=0)
     return {
-        "heading_rmse_deg": float(np.sqrt(np.mean(err**2))),
-        "settling_time_s": settle,
-        "overshoot_deg": max(overshoot) if overshoot else 0.0,
-        "max_thruster_angle_deg": float(to_deg(np.abs(ds.alpha.values).max())),
-        "max_thrust_n": float(ds["T"].values.max()),
-        "settling_times_s": settling,
-        "max_thrust_cmd_n": float(ds.T_cmd.values.max()),
-        "final_speed_mps": float(ds.u.values[-1]),
+        "completion_time_s": np.where(any_done, t[done.argmax(axis=0)], np.nan),
+        "crosstrack_rms_m": np.where(n_captured > 0, rms, np.nan),
+        "crosstrack_max_m": np.where(n_captured > 0, peak, np.nan),
+        "waypoints_reached": np.max(np.where(keep, leg, -1), axis=0) + any_done,
+        "max_thruster_angle_deg": to_deg(np.max(np.where(keep, np.abs(alpha), -np.inf), axis=0)),
+        "final_crosstrack_m": np.take_along_axis(cross, (end - 1)[None, :], axis=0)[0],
     }
 
 
@@ -134,25 +189,49 @@ def waypoint_metrics(ds, leg_lengths, capture_distance: float = 20.0) -> dict:
     ``waypoints_reached``: waypoints after the start whose leg was completed. Samples after the
     completion are left out (a ship of a batch keeps sailing until every ship is done).
     """
-    t = ds.time.values
-    leg = ds.leg.values.astype(int)
-    s = ds.along_track.values
-    e = ds.cross_track_error.values
-    last = len(leg_lengths) - 1
-    done = (leg == last) & (s >= leg_lengths[last])
-    if done.any():
-        end = int(np.argmax(done)) + 1
-        t, leg, s, e, done = t[:end], leg[:end], s[:end], e[:end], done[:end]
-    captured = s >= capture_distance
-    e_c = e[captured]
-    return {
-        "completion_time_s": float(t[np.argmax(done)]) if done.any() else None,
-        "crosstrack_rms_m": _number(np.sqrt(np.mean(e_c**2))) if e_c.size else None,
-        "crosstrack_max_m": _number(np.abs(e_c).max()) if e_c.size else None,
-        "waypoints_reached": int(leg.max() + (1 if done.any() else 0)),
-        "max_thruster_angle_deg": float(to_deg(np.abs(ds.alpha.values[:t.size]).max())),
-        "final_crosstrack_m": float(e[-1]),
+    a = waypoint_arrays(ds.time.values, series(ds, "leg"), series(ds, "along_track"),
+                        series(ds, "cross_track_error"), series(ds, "alpha"), leg_lengths,
+                        capture_distance)
+    out = {key: _scalar(value[0]) for key, value in a.items()}
+    out["waypoints_reached"] = int(a["waypoints_reached"][0])
+    out["final_crosstrack_m"] = float(a["final_crosstrack_m"][0])
+    return out
+
+
+def course_quality_arrays(t, psi_error, delta, u, *, lam: float = 1.0, t_end: float | None = None,
+                          diverged=False, psi=None, psi_z=None, bound_deg: float = 90.0,
+                          settle_window_s: float = 30.0, settle_band_deg: float = 2.0) -> dict:
+    """The figures of :func:`course_quality_metrics` for every ship: arrays ``(time, ship)`` →
+    ``(ship,)`` arrays; samples after a ship's run stopped (NaN padding) are left out."""
+    t = np.asarray(t, dtype=float)[:, None]
+    dpsi = -psi_error  # psi_error = wrap(ψ − ψ_d)
+    finite = np.isfinite(dpsi)
+    dpsi0 = np.where(finite, dpsi, 0.0)
+    psi_E = time_sum(dpsi0**2)
+    delta_E = lam * time_sum(np.where(finite, delta, 0.0) ** 2)
+    t_last = np.max(np.where(finite, t, -np.inf), axis=0)
+    last = finite.shape[0] - 1 - finite[::-1].argmax(axis=0)
+    reached = np.ones_like(t_last, dtype=bool) if t_end is None else t_last >= t_end - 1e-9
+    late = finite & (t >= t_last - settle_window_s)
+    dpsi_deg = np.abs(to_deg(dpsi0))
+    out = {
+        "psi_E": psi_E,
+        "delta_E": delta_E,
+        "J": psi_E + delta_E,
+        "min_surge_mps": np.min(np.where(np.isfinite(u), u, np.inf), axis=0),
+        "final_heading_error_deg": to_deg(np.take_along_axis(dpsi0, last[None, :], axis=0)[0]),
+        "max_rudder_deg": to_deg(np.max(np.where(finite, np.abs(delta), -np.inf), axis=0)),
+        "stable": reached & ~np.asarray(diverged, dtype=bool) & np.all(
+            ~finite | (dpsi_deg < bound_deg), axis=0),
+        "settled": np.all(~late | (dpsi_deg <= settle_band_deg), axis=0),
     }
+    if psi_z is not None:
+        ref = np.where(finite & np.isfinite(psi_z), wrap_angle(psi_z - psi), np.nan)
+        known = np.isfinite(ref).any(axis=0)
+        out["psi_E_ref"] = np.where(known, time_sum(np.where(np.isfinite(ref), ref**2, 0.0)), np.nan)
+    else:
+        out["psi_E_ref"] = np.full(psi_E.shape, np.nan)
+    return out
 
 
 def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
@@ -167,28 +246,13 @@ def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
     ``settled`` (|Δψ| ≤ 2° over the last 30 s) and ``psi_E_ref`` (Σ wrap(ψ_z − ψ)² against the
     reference model, for controllers that have one; spec 003 B11).
     """
-    t = ds.time.values
-    dpsi = -ds.psi_error.values  # psi_error = wrap(ψ − ψ_d)
-    delta = ds.delta.values
-    finite = np.isfinite(dpsi)
-    dpsi, delta, t = dpsi[finite], delta[finite], t[finite]
-    psi_E = float(np.sum(dpsi**2))
-    delta_E = float(lam * np.sum(delta**2))
-    reached = t_end is None or (t.size and t[-1] >= t_end - 1e-9)
-    late = t >= t[-1] - settle_window_s
-    out = {
-        "psi_E": psi_E,
-        "delta_E": delta_E,
-        "J": psi_E + delta_E,
-        "min_surge_mps": float(np.min(ds.u.values[np.isfinite(ds.u.values)])),
-        "final_heading_error_deg": float(to_deg(dpsi[-1])),
-        "max_rudder_deg": float(to_deg(np.max(np.abs(delta)))),
-        "stable": bool(reached and not diverged and np.all(np.abs(to_deg(dpsi)) < bound_deg)),
-        "settled": bool(np.all(np.abs(to_deg(dpsi[late])) <= settle_band_deg)),
-    }
-    if "psi_z" in ds and np.isfinite(ds.psi_z.values).any():
-        ref = wrap_angle(ds.psi_z.values[finite] - ds.psi.values[finite])
-        out["psi_E_ref"] = float(np.nansum(ref**2))
-    else:
-        out["psi_E_ref"] = None
+    has_ref = "psi_z" in ds
+    a = course_quality_arrays(ds.time.values, series(ds, "psi_error"), series(ds, "delta"),
+                              series(ds, "u"), lam=lam, t_end=t_end, diverged=diverged,
+                              psi=series(ds, "psi") if has_ref else None,
+                              psi_z=series(ds, "psi_z") if has_ref else None,
+                              bound_deg=bound_deg, settle_window_s=settle_window_s,
+                              settle_band_deg=settle_band_deg)
+    out = {key: _scalar(value[0]) for key, value in a.items()}
+    out["stable"], out["settled"] = bool(a["stable"][0]), bool(a["settled"][0])
     return out

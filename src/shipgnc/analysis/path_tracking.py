@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 
+from shipgnc.batchmath import time_sum
 from shipgnc.units import MINUTE, NAUTICAL_MILE, to_deg
 
 #: |y_r| below which leg 1 counts as settled [m] (0.05 nm)
@@ -78,7 +79,7 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
     with np.errstate(invalid="ignore", divide="ignore"):
         abs_after = np.where(after, np.abs(y), np.nan)
         max_after = np.where(has_switch, np.nanmax(np.where(after, abs_after, -np.inf), axis=0), np.nan)
-        rms_after = np.sqrt(np.nansum(np.where(after, y * y, np.nan), axis=0) / after.sum(axis=0))
+        rms_after = np.sqrt(time_sum(np.where(after, y * y, 0.0)) / after.sum(axis=0))
         rms_after = np.where(has_switch, rms_after, np.nan)
 
         t_last = np.max(np.where(valid, t[:, None], -np.inf), axis=0)
@@ -86,10 +87,10 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
         count = final.sum(axis=0)
 
         def final_mean(a):
-            return np.where(final, a, 0.0).sum(axis=0) / count
+            return time_sum(np.where(final, a, 0.0)) / count
 
         applied = valid & np.isfinite(d)
-        rudder_rms = np.sqrt(np.where(applied, d * d, 0.0).sum(axis=0) / applied.sum(axis=0))
+        rudder_rms = np.sqrt(time_sum(np.where(applied, d * d, 0.0)) / applied.sum(axis=0))
         saturated = applied & (np.abs(d) >= delta_max * (1.0 - 1e-9))
         saturation = saturated.sum(axis=0) / applied.sum(axis=0)
         peak = np.max(np.where(valid, np.abs(y), 0.0), axis=0)

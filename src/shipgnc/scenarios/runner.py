@@ -234,6 +234,54 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     return out
 
 
+def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndarray] | None:
+    """Every ship's scalar metrics at once, ``(ship,)`` arrays in :func:`compute_metrics`'s key
+    order (lists left out; NaN where a figure does not exist), from a batch result that did not
+    diverge; None for a metric set that is scored one ship at a time (``stern-kick``)."""
+    from shipgnc.analysis import metrics
+    from shipgnc.analysis.metrics import series
+
+    t = result.time.values
+    if scenario.metrics == "heading-steps":
+        out = metrics.heading_step_arrays(t, series(result, "psi_error"), series(result, "psi_d"),
+                                          series(result, "alpha"), series(result, "T"),
+                                          series(result, "T_cmd"), series(result, "u"),
+                                          setup.guidance.step_times)
+        del out["settling_times_s"]
+    elif scenario.metrics == "waypoints":
+        out = metrics.waypoint_arrays(t, series(result, "leg"), series(result, "along_track"),
+                                      series(result, "cross_track_error"), series(result, "alpha"),
+                                      setup.guidance.path.leg_lengths,
+                                      scenario.guidance.capture_distance)
+    elif scenario.metrics == "course-quality":
+        has_ref = "psi_z" in result
+        out = metrics.course_quality_arrays(
+            t, series(result, "psi_error"), series(result, "delta"), series(result, "u"),
+            lam=scenario.quality.lam, t_end=scenario.simulation.t_end,
+            psi=series(result, "psi") if has_ref else None,
+            psi_z=series(result, "psi_z") if has_ref else None)
+    elif scenario.metrics == "path-tracking" and scenario.montecarlo is None:
+        from shipgnc.analysis import path_tracking
+
+        out = path_tracking.path_tracking_arrays(
+            t, series(result, "cross_track_error"), series(result, "heading_error"),
+            series(result, "leg"), series(result, "delta"),
+            delta_max=float(setup.model.params.delta_max), reached_end=True)
+        out = {key: out[key] for key in path_tracking.PATH_TRACKING_KEYS}
+        single = compute_metrics(scenario, result.isel({result.psi.dims[1]: 0}), setup)
+        for key, value in single.items():  # the design's figures: the same for every ship
+            if key not in out and key != "diverged" and isinstance(value, (int, float)):
+                out[key] = value
+    elif scenario.metrics is None:
+        out = {}
+    else:
+        return None
+    n = series(result, result.psi.name).shape[1]
+    arrays = {key: np.broadcast_to(np.asarray(value, dtype=float), (n,)) for key, value in out.items()}
+    arrays["diverged"] = np.zeros(n)
+    return arrays
+
+
 def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progress=None,
                  on_divergence: str = "raise") -> ScenarioRun:
     """Run a scenario (object, built-in name or YAML path) and compute its metrics.

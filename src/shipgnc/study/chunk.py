@@ -202,7 +202,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """
     import xarray as xr
 
-    from shipgnc.scenarios.runner import build, compute_metrics
+    from shipgnc.scenarios.runner import build, compute_metrics, metric_arrays
 
     scenario = study.scenario_at(study.points[chunk.point])
     check_sweepable(scenario)
@@ -211,6 +211,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     seeds = [study.member_streams(m)[1] for m in range(chunk.start, chunk.stop)]
     route = ends_early(setup)
     result, done_at = _run_batch(setup, scenario, x0, seeds, backend, route)
+    arrays = None
     if result.attrs.get("diverged", 0):
         runs = [_run_batch(setup, scenario, x0[i:i + 1], seeds[i:i + 1], backend, route)
                 for i in range(chunk.size)]
@@ -220,10 +221,13 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
         done_at = np.concatenate([d for _, d in runs]) if route else None
     else:
         ran_on = {result.attrs.get("backend")}
-        members = [result.isel(member=i) for i in range(chunk.size)]
-    rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
-    keys = list(dict.fromkeys(k for row in rows for k in row))
-    data = {k: ("member", np.array([row.get(k, math.nan) for row in rows])) for k in keys}
+        arrays = metric_arrays(scenario, result, setup)  # every member scored at once
+        members = [result.isel(member=i) for i in range(chunk.size)] if arrays is None else []
+    if arrays is None:
+        rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
+        keys = list(dict.fromkeys(k for row in rows for k in row))
+        arrays = {k: np.array([row.get(k, math.nan) for row in rows]) for k in keys}
+    data = {k: ("member", np.asarray(v, dtype=float)) for k, v in arrays.items()}
     out = xr.Dataset(data, coords={"member": np.arange(chunk.start, chunk.stop)},
                      attrs={"backend": ", ".join(sorted(str(b) for b in ran_on))})
     if study.series:
