@@ -29,6 +29,7 @@ so NaN and inf keep their meaning for the divergence guard; results move at roun
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -46,10 +47,12 @@ class NotCompiled(Exception):
 
 def kernel_function(function):
     """Compile ``function`` as a component kernel or scalar helper (lazily, on first call; cached
-    on disk). Kernels are called, not inlined, by the composed loop: numba's IR-level inlining
-    (``inline="always"``) ran the boat ≈ 25 % faster but tripled the loop's first compile and
-    defeated its disk cache."""
-    return numba.njit(**JIT_OPTIONS)(function)
+    on disk when it is defined in a file; a kernel typed into a notebook or ``exec``-ed compiles
+    once per process). Kernels are called, not inlined, by the composed loop: numba's IR-level
+    inlining (``inline="always"``) ran the boat ≈ 25 % faster but tripled the loop's first compile
+    and defeated its disk cache."""
+    in_a_file = os.path.isfile(function.__code__.co_filename)
+    return numba.njit(**{**JIT_OPTIONS, "cache": in_a_file})(function)
 
 
 @dataclass(frozen=True, eq=False)
