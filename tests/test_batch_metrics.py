@@ -58,3 +58,17 @@ def test_time_sum_ignores_batch_width_and_trailing_zeros():
     wide = time_sum(x)
     for j in range(5):
         assert time_sum(x[:, j:j + 1])[0] == wide[j] == time_sum(padded[:, j:j + 1])[0]
+
+
+def test_a_schedule_without_turn_reports_what_is_defined_and_why_not_the_rest():
+    """Straight running at 100 N: the steady speed T/(−X_u) exists (spec 001 §1.7), the turn's
+    figures do not, and the note names them."""
+    from shipgnc.scenarios.runner import run_scenario
+
+    run = run_scenario("boat-stern-kick", overrides=["controller.schedule=[{t: 0, T: 100, alpha_deg: 0}]",
+                                                     "simulation.t_end=60"])
+    m = run.metrics
+    assert m["final_speed_mps"] == pytest.approx(100.0 / 77.55, rel=1e-3)  # 60 s ≫ τ_s ≈ 1.1 s
+    assert m["final_heading_deg"] == 0.0 and m["heading_change_deg"] is None
+    assert "heading_change_deg" in m["note"] and "alpha_cmd" in m["note"]
+    assert "final_speed_mps" not in m["note"]

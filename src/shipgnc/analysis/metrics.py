@@ -57,16 +57,26 @@ def stern_kick_metrics(ds) -> dict:
 
     With the turn commanded over [t_on, t_off]: ``initial_sway_sign`` and
     ``initial_yaw_rate_sign`` are the signs of v and r at t_on + dt; ``steady_yaw_rate_sign`` and
-    ``steady_yaw_rate_rad_s`` use the mean r over the last 40 % of the turn (every figure is
-    ``None`` when the run holds no turn command); ([8, 10] s in the
+    ``steady_yaw_rate_rad_s`` use the mean r over the last 40 % of the turn ([8, 10] s in the
     document's sequence); ``heading_change_deg`` = ψ(t_off) − ψ(t_on); ``max_speed_mps`` and
     ``final_speed_mps`` use U = √(u² + v²); ``stern_kick_min_lateral_m`` is the least lateral
     offset of the CG during the turn, in the frame of the heading at t_on (positive to starboard).
+    A run without a turn command has the speeds and the final heading only; the turn's figures
+    are ``None`` and ``note`` names them and says why.
     """
     t = ds.time.values
     if t.size < 2 or not np.any(ds.alpha_cmd.values != 0):
-        # no turn inside the run (too short, or diverged first): the figures do not exist
-        return dict.fromkeys(STERN_KICK_KEYS)
+        # no turn inside the run (a schedule without one, too short, or diverged first): the
+        # speeds and the final heading exist, the turn's figures do not; the note says which
+        speed = np.hypot(ds.u.values, ds.v.values)
+        out = dict.fromkeys(STERN_KICK_KEYS)
+        out.update(max_speed_mps=float(speed.max()), final_speed_mps=float(speed[-1]),
+                   final_heading_deg=float(to_deg(ds.psi.values[-1])))
+        undefined = [key for key, value in out.items() if value is None]
+        why = ("the run holds a single sample" if t.size < 2 else
+               "the thruster angle command alpha_cmd is 0 throughout the run (no turn window)")
+        out["note"] = f"{', '.join(undefined)}: undefined, {why}"
+        return out
     dt = float(t[1] - t[0])
     t_on, t_off = turn_window(t, ds.alpha_cmd.values)
     speed = np.hypot(ds.u.values, ds.v.values)
