@@ -4,7 +4,11 @@ promise of ``simulate``'s ``backend``).
 
 Runs are shortened where a full run would take long in numpy (the comparison holds step by step,
 so a shorter run checks the same arithmetic); a catamaran builder takes ``simulation.t_end`` where
-it has one.
+it has one. Document 003's closed loops amplify round-off (the printed sliding mode chatters; in
+waves the rate-limited rudder follows the wave-frequency yaw): fused multiply-adds in the compiled
+code and numpy's ``tanh`` move the last bit, and the numpy loop itself departs from its own run
+started 1e-15 rad/s apart by more than 1e-9 within 80 s (``tests/test_compose_cybership.py``), so
+those scenarios are compared over the horizon where a run is reproducible at all.
 """
 
 from __future__ import annotations
@@ -18,8 +22,8 @@ from shipgnc.scenarios.runner import run_scenario
 #: overrides that keep the numpy run short
 SHORTER = {
     "boat-los": ("simulation.t_end=120",),
-    "cybership-calm": ("simulation.t_end=80",),
-    "cybership-waves": ("simulation.t_end=40",),
+    "cybership-calm": ("simulation.t_end=12",),
+    "cybership-waves": ("simulation.t_end=20",),
     "mariner-compare": ("simulation.t_end=1200",),
     "mariner-lqr": ("simulation.t_end=1200",),
     "mariner-los-fl": ("simulation.t_end=1200",),

@@ -28,6 +28,7 @@ Every controller reads the reference ``psi_d`` and the CyberShip II state
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import control
@@ -36,6 +37,7 @@ import numpy as np
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.guidance.reference import HeadingReferenceModel
+from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
 from shipgnc.models.cybership2 import CRUISE_RPS
 
@@ -94,6 +96,18 @@ class CoursePD(_CourseController):
         psi, r = measurement[..., 2], measurement[..., 5]
         delta_z = self.Kp * wrap_angle(psi - reference[..., 0]) + self.Kd * r
         return self._command(np.asarray(delta_z, dtype=float))
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`step` for the composed loop (:func:`course_pd_step`); no per-ship state."""
+        return Kernel(course_pd_step, flat(self.Kp, self.Kd, self.propeller_rps))
+
+
+@kernel_function
+def course_pd_step(t, x, ref, z, p, cmd, sig):
+    """Eq. (3) for one ship, as :meth:`CoursePD.step`: δ_z = K_P wrap(ψ − ψ_d) + K_D r,
+    n = the held propeller speed; ``p`` = [K_P, K_D, n]."""
+    cmd[0] = p[2]
+    cmd[1] = p[0] * wrap(x[2] - ref[0]) + p[1] * x[5]
 
 
 @dataclass(frozen=True, eq=False)
@@ -226,6 +240,56 @@ class SlidingModeCourse(_CourseController):
                         "sigma": np.asarray(sigma, dtype=float)}
         ref.advance(r_dot_z, self.Ts)
         return self._command(np.asarray(delta_z, dtype=float))
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`step` for the composed loop (:func:`sliding_mode_step`). Per-ship state
+        ``[psi_z, r_z, started, psi_z, r_z, sigma]``: the reference model (15) and the last logged
+        signals, which :meth:`restore <shipgnc.kernels.Kernel>` hands back."""
+        g, ref = self.design, self.reference_model
+        params = flat(g.K[0], g.K[1], g.h[0], g.h[1], g.N, g.hB, self.eta, self.phi, ref.omega,
+                      ref.zeta, self.Ts, float(self.form == "consistent"), self.propeller_rps)
+        state = np.zeros((*batch_shape, 6))
+        if ref.psi is not None:
+            state[..., 0], state[..., 1], state[..., 2] = ref.psi, ref.rate, 1.0
+        names = [s.name for s in self.signals]
+
+        def restore(z: np.ndarray) -> None:
+            z = z.reshape(*batch_shape, 6)
+            if np.all(z[..., 2] > 0):
+                ref.psi, ref.rate = z[..., 0].copy(), z[..., 1].copy()
+                self._logged = {name: z[..., 3 + j].copy() for j, name in enumerate(names)}
+
+        return Kernel(sliding_mode_step, params, state, restore=restore)
+
+
+@kernel_function
+def sliding_mode_step(t, x, ref, z, p, cmd, sig):
+    """Law (14) with the reference model (15) for one ship, as :meth:`SlidingModeCourse.step`
+    operation for operation (both forms); ``p`` from :meth:`SlidingModeCourse.kernel`, ``z`` =
+    [ψ_z, r_z, started, logged ψ_z, r_z, σ], ``sig`` = [ψ_z, r_z, σ] before the Euler step."""
+    k1, k2, h1, h2, N, hB, eta, phi = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+    w, zeta, Ts, consistent, rps = p[8], p[9], p[10], p[11], p[12]
+    psi, r = x[2], x[5]
+    if z[2] == 0.0:  # the reference model starts at the measured heading, r_z = 0
+        z[0], z[1], z[2] = psi, 0.0, 1.0
+    psi_z, r_z = z[0], z[1]
+    r_dot_z = w * w * wrap(ref[0] - psi_z) - 2.0 * zeta * w * r_z
+    e_psi = wrap(psi - psi_z)
+    e_r = r - r_z
+    u_eq = -k1 * e_psi - k2 * r + (N - k1) * psi_z
+    feedforward = h1 * r_z + h2 * r_dot_z
+    if consistent != 0.0:
+        sigma = h1 * e_psi + h2 * e_r
+        delta_z = u_eq + (feedforward - eta * math.tanh(sigma / phi)) / hB
+    else:
+        sigma = -(h1 * e_psi + h2 * e_r)
+        delta_z = u_eq + feedforward - eta * math.tanh(sigma / phi)
+    sig[0], sig[1], sig[2] = psi_z, r_z, sigma
+    z[3], z[4], z[5] = psi_z, r_z, sigma
+    z[0] = psi_z + Ts * r_z
+    z[1] = r_z + Ts * r_dot_z
+    cmd[0] = rps
+    cmd[1] = delta_z
 
 
 def smc_paper(form: str = "consistent", design_model: tuple[float, float] | None = None, *,

@@ -1,9 +1,16 @@
-"""Compiled (numba) twin of :meth:`FroudeKrylovWaveLoads.__call__` (document 003's wave loads).
+"""Compiled (numba) forms of document 003's wave loads (:class:`FroudeKrylovWaveLoads`).
 
-The numpy form in :mod:`shipgnc.environment.waves` is the reference; this kernel repeats it for one
-(ship, component) pair at a time, so a batch of ships does not allocate a dozen (ships × components)
-temporaries per RK stage (about 3× faster; one thread: a parallel region's spinning workers would slow the
-numpy loop around it). Tests hold both equal to round-off.
+The numpy form in :mod:`shipgnc.environment.waves` (``loads_numpy``) is the reference. Two
+compiled forms repeat it:
+
+* :func:`loads` — the twin the numpy loop calls (``__call__``, recorded as ``+wave_kernel``): one
+  (ship, component) pair at a time, so a batch does not allocate a dozen (ships × components)
+  temporaries per RK stage (about 3× faster; one thread: a parallel region's spinning workers
+  would slow the numpy loop around it);
+* :func:`froude_krylov_sample` — the disturbance kernel of the composed loop
+  (:mod:`shipgnc.kernels`), one ship per call, its sea in the ship's kernel state.
+
+Tests hold both equal to the reference to round-off.
 """
 
 from __future__ import annotations
@@ -72,3 +79,168 @@ def loads(t: float, north, east, psi, arrays: dict, length: float, beam: float,
             arrays["phase"], arrays["half_kL"], arrays["half_kB"], arrays["chi"], arrays["wX"],
             arrays["wY"], arrays["wN"], float(length), float(beam), bool(long_crested), out)
     return out
+
+
+# ----------------------------------------------------------------------------------------------
+# the disturbance kernel of the composed loop (shipgnc.kernels): one ship, every RK stage
+# ----------------------------------------------------------------------------------------------
+
+import numba  # noqa: E402
+
+from shipgnc.kernels import JIT_OPTIONS, kernel_function  # noqa: E402
+
+#: rows of a ship's per-component block in the kernel's state (each ``n_components`` long)
+ROWS = ("omega", "phase", "k_north", "k_east", "half_kL", "half_kB", "chi", "wX", "wY", "wN")
+#: scratch rows after them: the per-component terms of X, Y and N, summed as numpy sums them
+N_SCRATCH = 3
+
+
+@kernel_function
+def pairwise_sum(a, lo, n):
+    """Σ a[lo:lo + n] in the order of numpy's ``np.sum`` along a contiguous axis (its pairwise
+    summation: eight interleaved partial sums in blocks of at most 128, halves above that), so the
+    kernel adds the components exactly as :meth:`FroudeKrylovWaveLoads.loads_numpy` does."""
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[lo + i]
+        return res
+    if n <= 128:
+        r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+        r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+        i = 8
+        end = n - n % 8
+        while i < end:
+            j = lo + i
+            r0 += a[j]
+            r1 += a[j + 1]
+            r2 += a[j + 2]
+            r3 += a[j + 3]
+            r4 += a[j + 4]
+            r5 += a[j + 5]
+            r6 += a[j + 6]
+            r7 += a[j + 7]
+            i += 8
+        res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+        while i < n:
+            res += a[lo + i]
+            i += 1
+        return res
+    n2 = n // 2
+    n2 -= n2 % 8
+    return pairwise_sum(a, lo, n2) + pairwise_sum(a, lo + n2, n - n2)
+
+
+# sin and cos of many arguments in one vectorisable loop (no libm call per element): Cody–Waite
+# reduction by π/2 in three parts (exact products for |x| < 2²⁰·π/2) and fdlibm's kernels
+# __kernel_sin / __kernel_cos on |r| ≤ π/4 (error < 1 ulp; libm's own reduction and kernels)
+_PIO2_1 = 1.57079632673412561417e+00
+_PIO2_2 = 6.07710050630396597660e-11
+_PIO2_3 = 2.02226624871116645580e-21
+_INV_PIO2 = 6.36619772367581382433e-01
+#: beyond this |x| the three-part reduction loses bits: those arguments go to libm
+SINCOS_LIMIT = 1.0e6
+_S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
+_S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
+_C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
+_C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
+
+
+@numba.njit(inline="always", **JIT_OPTIONS)
+def sincos(x):
+    """(sin x, cos x) within 1 ulp of libm for |x| ≤ :data:`SINCOS_LIMIT`, branch-free (so a loop
+    of it vectorises); NaN stays NaN."""
+    q = math.floor(x * _INV_PIO2 + 0.5)
+    r = x - q * _PIO2_1
+    r = r - q * _PIO2_2
+    r = r - q * _PIO2_3
+    z = r * r
+    s = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
+    rc = z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
+    hz = 0.5 * z
+    w = 1.0 - hz
+    c = w + (((1.0 - w) - hz) + z * rc)
+    m = q - 4.0 * math.floor(q * 0.25)  # quadrant 0..3
+    sn = s if m == 0.0 else (c if m == 1.0 else (-s if m == 2.0 else -c))
+    cs = c if m == 0.0 else (-s if m == 1.0 else (-c if m == 2.0 else s))
+    return sn, cs
+
+
+@numba.njit(inline="always", **JIT_OPTIONS)
+def _sinc_j1(s, c, u):
+    """sinc u and j₁(u) from s = sin u, c = cos u, as ``waves._sin_sinc_j1`` (series for
+    |u| < 1e-3), without branches."""
+    small = abs(u) < 1e-3
+    us = 1.0 if small else u
+    u2 = u * u
+    inv = 1.0 / us  # one division for both (x/u → x·(1/u): round-off only, as arcp allows)
+    sinc = 1.0 - u2 * (1.0 / 6.0) if small else s * inv
+    j1 = u * (1.0 / 3.0 - u2 * (1.0 / 30.0)) if small else (sinc - c) * inv
+    return sinc, j1
+
+
+@numba.njit(inline="always", **JIT_OPTIONS)
+def _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v):
+    """Component j's terms of X, Y, N (:meth:`FroudeKrylovWaveLoads.loads_numpy`'s products)."""
+    sinc_u, j1_u = _sinc_j1(s_u, c_u, u)
+    sinc_v, j1_v = _sinc_j1(s_v, c_v, v)
+    z[o_t + j] = z[7 * n + j] * (beam * s_u * sinc_v) * s
+    z[o_t + n + j] = z[8 * n + j] * (length * s_v * sinc_u) * s
+    z[o_t + 2 * n + j] = z[9 * n + j] * (L2 * s_v * j1_u - B2 * s_u * j1_v) * c
+
+
+@kernel_function
+def froude_krylov_sample(t, x, z, p, w, d):
+    """[X_env, Y_env, N_env] of one ship at time ``t`` and stage state ``x``: document 003's
+    seeded Froude–Krylov loads (spec 003 §3.6; :class:`~shipgnc.environment.waves.FroudeKrylovWaveLoads`),
+
+        θᵢ = ωᵢ t − (k_n,ᵢ n + k_e,ᵢ e) + φᵢ,   βᵢ = χᵢ − ψ,   uᵢ = ½kᵢL cos βᵢ,  vᵢ = ½kᵢB sin βᵢ,
+        X = Σ w_X,ᵢ B sin uᵢ sinc vᵢ sin θᵢ,   Y = Σ w_Y,ᵢ L sin vᵢ sinc uᵢ sin θᵢ,
+        N = Σ w_N,ᵢ (L² sin vᵢ j₁(uᵢ) − B² sin uᵢ j₁(vᵢ)) cos θᵢ,
+
+    operation for operation as :meth:`~FroudeKrylovWaveLoads.loads_numpy`, the sums in numpy's
+    order (:func:`pairwise_sum`). The cost is three sin/cos pairs per component and stage: they
+    are evaluated by :func:`sincos` in one vectorised loop over the components (libm for any
+    argument beyond :data:`SINCOS_LIMIT`). ``z`` holds the ship's sea (:data:`ROWS`) and the
+    scratch rows of the terms; ``p`` = [n_components, L, B, long-crested, i_north, i_east, i_psi]."""
+    n = int(p[0])
+    length, beam = p[1], p[2]
+    north, east, psi = x[int(p[4])], x[int(p[5])], x[int(p[6])]
+    L2, B2 = length ** 2, beam ** 2
+    o_t = 10 * n
+    n_big = 0
+    if p[3] != 0.0:  # long-crested: one direction, so β is the ship's
+        beta = z[6 * n] - psi
+        cos_b, sin_b = math.cos(beta), math.sin(beta)
+        for j in range(n):
+            theta = z[j] * t - (z[2 * n + j] * north + z[3 * n + j] * east) + z[n + j]
+            u = z[4 * n + j] * cos_b
+            v = z[5 * n + j] * sin_b
+            n_big += max(abs(theta), abs(u), abs(v)) > SINCOS_LIMIT
+            s, c = sincos(theta)
+            s_u, c_u = sincos(u)
+            s_v, c_v = sincos(v)
+            _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v)
+    else:
+        for j in range(n):
+            theta = z[j] * t - (z[2 * n + j] * north + z[3 * n + j] * east) + z[n + j]
+            beta = z[6 * n + j] - psi
+            n_big += max(abs(theta), abs(beta)) > SINCOS_LIMIT
+            sin_b, cos_b = sincos(beta)
+            u = z[4 * n + j] * cos_b
+            v = z[5 * n + j] * sin_b
+            s, c = sincos(theta)
+            s_u, c_u = sincos(u)
+            s_v, c_v = sincos(v)
+            _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v)
+    if n_big:  # arguments beyond the fast reduction (a run of hours, a runaway heading): libm
+        for j in range(n):
+            theta = z[j] * t - (z[2 * n + j] * north + z[3 * n + j] * east) + z[n + j]
+            beta = (z[6 * n] if p[3] != 0.0 else z[6 * n + j]) - psi
+            u = z[4 * n + j] * math.cos(beta)
+            v = z[5 * n + j] * math.sin(beta)
+            _terms(z, j, n, o_t, length, beam, L2, B2, math.sin(theta), math.cos(theta),
+                   math.sin(u), math.cos(u), math.sin(v), math.cos(v), u, v)
+    d[0] = pairwise_sum(z, o_t, n)
+    d[1] = pairwise_sum(z, o_t + n, n)
+    d[2] = pairwise_sum(z, o_t + 2 * n, n)

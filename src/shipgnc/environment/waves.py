@@ -28,6 +28,7 @@ of ships gets independent seas from one generator in one array operation.
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from itertools import pairwise
@@ -36,6 +37,7 @@ import numpy as np
 from scipy import integrate
 
 from shipgnc.errors import ConfigError, require
+from shipgnc.kernels import Kernel, flat
 from shipgnc.sim.streams import is_generator
 from shipgnc.units import G
 
@@ -733,6 +735,7 @@ class FroudeKrylovWaveLoads:
         require(backend in ("auto", "numpy"), "waves.backend", backend,
                 "allowed: auto (compiled kernel when numba is available), numpy")
         self.backend = backend
+        self._numpy_only = False
         self._flat = None
         self.spectrum = spectrum
         self.direction = _angle(direction)
@@ -828,11 +831,45 @@ class FroudeKrylovWaveLoads:
         return out.reshape(*self._batch, 3)
 
     def evaluator(self) -> str:
-        """Which code evaluates the loads: ``"wave_kernel"`` (numba) or ``"numpy"``; they agree to
-        round-off, not to the bit, so a run records it (``attrs["backend"]``)."""
+        """Which code evaluates the loads in the numpy loop: ``"wave_kernel"`` (numba) or
+        ``"numpy"`` (``backend="numpy"``, inside :meth:`numpy_only`, or without numba); they agree
+        to round-off, not to the bit, so a run records it (``attrs["backend"]``)."""
         from shipgnc.environment import wave_kernel
 
-        return "numpy" if self.backend == "numpy" or not wave_kernel.available() else "wave_kernel"
+        if self.backend == "numpy" or self._numpy_only or not wave_kernel.available():
+            return "numpy"
+        return "wave_kernel"
+
+    @contextmanager
+    def numpy_only(self):
+        """Within the block the loads are :meth:`loads_numpy` whatever ``backend`` says
+        (``simulate(backend="numpy")``: the reference loop keeps every component in numpy)."""
+        before, self._numpy_only = self._numpy_only, True
+        try:
+            yield self
+        finally:
+            self._numpy_only = before
+
+    def kernel(self, batch_shape) -> Kernel:
+        """The loads for the composed loop, evaluated in every RK stage
+        (:func:`~shipgnc.environment.wave_kernel.froude_krylov_sample`). The ship's sea is its
+        per-ship state: the rows of :data:`~shipgnc.environment.wave_kernel.ROWS` (ωᵢ, φᵢ,
+        kᵢcos χᵢ, kᵢsin χᵢ, ½kᵢL, ½kᵢB, χᵢ and the weights −2g_X ρgDᵢaᵢ, −2g_Y ρgDᵢaᵢ,
+        g_N ρgDᵢaᵢ, the very arrays :meth:`loads_numpy` reads) and scratch rows; the same seed
+        therefore gives the same sea."""
+        from shipgnc.environment.wave_kernel import N_SCRATCH, ROWS, froude_krylov_sample
+
+        r = self._require_reset()
+        n = r.n_components
+        shape = (*tuple(batch_shape), n)
+        chi = self.direction if self.spreading is None else r.direction
+        rows = (r.omega, r.phase, r._k_north, r._k_east, self._half_kL, self._half_kB, chi,
+                *self._weights)
+        state = np.zeros((*tuple(batch_shape), (len(ROWS) + N_SCRATCH) * n))
+        for i, row in enumerate(rows):
+            state[..., i * n:(i + 1) * n] = np.broadcast_to(row, shape)
+        params = flat(n, self.length, self.beam, float(self.spreading is None), self.state_index)
+        return Kernel(froude_krylov_sample, params, state, per_stage=True)
 
     def _flat_arrays(self) -> dict[str, np.ndarray]:
         """The sea's per-component arrays as (ships, components) rows for the kernel (made once)."""
@@ -865,5 +902,6 @@ class FroudeKrylovWaveLoads:
                          np.sum(wN * fN * c, axis=-1)], axis=-1)
 
 
-#: the name used in the issue text for the wave-load disturbance
+#: another name of :class:`FroudeKrylovWaveLoads`, the wave-load disturbance of document 003's
+#: ``cybership-waves`` (spec 003 §3.6): its yaw moment is what moves the heading in waves
 WaveYawDisturbance = FroudeKrylovWaveLoads

@@ -44,6 +44,7 @@ import numpy as np
 from shipgnc.actuators import Actuator
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
+from shipgnc.kernels import Kernel, flat, kernel_function
 from shipgnc.models.base import Signal
 from shipgnc.models.fossen3dof import DISTURBANCES, STATES
 
@@ -327,10 +328,82 @@ class CyberShip2:
         return np.stack([north_dot, east_dot, sr, f_x / p.M11, a * f_y + b * f_n, c * f_y + e * f_n],
                         axis=-1)
 
+    def kernel(self) -> Kernel:
+        """:meth:`derivatives` for the composed loop (:func:`cybership2_rhs`); the parameters
+        are combined exactly as the numpy form combines them."""
+        p = self.params
+        (a, b), (c, e) = self._sway_yaw_inverse
+        return Kernel(cybership2_rhs, flat(
+            p.T_nn, p.T_nu, float(p.rudder_model == "skjetne"), p.Y_delta, p.N_delta,
+            p.L_delta, p.L_absdelta_delta, p.k_u, math.pi * p.rho * p.d_prop**2, p.x_rudder,
+            p.m, p.x_G, p.Y_vdot, 0.5 * (p.N_vdot + p.Y_rdot), p.m - p.X_udot,
+            p.Y_v, p.Y_absv_v, p.Y_absr_v, p.Y_r, p.Y_absv_r, p.Y_absr_r,
+            p.N_v, p.N_absv_v, p.N_absr_v, p.N_r, p.N_absv_r, p.N_absr_r,
+            p.X_u, p.X_absu_u, p.X_uuu, p.M11, a, b, c, e))
+
     @cached_property
     def _sway_yaw_inverse(self) -> tuple[tuple[float, float], tuple[float, float]]:
         inv = np.linalg.inv(self.params.sway_yaw_mass)
         return (float(inv[0, 0]), float(inv[0, 1])), (float(inv[1, 0]), float(inv[1, 1]))
+
+
+@kernel_function
+def _thrust(T_nn, T_nu, n, su):
+    """:func:`propeller_thrust` for one propeller speed (NaN passes through)."""
+    raw = T_nn * abs(n) * n - T_nu * abs(n) * su
+    if n >= 0 and raw < 0.0:
+        return 0.0
+    return raw
+
+
+@kernel_function
+def cybership2_rhs(x, u, d, p, xdot):
+    """ẋ of spec 003 §3.5 for one ship: M ν̇ + C(ν)ν + D(ν)ν = τ + τ_env, η̇ = J(ψ)ν, with the
+    propeller thrust and both rudder models of :meth:`CyberShip2.derivatives`, operation for
+    operation (zero ``d`` is no disturbance). ``p`` from :meth:`CyberShip2.kernel`."""
+    T_nn, T_nu, skjetne, Y_delta, N_delta = p[0], p[1], p[2], p[3], p[4]
+    L_delta, L_absdd, k_u, jet_den, x_rudder = p[5], p[6], p[7], p[8], p[9]
+    m, x_G, Y_vdot, c13_r, c23_u = p[10], p[11], p[12], p[13], p[14]
+    Y_v, Y_absv_v, Y_absr_v, Y_r, Y_absv_r, Y_absr_r = p[15], p[16], p[17], p[18], p[19], p[20]
+    N_v, N_absv_v, N_absr_v, N_r, N_absv_r, N_absr_r = p[21], p[22], p[23], p[24], p[25], p[26]
+    X_u, X_absu_u, X_uuu, M11, a, b, c, e = p[27], p[28], p[29], p[30], p[31], p[32], p[33], p[34]
+    psi, su, sv, sr = x[2], x[3], x[4], x[5]
+    n, delta = u[0], u[1]
+    thrust = _thrust(T_nn, T_nu, n, su)
+    tau_x = 2.0 * thrust
+    if skjetne == 0.0:  # Table 1's linear coefficients
+        tau_y = -Y_delta * delta
+        tau_n = -N_delta * delta
+    else:  # lift in the propeller slipstream
+        jet = 8.0 * thrust / jet_den + su * su
+        if jet < 0.0:
+            jet = 0.0
+        jet = math.sqrt(jet)
+        u_rud = su + k_u * (jet - su) if su >= 0 else su
+        lift = (L_delta * delta - L_absdd * abs(delta) * delta) * abs(u_rud) * u_rud
+        tau_y = 2.0 * lift
+        tau_n = x_rudder * tau_y
+    tau_x = tau_x + d[0]
+    tau_y = tau_y + d[1]
+    tau_n = tau_n + d[2]
+    c13 = -m * (x_G * sr + sv) + Y_vdot * sv + c13_r * sr
+    c23 = c23_u * su
+    abs_v, abs_r = abs(sv), abs(sr)
+    d22 = -Y_v - Y_absv_v * abs_v - Y_absr_v * abs_r
+    d23 = -Y_r - Y_absv_r * abs_v - Y_absr_r * abs_r
+    d32 = -N_v - N_absv_v * abs_v - N_absr_v * abs_r
+    d33 = -N_r - N_absv_r * abs_v - N_absr_r * abs_r
+    d11 = -X_u - X_absu_u * abs(su) - X_uuu * su * su
+    f_x = tau_x - c13 * sr - d11 * su
+    f_y = tau_y - c23 * sr - d22 * sv - d23 * sr
+    f_n = tau_n + c13 * su + c23 * sv - d32 * sv - d33 * sr
+    cp, sp = math.cos(psi), math.sin(psi)
+    xdot[0] = cp * su - sp * sv
+    xdot[1] = sp * su + cp * sv
+    xdot[2] = sr
+    xdot[3] = f_x / M11
+    xdot[4] = a * f_y + b * f_n
+    xdot[5] = c * f_y + e * f_n
 
 
 def steering_machine(params: CyberShip2Params, *, rate_limit: bool = True,
