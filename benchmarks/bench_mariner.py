@@ -10,7 +10,9 @@ Times, side by side in one run:
     default backend (``auto``: the compiled loop for runs this long) and with the numpy loop;
 (b) the ``mariner-montecarlo`` batch: 1 000 Mariner runs (random initial offsets, each ship in its
     own wave realisation) per controller, LQR and LOS + FL, one batched ``simulate`` call each, as
-    ``run_scenario`` does it (metrics included); reported as ship-steps per second.
+    ``run_scenario`` does it (metrics included); reported as ship-steps per second. The wave noise
+    is not composed yet (its table needs the step dt, which the composed loop does not pass to a
+    disturbance), so this batch runs in the numpy loop.
 
 Writes ``benchmarks/results/bench_mariner.json`` (``..._quick.json`` with ``--quick``).
 """

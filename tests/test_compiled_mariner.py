@@ -1,9 +1,12 @@
-"""The Mariner's compiled (numba) loop against the numpy reference loop (document 000).
+"""Document 000's Mariner in the composed compiled loop (:mod:`shipgnc.sim.compose`) against the
+numpy reference loop.
 
-Every comparison runs the same setup, on fresh components, through ``simulate(...,
-backend="numpy")`` and ``backend="compiled"`` and requires the same variables, sample times and
-attributes, values equal to 1e-9 relative (round-off of the variable's scale absolute), the same
-divergence errors and the components left in the same state.
+Each component's kernel equals its numpy form on single ships (the model's eq. (25), the path
+controllers' laws (13), (19)–(23) and LOS + FL, the disturbance of §0.6); and every comparison of a
+whole run goes through ``simulate(..., backend="numpy")`` and ``backend="compiled"`` on fresh
+components and requires the same variables, sample times and attributes, values equal to 1e-9
+relative (round-off of the variable's scale absolute), the same divergence errors and the
+components left in the same state.
 """
 
 from __future__ import annotations
@@ -12,17 +15,15 @@ import numpy as np
 import pytest
 
 from shipgnc.actuators import Actuator
-from shipgnc.control.feedback_linearization import LOSFL, fl_lookahead, fl_paper
+from shipgnc.control.feedback_linearization import LOSFL, OutputFL, fl_lookahead, fl_paper
 from shipgnc.control.lqr import PathLQR, design_lqr
-from shipgnc.control.open_loop import OpenLoopSchedule
 from shipgnc.environment.current import CrossCurrent
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
 from shipgnc.environment.filtered_noise import SecondOrderNoise
 from shipgnc.errors import ConfigError, DivergenceError
 from shipgnc.guidance.path import WaypointPath
-from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.mariner import DOC_B_R, DOC_D_Y, MarinerDisturbance, MarinerWitOppe, rudder
-from shipgnc.sim import compiled_mariner, simulator
+from shipgnc.sim import compose, simulator
 from shipgnc.sim.simulator import _validate, simulate
 from shipgnc.units import NAUTICAL_MILE as NM
 
@@ -55,7 +56,8 @@ def waves():
 
 
 def doc_disturbance(path, **kw):
-    return MarinerDisturbance(b_r=DOC_B_R, current=CrossCurrent(DOC_D_Y, path, **kw), waves=waves())
+    """b_r and the cross current of spec 000 §0.6 (A9, A10), no wave noise."""
+    return MarinerDisturbance(b_r=DOC_B_R, current=CrossCurrent(DOC_D_Y, path, **kw))
 
 
 DISTURBANCES = {
@@ -63,6 +65,8 @@ DISTURBANCES = {
     "constant": lambda path: ConstantDisturbance([[DOC_B_R, 0.1, -0.2], [0.0, 0.0, 0.0],
                                                   [-DOC_B_R, 0.3, 0.0]]),
     "doc": doc_disturbance,
+    "doc_global": lambda path: doc_disturbance(path, frame="global"),
+    "force_noise": lambda path: GaussianForceNoise([2e-5, 0.05, 0.05], mean=[DOC_B_R, 0.0, 0.0]),
 }
 
 
@@ -84,10 +88,11 @@ def both(x0, make, **kw):
 
 
 def assert_same(ref, got, rtol=RTOL):
+    assert (ref.attrs["backend"], got.attrs["backend"]) == ("numpy", "compiled")
     assert list(got.data_vars) == list(ref.data_vars)
     assert got.sizes == ref.sizes
     np.testing.assert_array_equal(got.time.values, ref.time.values)
-    assert {**got.attrs, "backend": ""} == {**ref.attrs, "backend": ""}  # backend: which loop ran
+    assert {**got.attrs, "backend": ""} == {**ref.attrs, "backend": ""}
     for name in ref.data_vars:
         assert got[name].dims == ref[name].dims
         assert got[name].attrs == ref[name].attrs
@@ -114,6 +119,132 @@ def assert_same_end_state(numpy_parts, compiled_parts):
     if isinstance(a, MarinerDisturbance) and a.current is not None:
         np.testing.assert_array_equal(b.current.tracker.leg, a.current.tracker.leg)
 
+
+# ----------------------------------------------------------------------------------------------
+# each component's kernel against its numpy form, one ship at a time
+# ----------------------------------------------------------------------------------------------
+
+def random_states(n, seed=0):
+    """Ships around SHORT_PATH, on all three legs, with headings and yaw rates of every sign."""
+    rng = np.random.default_rng(seed)
+    x = np.empty((n, 5))
+    x[:, 0] = rng.uniform(-200.0, 1200.0, n)
+    x[:, 1] = rng.uniform(-300.0, 900.0, n)
+    x[:, 2] = rng.uniform(-8.0, 8.0, n)
+    x[:, 3] = rng.uniform(-1.0, 9.0, n)
+    x[:, 4] = rng.normal(0.0, 0.02, n)
+    return x
+
+
+def test_model_kernel_equals_derivatives():
+    kernel = M.kernel()
+    rng = np.random.default_rng(1)
+    for x in random_states(200):
+        u, d = rng.normal(0.0, 0.4, 1), rng.normal(0.0, [1e-4, 0.5, 0.5])
+        xdot = np.empty(5)
+        kernel.function(x, u, d, kernel.params, xdot)
+        np.testing.assert_allclose(xdot, M.derivatives(x, u, d), rtol=1e-13, atol=1e-18)
+        kernel.function(x, u, np.zeros(3), kernel.params, xdot)  # zero d is no disturbance
+        np.testing.assert_allclose(xdot, M.derivatives(x, u, None), rtol=1e-13, atol=1e-18)
+
+
+@pytest.mark.parametrize("ctrl", [*sorted(CONTROLLERS), "fl_global", "los_global"])
+def test_controller_kernel_equals_step(ctrl):
+    """Command, logged signals and end state (leg, e_I, signal_values) of one ship at a time over
+    a run of samples that switches legs, against the batched numpy ``step``."""
+    make = {**CONTROLLERS,
+            "fl_global": lambda path: OutputFL(M.params, path, Ts=0.3, lookahead=40.0, b_r=DOC_B_R,
+                                               d_y=DOC_D_Y, current_frame="global"),
+            "los_global": lambda path: LOSFL(M.params, path, Ts=0.3, b_r=DOC_B_R, d_y=-DOC_D_Y,
+                                             current_frame="global")}[ctrl]
+    n = 40
+    reference, compiled = make(SHORT_PATH), make(SHORT_PATH)
+    reference.reset((n,))
+    compiled.reset((n,))
+    kernel = compiled.kernel((n,))
+    z = kernel.state_for(n)
+    x = random_states(n, seed=3)
+    x[:, :2] = np.linspace([-100.0, -50.0], [100.0, 40.0], n)
+    names = [s.name for s in reference.signals]
+    legs = set()
+    for k in range(25):
+        x[:, 0] += 25.0 + 3.0 * k  # northwards along leg 0, then onto legs 1 and 2
+        x[:, 1] += 4.0 * k
+        x[:, 2:] += 0.01
+        expected = reference.step(0.3 * k, x, None)
+        logged = reference.signal_values()
+        legs |= set(logged["leg"].tolist())
+        for i in range(n):
+            cmd, sig = np.empty(1), np.empty(len(names))
+            kernel.function(0.3 * k, x[i], np.zeros(0), z[i], kernel.params, cmd, sig)
+            np.testing.assert_allclose(cmd, expected[i], rtol=1e-12, atol=1e-15)
+            np.testing.assert_allclose(sig, [logged[name][i] for name in names], rtol=1e-12,
+                                       atol=1e-12)
+    assert legs == {0.0, 1.0, 2.0}  # the ships switch legs on the way
+    kernel.restore(z)
+    np.testing.assert_array_equal(compiled.tracker.leg, reference.tracker.leg)
+    assert compiled.tracker.leg.dtype == reference.tracker.leg.dtype
+    if isinstance(reference, PathLQR):
+        np.testing.assert_allclose(compiled.e_I, reference.e_I, rtol=1e-12)
+    for name in names:
+        np.testing.assert_allclose(compiled.signal_values()[name], logged[name], rtol=1e-12,
+                                   atol=1e-12)
+
+
+@pytest.mark.parametrize("frame", [None, "path", "global"])
+def test_disturbance_kernel_equals_call(frame):
+    n = 30
+    current = (lambda: None) if frame is None else (
+        lambda: CrossCurrent(DOC_D_Y, SHORT_PATH, frame=frame))
+    reference, compiled = MarinerDisturbance(DOC_B_R, current()), MarinerDisturbance(DOC_B_R, current())
+    for dist in (reference, compiled):
+        dist.reset((n,), np.random.default_rng(0))
+    kernel = compiled.kernel((n,))
+    z = kernel.state_for(n)
+    x = random_states(n, seed=4)
+    x[:, 0] -= 400.0
+    legs = set()
+    for k in range(20):
+        x[:, 0] += 40.0
+        expected = reference(0.3 * k, x)
+        if frame == "path":
+            legs |= set(reference.current.tracker.leg.tolist())
+        for i in range(n):
+            d = np.empty(3)
+            kernel.function(0.3 * k, x[i], z[i], kernel.params, np.zeros(0), d)
+            np.testing.assert_array_equal(d, expected[i])
+    if frame == "path":
+        assert legs == {0, 1, 2}
+        kernel.restore(z)
+        np.testing.assert_array_equal(compiled.current.tracker.leg, reference.current.tracker.leg)
+
+
+def test_wave_table_draws_the_numpy_sea():
+    """With the step dt, the wave table is the numpy loop's sequence of calls (t_k = k·dt), chunk
+    by chunk: same values, the generator used alike and the filter left in the same state."""
+    n, dt = 4, 0.3
+    reference, compiled = (MarinerDisturbance(DOC_B_R, waves=waves()) for _ in range(2))
+    generators = [np.random.default_rng(8), np.random.default_rng(8)]
+    reference.reset((n,), generators[0])
+    compiled.reset((n,), generators[1])
+    kernel = compiled.kernel((n,), dt=dt)
+    W = np.concatenate([kernel.table(0, 7), kernel.table(7, 30)])
+    assert W.shape == (30, n, kernel.n_table)
+    z = kernel.state_for(n)
+    x = random_states(n)
+    for k in range(30):
+        expected = reference(k * dt, x)
+        for i in range(n):
+            d = np.empty(3)
+            kernel.function(k * dt, x[i], z[i], kernel.params, W[k, i], d)
+            np.testing.assert_array_equal(d, expected[i])
+    assert generators[0].random() == generators[1].random()
+    np.testing.assert_array_equal(compiled.waves(30 * dt), reference.waves(30 * dt))
+
+
+# ----------------------------------------------------------------------------------------------
+# whole runs: the composed loop against the numpy loop
+# ----------------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("rate_mode", ["ramp", "hold"])
 @pytest.mark.parametrize("dist", sorted(DISTURBANCES))
@@ -165,6 +296,18 @@ def test_sample_time_log_every_progress_and_batch_shape():
     assert (0, 900) in calls and calls[-1] == (900, 900)
 
 
+def test_rudder_lag_is_composed_too():
+    """A steering machine with a first-order lag (no twin ever covered it)."""
+    def make():
+        return {"controller": PathLQR(K_SI, SHORT_PATH, Ts=0.9),
+                "disturbance": doc_disturbance(SHORT_PATH),
+                "actuator": Actuator([-0.6], [0.6], rate=[0.07], tau=[2.0], names=("delta",))}
+
+    ref, got, parts_np, parts_c = both(X0_SHORT, make, t_end=90.0, dt=0.3)
+    assert_same(ref, got)
+    assert_same_end_state(parts_np, parts_c)
+
+
 def test_several_leg_switches_in_one_sample():
     x0 = np.array([[500.0, 400.0, 0.7, U, 0.0], [0.0, -20.0, 0.0, U, 0.0]])
     ref, got, parts_np, parts_c = both(x0, components("lqr", "doc", SHORT_PATH), t_end=30.0,
@@ -189,28 +332,9 @@ def test_edge_sizes():
         assert_same(ref, got)
 
 
-def test_same_seed_same_sea_and_the_generator_is_used_alike():
-    make = components("fl_lookahead", "doc", DOC_PATH)
-    generators = [np.random.default_rng(8), np.random.default_rng(8)]
-    results, parts = [], []
-    for backend, rng in zip(("numpy", "compiled"), generators, strict=True):
-        part = make()
-        results.append(simulate(M, X0_DOC, t_end=60.0, dt=0.3, seed=rng, backend=backend, **part))
-        parts.append(part)
-    assert_same(*results)
-    # the wave filters and the generators end in the same state: the next sample of the sea agrees
-    after = [p["disturbance"].waves(60.3) for p in parts]
-    np.testing.assert_array_equal(after[1], after[0])
-    assert generators[0].random() == generators[1].random()
-    # and the waves matter: another seed, another run
-    other = simulate(M, X0_DOC, t_end=60.0, dt=0.3, seed=9, backend="compiled", **make())
-    assert not np.allclose(other.r.values, results[1].r.values, rtol=1e-6, atol=0)
-
-
-def test_wave_chunks_and_progress_give_identical_results(monkeypatch):
-    make = components("lqr", "doc", SHORT_PATH)
+def test_progress_chunks_give_identical_results():
+    make = components("lqr", "force_noise", SHORT_PATH)
     plain = simulate(M, X0_SHORT, t_end=60.0, dt=0.3, seed=3, backend="compiled", **make())
-    monkeypatch.setattr(compiled_mariner, "WAVE_CHUNK", 100)  # 7 steps of 3 ships per kernel call
     chunked = simulate(M, X0_SHORT, t_end=60.0, dt=0.3, seed=3, backend="compiled",
                        progress=lambda k, n: None, **make())
     for name in plain.data_vars:
@@ -272,6 +396,10 @@ def test_divergence_stop_keeps_the_same_partial_result(case):
     assert 0 < got.time.values[-1] < 120
 
 
+# ----------------------------------------------------------------------------------------------
+# what the composed loop does not cover, and the choice of loop
+# ----------------------------------------------------------------------------------------------
+
 def setup_of(**kw):
     base = dict(t_end=3.0, dt=0.3, controller=PathLQR(K_SI, DOC_PATH, Ts=0.3),
                 actuator=rudder(M.params), guidance=None, disturbance=None, u0=None,
@@ -281,51 +409,43 @@ def setup_of(**kw):
 
 
 def test_unsupported_reasons():
-    reason = compiled_mariner.unsupported_reason
+    from shipgnc.routing.fields import UniformCurrent
+
+    reason = compose.unsupported_reason
     assert reason(setup_of()) is None
     assert reason(setup_of(disturbance=doc_disturbance(DOC_PATH), controller=None)) is None
     cases = {
-        "GaussianForceNoise": {"disturbance": GaussianForceNoise([1e-4, 0.0, 0.0])},
-        "OpenLoopSchedule": {"controller": OpenLoopSchedule([0.0], [[0.1]])},
-        "guidance": {"guidance": ReferenceSchedule([0.0], [0.0], [U])},
-        "lag": {"actuator": Actuator([-0.6], [0.6], tau=[2.0], names=("delta",))},
+        "SecondOrderNoise waves need the step dt": {"disturbance": MarinerDisturbance(waves=waves())},
+        "current UniformCurrent has no kernel": {
+            "disturbance": MarinerDisturbance(current=UniformCurrent(0.5, 0.0))},
         "solve_ivp": {"integrator": "solve_ivp"},
         "observer": {"observer": lambda t, x, c, u: None},
-        "do not fit": {"disturbance": ConstantDisturbance([[0.0, 0.0, 0.0]] * 4)},
     }
-    for word, kw in cases.items():
+    for words, kw in cases.items():
         text = reason(setup_of(**kw))
-        assert text and word in text, (word, text)
-    from shipgnc.models.fossen3dof import VectoredThrustBoat
-
-    boat = _validate(VectoredThrustBoat(), np.zeros(6), t_end=1.0, dt=0.05, controller=None,
-                     actuator=None, guidance=None, disturbance=None, u0=None, integrator="rk4",
-                     method="RK45", rtol=1e-3, atol=1e-6, seed=None, on_divergence="raise",
-                     observer=None, progress=None, log_every=1)
-    assert "MarinerWitOppe" in reason(boat)
+        assert text and words in text, (words, text)
 
 
-def test_compiled_backend_refuses_an_uncovered_mariner_setup():
-    with pytest.raises(ConfigError, match="GaussianForceNoise") as info:
-        simulate(M, X0_DOC, t_end=3.0, dt=0.3, controller=PathLQR(K_SI, DOC_PATH, Ts=0.3),
-                 disturbance=GaussianForceNoise([1e-4, 0.0, 0.0]), backend="compiled")
+def test_compiled_backend_refuses_wave_noise_and_auto_falls_back():
+    make = lambda: {"controller": PathLQR(K_SI, DOC_PATH, Ts=0.3),  # noqa: E731
+                    "disturbance": MarinerDisturbance(DOC_B_R, waves=waves())}
+    with pytest.raises(ConfigError, match="SecondOrderNoise") as info:
+        simulate(M, X0_DOC, t_end=3.0, dt=0.3, backend="compiled", **make())
     assert "backend='numpy'" in str(info.value)
+    x0 = np.repeat(X0_DOC[:1], simulator.COMPILED_MIN_BATCH, axis=0)
+    assert simulate(M, x0, t_end=0.6, dt=0.3, **make()).attrs["backend"] == "numpy"
 
 
-def test_auto_backend_picks_the_twin_by_batch_or_work(monkeypatch):
+def test_auto_backend_picks_the_composed_loop_by_batch_or_work(monkeypatch):
     calls = []
-    run = compiled_mariner.run
-    monkeypatch.setattr(compiled_mariner, "run", lambda setup: calls.append(setup) or run(setup))
+    run = compose.run
+    monkeypatch.setattr(compose, "run", lambda setup: calls.append(setup) or run(setup))
     make = components("lqr", "doc", DOC_PATH)
     simulate(M, X0_DOC, t_end=30.0, dt=0.3, seed=1, **make())  # 2 ships × 100 steps: numpy
     assert calls == []
     monkeypatch.setattr(simulator, "COMPILED_MIN_WORK", 200)
-    simulate(M, X0_DOC, t_end=30.0, dt=0.3, seed=1, **make())  # 200 ship-steps: compiled
-    assert len(calls) == 1
-    # not covered: the numpy loop, silently
-    simulate(M, X0_DOC, t_end=30.0, dt=0.3, seed=1, controller=PathLQR(K_SI, DOC_PATH, Ts=0.3),
-             disturbance=GaussianForceNoise([1e-4, 0.0, 0.0]))
-    assert len(calls) == 1
+    result = simulate(M, X0_DOC, t_end=30.0, dt=0.3, seed=1, **make())  # 200 ship-steps
+    assert len(calls) == 1 and result.attrs["backend"] == "compiled"
     # a batch of COMPILED_MIN_BATCH ships: compiled, however short the run
     x0 = np.repeat(X0_DOC[:1], simulator.COMPILED_MIN_BATCH, axis=0)
     simulate(M, x0, t_end=0.6, dt=0.3, seed=1, **make())

@@ -44,6 +44,8 @@ g = 0 (cos ψ_r = 0) the literal law saturates instead of dividing by zero.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from shipgnc.control.lqr import (
@@ -56,12 +58,23 @@ from shipgnc.control.lqr import (
     PATH_SIGNALS,
     check_controller_args,
     nominal_speed,
+    path_state,
     plant_coefficient,
+    restore_path_state,
 )
 from shipgnc.environment.current import CURRENT_FRAMES
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
-from shipgnc.guidance.path import LegTracker, WaypointPath
+from shipgnc.guidance.path import (
+    LEG_ANGLE,
+    LEG_COS,
+    LegTracker,
+    WaypointPath,
+    leg_table,
+    leg_value,
+    track_leg,
+)
+from shipgnc.kernels import Kernel, clip, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 
@@ -159,6 +172,14 @@ class _PathFL:
         return {"y_r": y_r, "psi_r": psi_r, "u": u, "r": r, "v": v, "y_dot": y_dot,
                 "d_cross": d_cross + np.zeros_like(y_r)}
 
+    def _kernel(self, function, batch_shape, *specific) -> Kernel:
+        """The kernel of a path FL controller: ``p`` = [δ_max, a, b, c, r₁, r₂, b_r, d_y, global
+        frame, *specific, leg table]; per-ship state of :func:`~shipgnc.control.lqr.path_state`."""
+        params = flat(self.delta_max, self.a, self.b, self.c, self.r1, self.r2, self.b_r, self.d_y,
+                      float(self.current_frame == "global"), *specific, leg_table(self.path))
+        return Kernel(function, params, path_state(self, batch_shape),
+                      restore=lambda z: restore_path_state(self, batch_shape, z))
+
     def _finish(self, raw: np.ndarray, k: dict[str, np.ndarray], **extra) -> np.ndarray:
         delta = np.clip(raw, -self.delta_max, self.delta_max)
         self._logged = {"cross_track_error": k["y_r"], "heading_error": k["psi_r"],
@@ -218,6 +239,12 @@ class OutputFL(_PathFL):
         g_safe = np.where(np.abs(g) < tiny, np.where(g < 0, -tiny, tiny), g)
         return self._finish((nu - f) / g_safe, k, fl_output=z)
 
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`step` for the composed loop (:func:`output_fl_step`), after ``reset``."""
+        tiny = 1e-12 * abs(self.c) * (abs(self.r1) + self.lookahead + NAUTICAL_MILE)
+        return self._kernel(output_fl_step, batch_shape, self.lookahead, self.k1, self.k2, tiny,
+                            3.0 * self.r2)
+
 
 def fl_paper(params, path: WaypointPath, *, Ts: float, **options) -> OutputFL:
     """``fl_paper``: the literal FL (19)–(23) on y_r, k₁ = 0.18 /min², k₂ = 0.7 /min (unstable)."""
@@ -264,6 +291,86 @@ class LOSFL(_PathFL):
         nu = -self.kp * e - self.kd * (k["r"] - psi_d_dot)
         raw = (nu + self.H_N(k["r"]) - self.b_r) / self.c
         return self._finish(raw, k, los_heading=psi_d)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`step` for the composed loop (:func:`los_fl_step`), after ``reset``."""
+        return self._kernel(los_fl_step, batch_shape, self.delta_los, self.kp, self.kd,
+                            self.delta_los**2, 0.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# kernels (shipgnc.kernels): one ship's step, operation for operation as the numpy methods
+# ----------------------------------------------------------------------------------------------
+
+#: where the FL kernels find the leg table in their parameters (9 common + 5 specific numbers)
+_FL_LEGS = 14
+
+
+@kernel_function
+def path_kinematics(x, z, p):
+    """:meth:`_PathFL.kinematics` for one ship (its leg tracker in ``z[0]``, updated):
+    ``(leg, y_r, ψ_r, u, r, v, ẏ_r, d_cross, sin ψ_r, cos ψ_r)``, with v = r₁ r + r₂ r³ and the
+    "measured" ẏ_r = u sin ψ_r + v cos ψ_r + d_cross (d_cross = d_y, or d_y cos ψ_r0 in the
+    global frame)."""
+    r1, r2, d_y, frame_global = p[4], p[5], p[7], p[8]
+    leg, _, y_r = track_leg(x[I_NORTH], x[I_EAST], int(z[0]), p, _FL_LEGS)
+    z[0] = leg
+    psi_r = wrap(x[I_PSI] - leg_value(p, _FL_LEGS, LEG_ANGLE, leg))
+    u, r = x[I_U], x[I_R]
+    v = r1 * r + r2 * r ** 3.0
+    d_cross = d_y * leg_value(p, _FL_LEGS, LEG_COS, leg) if frame_global != 0.0 else d_y
+    s, c = math.sin(psi_r), math.cos(psi_r)
+    y_dot = u * s + v * c + d_cross
+    return leg, y_r, psi_r, u, r, v, y_dot, d_cross, s, c
+
+
+@kernel_function
+def _log_path(z, sig, y_r, psi_r, leg, extra):
+    """The logged signals [y_r, ψ_r, leg, extra], also kept in ``z`` for ``signal_values``."""
+    sig[0], sig[1], sig[2], sig[3] = y_r, psi_r, float(leg), extra
+    z[1], z[2], z[3], z[4], z[5] = y_r, psi_r, float(leg), extra, 1.0
+
+
+@kernel_function
+def output_fl_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`OutputFL.step` for one ship: z = y_r + l sin ψ_r, ż, f, g of
+    :meth:`OutputFL.linearization` ((19)–(20) with r₁ → r₁ + l + 3r₂r²), δ = clip((ν − f)/g) with
+    ν = −k₁ z − k₂ ż ((21)–(23)) and |g| kept ≥ tiny. ``p`` = [common 9, l, k₁, k₂, tiny, 3r₂,
+    leg table]."""
+    delta_max, a, b, c_rudder, r1, b_r = p[0], p[1], p[2], p[3], p[4], p[6]
+    l, k1, k2, tiny, r2_3 = p[9], p[10], p[11], p[12], p[13]
+    leg, y_r, psi_r, u, r, v, y_dot, _, s, c = path_kinematics(x, z, p)
+    lateral = v + l * r
+    out = y_r + l * s
+    out_dot = y_dot + l * r * c
+    m = r1 + l + r2_3 * (r * r)
+    f = (u * c - lateral * s) * r + m * c * (b_r - (a * r + b * r ** 3.0))
+    g = m * c_rudder * c
+    nu = -k1 * out - k2 * out_dot
+    if abs(g) < tiny:  # the g_safe guard of OutputFL.step (NaN passes through)
+        g = -tiny if g < 0.0 else tiny
+    _log_path(z, sig, y_r, psi_r, leg, out)
+    cmd[0] = clip((nu - f) / g, -delta_max, delta_max)
+
+
+@kernel_function
+def los_fl_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`LOSFL.step` for one ship: ψ_d,r = −atan(y_r/Δ) − asin(clip(d_cross/max(u, 1e-6))),
+    ψ̇_d,r = −Δ ẏ_r/(Δ² + y_r²), e = wrap(ψ_r − ψ_d,r), ν = −k_p e − k_d (r − ψ̇_d,r),
+    δ = clip((ν + H_N(r) − b_r)/c) (spec 000 §0.5). ``p`` = [common 9, Δ, k_p, k_d, Δ², 0, leg
+    table]."""
+    delta_max, a, b, c_rudder, b_r = p[0], p[1], p[2], p[3], p[6]
+    D, kp, kd, D2 = p[9], p[10], p[11], p[12]
+    leg, y_r, psi_r, u, r, _, y_dot, d_cross, _, _ = path_kinematics(x, z, p)
+    u_safe = u if (u > 1e-6 or u != u) else 1e-6  # np.maximum(u, 1e-6), NaN kept
+    crab = math.asin(clip(d_cross / u_safe, -1.0, 1.0))
+    psi_d = -math.atan(y_r / D) - crab
+    psi_d_dot = -D * y_dot / (D2 + y_r * y_r)
+    e = wrap(psi_r - psi_d)
+    nu = -kp * e - kd * (r - psi_d_dot)
+    raw = (nu + (a * r + b * r ** 3.0) - b_r) / c_rudder
+    _log_path(z, sig, y_r, psi_r, leg, psi_d)
+    cmd[0] = clip(raw, -delta_max, delta_max)
 
 
 class HeadingFL:

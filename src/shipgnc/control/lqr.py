@@ -38,7 +38,15 @@ import numpy as np
 from shipgnc.batchmath import row_dot
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
-from shipgnc.guidance.path import LegTracker, WaypointPath
+from shipgnc.guidance.path import (
+    LEG_ANGLE,
+    LegTracker,
+    WaypointPath,
+    leg_table,
+    leg_value,
+    track_leg,
+)
+from shipgnc.kernels import Kernel, clip, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
 from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
 
@@ -270,3 +278,78 @@ class PathLQR:
 
     def signal_values(self) -> dict[str, np.ndarray]:
         return self._logged
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`step` for the composed loop (:func:`path_lqr_step`), after ``reset``; per-ship
+        state ``[leg, e_I, logged signals (4), logged]`` (see :func:`path_state`)."""
+        params = flat(self.K, self.delta_max, self.Ts, float(self.anti_windup),
+                      leg_table(self.path))
+        state = path_state(self, batch_shape, self.e_I)
+        return Kernel(path_lqr_step, params, state,
+                      restore=lambda z: restore_path_state(self, batch_shape, z, e_I=True))
+
+
+def path_state(ctrl, batch_shape, *extra) -> np.ndarray:
+    """Initial per-ship state of a path controller's kernel: ``[leg, *extra, signals, logged]``
+    (its tracker's leg, e.g. PathLQR's e_I, the last logged signal values and a flag: 1 once
+    ``step`` has run, as ``signal_values()`` is empty before)."""
+    shape = tuple(batch_shape)
+    parts = [ctrl.tracker.leg, *extra]
+    logged = ctrl.signal_values()
+    parts += [logged.get(s.name, np.zeros(shape)) for s in ctrl.signals]
+    parts.append(np.full(shape, float(bool(logged))))
+    return np.stack([np.broadcast_to(np.asarray(v, dtype=float), shape) for v in parts], axis=-1)
+
+
+def restore_path_state(ctrl, batch_shape, z: np.ndarray, *, e_I: bool = False) -> None:
+    """Leave a path controller as its numpy ``step`` would: the tracker's leg, e_I (PathLQR) and
+    the logged signal values, from the final per-ship state of :func:`path_state`."""
+    z = z.reshape(*tuple(batch_shape), z.shape[-1])
+    ctrl.tracker.leg = z[..., 0].astype(int)
+    first = 1
+    if e_I:
+        ctrl.e_I = z[..., 1].copy()
+        first = 2
+    if np.all(z[..., -1] > 0):
+        ctrl._logged = {s.name: z[..., first + j].copy() for j, s in enumerate(ctrl.signals)}
+
+
+@kernel_function
+def sign(value):
+    """``np.sign`` for one float (NaN passes through)."""
+    if value > 0.0:
+        return 1.0
+    if value < 0.0:
+        return -1.0
+    if value == 0.0:
+        return 0.0
+    return value
+
+
+#: where :func:`path_lqr_step` finds the leg table in its parameters
+_LQR_LEGS = 7
+
+
+@kernel_function
+def path_lqr_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`PathLQR.step` for one ship, operation for operation: law (13)
+    δ = clip(−K·[y_r, ψ_r, r, e_I]) (the sum left to right, as :func:`~shipgnc.batchmath.row_dot`),
+    then e_I += Ts·y_r (held by the anti-windup). ``p`` = [K (4), δ_max, Ts, anti-windup, leg
+    table]; ``z`` = [leg, e_I, y_r, ψ_r, leg, e_I logged, logged]."""
+    k_y, k_psi, k_r, k_e = p[0], p[1], p[2], p[3]
+    delta_max, Ts, anti_windup = p[4], p[5], p[6]
+    leg, _, y_r = track_leg(x[I_NORTH], x[I_EAST], int(z[0]), p, _LQR_LEGS)
+    psi_r = wrap(x[I_PSI] - leg_value(p, _LQR_LEGS, LEG_ANGLE, leg))
+    e_I = z[1]
+    raw = -(y_r * k_y + psi_r * k_psi + x[I_R] * k_r + e_I * k_e)
+    delta = clip(raw, -delta_max, delta_max)
+    integrate = True
+    if anti_windup != 0.0:  # hold e_I when integrating would deepen the saturation
+        deepens = sign(-k_e * y_r) == sign(raw)
+        integrate = abs(raw) <= delta_max or not deepens
+    if integrate:
+        z[1] = e_I + Ts * y_r
+    z[0] = leg
+    sig[0], sig[1], sig[2], sig[3] = y_r, psi_r, float(leg), e_I
+    z[2], z[3], z[4], z[5], z[6] = y_r, psi_r, float(leg), e_I, 1.0
+    cmd[0] = delta

@@ -1,4 +1,5 @@
-"""Waypoint paths: straight legs between waypoints in NED, with the path-fixed frame."""
+"""Waypoint paths: straight legs between waypoints in NED, with the path-fixed frame; the leg
+tracker of spec 000 (A6) and its scalar form for component kernels (:func:`track_leg`)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import numpy as np
 
 from shipgnc.errors import require
 from shipgnc.frames import path_frame
+from shipgnc.kernels import flat, kernel_function
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,3 +81,50 @@ class LegTracker:
             x_r, y_r = path.project(north, east, leg)
         self.leg = leg
         return np.asarray(x_r, dtype=float), np.asarray(y_r, dtype=float), path.leg_angles[leg]
+
+
+# ----------------------------------------------------------------------------------------------
+# the leg tracker for component kernels (shipgnc.kernels)
+# ----------------------------------------------------------------------------------------------
+
+def leg_table(path: WaypointPath) -> np.ndarray:
+    """A path's legs as a flat parameter block for :func:`track_leg`: ``[n, start north (n),
+    start east (n), cos π_p (n), sin π_p (n), length (n), π_p (n)]`` (cos, sin by numpy, the values
+    :meth:`WaypointPath.project` forms)."""
+    angles = path.leg_angles
+    return flat(path.n_legs, path.waypoints[:-1, 0], path.waypoints[:-1, 1], np.cos(angles),
+                np.sin(angles), path.leg_lengths, angles)
+
+
+#: offsets within a :func:`leg_table` block of n legs: column j starts at 1 + j·n
+LEG_NORTH, LEG_EAST, LEG_COS, LEG_SIN, LEG_LENGTH, LEG_ANGLE = range(6)
+
+
+@kernel_function
+def track_leg(north, east, leg, p, o):
+    """:meth:`LegTracker.update` for one ship (switching rule A6 of spec 000, several switches in
+    one sample allowed): ``(leg, x_r, y_r)`` after any due switches, with the path frame of
+    :func:`shipgnc.frames.path_frame` (s = Δn cos π_p + Δe sin π_p, e = −Δn sin π_p + Δe cos π_p).
+
+    ``p[o:]`` is a :func:`leg_table` block; a NaN position switches nothing (as numpy's compare).
+    """
+    n = int(p[o])
+    last = n - 1
+    while True:
+        dn = north - p[o + 1 + leg]
+        de = east - p[o + 1 + n + leg]
+        c = p[o + 1 + 2 * n + leg]
+        s = p[o + 1 + 3 * n + leg]
+        x_r = dn * c + de * s
+        y_r = -dn * s + de * c
+        if leg < last and x_r >= p[o + 1 + 4 * n + leg]:
+            leg += 1
+        else:
+            return leg, x_r, y_r
+
+
+@kernel_function
+def leg_value(p, o, column, leg):
+    """Column ``column`` (:data:`LEG_COS`, :data:`LEG_ANGLE`, ...) of leg ``leg`` in the
+    :func:`leg_table` block ``p[o:]``."""
+    return p[o + 1 + column * int(p[o]) + leg]

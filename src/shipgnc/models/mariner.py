@@ -37,6 +37,8 @@ import numpy as np
 from shipgnc.actuators import Actuator
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
+from shipgnc.guidance.path import leg_table, track_leg
+from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
 from shipgnc.models.base import Signal
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 
@@ -218,6 +220,28 @@ class MarinerWitOppe:
         u_dot = -p.f * su - p.W * sr * sr + p.S
         return np.stack([north_dot, east_dot, sr, u_dot, r_dot], axis=-1)
 
+    def kernel(self) -> Kernel:
+        """:meth:`derivatives` for the composed loop (:func:`mariner_rhs`)."""
+        p = self.params
+        return Kernel(mariner_rhs, flat(p.a, p.b, p.c, p.r1, p.r2, p.f, p.W, p.S))
+
+
+@kernel_function
+def mariner_rhs(x, u, d, p, xdot):
+    """ẋ of eq. (25) for one ship: :meth:`MarinerWitOppe.derivatives`, operation for operation
+    (r³ by ``pow`` as numpy's ``r**3``; a zero ``d`` adds nothing); ``p`` = [a, b, c, r₁, r₂, f, W,
+    S]."""
+    a, b, c_rudder, r1, r2, f, W, S = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+    psi, su, sr = x[2], x[3], x[4]
+    r3 = sr ** 3.0
+    v = r1 * sr + r2 * r3
+    c, s = math.cos(psi), math.sin(psi)
+    xdot[0] = c * su - s * v + d[1]
+    xdot[1] = s * su + c * v + d[2]
+    xdot[2] = sr
+    xdot[3] = -f * su - W * sr * sr + S
+    xdot[4] = -a * sr - b * r3 + c_rudder * u[0] + d[0]
+
 
 def rudder(params: MarinerParams, *, rate_limit: bool = True, rate_mode: str = "ramp") -> Actuator:
     """The Mariner's steering machine: δ within ±delta_max slewing at most delta_rate (35°, 3.8°/s).
@@ -281,3 +305,91 @@ class MarinerDisturbance:
         if self.current is None:
             return np.stack([yaw, np.zeros_like(yaw), np.zeros_like(yaw)], axis=-1)
         return np.concatenate([yaw[..., None], self.current(t, x)], axis=-1)
+
+    def kernel_reason(self) -> str | None:
+        """None when :meth:`kernel` covers this disturbance, else why not (the run then uses numpy)."""
+        from shipgnc.environment.current import CrossCurrent
+        from shipgnc.environment.filtered_noise import SecondOrderNoise
+
+        if self.current is not None and type(self.current) is not CrossCurrent:
+            return f"current {type(self.current).__name__} has no kernel (only CrossCurrent)"
+        if self.waves is not None:
+            if type(self.waves) is not SecondOrderNoise:
+                return f"waves {type(self.waves).__name__} have no kernel (only SecondOrderNoise)"
+            # the table of wave values needs the step times t_k = k·dt, which the composed loop
+            # does not hand to a disturbance (kernel(batch_shape), table(k0, k1))
+            return ("SecondOrderNoise waves need the step dt, which the composed loop does not "
+                    "pass to Kernel.table")
+        return None
+
+    def kernel(self, batch_shape, dt: float | None = None) -> Kernel:
+        """:meth:`__call__` for the composed loop (:func:`mariner_disturbance`), after ``reset``.
+
+        Per-ship state ``[leg]``: the path current's own leg tracker (A6), from the ship's position
+        at each step's start. The wave noise does not depend on the state: ``table(k0, k1)`` runs
+        the :class:`~shipgnc.environment.filtered_noise.SecondOrderNoise` itself in numpy at
+        t_k = k·``dt`` (needs the run's step ``dt``), so it draws from the run's generator exactly
+        as the numpy loop does (same seed, same sea) and the filter ends in the same state.
+        """
+        from shipgnc.environment.current import CrossCurrent
+
+        current, waves = self.current, self.waves
+        shape = tuple(batch_shape)
+        leg = np.zeros(shape)
+        mode, d_y, i_north, i_east, legs = 0, 0.0, 0, 0, np.zeros(0)
+        if current is not None:
+            if type(current) is not CrossCurrent:
+                raise NotCompiled(self.kernel_reason())
+            d_y, (i_north, i_east) = current.d_y, current._i
+            if current.frame == "global":
+                mode = 1
+            else:  # d_y·[−sin ψ_r0, cos ψ_r0] of each leg, as CrossCurrent.__call__ forms it
+                mode, path = 2, current.tracker.path
+                legs = flat(leg_table(path), -current.d_y * np.sin(path.leg_angles),
+                            current.d_y * np.cos(path.leg_angles))
+                leg = current.tracker.leg.astype(float)
+        params = flat(self.b_r, mode, d_y, i_north, i_east, waves is not None, legs)
+        table, restore = None, None
+        if waves is not None:
+            if dt is None:
+                raise NotCompiled("SecondOrderNoise waves need the run's step dt")
+
+            def table(k0: int, k1: int) -> np.ndarray:  # the numpy loop's calls, t_k = k·dt
+                values = np.stack([waves(k * dt) for k in range(k0, k1)])
+                return values.reshape(k1 - k0, -1, 1)
+
+        if mode == 2:
+            def restore(z: np.ndarray) -> None:
+                current.tracker.leg = z[:, 0].astype(int).reshape(shape)
+
+        return Kernel(mariner_disturbance, params, leg[..., None], table=table,
+                      n_table=int(waves is not None), restore=restore)
+
+
+#: where :func:`mariner_disturbance` finds the path current's leg table in its parameters
+_LEGS = 6
+
+
+@kernel_function
+def mariner_disturbance(t, x, z, p, w, d):
+    """:meth:`MarinerDisturbance.__call__` for one ship: d = [b_r (+ w, the step's wave value),
+    current_north, current_east] (spec 000 §0.6, A9–A11); the path current d_y·[−sin ψ_r0,
+    cos ψ_r0] of the leg its tracker ``z[0]`` finds (A10, A6). ``p`` = [b_r, mode (0 none,
+    1 global, 2 path), d_y, north index, east index, has waves, leg table, c_N, c_E per leg]."""
+    yaw = p[0]
+    if p[5] != 0.0:
+        yaw = yaw + w[0]
+    d[0] = yaw
+    mode = p[1]
+    if mode == 0.0:
+        d[1] = 0.0
+        d[2] = 0.0
+    elif mode == 1.0:  # along east
+        d[1] = 0.0
+        d[2] = 0.0 + p[2]
+    else:
+        leg, _, _ = track_leg(x[int(p[3])], x[int(p[4])], int(z[0]), p, _LEGS)
+        z[0] = leg
+        n = int(p[_LEGS])
+        d[1] = p[_LEGS + 1 + 6 * n + leg]
+        d[2] = p[_LEGS + 1 + 7 * n + leg]

@@ -1,12 +1,10 @@
-"""The driver of the compiled loops: chunked kernel calls, progress, divergence and completion
-replay, the ``Log``; and the numba plumbing the loops share.
+"""The driver of the compiled loop: chunked kernel calls, progress, divergence and completion
+replay, the ``Log``.
 
 :mod:`shipgnc.sim.compose` composes any combination of components with kernels into one loop and
-runs it through :func:`drive` and :func:`make_log`; :mod:`shipgnc.sim.compiled_mariner` is the
-last whole-loop twin (document 000's Mariner and its path controllers), which uses the same
-driver. A run is one kernel call, or several that carry each ship's state from one to the next
-(bit-identical results): about twenty with a progress callback, and short ones for a batch
-logging many samples.
+runs it through :func:`drive` and :func:`make_log`. A run is one kernel call, or several that
+carry each ship's state from one to the next (bit-identical results): about twenty with a
+progress callback, and short ones for a batch logging many samples.
 """
 
 from __future__ import annotations
@@ -14,10 +12,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
-from shipgnc.kernels import JIT_OPTIONS
-from shipgnc.kernels import clip as _clip  # noqa: F401  (the Mariner twin's scalar helpers)
-from shipgnc.kernels import wrap as _wrap  # noqa: F401
 
 #: number of kernel calls when a progress callback is given
 PROGRESS_CHUNKS = 20
@@ -28,89 +22,10 @@ MIN_THREAD_WORK = 100_000
 #: the next (a 1 000-ship log of every step is written ≈ 2× faster)
 LOG_SAMPLES_PER_CALL = 256
 
-_JITTED: dict = {}
-_NUMBA_ERROR: str | None = None
-_NUMBA_CHECKED = False
-
-
-# ----------------------------------------------------------------------------------------------
-# sin/cos of RK4 stages (the Mariner twin)
-# ----------------------------------------------------------------------------------------------
-
-def _sin_cos_shifted(s, c, angle, delta):
-    """sin and cos of ``angle + delta`` from s = sin(angle), c = cos(angle).
-
-    Angle addition with the Taylor series of sin δ and cos δ − 1 (truncation < 3e-18 relative for
-    |δ| ≤ 0.1): the RK4 stages of one step share one libm ``sincos`` call. Larger δ use libm.
-    """
-    if abs(delta) <= 0.1:
-        d2 = delta * delta
-        sd = delta + delta * d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0
-                                                                          + d2 * (1.0 / 362880.0))))
-        cm1 = d2 * (-0.5 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 * (1.0 / 40320.0
-                                                                        - d2 * (1.0 / 3628800.0)))))
-        return s + (s * cm1 + c * sd), c + (c * cm1 - s * sd)
-    return math.sin(angle + delta), math.cos(angle + delta)
-
-
-# ----------------------------------------------------------------------------------------------
-# numba plumbing
-# ----------------------------------------------------------------------------------------------
-
-def jit(function, *, parallel: bool = False):
-    """The numba dispatcher of a kernel function or scalar helper (one per function, shared by the
-    twins; :data:`JIT_OPTIONS`). Scalar helpers are inlined by LLVM into the kernels calling them.
-
-    A kernel finds its helpers as module globals, so each twin's ``_load`` rebinds its names to
-    the dispatchers before its kernel compiles. numba's disk cache is keyed to the source file of
-    the cached function only: after editing a helper of this module, delete the twins'
-    ``__pycache__/*.nbi`` files so that no kernel inlining the old helper is loaded.
-    """
-    import numba
-
-    py = _py(function)
-    key = (py, parallel)
-    if key not in _JITTED:
-        _JITTED[key] = numba.njit(parallel=parallel, **JIT_OPTIONS)(py)
-    return _JITTED[key]
-
-
-def _py(function):
-    """The plain Python function behind a (possibly already wrapped) numba dispatcher."""
-    return getattr(function, "py_func", function)
-
-
-def _numba_error() -> str | None:
-    """None if numba imports, else the reason (checked once per process)."""
-    global _NUMBA_CHECKED, _NUMBA_ERROR
-    if not _NUMBA_CHECKED:
-        _NUMBA_CHECKED = True
-        try:
-            import numba  # noqa: F401
-        except Exception as exc:  # ImportError, or a broken install (llvmlite mismatch, ...)
-            _NUMBA_ERROR = f"numba cannot be imported ({type(exc).__name__}: {exc})"
-    return _NUMBA_ERROR
-
-
-def _owned(values) -> np.ndarray:
-    """A fresh, writeable, C-ordered float64 copy: one kernel signature whatever the caller passes
-    (numba compiles read-only or strided arrays as other types)."""
-    return np.array(values, dtype=np.float64, order="C", copy=True)
-
 
 # ----------------------------------------------------------------------------------------------
 # the shared driver: chunked kernel calls, progress, divergence replay, the Log
 # ----------------------------------------------------------------------------------------------
-
-def log_layout(setup, names: list[str]):
-    """``log_signals(setup)``, after checking that a kernel's log columns ``names`` match it."""
-    from shipgnc.sim.simulator import log_signals
-
-    signals = log_signals(setup)
-    if list(names) != list(signals):  # the kernel's column layout must match the numpy loop's log
-        raise RuntimeError(f"compiled loop: log layout {list(names)} differs from {list(signals)}")
-    return signals
-
 
 def log_length(setup) -> int:
     """Number of logged samples of a full run: every ``log_every``-th step and the last one."""

@@ -11,12 +11,12 @@ between. The plant (and any actuator lag) is integrated with fixed-step RK4 or w
 Batched: ``x0`` of shape ``(..., n)`` simulates every leading index as one ship, in one array
 operation per RK stage. The same loop compiled: :mod:`shipgnc.sim.compose` composes the kernels of
 the components (:mod:`shipgnc.kernels`) into one numba loop for any combination whose components
-all have one; document 000's Mariner still has a whole-loop twin
-(:mod:`shipgnc.sim.compiled_mariner`); ``backend="numpy"`` forces this readable reference loop.
+all have one; ``backend="numpy"`` forces this readable reference loop.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -39,9 +39,8 @@ COMPILED_MIN_BATCH = 64
 #: twin covers run in the numpy loop
 COMPILED_MIN_WORK = 20_000
 #: the compiled loops (modules of ``shipgnc.sim``), asked in this order, and the name each
-#: records in ``attrs["backend"]``: the composed loop of components with kernels, and the
-#: Mariner's whole-loop twin
-COMPILED_TWINS = {"compose": "compiled", "compiled_mariner": "compiled_mariner"}
+#: records in ``attrs["backend"]``: the composed loop of components with kernels
+COMPILED_TWINS = {"compose": "compiled"}
 #: most steps of one run, and most logged numbers (8 bytes each, 4 GB) of one result
 MAX_STEPS = 1e8
 MAX_LOGGED = 5e8
@@ -127,8 +126,9 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     -------
     xarray.Dataset
         See :mod:`shipgnc.sim.result`; ``attrs["backend"]`` names the loop that ran (``numpy``,
-        ``compiled``, ``compiled_mariner``), with ``+wave_kernel`` / ``+numpy`` when a disturbance
-        has a compiled twin of its own (the wave loads of document 003).
+        ``compiled``), with ``+wave_kernel`` when the numpy loop called a
+        disturbance's compiled twin (the wave loads of document 003; never with
+        ``backend="numpy"``).
     """
     setup = _validate(model, x0, t_end=t_end, dt=dt, controller=controller, actuator=actuator,
                       guidance=guidance, disturbance=disturbance, u0=u0, integrator=integrator,
@@ -148,12 +148,16 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
             raise ConfigError(f"backend = 'compiled': no compiled loop covers this run "
                               f"({'; '.join(reasons)}); use backend='numpy'")
     if log is None:
-        log = run_numpy(setup)
+        # a disturbance with a compiled twin of its own (the wave loads of document 003) stays in
+        # numpy with backend="numpy"; else the numpy loop records the twin it called
+        numpy_only = getattr(disturbance, "numpy_only", None) if backend == "numpy" else None
+        with numpy_only() if numpy_only is not None else contextlib.nullcontext():
+            log = run_numpy(setup)
+            evaluator = getattr(disturbance, "evaluator", None)
+            if evaluator is not None and evaluator() != "numpy":
+                ran_on = f"{ran_on}+{evaluator()}"
     from shipgnc.sim.result import build_dataset
 
-    evaluator = getattr(disturbance, "evaluator", None)  # a disturbance with a compiled twin
-    if evaluator is not None:
-        ran_on = f"{ran_on}+{evaluator()}"
     run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold,
                  "t_end": t_end, "model": type(model).__name__, **(attrs or {})}
     return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
