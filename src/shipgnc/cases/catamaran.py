@@ -9,11 +9,13 @@ t_end, dt`` and, for heading runs, ``heading_target``. A runner calls::
                   actuator=case.actuator, guidance=case.guidance, on_divergence="stop")
     metrics = case.metrics(ds)          # spec 004 metrics, events included
 
-or simply ``ds = case.run()``. Common settings: u(0) = 4 m/s, everything else 0; RK4 with
-dt = 0.0625 s; t_f = 1500 s; gains per preset (``paper``: T_u = 0.1 s, h = 0.0625 s; ``si``:
-T_u = h = 2.5 s); the laws in continuous mode; preset ``si`` unless given. ``vessel`` (a dict of
-:class:`~shipgnc.models.catamaran.CatamaranParams` overrides, e.g. ``{"coriolis": "consistent"}``)
-changes the catamaran itself — plant and the controller's model alike — for every builder.
+or simply ``ds = case.run()`` (``backend="auto"``: the composed compiled loop when the run is long
+or batched and every component has a kernel, see ``simulate``). Common settings: u(0) = 4 m/s,
+everything else 0; RK4 with dt = 0.0625 s; t_f = 1500 s; gains per preset (``paper``:
+T_u = 0.1 s, h = 0.0625 s; ``si``: T_u = h = 2.5 s); the laws in continuous mode; preset ``si``
+unless given. ``vessel`` (a dict of :class:`~shipgnc.models.catamaran.CatamaranParams` overrides,
+e.g. ``{"coriolis": "consistent"}``) changes the catamaran itself — plant and the controller's
+model alike — for every builder.
 """
 
 from __future__ import annotations
@@ -60,11 +62,13 @@ class CatamaranCase:
                 "guidance": self.guidance}
 
     def run(self, **kwargs):
-        """``simulate`` this case (numpy loop, ``on_divergence="stop"``); events in ``attrs``."""
+        """``simulate`` this case (``on_divergence="stop"``; ``backend="auto"``: the composed
+        compiled loop for a long or batched run, ``"numpy"``/``"compiled"`` to choose); events in
+        ``attrs``."""
         from shipgnc.analysis.catamaran_metrics import attach_events
         from shipgnc.sim.simulator import simulate
 
-        options = {"backend": "numpy", "on_divergence": "stop", "attrs": {"case": self.name}, **kwargs}
+        options = {"backend": "auto", "on_divergence": "stop", "attrs": {"case": self.name}, **kwargs}
         ds = simulate(self.model, self.x0, **self.simulate_kwargs(), **options)
         attach_events(ds, self.controller)
         return ds

@@ -10,7 +10,9 @@
   sway feedback. The heading reference is the ramp of the capture profile (17).
 
 Both are stateless continuous laws (their integral is the physical δ), like the FSM laws, so the
-comparison runs them in the same ``continuous`` mode.
+comparison runs them in the same ``continuous`` mode. Each has a kernel for the composed compiled
+loop (:func:`yaw_rate_pi_step`, :func:`heading_lqr_step`; ω* and the heading capture's latch by
+:func:`~shipgnc.control.finite_state.rate_value`, as the FSM laws).
 """
 
 from __future__ import annotations
@@ -20,11 +22,32 @@ import math
 import numpy as np
 
 from shipgnc.batchmath import row_dot
-from shipgnc.control.finite_state import HeadingCapture, as_rate_reference, default_gains
+from shipgnc.control.finite_state import (
+    N_RATE_STATE,
+    HeadingCapture,
+    as_rate_reference,
+    default_gains,
+    np_sign,
+    rate_value,
+    source_reason,
+)
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
+from shipgnc.kernels import Kernel, NotCompiled, clip, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
-from shipgnc.models.catamaran import DELTA, PSI, Catamaran, R, V, linearize, straight_running_state
+from shipgnc.models.catamaran import (
+    DELTA,
+    N_KERNEL_PARAMS,
+    PSI,
+    Catamaran,
+    R,
+    V,
+    catamaran_yaw_acceleration,
+    kernel_params,
+    kernel_params_reason,
+    linearize,
+    straight_running_state,
+)
 
 
 def pi_gains(params, T_u: float, h: float) -> tuple[float, float]:
@@ -60,6 +83,47 @@ class YawRatePI:
 
     def signal_values(self):
         return dict(self._last)
+
+    def kernel_reason(self) -> str | None:
+        """Why :meth:`kernel` cannot compile this controller (None when it can)."""
+        return kernel_params_reason(self.model.params) or source_reason(self.omega_ref)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`law` for the composed loop (:func:`yaw_rate_pi_step`): parameters ``[K_i, K_p,
+        model, ω* source]``, per-ship state ``[calls, ω*, source state]``."""
+        reason = self.kernel_reason()
+        if reason:
+            raise NotCompiled(reason)
+        batch_shape = tuple(batch_shape)
+        block, block_state = self.omega_ref.rate_block(batch_shape)
+        state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
+        state[..., 2:] = block_state
+
+        def restore(z: np.ndarray) -> None:
+            z = z.reshape(-1, 2 + N_RATE_STATE)
+            if z.shape[0] and np.any(z[:, 0] > 0):
+                self._last = {"omega_ref": z[:, 1].reshape(batch_shape).copy()}
+            self.omega_ref.restore_block(z[:, 2:], batch_shape)
+
+        return Kernel(yaw_rate_pi_step, flat(self.K_i, self.K_p, kernel_params(self.model.params),
+                                             block), state, restore=restore,
+                      continuous=self.continuous)
+
+
+#: offset of the ω* source's parameters in :meth:`YawRatePI.kernel`
+PI_SOURCE = 2 + N_KERNEL_PARAMS
+
+
+@kernel_function
+def yaw_rate_pi_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`YawRatePI.law` for one ship: δ̇ = K_i (ω* − ω) − K_p Φ₃ (law (20) with
+    cos δ = 1, spec 004 §4.11.3), operation for operation."""
+    z[0] += 1.0
+    w = rate_value(t, x, ref, p, PI_SOURCE, z, 2)
+    u = p[0] * (w - x[R]) - p[1] * catamaran_yaw_acceleration(x, p, 2)
+    z[1] = w
+    sig[0] = w
+    cmd[0] = u
 
 
 def heading_lqr_gain(model: Catamaran, q=(0.0, 1.0e3, 1.0, 0.0), r: float = 1.0e3) -> np.ndarray:
@@ -107,6 +171,53 @@ class HeadingLQR:
 
     def signal_values(self):
         return dict(self._last)
+
+    def kernel_reason(self) -> str | None:
+        """Why :meth:`kernel` cannot compile this controller (None when it can)."""
+        if np.size(self.K) != 4:
+            return f"gain of {np.size(self.K)} values (need 4)"
+        return None
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`law` for the composed loop (:func:`heading_lqr_step`): parameters ``[K (4),
+        capture]``, per-ship state ``[calls, ψ_r, capture state]`` (K(t₀) latched there)."""
+        reason = self.kernel_reason()
+        if reason:
+            raise NotCompiled(reason)
+        batch_shape = tuple(batch_shape)
+        block, block_state = self.capture.rate_block(batch_shape)
+        state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
+        state[..., 2:] = block_state
+
+        def restore(z: np.ndarray) -> None:
+            z = z.reshape(-1, 2 + N_RATE_STATE)
+            if z.shape[0] and np.any(z[:, 0] > 0):
+                self._last = {"psi_ref": z[:, 1].reshape(batch_shape).copy()}
+            self.capture.restore_block(z[:, 2:], batch_shape)
+
+        return Kernel(heading_lqr_step, flat(np.ravel(self.K), block), state, restore=restore,
+                      continuous=self.continuous)
+
+
+@kernel_function
+def heading_lqr_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`HeadingLQR.law` for one ship, operation for operation: the ramp ψ_r = K(t₀) +
+    sign(ΔK) ω_c clip(t − t₀, 0, t* − t₀) and ω* of the capture (17), then
+    δ̇ = −K [v, r − ω*, wrap(ψ − ψ_r), δ] summed left to right (:func:`~shipgnc.batchmath.row_dot`)."""
+    z[0] += 1.0
+    r_ref = rate_value(t, x, ref, p, 4, z, 2)  # the capture's block at p[4:], its state at z[2:]
+    psi_target, omega_c, t0 = p[5], p[6], p[7]
+    psi0 = z[4] if z[3] != 0.0 else math.nan  # numpy: K(t0) unknown is an error (t0 = 0 here)
+    diff = wrap(psi_target - psi0)
+    t_star = t0 + abs(diff) / omega_c
+    psi_ref = psi0 + np_sign(diff) * omega_c * clip(t - t0, 0.0, t_star - t0)
+    total = x[V] * p[0]
+    total = total + (x[R] - r_ref) * p[1]
+    total = total + wrap(x[PSI] - psi_ref) * p[2]
+    total = total + x[DELTA] * p[3]
+    z[1] = psi_ref
+    sig[0] = psi_ref
+    cmd[0] = -total
 
 
 def comparison_cases(preset_name: str = "si", t_end_rate: float = 300.0, t_end_heading: float = 600.0,

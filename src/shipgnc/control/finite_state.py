@@ -35,6 +35,14 @@ it is evaluated at the time of every RK stage (needed for an exact switch at t*)
 The laws are stateless functions of (t, measured state, reference) — their "integral" is the
 physical δ — so they run in ``continuous`` mode (evaluated inside every RK stage, as the document
 does) or sampled every ``Ts`` with a hold.
+
+**Compiled** (:mod:`shipgnc.kernels`): :meth:`YawRateFSM.kernel` is the law for the composed loop
+(:func:`yaw_rate_fsm_step`), the references' ω* is :func:`rate_value` (one kernel for the three
+sources, used by the laws and by the references as guidance, :func:`rate_reference`). The per-ship
+kernel state holds what the numpy objects mutate, in the same calls: the heading capture's latch
+K(t₀), the last ω* and u (``signal_values``) and, per event kind, the index of the first law call
+(samples and RK stages counted alike), its time and the ship's |ω*| or |δ| there, from which
+``restore`` rebuilds ``events`` with the batch-wide values of numpy's messages.
 """
 
 from __future__ import annotations
@@ -46,8 +54,18 @@ import numpy as np
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
+from shipgnc.kernels import Kernel, NotCompiled, clip, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
-from shipgnc.models.catamaran import DELTA, PSI, Catamaran, R
+from shipgnc.models.catamaran import (
+    DELTA,
+    N_KERNEL_PARAMS,
+    PSI,
+    Catamaran,
+    R,
+    catamaran_yaw_acceleration,
+    kernel_params,
+    kernel_params_reason,
+)
 
 EVENT_KINDS = ("omega_ref_above_max", "delta_clamped", "delta_reached_90")
 
@@ -151,6 +169,12 @@ def thruster_lag_rate(delta, v_a, T: float, k: float):
 
 
 # --- yaw-rate references --------------------------------------------------------------------------
+#: ω* sources of :func:`rate_value` (``RATE_GUIDANCE``: the guidance's first reference)
+RATE_CONSTANT, RATE_SINE, RATE_CAPTURE, RATE_GUIDANCE = 0.0, 1.0, 2.0, 3.0
+#: lengths of a source's parameter block and per-ship state block in a kernel
+N_RATE_PARAMS, N_RATE_STATE = 6, 3
+
+
 class _RateReference:
     """Base of the ω* sources: a guidance object with one reference ``r_ref`` (tracks ``r``)."""
 
@@ -162,6 +186,29 @@ class _RateReference:
 
     def reset(self, batch_shape, model=None) -> None:
         self._batch_shape = tuple(batch_shape)
+
+    # --- the composed compiled loop ------------------------------------------------------------
+    def rate_block(self, batch_shape) -> tuple[np.ndarray, np.ndarray]:
+        """``(params, state)`` of :func:`rate_value`: the source's parameter block
+        ``[kind, …]`` (:data:`N_RATE_PARAMS`) and its per-ship state ``[ω, latched, K(t₀)]``
+        (``batch_shape + (N_RATE_STATE,)``), from the object's current state."""
+        raise NotCompiled(f"{type(self).__name__} has no kernel")
+
+    def restore_block(self, z: np.ndarray, batch_shape) -> None:
+        """Leave the object as the numpy loop would, from the final per-ship state block."""
+
+    def kernel_reason(self) -> str | None:
+        """Why the reference, as guidance, has no kernel (None when it has one)."""
+        return source_reason(self) and f"{type(self).__name__} has no kernel"
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`reference` for the composed loop (:func:`rate_reference`)."""
+        params, state = self.rate_block(batch_shape)
+
+        def restore(z: np.ndarray) -> None:
+            self.restore_block(z, batch_shape)
+
+        return Kernel(rate_reference, params, state, restore=restore)
 
     def value(self, t: float, x: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -190,6 +237,11 @@ class ConstantRate(_RateReference):
     def value(self, t, x):
         return self.omega if t >= self.t_start else 0.0 * self.omega
 
+    def rate_block(self, batch_shape):
+        state = np.zeros((*batch_shape, N_RATE_STATE))
+        state[..., 0] = np.broadcast_to(self.omega, tuple(batch_shape))
+        return _block(RATE_CONSTANT, self.t_start), state
+
 
 class SineRate(_RateReference):
     """ω*(t) = A sin(2π t / period) (S6: A = 0.0072 rad/s, period t_f/4 = 375 s, reading C11)."""
@@ -208,6 +260,9 @@ class SineRate(_RateReference):
 
     def value(self, t, x):
         return self.amplitude * math.sin(2.0 * math.pi * t / self.period)
+
+    def rate_block(self, batch_shape):
+        return _block(RATE_SINE, self.amplitude, self.period), np.zeros((*batch_shape, N_RATE_STATE))
 
 
 class HeadingCapture(_RateReference):
@@ -257,6 +312,87 @@ class HeadingCapture(_RateReference):
         else:
             frac = np.where(t < t_star, 1.0, 0.0)
         return np.broadcast_to(np.sign(diff) * self.omega_c * frac, x.shape[:-1]).copy()
+
+    def rate_block(self, batch_shape):
+        state = np.zeros((*batch_shape, N_RATE_STATE))
+        if self.psi0 is not None:
+            state[..., 1], state[..., 2] = 1.0, np.broadcast_to(self.psi0, tuple(batch_shape))
+        return _block(RATE_CAPTURE, self.psi_target, self.omega_c, self.t0, self.ramp_s), state
+
+    def restore_block(self, z, batch_shape) -> None:
+        z = np.asarray(z).reshape(*batch_shape, N_RATE_STATE)
+        if self._psi0_given is None and z.size and bool(np.all(z[..., 1] > 0)):
+            self.psi0 = z[..., 2].copy()
+
+    def kernel_reason(self) -> str | None:
+        """As guidance, K(t₀) latched after t = 0 is refused: numpy latches it in the object the
+        guidance shares with a continuous law, possibly in an RK stage between two samples, and
+        the guidance's kernel only sees the samples."""
+        if self._psi0_given is None and self.t0 > 0:
+            return ("as guidance, a heading capture with t0 > 0 latches K(t0) in the object it "
+                    "shares with the controller (possibly in an RK stage); give psi0 or t0 = 0")
+        return None
+
+
+def source_reason(source) -> str | None:
+    """Why the ω* source ``source`` (None: the guidance's reference) has no kernel in a law."""
+    if source is not None and type(source).rate_block is _RateReference.rate_block:
+        return f"omega_ref: {type(source).__name__} has no kernel"
+    return None
+
+
+def _block(kind: float, *values: float) -> np.ndarray:
+    out = np.zeros(N_RATE_PARAMS)
+    out[0] = kind
+    out[1:1 + len(values)] = values
+    return out
+
+
+@kernel_function
+def np_sign(value):
+    """``np.sign`` for one float (NaN for NaN)."""
+    if value > 0.0:
+        return 1.0
+    if value < 0.0:
+        return -1.0
+    if value == 0.0:
+        return 0.0
+    return value
+
+
+@kernel_function
+def rate_value(t, x, ref, p, o, z, oz):
+    """ω*(t) of one ship, operation for operation as the numpy sources' ``value``: ``p[o:]`` a
+    parameter block of :meth:`_RateReference.rate_block`, ``z[oz:]`` its per-ship state (the
+    heading capture (17) latches K(t₀) there at the first call with t ≥ t₀, as
+    :class:`HeadingCapture` does); ``ref`` the held guidance references (source
+    ``RATE_GUIDANCE``: ``ref[0]``). Offsets, not slices: no array view per call."""
+    kind = p[o]
+    if kind == RATE_CONSTANT:
+        return z[oz] if t >= p[o + 1] else 0.0 * z[oz]
+    if kind == RATE_SINE:
+        return p[o + 1] * math.sin(2.0 * math.pi * t / p[o + 2])
+    if kind == RATE_CAPTURE:
+        psi_target, omega_c, t0, ramp = p[o + 1], p[o + 2], p[o + 3], p[o + 4]
+        if z[oz + 1] == 0.0 and t >= t0:
+            z[oz + 1], z[oz + 2] = 1.0, x[PSI]
+        if z[oz + 1] == 0.0:
+            return 0.0
+        diff = wrap(psi_target - z[oz + 2])
+        t_star = t0 + abs(diff) / omega_c
+        if ramp > 0:
+            frac = clip((t_star + ramp / 2 - t) / ramp, 0.0, 1.0)
+        else:
+            frac = 1.0 if t < t_star else 0.0
+        return np_sign(diff) * omega_c * frac
+    return ref[0]
+
+
+@kernel_function
+def rate_reference(t, x, z, p, ref, out):
+    """:meth:`_RateReference.reference` for one ship: ``r_ref`` = ω*(t); never finished."""
+    ref[0] = rate_value(t, x, ref, p, 0, z, 0)
+    return False
 
 
 def as_rate_reference(omega_ref) -> _RateReference | None:
@@ -360,6 +496,17 @@ class YawRateFSM:
         if all(e["kind"] != kind for e in self.events):
             self.events.append({"time_s": float(t), "kind": kind, "message": message})
 
+    def _message(self, kind: str, value: float) -> str:
+        """The text of event ``kind``; ``value`` the batch's largest |ω*| or |δ| at the call."""
+        if kind == "omega_ref_above_max":
+            return (f"|omega*| = {value:.6g} rad/s exceeds omega_max = {self.omega_max:.6g} "
+                    "rad/s: no steady turn with |delta| < 90°")
+        if kind == "delta_reached_90":
+            return (f"|delta| reached 90° ({math.degrees(value):.2f}°): the FSM gain 1/cos(delta) "
+                    "is singular and the thruster keeps turning")
+        return (f"thruster angle held at the clamp |delta| = {math.degrees(self.delta_max):.2f}°: "
+                "the reference is not reached")
+
     def law(self, t: float, x: np.ndarray, reference: np.ndarray) -> np.ndarray:
         if self.omega_ref is not None:
             w_ref = self.omega_ref.value(t, x)
@@ -371,13 +518,11 @@ class YawRateFSM:
             raise ConfigError("omega_ref = nan: the yaw-rate reference must be finite")
         if self.omega_max is not None and np.max(np.abs(w_ref)) > self.omega_max:
             self._event(t, "omega_ref_above_max",
-                        f"|omega*| = {float(np.max(np.abs(w_ref))):.6g} rad/s exceeds omega_max = "
-                        f"{self.omega_max:.6g} rad/s: no steady turn with |delta| < 90°")
+                        self._message("omega_ref_above_max", float(np.max(np.abs(w_ref)))))
         delta = x[..., DELTA]
         delta_peak = float(np.max(np.abs(delta)))
         if delta_peak >= math.pi / 2:
-            self._event(t, "delta_reached_90", f"|delta| reached 90° ({math.degrees(delta_peak):.2f}°): the "
-                        "FSM gain 1/cos(delta) is singular and the thruster keeps turning")
+            self._event(t, "delta_reached_90", self._message("delta_reached_90", delta_peak))
         if self.gain_freeze is not None:  # W37 with cos(delta) frozen beyond gain_freeze
             frozen = np.clip(delta, -self.gain_freeze, self.gain_freeze)
             scale = np.cos(delta) / np.cos(frozen)
@@ -390,8 +535,7 @@ class YawRateFSM:
         if self.delta_max is not None:
             outward = (np.abs(delta) >= self.delta_max) & (np.sign(u) == np.sign(delta))
             if np.any(outward):
-                self._event(t, "delta_clamped", f"thruster angle held at the clamp |delta| = "
-                            f"{math.degrees(self.delta_max):.2f}°: the reference is not reached")
+                self._event(t, "delta_clamped", self._message("delta_clamped", 0.0))
             u = np.where(outward, 0.0, u)
         self._last = {"omega_ref": w_ref, "fsm_u": u}
         if self.actuator is not None:
@@ -404,6 +548,115 @@ class YawRateFSM:
 
     def signal_values(self) -> dict[str, np.ndarray]:
         return dict(self._last)
+
+    # --- the composed compiled loop ------------------------------------------------------------
+    def kernel_reason(self) -> str | None:
+        """Why :meth:`kernel` cannot compile this controller (None when it can)."""
+        return kernel_params_reason(self.model.params) or source_reason(self.omega_ref)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`law` for the composed loop (:func:`yaw_rate_fsm_step`, sampled or continuous).
+
+        Parameters ``[law 20?, T_u, h, h L T_v, J, ω_max?, ω_max, freeze?, δ_f, clamp?, δ_max,
+        inverse?, T_a, k_a, 0, 0, model (:func:`~shipgnc.models.catamaran.kernel_params`), ω*
+        source]``; per-ship state ``[calls, first call (3), time (3), value (3), ω*, u, source
+        state (3)]`` (events in the order the law checks them: ω_max, 90°, clamp).
+        """
+        reason = self.kernel_reason()
+        if reason:
+            raise NotCompiled(reason)
+        batch_shape = tuple(batch_shape)
+        p = self.model.params
+        source = self.omega_ref
+        if source is None:
+            block, block_state = _block(RATE_GUIDANCE), np.zeros((*batch_shape, N_RATE_STATE))
+        else:
+            block, block_state = source.rate_block(batch_shape)
+        T_a, k_a = self.actuator if self.actuator is not None else (1.0, 1.0)
+        params = flat(float(self.law_number == 20), self.T_u, self.h, self.h * p.L * p.T_v,
+                      kernel_params(p)[2], self.omega_max is not None,
+                      self.omega_max if self.omega_max is not None else 0.0,
+                      self.gain_freeze is not None, self.gain_freeze or 0.0,
+                      self.delta_max is not None, self.delta_max or 0.0,
+                      self.actuator is not None, T_a, k_a, 0.0, 0.0, kernel_params(p), block)
+        state = np.zeros((*batch_shape, FSM_STATE))
+        state[..., 1:4] = -1.0
+        state[..., FSM_STATE - N_RATE_STATE:] = block_state
+
+        def restore(z: np.ndarray) -> None:
+            self._restore(z.reshape(-1, FSM_STATE), batch_shape)
+
+        return Kernel(yaw_rate_fsm_step, params, state, restore=restore, continuous=self.continuous)
+
+    def _restore(self, z: np.ndarray, batch_shape) -> None:
+        """``events``, ``signal_values`` and the ω* source as the numpy loop leaves them."""
+        if z.shape[0] == 0:
+            return
+        found = []
+        for j, kind in enumerate(FSM_EVENTS):
+            first = z[:, 1 + j]
+            if not np.any(first >= 0):
+                continue
+            call = first[first >= 0].min()
+            at = first == call  # the ships over the threshold in numpy's first such call
+            found.append((call, j, kind, float(z[at, 4 + j][0]), float(z[at, 7 + j].max())))
+        self.events = [{"time_s": t, "kind": kind, "message": self._message(kind, value)}
+                       for _, _, kind, t, value in sorted(found)]
+        if np.any(z[:, 0] > 0):
+            self._last = {"omega_ref": z[:, 10].reshape(batch_shape).copy(),
+                          "fsm_u": z[:, 11].reshape(batch_shape).copy()}
+        if self.omega_ref is not None:
+            self.omega_ref.restore_block(z[:, FSM_STATE - N_RATE_STATE:], batch_shape)
+
+
+#: the events of :func:`yaw_rate_fsm_step`, in the order the law checks them
+FSM_EVENTS = ("omega_ref_above_max", "delta_reached_90", "delta_clamped")
+#: offsets of :meth:`YawRateFSM.kernel`'s parameters: the model's, the ω* source's
+FSM_MODEL = 16
+FSM_SOURCE = FSM_MODEL + N_KERNEL_PARAMS
+#: length of :meth:`YawRateFSM.kernel`'s per-ship state
+FSM_STATE = 12 + N_RATE_STATE
+
+
+@kernel_function
+def _first(z, j, t, value):
+    """Record event ``j`` in the per-ship state at its first call (index, time, value)."""
+    if z[1 + j] < 0.0:
+        z[1 + j], z[4 + j], z[7 + j] = z[0], t, value
+
+
+@kernel_function
+def yaw_rate_fsm_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`YawRateFSM.law` for one ship, operation for operation: ω* of the source,
+    law (20) u = (ω* − ω − h Φ₃)/(T_u W₃₇) or (21) u = (ω* − ω)/(T_u W₃₇) with W₃₇ = h L T_v
+    cos δ / J (eq. (19)); cos δ frozen beyond δ_f; u = 0 pushing |δ| beyond δ_max; the command
+    u or v_a = (δ + T_a u)/k_a (eq. (23)). Events recorded in ``z`` (see :meth:`YawRateFSM.kernel`)."""
+    z[0] += 1.0
+    w = rate_value(t, x, ref, p, FSM_SOURCE, z, FSM_STATE - N_RATE_STATE)
+    if p[5] != 0.0 and abs(w) > p[6]:
+        _first(z, 0, t, abs(w))
+    delta = x[DELTA]
+    if abs(delta) >= math.pi / 2:
+        _first(z, 1, t, abs(delta))
+    T_u, h = p[1], p[2]
+    w37 = p[3] * math.cos(delta) / p[4]
+    if p[0] != 0.0:
+        omega_bar = x[R] + h * catamaran_yaw_acceleration(x, p, FSM_MODEL)
+        u = (w - omega_bar) / (T_u * w37)
+    else:
+        u = (w - x[R]) / (T_u * w37)
+    if p[7] != 0.0:
+        frozen = clip(delta, -p[8], p[8])
+        u = u * (math.cos(delta) / math.cos(frozen))
+    if p[9] != 0.0 and abs(delta) >= p[10] and np_sign(u) == np_sign(delta):
+        _first(z, 2, t, 0.0)
+        u = 0.0
+    sig[0], sig[1] = w, u
+    z[10], z[11] = w, u
+    if p[11] != 0.0:
+        cmd[0] = (delta + p[12] * u) / p[13]
+    else:
+        cmd[0] = u
 
 
 def default_gains(preset_name: str) -> tuple[float, float]:

@@ -27,6 +27,12 @@ units: ρ = 1.025 in M_D and J in t·m² used as kg·m², which reproduces the d
 Both keep the printed sway Coriolis sign; ``coriolis="consistent"`` flips it (the hull is then
 directionally unstable, spec 004 C3). The document-frame form (x forward, y to port, ω and K
 clockwise) is :func:`document_derivatives`, with :func:`to_document`/:func:`from_document`.
+
+**Compiled** (:mod:`shipgnc.kernels`): :meth:`Catamaran.kernel` is :meth:`Catamaran.derivatives`
+for one ship (:func:`catamaran_rhs`, every option above; :func:`catamaran_yaw_acceleration` is Φ₃
+for the laws' kernels). Per-ship plant factors (arrays of ``m_x_factor``, ``m_y_factor``,
+``J_factor``, the Monte Carlo of S10) have no kernel: a model kernel has one parameter array for
+all ships, so such a run stays in the numpy loop (:meth:`Catamaran.kernel_reason`).
 """
 
 from __future__ import annotations
@@ -39,6 +45,7 @@ import numpy as np
 from shipgnc.actuators import Actuator
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
+from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
 from shipgnc.models.base import Signal
 
 #: resistance fit R_K(V) = a0 + a1 V + a2 V² [kN, one hull] of eq. (8)
@@ -302,6 +309,108 @@ class Catamaran:
         if d is not None:
             N = N + d[..., 2]
         return N / p.J
+
+    # --- the composed compiled loop (shipgnc.kernels) ----------------------------------------
+    def kernel_reason(self) -> str | None:
+        """Why :meth:`kernel` cannot compile this model (None when it can)."""
+        return kernel_params_reason(self.params)
+
+    def kernel(self) -> Kernel:
+        """:meth:`derivatives` for the composed loop (:func:`catamaran_rhs`); parameters of
+        :func:`kernel_params`."""
+        return Kernel(catamaran_rhs, kernel_params(self.params))
+
+
+#: per-ship parameter fields (a kernel's parameters are shared by every ship of the loop)
+FACTORS = ("m_x_factor", "m_y_factor", "J_factor")
+#: length of :func:`kernel_params`
+N_KERNEL_PARAMS = 15
+
+
+def kernel_params_reason(params: CatamaranParams) -> str | None:
+    """None when ``params`` hold one value per field, else which fields vary per ship."""
+    varying = [name for name in FACTORS if np.size(getattr(params, name)) > 1]
+    if varying:
+        return (f"per-ship plant parameters ({', '.join(varying)}) are not compiled: a model "
+                "kernel rhs(x, u, d, p, xdot) has one parameter array for every ship")
+    return None
+
+
+def kernel_params(params: CatamaranParams) -> np.ndarray:
+    """The flat parameters of :func:`catamaran_rhs` and :func:`catamaran_yaw_acceleration`:
+    ``[m_x, m_y, J, σ m_x, m_x − m_y, c_D, 0.4 L, 2 T_v, L T_v, literal, V_m, 2000 R_K(V_m)/V_m²,
+    lag row, k_t, T_t]`` (each product formed as :meth:`Catamaran.hull_forces` and
+    :meth:`Catamaran.derivatives` form it, so the kernel repeats numpy's operations)."""
+    reason = kernel_params_reason(params)
+    if reason:
+        raise NotCompiled(reason)
+    p = params
+    m_x, m_y, J = (float(np.asarray(v).reshape(-1)[0]) for v in (p.m_x, p.m_y, p.J))
+    a0, a1, a2 = RK_COEFFS
+    rk_min = a0 + a1 * V_MIN_FIT + a2 * V_MIN_FIT**2
+    out = flat(m_x, m_y, J, p.sigma * m_x, m_x - m_y, p.c_D, 0.4 * p.L, 2.0 * p.T_v, p.L * p.T_v,
+               float(p.low_speed == "literal"), V_MIN_FIT, 2000.0 * rk_min / V_MIN_FIT**2,
+               float(p.delta_row == "lag"), p.k_t, p.T_t)
+    assert out.size == N_KERNEL_PARAMS
+    return out
+
+
+@kernel_function
+def _hull_forces(x, p, o):
+    """(X, Y, N) of the hull alone for one ship: :meth:`Catamaran.hull_forces` operation for
+    operation — resistance R(V)/V of eq. (8) (continued below V_m unless literal), Coriolis with
+    sign σ (eq. (1)–(2)), the moment of R at x_p(β), yaw damping c_D V r and the Munk moment (3).
+    ``p[o:]`` holds :func:`kernel_params` (an offset, not a slice: no array view per call)."""
+    m_y, sig_m_x, munk, c_D, x_p0 = p[o + 1], p[o + 3], p[o + 4], p[o + 5], p[o + 6]
+    su, sv, sr = x[0], x[1], x[2]
+    speed = math.hypot(su, sv)
+    a0, a1, a2 = RK_COEFFS
+    if p[o + 9] != 0.0:  # literal fit, 0 at V = 0
+        r_over_v = 2000.0 * (a0 / speed + a1 + a2 * speed) if speed > 0 else 0.0
+    elif speed >= p[o + 10]:
+        r_over_v = 2000.0 * (a0 / speed + a1 + a2 * speed)
+    else:
+        r_over_v = p[o + 11] * speed
+    beta = math.atan2(sv, su)
+    x_p = x_p0 * (0.5 - abs(beta) / math.pi)
+    X = -r_over_v * su + m_y * sv * sr
+    Y = -r_over_v * sv + sig_m_x * su * sr
+    N = -x_p * r_over_v * sv - c_D * speed * sr + munk * su * sv
+    return X, Y, N
+
+
+@kernel_function
+def catamaran_rhs(x, u, d, p, xdot):
+    """ẋ of document 004 eq. (1)–(3) with δ̇ of eq. (2) (rate row) or of the lag (22) for one
+    ship: :meth:`Catamaran.derivatives`, operation for operation (``p``: :func:`kernel_params`;
+    a zero ``d`` is ``d=None``)."""
+    m_x, m_y, J, two_T_v, L_T_v = p[0], p[1], p[2], p[7], p[8]
+    delta = x[6]
+    X, Y, N = _hull_forces(x, p, 0)
+    cd, sd = math.cos(delta), math.sin(delta)
+    X = X + two_T_v * cd + d[0]
+    Y = Y - two_T_v * sd + d[1]
+    N = N + L_T_v * sd + d[2]
+    c, s = math.cos(x[5]), math.sin(x[5])
+    xdot[0] = X / m_x
+    xdot[1] = Y / m_y
+    xdot[2] = N / J
+    xdot[3] = c * x[0] - s * x[1]
+    xdot[4] = s * x[0] + c * x[1]
+    xdot[5] = x[2]
+    if p[12] != 0.0:
+        xdot[6] = (-delta + p[13] * u[0]) / p[14]
+    else:
+        xdot[6] = u[0]
+
+
+@kernel_function
+def catamaran_yaw_acceleration(x, p, o):
+    """Φ₃ = ṙ of eq. (3) at one ship's state without disturbance:
+    :meth:`Catamaran.yaw_acceleration` (``p[o:]``: :func:`kernel_params`)."""
+    N = _hull_forces(x, p, o)[2]
+    N = N + p[o + 8] * math.sin(x[6])
+    return N / p[o + 2]
 
 
 def slew_actuator(model: Catamaran, rate_deg_s: float) -> Actuator:
