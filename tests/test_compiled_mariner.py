@@ -20,14 +20,12 @@ from shipgnc.control.lqr import PathLQR, design_lqr
 from shipgnc.environment.current import CrossCurrent
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
 from shipgnc.environment.filtered_noise import SecondOrderNoise
-from shipgnc.errors import ConfigError, DivergenceError
+from shipgnc.errors import DivergenceError
 from shipgnc.guidance.path import WaypointPath
 from shipgnc.models.mariner import DOC_B_R, DOC_D_Y, MarinerDisturbance, MarinerWitOppe, rudder
 from shipgnc.sim import compose, simulator
 from shipgnc.sim.simulator import _validate, simulate
 from shipgnc.units import NAUTICAL_MILE as NM
-
-pytest.importorskip("numba")
 
 RTOL = 1e-9
 M = MarinerWitOppe()
@@ -415,7 +413,6 @@ def test_unsupported_reasons():
     assert reason(setup_of()) is None
     assert reason(setup_of(disturbance=doc_disturbance(DOC_PATH), controller=None)) is None
     cases = {
-        "SecondOrderNoise waves need the step dt": {"disturbance": MarinerDisturbance(waves=waves())},
         "current UniformCurrent has no kernel": {
             "disturbance": MarinerDisturbance(current=UniformCurrent(0.5, 0.0))},
         "solve_ivp": {"integrator": "solve_ivp"},
@@ -426,14 +423,23 @@ def test_unsupported_reasons():
         assert text and words in text, (words, text)
 
 
-def test_compiled_backend_refuses_wave_noise_and_auto_falls_back():
-    make = lambda: {"controller": PathLQR(K_SI, DOC_PATH, Ts=0.3),  # noqa: E731
-                    "disturbance": MarinerDisturbance(DOC_B_R, waves=waves())}
-    with pytest.raises(ConfigError, match="SecondOrderNoise") as info:
-        simulate(M, X0_DOC, t_end=3.0, dt=0.3, backend="compiled", **make())
-    assert "backend='numpy'" in str(info.value)
-    x0 = np.repeat(X0_DOC[:1], simulator.COMPILED_MIN_BATCH, axis=0)
-    assert simulate(M, x0, t_end=0.6, dt=0.3, **make()).attrs["backend"] == "numpy"
+def test_wave_noise_runs_compiled_with_the_same_sea():
+    """Document 000's wave noise (A11) drawn by the numpy filter at t_k = k·dt for the compiled loop:
+    same seed, same sea, and the filter ends in the numpy loop's state."""
+    made = []
+
+    def make():
+        made.append(MarinerDisturbance(DOC_B_R, waves=waves()))
+        return {"controller": PathLQR(K_SI, DOC_PATH, Ts=0.3), "disturbance": made[-1]}
+
+    x0 = np.repeat(X0_DOC[:1], 5, axis=0)
+    ref = simulate(M, x0, t_end=300.0, dt=0.3, backend="numpy", seed=4, **make())
+    got = simulate(M, x0, t_end=300.0, dt=0.3, backend="compiled", seed=4, **make())
+    assert got.attrs["backend"] == "compiled"
+    for name in ref.data_vars:
+        np.testing.assert_allclose(got[name].values, ref[name].values, rtol=RTOL, atol=1e-12,
+                                   err_msg=name)
+    np.testing.assert_array_equal(made[1].waves._x, made[0].waves._x)
 
 
 def test_auto_backend_picks_the_composed_loop_by_batch_or_work(monkeypatch):

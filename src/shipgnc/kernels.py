@@ -19,8 +19,14 @@ per-ship state, mutated in place; every array is a 1-D float64 slice of one ship
 * guidance    ``reference(t, x, z, p, ref, out) -> finished`` — writes the references and the
   logged outputs, returns True once the ship's task is complete;
 * disturbance ``sample(t, x, z, p, w, d)`` — writes ``d``; ``w`` is the step's row of a table the
-  component fills in numpy before each kernel call (its random draws), so a seed gives the same
-  sea as the numpy loop; ``per_stage`` disturbances are called in every RK4 stage.
+  component fills in numpy before each kernel call (its random draws, at t_k = k·dt: a
+  disturbance's ``kernel(batch_shape, dt)`` is told the step), so a seed gives the same sea as the
+  numpy loop; ``per_stage`` disturbances are called in every RK4 stage.
+
+Methods, called after the component's ``reset``: ``model.kernel()``,
+``controller.kernel(batch_shape)``, ``guidance.kernel(batch_shape)``,
+``disturbance.kernel(batch_shape, dt)``; optionally ``kernel_reason()`` → None or why a setting of
+the component has no kernel (checked before the run, so the fallback to numpy costs nothing).
 
 All kernels use :data:`JIT_OPTIONS`: cached on disk, fused multiply-add and x/c → x·(1/c) only,
 so NaN and inf keep their meaning for the divergence guard; results move at round-off level.

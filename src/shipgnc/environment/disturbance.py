@@ -32,7 +32,7 @@ class ConstantDisturbance:
     def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
         return np.broadcast_to(self.values, self._shape)
 
-    def kernel(self, batch_shape) -> Kernel:
+    def kernel(self, batch_shape, dt: float | None = None) -> Kernel:
         """The values per ship as the kernel's state (:func:`copy_state`)."""
         return Kernel(copy_state, state=np.broadcast_to(self.values, self._shape))
 
@@ -61,7 +61,7 @@ class GaussianForceNoise:
         assert self._rng is not None, "reset() must be called before sampling"
         return self.mean + self.std * self._rng.standard_normal(self._shape)
 
-    def kernel(self, batch_shape) -> Kernel:
+    def kernel(self, batch_shape, dt: float | None = None) -> Kernel:
         """mean + std·w with w drawn in numpy, step by step as :meth:`__call__` draws it."""
         rng, shape, n = self._rng, self._shape, self.std.size
 

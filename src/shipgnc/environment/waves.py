@@ -850,7 +850,7 @@ class FroudeKrylovWaveLoads:
         finally:
             self._numpy_only = before
 
-    def kernel(self, batch_shape) -> Kernel:
+    def kernel(self, batch_shape, dt: float | None = None) -> Kernel:
         """The loads for the composed loop, evaluated in every RK stage
         (:func:`~shipgnc.environment.wave_kernel.froude_krylov_sample`). The ship's sea is its
         per-ship state: the rows of :data:`~shipgnc.environment.wave_kernel.ROWS` (ωᵢ, φᵢ,

@@ -316,10 +316,6 @@ class MarinerDisturbance:
         if self.waves is not None:
             if type(self.waves) is not SecondOrderNoise:
                 return f"waves {type(self.waves).__name__} have no kernel (only SecondOrderNoise)"
-            # the table of wave values needs the step times t_k = k·dt, which the composed loop
-            # does not hand to a disturbance (kernel(batch_shape), table(k0, k1))
-            return ("SecondOrderNoise waves need the step dt, which the composed loop does not "
-                    "pass to Kernel.table")
         return None
 
     def kernel(self, batch_shape, dt: float | None = None) -> Kernel:

@@ -215,7 +215,7 @@ def run(setup):
         km = model.kernel()
         kc = ctrl.kernel(batch) if ctrl is not None else None
         kg = gd.kernel(batch) if gd is not None else None
-        kd = dist.kernel(batch) if dist is not None else None
+        kd = dist.kernel(batch, dt=setup.dt) if dist is not None else None
     except NotCompiled as exc:  # a setting only known after reset: the caller falls back
         raise ConfigError(f"compiled loop: {exc}") from None
     empty = Kernel(_no_controller)
