@@ -59,7 +59,8 @@ def family_setup(scenario_name: str):
 
         case = next(iter(cases(scenario).values()))
         x0 = np.asarray(case.x0, dtype=float)
-        return case.model, x0.reshape(-1, x0.shape[-1])[0], case.simulate_kwargs(), round(case.t_end / case.dt)
+        steps = round(case.t_end / case.dt)
+        return case.model, x0.reshape(-1, x0.shape[-1])[0], case.simulate_kwargs(), steps
     from shipgnc.scenarios.runner import build
 
     setup = build(scenario)
@@ -95,9 +96,10 @@ def fresh_process(code: str, env: dict) -> float:
 def first_compile(scenario_name: str) -> float:
     """Seconds of a 2-step run of the family in a fresh process with empty caches, minus the same
     process's import cost."""
-    code = ("import sys; sys.path.insert(0, %r); from bench_families import family_setup, time_run; "
-            "m, x, k, _ = family_setup(%r); time_run(m, x, k, 1, 2, 'compiled', 1)"
-            % (str(Path(__file__).resolve().parent), scenario_name))
+    here = str(Path(__file__).resolve().parent)
+    code = (f"import sys; sys.path.insert(0, {here!r}); from bench_families import family_setup, "
+            f"time_run; m, x, k, _ = family_setup({scenario_name!r}); "
+            "time_run(m, x, k, 1, 2, 'compiled', 1)")
     with tempfile.TemporaryDirectory() as numba_dir, tempfile.TemporaryDirectory() as loops:
         env = {"NUMBA_CACHE_DIR": numba_dir, "SHIPGNC_CACHE_DIR": loops}
         cold = fresh_process(code, env)

@@ -321,37 +321,41 @@ class Catamaran:
         return Kernel(catamaran_rhs, kernel_params(self.params))
 
 
-#: per-ship parameter fields (a kernel's parameters are shared by every ship of the loop)
+#: fields that may hold one value per ship (a Monte Carlo over the plant, check 16 / S10)
 FACTORS = ("m_x_factor", "m_y_factor", "J_factor")
 #: length of :func:`kernel_params`
 N_KERNEL_PARAMS = 15
 
 
 def kernel_params_reason(params: CatamaranParams) -> str | None:
-    """None when ``params`` hold one value per field, else which fields vary per ship."""
-    varying = [name for name in FACTORS if np.size(getattr(params, name)) > 1]
-    if varying:
-        return (f"per-ship plant parameters ({', '.join(varying)}) are not compiled: a model "
-                "kernel rhs(x, u, d, p, xdot) has one parameter array for every ship")
+    """None when :func:`kernel_params` covers ``params`` (scalar factors, or one per ship along a
+    single batch axis), else why not."""
+    shapes = {np.shape(getattr(params, name)) for name in FACTORS} - {()}
+    if any(len(shape) > 1 for shape in shapes) or len({s[0] for s in shapes}) > 1:
+        return (f"per-ship factors ({', '.join(FACTORS)}) of shapes {sorted(shapes)}: the compiled "
+                "loop takes one value per ship along one batch axis")
     return None
 
 
 def kernel_params(params: CatamaranParams) -> np.ndarray:
-    """The flat parameters of :func:`catamaran_rhs` and :func:`catamaran_yaw_acceleration`:
+    """The parameters of :func:`catamaran_rhs` and :func:`catamaran_yaw_acceleration`:
     ``[m_x, m_y, J, σ m_x, m_x − m_y, c_D, 0.4 L, 2 T_v, L T_v, literal, V_m, 2000 R_K(V_m)/V_m²,
     lag row, k_t, T_t]`` (each product formed as :meth:`Catamaran.hull_forces` and
-    :meth:`Catamaran.derivatives` form it, so the kernel repeats numpy's operations)."""
+    :meth:`Catamaran.derivatives` form it, so the kernel repeats numpy's operations): a flat
+    array, or one row per ship when the mass factors vary from ship to ship."""
     reason = kernel_params_reason(params)
     if reason:
         raise NotCompiled(reason)
     p = params
-    m_x, m_y, J = (float(np.asarray(v).reshape(-1)[0]) for v in (p.m_x, p.m_y, p.J))
+    m_x, m_y, J = (np.asarray(v, dtype=float) for v in (p.m_x, p.m_y, p.J))
     a0, a1, a2 = RK_COEFFS
     rk_min = a0 + a1 * V_MIN_FIT + a2 * V_MIN_FIT**2
-    out = flat(m_x, m_y, J, p.sigma * m_x, m_x - m_y, p.c_D, 0.4 * p.L, 2.0 * p.T_v, p.L * p.T_v,
-               float(p.low_speed == "literal"), V_MIN_FIT, 2000.0 * rk_min / V_MIN_FIT**2,
-               float(p.delta_row == "lag"), p.k_t, p.T_t)
-    assert out.size == N_KERNEL_PARAMS
+    columns = np.broadcast_arrays(
+        m_x, m_y, J, p.sigma * m_x, m_x - m_y, p.c_D, 0.4 * p.L, 2.0 * p.T_v, p.L * p.T_v,
+        float(p.low_speed == "literal"), V_MIN_FIT, 2000.0 * rk_min / V_MIN_FIT**2,
+        float(p.delta_row == "lag"), p.k_t, p.T_t)
+    out = np.ascontiguousarray(np.stack(columns, axis=-1), dtype=np.float64)
+    assert out.shape[-1] == N_KERNEL_PARAMS
     return out
 
 

@@ -260,7 +260,7 @@ def run(setup):
     out = np.empty((n_columns, log_length(setup), n))
     event_at = np.full(n, -1, dtype=np.int64)
     done_at = np.full(n, -1, dtype=np.int64) if gd is not None else None
-    params = [np.ascontiguousarray(k.params, dtype=np.float64) for k in (km, kc_, kg_, kd_)]
+    params = [_param_rows(k, n) for k in (km, kc_, kg_, kd_)]
     pa = act.kernel_params()
     limits = np.asarray(model.state_limits, dtype=np.float64)
     table = {"W": np.zeros((1, n, 0))}
@@ -281,6 +281,14 @@ def run(setup):
         if k is not None and k.restore is not None:
             k.restore(S[:, lay[key]:lay[key] + width].copy())
     return make_log(setup, signals, out, S, event, state_slot=0, cmd_slot=lay["cmd"], k_end=k_end)
+
+
+def _param_rows(kernel: Kernel, n_ships: int) -> np.ndarray:
+    """A kernel's parameters as rows: ``(1, n_p)`` shared by every ship, or ``(n_ships, n_p)``."""
+    rows = np.ascontiguousarray(np.atleast_2d(kernel.params), dtype=np.float64)
+    if rows.shape[0] not in (1, n_ships):
+        raise ConfigError(f"compiled loop: {rows.shape[0]} parameter rows for {n_ships} ships")
+    return rows
 
 
 def row_layout(nx, nl, nu, nref, nout, nsig, nd, nzc, nzg, nzd) -> dict[str, int]:

@@ -17,11 +17,17 @@ from shipgnc.actuators import input_at_kernel, lag_rate_kernel, plan_kernel
 from shipgnc.kernels import JIT_OPTIONS, clip, wrap  # noqa: F401  (JIT_OPTIONS: the generated tail)
 
 
-def loop(k0, k1, k_last, hold, every, dt, S, W, pm, pa, pc, pg, pd, limits, err,
-         out, event, done_at):
+def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, pd_rows, limits,
+         err, out, event, done_at):
     n_ships = S.shape[0]
     for i in numba.prange(n_ships):
         row = S[i]
+        # a component's parameters: one row for every ship, or a row per ship (1 or n rows)
+        ship = np.int64(i)  # the prange index may be unsigned: int64 keeps min() an integer
+        pm = pm_rows[min(ship, pm_rows.shape[0] - 1)]
+        pc = pc_rows[min(ship, pc_rows.shape[0] - 1)]
+        pg = pg_rows[min(ship, pg_rows.shape[0] - 1)]
+        pd = pd_rows[min(ship, pd_rows.shape[0] - 1)]
         x = row[o_x:o_x + nx]
         lag = row[o_lag:o_lag + nl]
         applied = row[o_app:o_app + nu]
