@@ -14,7 +14,6 @@ import pytest
 from shipgnc.cases import catamaran as C
 from shipgnc.control.catamaran_baselines import HeadingLQR, YawRatePI, comparison_cases
 from shipgnc.control.finite_state import ConstantRate, HeadingCapture, SineRate, YawRateFSM
-from shipgnc.errors import ConfigError
 from shipgnc.models.catamaran import Catamaran, catamaran_yaw_acceleration
 from shipgnc.scenarios.runner import run_scenario
 from shipgnc.sim.simulator import simulate

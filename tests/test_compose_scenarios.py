@@ -35,7 +35,7 @@ SHORTER = {
     "catamaran-fixed-angle": ("simulation.t_end=300",),
     "catamaran-sine": ("simulation.t_end=300",),
     "catamaran-heading": ("simulation.t_end=300",),
-    "catamaran-actuator": ("simulation.t_end=200",),
+    "catamaran-actuator": ("simulation.t_end=12",),  # chaotic once |delta| passes 90° (12.75 s)
     "catamaran-compare": ("simulation.t_end=200",),
     "catamaran-montecarlo": ("simulation.t_end=100",),
 }

@@ -45,7 +45,7 @@ import numpy as np
 from shipgnc.actuators import Actuator
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
-from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
+from shipgnc.kernels import Kernel, NotCompiled, kernel_function
 from shipgnc.models.base import Signal
 
 #: resistance fit R_K(V) = a0 + a1 V + a2 V² [kN, one hull] of eq. (8)
