@@ -68,9 +68,10 @@ class Kernel:
     ``function`` is the numba dispatcher (its identity keys the memoised composed loops);
     ``params`` the flat parameter array, or one row per ship ``(n_ships, n_p)`` (parameters that
     differ from ship to ship, e.g. a Monte Carlo over the plant; the kernel gets its ship's row);
-    ``state`` the initial per-ship state ``(n_ships, n_z)`` (after the component's ``reset``); ``table(k0, k1)`` the per-step inputs of steps
-    ``k0 <= k < k1``, shape ``(k1 - k0, n_ships, n_table)``; ``restore(z)`` leaves the component
-    as the numpy loop would, from the final per-ship state.
+    ``state`` the initial per-ship state ``(n_ships, n_z)`` (after the component's ``reset``);
+    ``table(k0, k1)`` the per-step inputs of steps ``k0 <= k < k1``, shape
+    ``(k1 - k0, n_ships, n_table)``; ``restore(z)`` leaves the component as the numpy loop would,
+    from the final per-ship state.
     """
 
     function: Callable
