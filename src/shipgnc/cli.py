@@ -44,8 +44,8 @@ def friendly_errors():
         hint = "; --keep-partial writes the partial result" if isinstance(exc, DivergenceError) else ""
         stderr.print(f"[bold red]error:[/] {_one_line(exc)}{hint}", soft_wrap=True)
         raise typer.Exit(exc.exit_code) from None
-    except KeyboardInterrupt:
-        stderr.print("interrupted")
+    except KeyboardInterrupt as exc:  # Ctrl-C: one line, no traceback (Interrupted names the time)
+        stderr.print(_one_line(exc) if str(exc) else "interrupted", soft_wrap=True)
         raise typer.Exit(130) from None
     except Exception as exc:
         if os.environ.get("SHIPGNC_DEBUG"):
@@ -116,7 +116,8 @@ def run_command(
         "--realtime", help="With --live: pace the run against the wall clock (1.0 = real time).")] = None,
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write PNG figures.")] = True,
     keep_partial: Annotated[bool, typer.Option(
-        "--keep-partial", help="If the run diverges, still write the partial result (exit 3).")] = False,
+        "--keep-partial", help="If the run diverges (exit 3) or is interrupted by Ctrl-C (exit 130), "
+                               "still write the partial result.")] = False,
 ) -> None:
     """Run a scenario: write result.nc, metrics.json and figures; print the metrics."""
     with friendly_errors(), ExitStack() as stack:
@@ -141,7 +142,8 @@ def run_command(
         observer = _live_observer(sc, realtime) if live else None
         with _progress(enabled=not live) as progress:
             run = run_scenario(sc, observer=observer, progress=progress,
-                               on_divergence="stop" if keep_partial else "raise")
+                               on_divergence="stop" if keep_partial else "raise",
+                               keep_interrupted=keep_partial)
         if observer is not None:
             observer.finish()  # draw the last samples (a LOS run may end before t_end)
         written = write_outputs(run, out_dir, figures=figures, figure_process=figure_process)
@@ -150,6 +152,9 @@ def run_command(
         else:
             _print_metrics(sc.name, run.metrics)
         stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
+        if run.interrupted:
+            stderr.print(run.interrupted, soft_wrap=True)
+            raise typer.Exit(130)
         if observer is not None and not observer.closed:
             stderr.print("close the live window to exit")
             observer.finish(block=True)

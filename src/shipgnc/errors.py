@@ -33,6 +33,21 @@ class DivergenceError(ShipGNCError, FloatingPointError):
         self.index = index
 
 
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during a run: ``time`` [s] is the last sample computed and ``partial`` the result up
+    to it (an ``xarray.Dataset`` with ``attrs["interrupted"] = 1``, or None). A KeyboardInterrupt,
+    so code that does not know it stops as before; the command line prints one line and exits 130
+    (``--keep-partial`` writes the partial result first)."""
+
+    exit_code = 130
+
+    def __init__(self, time: float | None = None, partial=None, message: str | None = None):
+        text = message or ("interrupted" if time is None else f"interrupted at t = {time:.6g} s")
+        super().__init__(text)
+        self.time = time
+        self.partial = partial
+
+
 class ShipGNCWarning(UserWarning):
     """A result that is sound but weaker than asked (e.g. a study whose chunks ran on different
     loops agrees to round-off, not to the bit); the command line prints it as a one-line warning."""

@@ -89,37 +89,48 @@ def cases(scenario: Scenario) -> dict:
     return built
 
 
-def run(scenario: Scenario, *, seed: int, progress=None, on_divergence: str = "raise"):
+def run(scenario: Scenario, *, seed: int, progress=None, on_divergence: str = "raise",
+        keep_interrupted: bool = False):
     """Run every case of the scenario with the one loop; returns a
-    :class:`~shipgnc.scenarios.runner.ScenarioRun` (metrics keyed by run when there are several)."""
+    :class:`~shipgnc.scenarios.runner.ScenarioRun` (metrics keyed by run when there are several;
+    Ctrl-C as :func:`~shipgnc.scenarios.runner.run_scenario`)."""
     from shipgnc.analysis.catamaran_metrics import attach_events, catamaran_metrics, comparison_metrics
-    from shipgnc.scenarios.runner import ScenarioRun, Setup, combine
+    from shipgnc.scenarios.runner import ScenarioRun, Setup, combine, interruptible
     from shipgnc.sim.simulator import simulate
 
     runs = cases(scenario)
     results, metrics, setups = {}, {}, {}
     several = len(runs) > 1
     for key, case in runs.items():
-        ds = simulate(case.model, case.x0, **case.simulate_kwargs(), seed=seed, progress=progress,
-                      backend=scenario.simulation.backend,
-                      on_divergence="stop" if several else on_divergence,
-                      attrs={"scenario": scenario.name, "controller": key, "seed": seed,
-                             "vessel": "catamaran", "preset": scenario.vessel.preset})
+        with interruptible(keep_interrupted) as run:
+            run.result = simulate(case.model, case.x0, **case.simulate_kwargs(), seed=seed,
+                                  progress=progress, backend=scenario.simulation.backend,
+                                  on_divergence="stop" if several else on_divergence,
+                                  attrs={"scenario": scenario.name, "controller": key, "seed": seed,
+                                         "vessel": "catamaran", "preset": scenario.vessel.preset})
+        ds = run.result
         attach_events(ds, case.controller)
-        if np.ndim(case.x0) > 1:
-            m = montecarlo_summary(ds, case)
-        elif scenario.case.builder == "compare":
-            m = {**catamaran_metrics(ds, case.controller, case.heading_target),
-                 **comparison_metrics(ds, case.heading_target)}
-        else:
-            m = catamaran_metrics(ds, case.controller, case.heading_target)
+
+        def score(ds, case=case):
+            if np.ndim(case.x0) > 1:
+                return montecarlo_summary(ds, case)
+            if scenario.case.builder == "compare":
+                return {**catamaran_metrics(ds, case.controller, case.heading_target),
+                        **comparison_metrics(ds, case.heading_target)}
+            return catamaran_metrics(ds, case.controller, case.heading_target)
+
+        m = run.metrics(score)
         m["diverged"] = bool(ds.attrs.get("diverged", 0))
         results[key], metrics[key] = ds, m
         setups[key] = Setup(case.model, case.x0, case.actuator, case.controller, case.guidance, None)
-    first = next(iter(runs))
+        if run.interrupted:
+            break
+    first = next(iter(results))
     if not several:
-        return ScenarioRun(scenario, setups[first], results[first], metrics[first])
-    return ScenarioRun(scenario, setups[first], combine(results), metrics, setups)
+        return ScenarioRun(scenario, setups[first], results[first], metrics[first],
+                           interrupted=run.message)
+    return ScenarioRun(scenario, setups[first], combine(results), metrics, setups,
+                       interrupted=run.message)
 
 
 def montecarlo_summary(ds, case) -> dict:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,7 +19,7 @@ from shipgnc.actuators import Actuator
 from shipgnc.control.heading_speed import HeadingSpeedAutopilot
 from shipgnc.control.open_loop import OpenLoopSchedule
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
-from shipgnc.errors import ConfigError
+from shipgnc.errors import ConfigError, Interrupted
 from shipgnc.guidance.los import LOSGuidance
 from shipgnc.guidance.path import WaypointPath
 from shipgnc.guidance.schedule import ReferenceSchedule
@@ -56,6 +57,8 @@ class ScenarioRun:
     #: document 002: the solved route and the sailed runs by label
     route: object = None
     sailed: dict | None = None
+    #: "interrupted at t = … s" when Ctrl-C cut the run short (``keep_interrupted``), else ""
+    interrupted: str = ""
 
 
 def _boat(scenario: Scenario):
@@ -283,8 +286,12 @@ def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndar
 
 
 def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progress=None,
-                 on_divergence: str = "raise") -> ScenarioRun:
+                 on_divergence: str = "raise", keep_interrupted: bool = False) -> ScenarioRun:
     """Run a scenario (object, built-in name or YAML path) and compute its metrics.
+
+    Ctrl-C raises :class:`~shipgnc.errors.Interrupted`; with ``keep_interrupted`` the run instead
+    returns what was computed (the runs before, the interrupted one up to its last sample;
+    ``result.attrs["interrupted"] = 1`` and ``metrics["interrupted"] = True``).
 
     With ``controllers`` every variant runs on the same plant, guidance and disturbance (same
     seed); the result gets a ``controller`` dimension and the metrics are keyed by controller.
@@ -310,26 +317,65 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     if scenario.vessel.model == "catamaran":
         from shipgnc.scenarios import catamaran
 
-        return catamaran.run(scenario, seed=seed, progress=progress, on_divergence=on_divergence)
+        return catamaran.run(scenario, seed=seed, progress=progress, on_divergence=on_divergence,
+                             keep_interrupted=keep_interrupted)
     results, all_metrics, setups = {}, {}, {}
     for name in scenario.variants:
         setup = build(scenario, name, seed=seed)
-        result = simulate(setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt,
-                          controller=setup.controller, actuator=setup.actuator,
-                          guidance=setup.guidance, disturbance=setup.disturbance, u0=setup.u0,
-                          integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
-                          atol=sim.atol, seed=seed, observer=observer, progress=progress,
-                          log_every=sim.log_every,
-                          backend="numpy" if observer is not None else sim.backend,
-                          on_divergence="stop" if compare else on_divergence,
-                          attrs={"scenario": scenario.name, "controller": name, "seed": seed,
-                                 **_vessel_attrs(setup.model, scenario)})
-        results[name], setups[name] = result, setup
-        all_metrics[name] = compute_metrics(scenario, result, setup)
+        with interruptible(keep_interrupted) as run:
+            run.result = simulate(
+                setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
+                actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
+                u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
+                atol=sim.atol, seed=seed, observer=observer, progress=progress,
+                log_every=sim.log_every, backend="numpy" if observer is not None else sim.backend,
+                on_divergence="stop" if compare else on_divergence,
+                attrs={"scenario": scenario.name, "controller": name, "seed": seed,
+                       **_vessel_attrs(setup.model, scenario)})
+        results[name], setups[name] = run.result, setup
+        all_metrics[name] = run.metrics(lambda r, s=setup: compute_metrics(scenario, r, s))
+        if run.interrupted:
+            break
     first = next(iter(results))
     if not compare:
-        return ScenarioRun(scenario, setups[first], results[first], all_metrics[first])
-    return ScenarioRun(scenario, setups[first], combine(results), all_metrics, setups)
+        return ScenarioRun(scenario, setups[first], results[first], all_metrics[first],
+                           interrupted=run.message)
+    return ScenarioRun(scenario, setups[first], combine(results), all_metrics, setups,
+                       interrupted=run.message)
+
+
+class _Interruptible:
+    """One run that Ctrl-C may cut short (see :func:`interruptible`)."""
+
+    def __init__(self) -> None:
+        self.result = None
+        self.interrupted = False
+        self.message = ""
+
+    def metrics(self, score) -> dict:
+        """``score(result)``, flagged ``interrupted`` when the run was cut short (the figures of a
+        run too short to score are left out, and a note says so)."""
+        if not self.interrupted:
+            return score(self.result)
+        try:
+            out = score(self.result)
+        except (ValueError, IndexError, KeyError, ConfigError) as exc:
+            out = {"note": f"the interrupted run is too short to score ({type(exc).__name__})"}
+        out["interrupted"] = True
+        return out
+
+
+@contextmanager
+def interruptible(keep: bool):
+    """Run a simulation inside; on Ctrl-C with ``keep``, hold its partial result instead of
+    raising :class:`~shipgnc.errors.Interrupted` (the caller stops after this run)."""
+    run = _Interruptible()
+    try:
+        yield run
+    except Interrupted as exc:
+        if not keep or exc.partial is None:
+            raise
+        run.result, run.interrupted, run.message = exc.partial, True, str(exc)
 
 
 def combine(results: dict):

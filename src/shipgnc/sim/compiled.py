@@ -10,6 +10,7 @@ progress callback, and short ones for a batch logging many samples.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -17,6 +18,8 @@ import numpy as np
 PROGRESS_CHUNKS = 20
 #: ship-steps worth a thread of their own (≈ 10 ms)
 MIN_THREAD_WORK = 100_000
+#: most ship-steps of one kernel call (≈ 0.5 s): Ctrl-C is seen between calls
+MAX_CALL_WORK = 5_000_000
 #: most logged samples per ship of one kernel call in a batch: the log is (variable, sample, ship),
 #: so neighbouring ships share its cache lines, and short calls keep them cached from one ship to
 #: the next (a 1 000-ship log of every step is written ≈ 2× faster)
@@ -34,9 +37,8 @@ def log_length(setup) -> int:
 
 
 def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 1,
-          prepare=None, done_at: np.ndarray | None = None) -> tuple[int | None, int]:
-    """Run a kernel over steps 0 … n_steps; returns the first divergence event (or None) and the
-    last step run.
+          prepare=None, done_at: np.ndarray | None = None) -> Stop:
+    """Run a kernel over steps 0 … n_steps; returns how it ended (:class:`Stop`).
 
     ``call(k0, k1, k_last)`` runs steps ``k0 <= k < k1`` of every ship (``k_last``: the step that
     is logged whatever ``log_every`` and ends the run), carrying each ship's state in its row of
@@ -69,41 +71,56 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
         n_chunks = max(n_chunks, PROGRESS_CHUNKS)
     if n_ships > 1:
         n_chunks = max(n_chunks, math.ceil(log_length(setup) / LOG_SAMPLES_PER_CALL))
+    n_chunks = max(n_chunks, math.ceil(n_ships * (n_steps + 1) / MAX_CALL_WORK))
     bounds = np.linspace(0, n_steps + 1, min(n_chunks, n_steps + 1) + 1).round().astype(int)
     if setup.progress is not None:
         setup.progress(0, n_steps)
-    for k0, k1 in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
-        if prepare is not None:
-            prepare(k0, k1)
-        start = S.copy()
-        done_start = None if done_at is None else done_at.copy()
-        limited(k0, k1, n_steps)
-        event = int(div_event[div_event >= 0].min()) if (div_event >= 0).any() else None
-        k_done = None
-        if done_at is not None and n_ships and bool(np.all(done_at >= 0)):
-            k_done = int(done_at.max())  # every ship finished: the run ends at this sample ...
-            if event is not None and event < 2 * k_done + 1:
-                k_done = None  # ... unless a ship diverged before
-        if event is None and k_done is None:
-            if setup.progress is not None:
-                setup.progress(k1 - 1, n_steps)
-            continue
-        S[:] = start
-        div_event[:] = -1
-        if done_start is not None:
-            done_at[:] = done_start
-        if k_done is not None:
-            limited(k0, k_done + 1, k_done)
-            if setup.progress is not None:
-                setup.progress(n_steps, n_steps)
-            return None, k_done
-        limited(k0, event // 2 + 1, n_steps)
-        return event, event // 2
-    return None, n_steps
+    done_through = -1  # the last step every ship has completed (Ctrl-C keeps the log up to it)
+    try:
+        for k0, k1 in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+            if prepare is not None:
+                prepare(k0, k1)
+            start = S.copy()
+            done_start = None if done_at is None else done_at.copy()
+            limited(k0, k1, n_steps)
+            event = int(div_event[div_event >= 0].min()) if (div_event >= 0).any() else None
+            k_done = None
+            if done_at is not None and n_ships and bool(np.all(done_at >= 0)):
+                k_done = int(done_at.max())  # every ship finished: the run ends at this sample ...
+                if event is not None and event < 2 * k_done + 1:
+                    k_done = None  # ... unless a ship diverged before
+            if event is None and k_done is None:
+                done_through = k1 - 1
+                if setup.progress is not None:
+                    setup.progress(k1 - 1, n_steps)
+                continue
+            S[:] = start
+            div_event[:] = -1
+            if done_start is not None:
+                done_at[:] = done_start
+            if k_done is not None:
+                limited(k0, k_done + 1, k_done)
+                if setup.progress is not None:
+                    setup.progress(n_steps, n_steps)
+                return Stop(None, k_done)
+            limited(k0, event // 2 + 1, n_steps)
+            return Stop(event, event // 2)
+    except KeyboardInterrupt:  # Ctrl-C between (or within) kernel calls
+        return Stop(None, done_through, interrupted=True)
+    return Stop(None, n_steps)
+
+
+class Stop(NamedTuple):
+    """How a compiled run ended: the first divergence ``event`` (or None), the last step run
+    ``k_end``, and whether Ctrl-C ended it (the log then holds the samples up to ``k_end``)."""
+
+    event: int | None
+    k_end: int
+    interrupted: bool = False
 
 
 def make_log(setup, signals, out: np.ndarray, S: np.ndarray, event: int | None, *, state_slot: int,
-             cmd_slot: int, k_end: int | None = None):
+             cmd_slot: int, k_end: int | None = None, interrupted: bool = False):
     """The run's ``Log`` from the kernel's ``out`` (variable, sample, ship), the first divergence
     ``event`` and the last step run ``k_end`` (see :func:`drive`): the numpy loop's sample times,
     status and divergence error (``S[:, state_slot:]`` holds the states, ``S[:, cmd_slot:]`` the
@@ -115,9 +132,12 @@ def make_log(setup, signals, out: np.ndarray, S: np.ndarray, event: int | None, 
     n_states, n_inputs = len(setup.model.states), int(setup.actuator.n)
     last = n_steps if (k_end is None or event is not None) else k_end
     log_steps = np.arange(0, last + 1, every)
-    if last % every:
+    if last % every and not interrupted:  # an interrupted run logged the grid only
         log_steps = np.append(log_steps, last)
     status: dict = {"diverged": 0, "stopped_early": 0, "message": ""}
+    if interrupted:
+        done = float(log_steps[-1] * dt) if log_steps.size else 0.0
+        status.update(stopped_early=1, interrupted=1, message=f"interrupted at t = {done:.6g} s")
     n_logged = log_steps.size
     if event is not None:
         k = event // 2

@@ -276,11 +276,12 @@ def run(setup):
              params[0], pa, params[1], params[2], params[3], limits, err, out, event_at,
              done_at if done_at is not None else np.zeros(n, dtype=np.int64))
 
-    event, k_end = drive(setup, call, S, event_at, prepare=prepare, done_at=done_at)
+    stop = drive(setup, call, S, event_at, prepare=prepare, done_at=done_at)
     for k, key, width in ((kc, "zc", zc0.shape[1]), (kg, "zg", zg0.shape[1]), (kd, "zd", zd0.shape[1])):
         if k is not None and k.restore is not None:
             k.restore(S[:, lay[key]:lay[key] + width].copy())
-    return make_log(setup, signals, out, S, event, state_slot=0, cmd_slot=lay["cmd"], k_end=k_end)
+    return make_log(setup, signals, out, S, stop.event, state_slot=0, cmd_slot=lay["cmd"],
+                    k_end=stop.k_end, interrupted=stop.interrupted)
 
 
 def _param_rows(kernel: Kernel, n_ships: int) -> np.ndarray:

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from shipgnc.actuators import Actuator
-from shipgnc.errors import ConfigError, DivergenceError, require
+from shipgnc.errors import ConfigError, DivergenceError, Interrupted, require
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import Signal, names
 from shipgnc.sim.integrators import rk4_step, solve_ivp_step
@@ -109,7 +109,9 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     on_divergence : ``"raise"`` (default) raises :class:`DivergenceError` naming time, state,
         value and ship; ``"stop"`` returns the partial result with ``attrs["diverged"] = 1``.
     observer : ``observer(t, x, command, applied)`` at every logged sample (live plots); it may
-        raise :class:`StopSimulation` to end the run and keep the result.
+        raise :class:`StopSimulation` to end the run and keep the result. Ctrl-C (a
+        KeyboardInterrupt) ends either loop too: it raises :class:`~shipgnc.errors.Interrupted`
+        carrying the samples computed so far (``.partial``, ``attrs["interrupted"] = 1``).
     progress : ``progress(k, n_steps)`` called about a hundred times per run.
     log_every : keep every n-th sample (large batches); the final sample is always kept.
     batch_dims : names of the batch dimensions (default ``("ship",)`` for one batch axis).
@@ -160,7 +162,11 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
 
     run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold,
                  "t_end": t_end, "model": type(model).__name__, **(attrs or {})}
-    return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
+    result = build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
+    if log.status.get("interrupted"):
+        last = float(log.time[-1]) if log.time.size else 0.0
+        raise Interrupted(last, partial=result)
+    return result
 
 
 def _compiled_twin(setup: SimSetup):
@@ -384,63 +390,68 @@ def run_numpy(setup: SimSetup) -> Log:
     n_logged = 0
     progress_every = max(1, setup.n_steps // 100)
 
-    for k in range(setup.n_steps + 1):
-        t = k * dt
-        if k % setup.hold == 0:
-            if gd is not None:
-                ref = gd.reference(t, x)
-                extra = dict(gd.output_values())
-            if ctrl is not None:
-                command = (ctrl.law(t, x, ref) if continuous else ctrl.step(t, x, ref))
-                command = np.asarray(command, dtype=float)
-                act.check_command_shape(command)
-                extra.update(ctrl.signal_values())
-                error = check_divergence(setup, t, command=command)
-                if error is not None:
-                    if setup.on_divergence == "raise":
-                        raise error
-                    status.update(diverged=1, message=str(error))
-                    break
-        plan = act.begin_step(applied, command, dt)
-        applied_now = act.input_at(plan, 0.0, lag)
-        if dist is not None and not dist.per_stage:
-            held_d = dist(t, x)
-        last = k == setup.n_steps
-        finished = gd.finished() if gd is not None else None
-        all_done = finished is not None and bool(np.all(finished))
-        if k % setup.log_every == 0 or last or all_done:
-            times[n_logged] = t
-            for i, s in enumerate(model.states):
-                data[s.name][n_logged] = x[..., i]
-            for i, name in enumerate(input_names):
-                data[f"{name}_cmd"][n_logged] = command[..., i]
-                data[name][n_logged] = applied_now[..., i]
-            if gd is not None:
-                for i, s in enumerate(gd.references):
-                    data[s.name][n_logged] = ref[..., i]
-            for name, value in extra.items():
-                data[name][n_logged] = value
-            if gd is not None:  # errors of the current state against the held reference
-                for name, value in tracking_errors(setup, x, ref).items():
+    t = 0.0
+    try:
+        for k in range(setup.n_steps + 1):
+            t = k * dt
+            if k % setup.hold == 0:
+                if gd is not None:
+                    ref = gd.reference(t, x)
+                    extra = dict(gd.output_values())
+                if ctrl is not None:
+                    command = (ctrl.law(t, x, ref) if continuous else ctrl.step(t, x, ref))
+                    command = np.asarray(command, dtype=float)
+                    act.check_command_shape(command)
+                    extra.update(ctrl.signal_values())
+                    error = check_divergence(setup, t, command=command)
+                    if error is not None:
+                        if setup.on_divergence == "raise":
+                            raise error
+                        status.update(diverged=1, message=str(error))
+                        break
+            plan = act.begin_step(applied, command, dt)
+            applied_now = act.input_at(plan, 0.0, lag)
+            if dist is not None and not dist.per_stage:
+                held_d = dist(t, x)
+            last = k == setup.n_steps
+            finished = gd.finished() if gd is not None else None
+            all_done = finished is not None and bool(np.all(finished))
+            if k % setup.log_every == 0 or last or all_done:
+                times[n_logged] = t
+                for i, s in enumerate(model.states):
+                    data[s.name][n_logged] = x[..., i]
+                for i, name in enumerate(input_names):
+                    data[f"{name}_cmd"][n_logged] = command[..., i]
+                    data[name][n_logged] = applied_now[..., i]
+                if gd is not None:
+                    for i, s in enumerate(gd.references):
+                        data[s.name][n_logged] = ref[..., i]
+                for name, value in extra.items():
                     data[name][n_logged] = value
-            n_logged += 1
-        if setup.observer is not None:
-            try:
-                setup.observer(t, x, command, applied_now)
-            except StopSimulation as stop:
-                status.update(stopped_early=1, message=str(stop) or "stopped by observer")
+                if gd is not None:  # errors of the current state against the held reference
+                    for name, value in tracking_errors(setup, x, ref).items():
+                        data[name][n_logged] = value
+                n_logged += 1
+            if setup.observer is not None:
+                try:
+                    setup.observer(t, x, command, applied_now)
+                except StopSimulation as stop:
+                    status.update(stopped_early=1, message=str(stop) or "stopped by observer")
+                    break
+            if setup.progress is not None and (k % progress_every == 0 or last):
+                setup.progress(k, setup.n_steps)
+            if last or all_done:
                 break
-        if setup.progress is not None and (k % progress_every == 0 or last):
-            setup.progress(k, setup.n_steps)
-        if last or all_done:
-            break
-        x, lag = advance_plant(setup, t, x, lag, plan, command, ref, held_d)
-        applied = act.input_at(plan, 1.0, lag)
-        error = check_divergence(setup, t + dt, x)
-        if error is not None:
-            if setup.on_divergence == "raise":
-                raise error
-            status.update(diverged=1, message=str(error))
-            break
+            x, lag = advance_plant(setup, t, x, lag, plan, command, ref, held_d)
+            applied = act.input_at(plan, 1.0, lag)
+            error = check_divergence(setup, t + dt, x)
+            if error is not None:
+                if setup.on_divergence == "raise":
+                    raise error
+                status.update(diverged=1, message=str(error))
+                break
+    except KeyboardInterrupt:  # Ctrl-C: keep the samples logged so far (see simulate)
+        last = float(times[n_logged - 1]) if n_logged else 0.0
+        status.update(stopped_early=1, interrupted=1, message=f"interrupted at t = {last:.6g} s")
     return Log(time=times[:n_logged], data={k: v[:n_logged] for k, v in data.items()},
                signals=signals, status=status)

@@ -11,13 +11,16 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
+import threading
 import warnings
 from collections.abc import Callable
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
-from shipgnc.errors import ConfigError, ShipGNCWarning
+from shipgnc.errors import ConfigError, Interrupted, ShipGNCWarning
 from shipgnc.study.chunk import Chunk, check_perturbable, check_sweepable, plan_chunks, run_chunk
 from shipgnc.study.spec import Study
 
@@ -73,22 +76,52 @@ def connect(scheduler: str | None, workers: str):
             reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise ConfigError(f"--scheduler {scheduler!r}: cannot reach a dask scheduler within "
                               f"{CONNECT_TIMEOUT_S} s ({reason})") from None
-    cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
+    # the workers start with Ctrl-C ignored (an ignored signal stays ignored in a child process):
+    # Ctrl-C reaches the whole terminal's process group, and this process alone answers it
+    with _sigint_ignored():
+        cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR)
     return Client(cluster)
+
+
+@contextmanager
+def _sigint_ignored():
+    """SIGINT ignored inside the block (main thread only; elsewhere a no-op)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def run_chunks(study: Study, chunks: list[Chunk], *, client=None,
                on_chunk: Callable[[int, int], None] | None = None) -> list:
     """The chunks' Datasets in chunk order; ``on_chunk(done, total)`` after each finished chunk."""
     total = len(chunks)
-    if client is None:
-        out = []
-        for i, chunk in enumerate(chunks):
-            out.append(run_chunk(study, chunk))
-            if on_chunk is not None:
-                on_chunk(i + 1, total)
-        return out
+    finished = [0]
+
+    def counted(done: int, total: int) -> None:
+        finished[0] = done
+        if on_chunk is not None:
+            on_chunk(done, total)
+
+    try:
+        if client is None:
+            out = []
+            for i, chunk in enumerate(chunks):
+                out.append(run_chunk(study, chunk))
+                counted(i + 1, total)
+            return out
+        return _run_on_dask(study, chunks, client, counted)
+    except KeyboardInterrupt:  # Ctrl-C: one line, whatever was running
+        raise Interrupted(message=f"interrupted after {finished[0]} of {total} chunks") from None
+
+
+def _run_on_dask(study: Study, chunks: list[Chunk], client, on_chunk) -> list:
+    total = len(chunks)
     from dask.distributed import as_completed
 
     # retries: one more try for a chunk that raised (e.g. a race on numba's cache); bad input
