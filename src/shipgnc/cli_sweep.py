@@ -2,6 +2,9 @@
 
     shipgnc sweep SCENARIO [--grid KEY=V1,V2,...]... [--mc N] [--seed S]
                   [--perturb FIELD=normal:SIGMA | FIELD=uniform:LOW,HIGH]... [--set KEY=VALUE]...
+                  (FIELD: an initial-state field, or vessel.params.NAME with SIGMA/LOW/HIGH in SI
+                  or in % of the nominal value: the plant's parameter; the controller keeps its
+                  nominal design)
                   [--workers local|dask] [--scheduler tcp://HOST:PORT] [--chunk-size M]
                   [--series] [--out DIR]
 
@@ -27,8 +30,12 @@ def sweep(
     mc: Annotated[int, typer.Option("--mc", help="Monte Carlo members per grid point.")] = 1,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the members' streams.")] = 0,
     perturb: Annotated[list[str] | None, typer.Option(
-        "--perturb", help="FIELD=normal:SIGMA or FIELD=uniform:LOW,HIGH, an initial-state offset per "
-                          "member (north, east [m], psi_deg [deg], u, v [m/s], r_deg_s [deg/s]).")] = None,
+        "--perturb", help="FIELD=normal:SIGMA or FIELD=uniform:LOW,HIGH, drawn per member "
+                          "(repeatable): an initial-state offset (north, east \\[m], psi_deg \\[deg], "
+                          "u, v \\[m/s], r_deg_s \\[deg/s]) or a plant parameter vessel.params.NAME "
+                          "(SI offset from the nominal value, or relative with %, e.g. "
+                          "vessel.params.m=normal:5%). Only the plant is perturbed: the controller "
+                          "keeps its nominal design (model uncertainty).")] = None,
     set_: Annotated[list[str] | None, typer.Option(
         "--set", help="KEY=VALUE applied to every point (repeatable).")] = None,
     workers: Annotated[str, typer.Option("--workers", help="local | dask (a LocalCluster).")] = "local",

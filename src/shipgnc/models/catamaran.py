@@ -38,7 +38,7 @@ all ships, so such a run stays in the numpy loop (:meth:`Catamaran.kernel_reason
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -47,6 +47,7 @@ from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, NotCompiled, kernel_function
 from shipgnc.models.base import Signal
+from shipgnc.params import Params
 
 #: resistance fit R_K(V) = a0 + a1 V + a2 V² [kN, one hull] of eq. (8)
 RK_COEFFS = (8.1, -8.436, 2.536)
@@ -69,7 +70,7 @@ def _is_number_or_array(value) -> bool:
 
 
 @dataclass(frozen=True, eq=False)
-class CatamaranParams:
+class CatamaranParams(Params):
     """Parameters of document 004's catamaran (defaults: preset ``si``; SI unless noted).
 
     ============  ==============  ======================================================
@@ -196,17 +197,6 @@ class CatamaranParams:
         c = a0 - 2.0 * self.T_v / 2000.0
         return (-a1 + math.sqrt(a1 * a1 - 4.0 * a2 * c)) / (2.0 * a2)
 
-    def with_(self, **changes) -> CatamaranParams:
-        """A copy with some parameters changed (validated; unknown names rejected)."""
-        known = {f.name for f in fields(self)}
-        for key in changes:
-            if key not in known:
-                raise ConfigError(f"vessel.params.{key}: unknown parameter; allowed: "
-                                  f"{', '.join(sorted(known))}")
-        return replace(self, **changes)
-
-    def as_dict(self) -> dict:
-        return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
 #: named parameter sets (spec 004 §4.4); ``coriolis="consistent"`` is an override of either

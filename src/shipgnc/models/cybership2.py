@@ -36,17 +36,18 @@ disturbance ``[X_env, Y_env, N_env]`` in body axes (N, N, N·m; e.g. wave loads)
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 from functools import cached_property
 
 import numpy as np
 
 from shipgnc.actuators import Actuator
-from shipgnc.errors import ConfigError, require
+from shipgnc.errors import require
 from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, flat, kernel_function
 from shipgnc.models.base import Signal
 from shipgnc.models.fossen3dof import DISTURBANCES, STATES
+from shipgnc.params import Params
 
 RUDDER_MODELS = ("table1", "skjetne")
 #: propeller speed of document 003 (both main propellers) [rps]; cruise ≈ 0.3 m/s in calm water
@@ -54,7 +55,7 @@ CRUISE_RPS = 8.13
 
 
 @dataclass(frozen=True)
-class CyberShip2Params:
+class CyberShip2Params(Params):
     """Parameters of CyberShip II (defaults: the published model; SI units throughout).
 
     ==================  ===========  ==============================================================
@@ -196,17 +197,6 @@ class CyberShip2Params:
         M[1:, 1:] = self.sway_yaw_mass
         return M
 
-    def with_(self, **changes) -> CyberShip2Params:
-        """A copy with some parameters changed (validated; unknown names rejected)."""
-        known = {f.name for f in fields(self)}
-        for key in changes:
-            if key not in known:
-                raise ConfigError(f"vessel.params.{key}: unknown parameter; allowed: "
-                                  f"{', '.join(sorted(known))}")
-        return replace(self, **changes)
-
-    def as_dict(self) -> dict:
-        return asdict(self)
 
 
 def propeller_thrust(params: CyberShip2Params, n, u):

@@ -20,7 +20,7 @@ drops the Munk yaw moment as Fossen's Otter model did (spec 001 A2, A3).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -28,11 +28,12 @@ from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, flat, kernel_function
 from shipgnc.models.base import Signal
+from shipgnc.params import Params
 from shipgnc.units import G
 
 
 @dataclass(frozen=True)
-class BoatParams:
+class BoatParams(Params):
     """Parameters of the vectored-thrust boat (defaults: preset ``otter``, spec 001 table 1.6).
 
     All SI: kg, kg·m², N·s/m, N·m·s/rad, N·m·s²/rad², m, N, rad.
@@ -103,17 +104,6 @@ class BoatParams:
         """τ_s = M₁₁/(−X_u) [s]."""
         return self.M11 / -self.X_u
 
-    def with_(self, **changes: float) -> BoatParams:
-        """A copy with some parameters changed (validated; unknown names rejected)."""
-        known = {f.name for f in fields(self)}
-        for key in changes:
-            if key not in known:
-                raise ConfigError(f"vessel.params.{key}: unknown parameter; allowed: "
-                                  f"{', '.join(sorted(known))}")
-        return replace(self, **changes)
-
-    def as_dict(self) -> dict[str, float]:
-        return asdict(self)
 
 
 #: Named parameter sets of spec 001 §1.6 (overrides on top of the ``otter`` defaults).

@@ -14,9 +14,14 @@ Registered ids (scenario; initial offsets drawn at each reset):
 * ``shipgnc/BoatLOS-v0``: ``boat-los`` (waypoints with LOS references);
 * ``shipgnc/CyberShipCourse-v0``: ``cybership-calm`` (document 003; the return is −J);
 * ``shipgnc/CyberShipWaves-v0``: ``cybership-waves`` (a seeded sea per episode);
+* ``shipgnc/CatamaranTurn-v0``: ``catamaran-turn`` (document 004, S3: yaw rate ω* = 0.08 rad/s;
+  reward −(r − ω*)², action δ̇);
+* ``shipgnc/CatamaranHeading-v0``: ``catamaran-heading`` (S7: heading K* = 0.8 rad; reward
+  −wrap(ψ − K*)²); heading ±30° at reset;
 * ``shipgnc/Ship-v0``: ``gym.make("shipgnc/Ship-v0", scenario=..., perturb=[...])`` for a boat or
   CyberShip II scenario with guidance and metric set ``heading-steps``, ``waypoints`` or
-  ``course-quality`` (the others have no per-sample reward: ConfigError).
+  ``course-quality``, or a catamaran scenario of case builder ``turn``, ``sine`` or ``heading``
+  (the others have no per-sample reward: ConfigError).
 """
 
 from __future__ import annotations
@@ -33,6 +38,8 @@ ENVIRONMENTS = {
     "shipgnc/BoatLOS-v0": {"scenario": "boat-los"},
     "shipgnc/CyberShipCourse-v0": {"scenario": "cybership-calm"},
     "shipgnc/CyberShipWaves-v0": {"scenario": "cybership-waves"},
+    "shipgnc/CatamaranTurn-v0": {"scenario": "catamaran-turn"},
+    "shipgnc/CatamaranHeading-v0": {"scenario": "catamaran-heading", "perturb": ("psi_deg=uniform:-30,30",)},
     "shipgnc/Ship-v0": {},
 }
 

@@ -4,7 +4,8 @@ ships stepped in one array operation (:class:`ShipVectorEnv`).
 * observation: the model's states (angles wrapped to (−π, π]), the guidance references and the
   tracking errors, named in ``observation_names``; unbounded ``Box`` (float64, SI units);
 * action: the model's inputs (``Box`` between the actuator limits, e.g. thrust [0, 200] N and
-  thruster angle ±45° for the boat), held over the scenario controller's sample time ``Ts``;
+  thruster angle ±45° for the boat; the catamaran's thruster rate δ̇ has no limit in document 004,
+  so its ``Box`` is unbounded), held over the scenario controller's sample time ``Ts``;
   the actuator (saturation, rate limit, lag) acts between the action and the plant;
 * reward: the scenario's metric, sample by sample (see :mod:`shipgnc.rl.episode`);
 * episode end: truncated at the scenario's ``t_end``; terminated when the guidance is finished

@@ -14,7 +14,14 @@ period (the final sample t_end included in the last step):
   ``heading_rmse_deg`` = deg(√(−return / N)) with N the number of samples;
 * ``course-quality`` (document 003, eq. 2): r = −Σ (Δψ² + λ δ²); the return is −J;
 * ``waypoints`` (spec 001 §1.10): r = −Σ e² with e the LOS cross-track error [m], over the samples
-  the metric counts (along-track distance past the capture distance on their own leg).
+  the metric counts (along-track distance past the capture distance on their own leg);
+* document 004's catamaran (metric set ``catamaran``, whose figures are end-of-run values, so the
+  reward is the tracking error its runs are about): a yaw-rate case (builders ``turn``, ``sine``)
+  r = −Σ (r − ω*)² [rad²/s²] with ω* the case's reference; a heading case (``heading``)
+  r = −Σ wrap(ψ − K*)² [rad²] with K* the heading target (``final_heading_error_rad`` is its
+  last sample's error). The observation adds K* and wrap(ψ − K*) (``psi_target``, ``psi_error``)
+  to the states, the reference ω* and r − ω*. The agent takes the finite-state law's place: the
+  action is the model's input δ̇ [rad/s], held over the law's ``Ts`` (continuous: one step dt).
 
 Each member of the batch has its own random stream (:class:`~shipgnc.sim.streams.MemberStreams`):
 its initial-state offsets (``perturb``) are drawn first, then its disturbance.
@@ -33,6 +40,9 @@ from shipgnc.study.chunk import check_perturbable
 from shipgnc.study.spec import PERTURBABLE, Perturbation
 
 REWARDS = ("heading-steps", "course-quality", "waypoints")
+#: document 004's case builders an environment takes, with the kind of their per-sample reward
+#: (one plant and one reference for every run of the builder: the agent replaces the law)
+CATAMARAN_REWARDS = {"turn": "yaw-rate", "sine": "yaw-rate", "heading": "heading"}
 
 
 class BatchedEpisode:
@@ -44,10 +54,18 @@ class BatchedEpisode:
 
         self.scenario = load_scenario(scenario) if isinstance(scenario, str) else scenario
         sc = self.scenario
-        if sc.route is not None or sc.vessel.model in ("catamaran", "mariner"):
+        if sc.route is not None or sc.vessel.model == "mariner":
             raise ConfigError(f"scenario {sc.name!r}: an environment needs a vessel stepped by the generic "
-                              "loop with guidance (the vectored-thrust boat or CyberShip II)")
-        if sc.metrics not in REWARDS:
+                              "loop with guidance (the vectored-thrust boat, CyberShip II or document "
+                              "004's catamaran)")
+        catamaran = sc.vessel.model == "catamaran"
+        self.reward_kind = CATAMARAN_REWARDS.get(sc.case.builder) if catamaran else sc.metrics
+        if catamaran and self.reward_kind is None:
+            raise ConfigError(f"scenario {sc.name!r}: case builder {sc.case.builder!r} has no per-sample "
+                              f"reward; catamaran environments take builders "
+                              f"{', '.join(CATAMARAN_REWARDS)} (one plant tracking one yaw-rate or "
+                              "heading reference)")
+        if not catamaran and sc.metrics not in REWARDS:
             raise ConfigError(f"scenario {sc.name!r}: metric set {sc.metrics!r} has no per-sample "
                               f"reward; environments take a scenario whose metrics are one of "
                               f"{', '.join(REWARDS)}")
@@ -63,7 +81,8 @@ class BatchedEpisode:
         self.batch = int(batch)
         self.model, self.actuator, self.guidance = setup.model, setup.actuator, setup.guidance
         self.disturbance = setup.disturbance
-        cfg = next(iter(sc.variants.values()))
+        # the control period: the scenario controller's Ts (a catamaran case's law: None = continuous)
+        ctrl = setup.controller if catamaran else next(iter(sc.variants.values()))
         x0 = np.tile(np.asarray(setup.x0, dtype=float), (self.batch, 1))
         sim = sc.simulation
         self.sim = _validate(self.model, x0, t_end=sim.t_end, dt=sim.dt, controller=None,
@@ -71,7 +90,8 @@ class BatchedEpisode:
                              u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
                              atol=sim.atol, seed=None, on_divergence="stop", observer=None,
                              progress=None, log_every=1)
-        self.hold = max(1, round(float(getattr(cfg, "Ts", sim.dt)) / sim.dt))
+        self.actuator = self.sim.actuator
+        self.hold = max(1, round(float(getattr(ctrl, "Ts", None) or sim.dt) / sim.dt))
         self.dt = sim.dt
         self.n_steps = self.sim.n_steps
         self.lam = float(sc.quality.lam) if sc.metrics == "course-quality" else 0.0
@@ -81,12 +101,19 @@ class BatchedEpisode:
         self._ref_angle = np.array([s.angle for s in self.guidance.references], dtype=bool)
         self._tracked = [(state_names.index(s.tracks), i, s.angle)
                          for i, s in enumerate(self.guidance.references) if s.tracks]
-        self._psi_error = next(n for n, (j, _, _) in enumerate(self._tracked) if state_names[j] == "psi")
+        self._psi_error = next((n for n, (j, _, _) in enumerate(self._tracked) if state_names[j] == "psi"),
+                               None)
+        self._r_error = next((n for n, (j, _, _) in enumerate(self._tracked) if state_names[j] == "r"), None)
+        #: (index of psi, K*) of a catamaran heading case: K* and wrap(psi - K*) join the observation
+        self._target = None
+        if self.reward_kind == "heading":
+            self._target = (state_names.index("psi"), float(setup.case.heading_target))
         self._i_delta = names(self.model.inputs).index("delta") if self.lam else None
         lower, upper = self.model.input_limits()
         self.action_low, self.action_high = np.asarray(lower, float), np.asarray(upper, float)
         self.observation_names = ([*state_names, *(s.name for s in self.guidance.references),
-                                   *(f"{state_names[j]}_error" for j, _, _ in self._tracked)])
+                                   *(f"{state_names[j]}_error" for j, _, _ in self._tracked),
+                                   *(("psi_target", "psi_error") if self._target else ())])
 
     # -- episode ---------------------------------------------------------------------------
     def reset(self, seeds) -> np.ndarray:
@@ -117,7 +144,15 @@ class BatchedEpisode:
     def observation(self) -> np.ndarray:
         x = np.where(self._angle, wrap_angle(self.x), self.x)
         ref = np.where(self._ref_angle, wrap_angle(self.ref), self.ref)
-        return np.concatenate([x, ref, self.errors()], axis=-1)
+        parts = [x, ref, self.errors()]
+        if self._target is not None:
+            parts += [np.full((self.batch, 1), self._target[1]), self.heading_error()[:, None]]
+        return np.concatenate(parts, axis=-1)
+
+    def heading_error(self) -> np.ndarray:
+        """wrap(ψ − K*) of a catamaran heading case (per member)."""
+        i, target = self._target
+        return wrap_angle(self.x[..., i] - target)
 
     def errors(self) -> np.ndarray:
         cols = []
@@ -128,7 +163,11 @@ class BatchedEpisode:
 
     def sample_cost(self) -> np.ndarray:
         """The metric's term at the current sample (per member)."""
-        metric = self.scenario.metrics
+        metric = self.reward_kind
+        if metric == "yaw-rate":
+            return self.errors()[..., self._r_error] ** 2
+        if metric == "heading":
+            return self.heading_error() ** 2
         if metric == "waypoints":  # the metric's samples: along-track >= capture distance on their leg
             out = self.guidance.output_values()
             captured = out["along_track"] >= self.scenario.guidance.capture_distance

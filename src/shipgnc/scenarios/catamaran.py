@@ -94,7 +94,7 @@ def run(scenario: Scenario, *, seed: int, progress=None, on_divergence: str = "r
     """Run every case of the scenario with the one loop; returns a
     :class:`~shipgnc.scenarios.runner.ScenarioRun` (metrics keyed by run when there are several;
     Ctrl-C as :func:`~shipgnc.scenarios.runner.run_scenario`)."""
-    from shipgnc.analysis.catamaran_metrics import attach_events, catamaran_metrics, comparison_metrics
+    from shipgnc.analysis.catamaran_metrics import attach_events
     from shipgnc.scenarios.runner import ScenarioRun, Setup, combine, interruptible
     from shipgnc.sim.simulator import simulate
 
@@ -110,19 +110,11 @@ def run(scenario: Scenario, *, seed: int, progress=None, on_divergence: str = "r
                                          "vessel": "catamaran", "preset": scenario.vessel.preset})
         ds = run.result
         attach_events(ds, case.controller)
-
-        def score(ds, case=case):
-            if np.ndim(case.x0) > 1:
-                return montecarlo_summary(ds, case)
-            if scenario.case.builder == "compare":
-                return {**catamaran_metrics(ds, case.controller, case.heading_target),
-                        **comparison_metrics(ds, case.heading_target)}
-            return catamaran_metrics(ds, case.controller, case.heading_target)
-
-        m = run.metrics(score)
+        m = run.metrics(lambda ds, case=case: score(scenario, ds, case, case.controller))
         m["diverged"] = bool(ds.attrs.get("diverged", 0))
         results[key], metrics[key] = ds, m
-        setups[key] = Setup(case.model, case.x0, case.actuator, case.controller, case.guidance, None)
+        setups[key] = Setup(case.model, case.x0, case.actuator, case.controller, case.guidance, None,
+                            case=case)
         if run.interrupted:
             break
     first = next(iter(results))
@@ -131,6 +123,48 @@ def run(scenario: Scenario, *, seed: int, progress=None, on_divergence: str = "r
                            interrupted=run.message)
     return ScenarioRun(scenario, setups[first], combine(results), metrics, setups,
                        interrupted=run.message)
+
+
+def score(scenario: Scenario, ds, case, controller=None) -> dict:
+    """The scenario's catamaran metrics of one run of ``case`` (the keys ``shipgnc run`` prints;
+    ``diverged`` is the caller's). ``controller``: the run's controller, whose events join those
+    found in the logged δ (None: the events in ``ds.attrs`` or the logged δ alone)."""
+    from shipgnc.analysis.catamaran_metrics import catamaran_metrics, comparison_metrics
+
+    if np.ndim(case.x0) > 1:
+        return montecarlo_summary(ds, case)
+    if scenario.case.builder == "compare":
+        return {**catamaran_metrics(ds, controller, case.heading_target),
+                **comparison_metrics(ds, case.heading_target)}
+    return catamaran_metrics(ds, controller, case.heading_target)
+
+
+def setup(scenario: Scenario, variant: str | None = None):
+    """The :class:`~shipgnc.scenarios.runner.Setup` of run ``variant`` (a run key; default: the
+    first run), for the generic loop of a study or an environment: the case's model, x0,
+    actuator (the model's own when the case has none), controller and guidance, the case kept
+    in ``Setup.case`` for its metrics. A run whose duration or step is not the scenario's
+    ``simulation`` is a ConfigError (whoever runs a Setup runs it for ``simulation.t_end``)."""
+    from shipgnc.actuators import Actuator
+    from shipgnc.scenarios.runner import Setup
+
+    runs = cases(scenario)
+    name = variant if variant is not None else next(iter(runs))
+    if name not in runs:
+        raise ConfigError(f"controller {name!r}: not a run of scenario {scenario.name!r}; have "
+                          f"{', '.join(runs)}")
+    case, sim = runs[name], scenario.simulation
+    if abs(case.t_end - sim.t_end) > 1e-9 * max(1.0, sim.t_end) or abs(case.dt - sim.dt) > 1e-12:
+        raise ConfigError(f"scenario {scenario.name!r}, run {name!r}: runs {case.t_end:g} s at dt = "
+                          f"{case.dt:g} s, not simulation.t_end = {sim.t_end:g} s at dt = {sim.dt:g} s")
+    actuator = case.actuator if case.actuator is not None else Actuator.for_model(case.model)
+    return Setup(case.model, np.array(case.x0, dtype=float), actuator, case.controller, case.guidance,
+                 None, case=case)
+
+
+def run_keys(scenario: Scenario) -> list[str]:
+    """The scenario's run keys (the ``controller`` coordinate of a scenario with several runs)."""
+    return list(cases(scenario))
 
 
 def montecarlo_summary(ds, case) -> dict:

@@ -42,6 +42,8 @@ class Setup:
     u0: np.ndarray | None = None
     #: the waypoint path of document 000's path-frame controllers (they track it themselves)
     path: WaypointPath | None = None
+    #: document 004's case this setup runs (a :class:`~shipgnc.cases.catamaran.CatamaranCase`)
+    case: object | None = None
 
 
 @dataclass
@@ -89,7 +91,12 @@ def _cybership(scenario: Scenario):
 
 def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
     """x0 of the scenario's vessel: one state, or ``montecarlo.runs`` states with random offsets
-    (drawn from a stream of their own, so the waves of the same seed are not shifted)."""
+    (drawn from a stream of their own, so the waves of the same seed are not shifted); for the
+    catamaran, its first run's x0 (document 004's cases set their own initial state)."""
+    if scenario.vessel.model == "catamaran":
+        from shipgnc.scenarios import catamaran
+
+        return np.array(next(iter(catamaran.cases(scenario).values())).x0, dtype=float)
     init = scenario.simulation.initial_state
     if scenario.vessel.model != "mariner":
         return np.array([init.north, init.east, deg(init.psi_deg), init.u, init.v, deg(init.r_deg_s)])
@@ -171,13 +178,38 @@ def _mariner(scenario: Scenario):
     return mariner.vessel(scenario)
 
 
-VESSELS = {"vectored-thrust-boat": _boat, "cybership2": _cybership, "mariner": _mariner}
+def _catamaran(scenario: Scenario):
+    from shipgnc.scenarios import catamaran
+
+    first = catamaran.setup(scenario)
+    return first.model, first.actuator, first.u0
+
+
+VESSELS = {"vectored-thrust-boat": _boat, "cybership2": _cybership, "mariner": _mariner,
+           "catamaran": _catamaran}
+
+
+def variant_names(scenario: Scenario) -> list[str] | None:
+    """The names of a ``controller`` dimension: a comparison's controllers, or the run keys of a
+    catamaran scenario with several runs (e.g. laws 20 and 21); None for one run."""
+    if scenario.vessel.model == "catamaran":
+        from shipgnc.scenarios import catamaran
+
+        keys = catamaran.run_keys(scenario)
+        return keys if len(keys) > 1 else None
+    return list(scenario.controllers) if scenario.controllers is not None else None
 
 
 def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = None) -> Setup:
     """Instantiate the scenario's components for one controller ``variant`` (default: the first).
 
-    ``seed`` draws a Monte Carlo batch's initial offsets (default: ``simulation.seed`` or 0)."""
+    ``seed`` draws a Monte Carlo batch's initial offsets (default: ``simulation.seed`` or 0).
+    A catamaran scenario's ``variant`` is a run key of its case builder (see
+    :func:`shipgnc.scenarios.catamaran.setup`)."""
+    if scenario.vessel.model == "catamaran":
+        from shipgnc.scenarios import catamaran
+
+        return catamaran.setup(scenario, variant)
     model, actuator, u0 = VESSELS[scenario.vessel.model](scenario)
     variants = scenario.variants
     name = variant if variant is not None else next(iter(variants))
@@ -201,7 +233,13 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     from shipgnc.analysis import metrics
 
     diverged = bool(result.attrs.get("diverged", 0))
-    if scenario.metrics == "stern-kick":
+    if scenario.metrics == "catamaran" and setup.case is not None:
+        from shipgnc.scenarios import catamaran
+
+        # the events of the member's own run: those in result.attrs, else its logged δ (a batch's
+        # controller keeps one event list for all its ships)
+        out = catamaran.score(scenario, result, setup.case)
+    elif scenario.metrics == "stern-kick":
         out = metrics.stern_kick_metrics(result)
     elif scenario.metrics == "heading-steps":
         out = metrics.heading_step_metrics(result, setup.guidance.step_times)

@@ -10,13 +10,15 @@ metrics. The result depends on the members' indices only, not on the slice they 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from shipgnc.errors import ConfigError
 from shipgnc.models.base import names
+from shipgnc.models.per_ship import PerShipModel
 from shipgnc.sim.streams import MemberStreams
+from shipgnc.study.plant import check_plant, member_params, member_plant, param_variables
 from shipgnc.study.spec import PERTURB_UNITS, PERTURBABLE, Study
 
 
@@ -53,9 +55,18 @@ def check_sweepable(scenario) -> None:
     if scenario.route is not None:
         raise ConfigError(f"scenario {scenario.name!r} is a routing problem (document 002): "
                           "sweep a simulation scenario")
-    if scenario.vessel.model == "catamaran":
-        raise ConfigError(f"scenario {scenario.name!r}: the catamaran's cases run through their "
-                          "own builders and are not sweepable yet")
+    if scenario.vessel.model == "catamaran":  # its runs: runner.build's Setup of each run key
+        case, t_end = scenario.case, scenario.simulation.t_end
+        if case.builder == "montecarlo":
+            raise ConfigError(f"scenario {scenario.name!r} is itself one batched run of plant draws "
+                              "(its ships take the batch axis a study gives its members): sweep "
+                              "catamaran-turn with --mc and --perturb instead")
+        rate_end = case.options.get("t_end_rate", 300.0)
+        if case.builder == "compare" and isinstance(rate_end, (int, float)) and rate_end < t_end:
+            raise ConfigError(f"scenario {scenario.name!r}: its yaw-rate runs last "
+                              f"case.options.t_end_rate = {rate_end:g} s, its heading runs "
+                              f"simulation.t_end = {t_end:g} s, and a study runs every member for "
+                              f"simulation.t_end: --set case.options.t_end_rate={t_end:g} to sweep it")
     if scenario.montecarlo is not None:
         raise ConfigError(f"scenario {scenario.name!r} has its own montecarlo section; sweep the "
                           "single-run scenario with --mc and --perturb instead")
@@ -67,10 +78,12 @@ def check_sweepable(scenario) -> None:
 
 def check_perturbable(perturb, model, x0=None, flag: str = "--perturb") -> None:
     """Every perturbed field must be a state of ``model``; with the scenario's ``x0``, a uniform
-    offset must keep every member inside the model's state range (checked before any work)."""
+    offset must keep every member inside the model's state range (checked before any work).
+    Plant parameters: :func:`shipgnc.study.plant.check_plant`."""
+    check_plant(perturb, model, flag)
     state_names = names(model.states)
     limits = np.asarray(model.state_limits, dtype=float)
-    for p in perturb:
+    for p in (p for p in perturb if p.param is None):
         state, scale = PERTURBABLE[p.field]
         if state not in state_names:
             raise ConfigError(f"{flag} {p.field}: the {type(model).__name__} has no state "
@@ -98,11 +111,11 @@ def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> 
     batch = np.tile(np.asarray(x0, dtype=float), (chunk.size, 1))
     for row, member in enumerate(range(chunk.start, chunk.stop)):
         rng = np.random.default_rng(study.member_streams(member)[0])
-        for p in study.perturb:
+        for p in study.offsets:
             state, scale = PERTURBABLE[p.field]
             batch[row, state_names.index(state)] += scale * p.draw(rng)
     limits = np.asarray(model.state_limits, dtype=float)
-    for p in study.perturb:
+    for p in study.offsets:
         state, scale = PERTURBABLE[p.field]
         i = state_names.index(state)
         outside = np.flatnonzero(np.abs(batch[:, i]) > limits[i])
@@ -186,6 +199,12 @@ def _run_batch(setup, scenario, x0, seeds, backend: str, route: bool):
     return result, np.asarray(done_at, dtype=float).reshape(-1).round(9)
 
 
+def _alone(setup, i: int):
+    """``setup`` for its batch's member ``i`` alone (its own plant, when the members have theirs)."""
+    model = setup.model
+    return replace(setup, model=model.subset(i, i + 1)) if isinstance(model, PerShipModel) else setup
+
+
 def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """Run one chunk; an ``xarray.Dataset`` with a ``member`` dimension: every scalar metric, and
     with ``study.series`` every time series; ``attrs["backend"]`` says which code ran it.
@@ -208,12 +227,15 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     check_sweepable(scenario)
     setup = build(scenario, chunk.variant, seed=study.seed)
     x0 = member_initial_states(study, setup.x0, setup.model, chunk)
+    drawn = member_params(study, setup.model, chunk.start, chunk.stop)  # the plant's parameters
+    if drawn:  # each member's own plant; the controller keeps its nominal design
+        setup = replace(setup, model=member_plant(study, setup.model, chunk.start, chunk.stop, drawn))
     seeds = [study.member_streams(m)[1] for m in range(chunk.start, chunk.stop)]
     route = ends_early(setup)
     result, done_at = _run_batch(setup, scenario, x0, seeds, backend, route)
     arrays = None
     if result.attrs.get("diverged", 0):
-        runs = [_run_batch(setup, scenario, x0[i:i + 1], seeds[i:i + 1], backend, route)
+        runs = [_run_batch(_alone(setup, i), scenario, x0[i:i + 1], seeds[i:i + 1], backend, route)
                 for i in range(chunk.size)]
         ran_on = {r.attrs.get("backend") for r, _ in runs}
         members = [r.isel(member=0) for r, _ in runs]
@@ -228,6 +250,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
         keys = list(dict.fromkeys(k for row in rows for k in row))
         arrays = {k: np.array([row.get(k, math.nan) for row in rows]) for k in keys}
     data = {k: ("member", np.asarray(v, dtype=float)) for k, v in arrays.items()}
+    data.update(param_variables(study, drawn))
     out = xr.Dataset(data, coords={"member": np.arange(chunk.start, chunk.stop)},
                      attrs={"backend": ", ".join(sorted(str(b) for b in ran_on))})
     if study.series:

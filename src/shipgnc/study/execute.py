@@ -44,10 +44,11 @@ class StudyRun:
 
 
 def variants_of(study: Study) -> list[str] | None:
-    """The controller variants (a ``controller`` dimension) of a comparison scenario, else None;
-    every grid point is loaded here, so a bad grid key or value, an unsweepable scenario or a
-    ``--perturb`` field the vessel does not have fails before any work starts."""
-    from shipgnc.scenarios.runner import VESSELS, initial_states
+    """The controller variants (a ``controller`` dimension) of a comparison scenario or of a
+    catamaran scenario with several runs, else None; every grid point is loaded here, so a bad
+    grid key or value, an unsweepable scenario or a ``--perturb`` field the vessel does not have
+    fails before any work starts."""
+    from shipgnc.scenarios.runner import VESSELS, initial_states, variant_names
 
     variants = None
     for point in study.points:
@@ -55,8 +56,8 @@ def variants_of(study: Study) -> list[str] | None:
         check_sweepable(scenario)
         check_perturbable(study.perturb, VESSELS[scenario.vessel.model](scenario)[0],
                           initial_states(scenario, study.seed))
-        if scenario.controllers is not None:
-            names = list(scenario.controllers)
+        names = variant_names(scenario)
+        if names is not None:
             if variants is not None and names != variants:
                 raise ConfigError(f"--grid: the controllers change across the grid ({variants} vs {names})")
             variants = names
@@ -184,7 +185,8 @@ def assemble(study: Study, chunks: list[Chunk], parts: list, variants: list[str]
                 "grid": "; ".join(f"{k}={','.join(map(str, v))}" for k, v in study.grid),
                 "perturb": "; ".join(str(p) for p in study.perturb),
                 "overrides": "; ".join(study.overrides), "backend": ", ".join(backends),
-                "streams": "member i: SeedSequence(seed).spawn(members)[i] (offsets, disturbances)"}
+                "streams": "member i: SeedSequence(seed).spawn(members)[i] (offsets, disturbances, "
+                            "plant parameters)"}
     return ds
 
 

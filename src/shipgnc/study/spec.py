@@ -2,12 +2,13 @@
 
 A study is the product of its grids (each grid key is a scenario field, as in ``--set``) times
 ``members`` Monte Carlo members. Member *i* has its own random streams,
-``SeedSequence(seed).spawn(members)[i]``, split in two children: one draws the member's initial
-state offsets (:class:`Perturbation`), the other feeds the scenario's random disturbances
-(:class:`~shipgnc.sim.streams.MemberStreams`). So a member's result depends on ``seed`` and *i*
-only, never on how the study is chunked or where a chunk runs; and member *i* meets the same sea
-and the same offsets at every grid point (common random numbers: differences between grid points
-are the grid's, not the dice's).
+``SeedSequence(seed).spawn(members)[i]``, split in three children: one draws the member's initial
+state offsets (:class:`Perturbation` of a state field), one feeds the scenario's random
+disturbances (:class:`~shipgnc.sim.streams.MemberStreams`), one draws the member's plant
+parameters (:class:`Perturbation` of ``vessel.params.NAME``). So a member's result depends on
+``seed`` and *i* only, never on how the study is chunked or where a chunk runs; and member *i*
+meets the same sea, the same offsets and the same plant at every grid point (common random
+numbers: differences between grid points are the grid's, not the dice's).
 """
 
 from __future__ import annotations
@@ -29,6 +30,9 @@ PERTURBABLE = {"north": ("north", 1.0), "east": ("east", 1.0), "psi_deg": ("psi"
 #: the unit an offset of each field is given in (and reported in)
 PERTURB_UNITS = {"north": "m", "east": "m", "psi_deg": "deg", "u": "m/s", "v": "m/s", "r_deg_s": "deg/s"}
 DISTRIBUTIONS = ("normal", "uniform")
+#: a perturbed plant parameter is named ``vessel.params.NAME`` (NAME a field of the model's
+#: parameter class, in SI)
+PARAM_PREFIX = "vessel.params."
 #: scenario fields a study sets itself, which --grid and --set may not
 STUDY_OWNED = {
     "simulation.seed": "member i's random streams come from --seed "
@@ -40,29 +44,45 @@ STUDY_OWNED = {
 
 @dataclass(frozen=True)
 class Perturbation:
-    """An offset of one initial-state field per member: ``normal:SIGMA`` (zero mean) or
-    ``uniform:LOW,HIGH``, in the field's unit (``psi_deg`` in degrees, ``north`` in metres, ...)."""
+    """A random change per member: an offset of one initial-state field, or of one plant parameter.
+
+    ``normal:SIGMA`` (zero mean) or ``uniform:LOW,HIGH``. An initial-state field takes offsets in
+    its unit (``psi_deg`` in degrees, ``north`` in metres, ...). A plant parameter
+    ``vessel.params.NAME`` takes offsets in SI added to the nominal value, or with a ``%`` suffix
+    relative to it (``relative``): ``normal:5%`` draws NAME = nominal · (1 + 0.05 z).
+    """
 
     field: str
     kind: str
     low: float  # normal: 0; uniform: lower bound
     high: float  # normal: sigma; uniform: upper bound
+    relative: bool = False  # percent of the nominal value (plant parameters only)
 
     @classmethod
     def parse(cls, text: str) -> Perturbation:
-        """``"psi_deg=uniform:-30,30"`` or ``"north=normal:5"``."""
+        """``"psi_deg=uniform:-30,30"``, ``"north=normal:5"`` or ``"vessel.params.m=normal:5%"``."""
         field, sep, rule = text.partition("=")
         field = field.strip().removeprefix("initial_state.")
-        if not sep or field not in PERTURBABLE:
+        param = field.removeprefix(PARAM_PREFIX) if field.startswith(PARAM_PREFIX) else None
+        if not sep or (field not in PERTURBABLE and not (param and param.isidentifier())):
             raise ConfigError(f"--perturb {text!r}: expected FIELD=normal:SIGMA or FIELD=uniform:LOW,HIGH "
-                              f"with FIELD one of {', '.join(PERTURBABLE)}")
+                              f"with FIELD one of {', '.join(PERTURBABLE)}, or {PARAM_PREFIX}NAME "
+                              "(a plant parameter)")
         kind, _, args = rule.partition(":")
         kind = kind.strip()
         if kind not in DISTRIBUTIONS:
             raise ConfigError(f"--perturb {text!r}: distribution {kind!r} unknown; allowed: "
                               f"{', '.join(DISTRIBUTIONS)}")
+        items = [a.strip() for a in args.split(",")]
+        percent = [a.endswith("%") for a in items]
+        relative = any(percent)
+        if relative and param is None:
+            raise ConfigError(f"--perturb {text!r}: a % spread is relative to a plant parameter's "
+                              "nominal value; an initial-state offset takes absolute values")
+        if relative and not all(percent):
+            raise ConfigError(f"--perturb {text!r}: give every bound in % or none")
         try:
-            numbers = [float(a) for a in args.split(",")]
+            numbers = [float(a.removesuffix("%")) for a in items]
         except ValueError:
             raise ConfigError(f"--perturb {text!r}: {args!r} is not a list of numbers") from None
         if not all(math.isfinite(v) for v in numbers):
@@ -70,18 +90,28 @@ class Perturbation:
         if kind == "normal":
             if len(numbers) != 1 or numbers[0] < 0:
                 raise ConfigError(f"--perturb {text!r}: normal takes one standard deviation >= 0")
-            return cls(field, kind, 0.0, numbers[0])
+            return cls(field, kind, 0.0, numbers[0], relative)
         if len(numbers) != 2 or numbers[0] > numbers[1]:
             raise ConfigError(f"--perturb {text!r}: uniform takes LOW,HIGH with LOW <= HIGH")
-        return cls(field, kind, numbers[0], numbers[1])
+        return cls(field, kind, numbers[0], numbers[1], relative)
+
+    @property
+    def param(self) -> str | None:
+        """The plant parameter's NAME (``vessel.params.NAME``), None for an initial-state field."""
+        return self.field.removeprefix(PARAM_PREFIX) if self.field.startswith(PARAM_PREFIX) else None
 
     def draw(self, rng: np.random.Generator) -> float:
         if self.kind == "normal":
             return float(rng.normal(0.0, self.high))
         return float(rng.uniform(self.low, self.high))
 
+    def apply(self, nominal: float, offset: float) -> float:
+        """A plant parameter's value from its ``nominal`` value and a drawn ``offset``."""
+        return float(nominal * (1.0 + offset / 100.0) if self.relative else nominal + offset)
+
     def __str__(self) -> str:
-        args = f"{self.high:g}" if self.kind == "normal" else f"{self.low:g},{self.high:g}"
+        pct = "%" if self.relative else ""
+        args = f"{self.high:g}{pct}" if self.kind == "normal" else f"{self.low:g}{pct},{self.high:g}{pct}"
         return f"{self.field}={self.kind}:{args}"
 
 
@@ -151,6 +181,16 @@ class Study:
                 "each field may be perturbed once")
 
     @property
+    def offsets(self) -> tuple[Perturbation, ...]:
+        """The perturbations of initial-state fields."""
+        return tuple(p for p in self.perturb if p.param is None)
+
+    @property
+    def plant(self) -> tuple[Perturbation, ...]:
+        """The perturbations of plant parameters (``vessel.params.NAME``)."""
+        return tuple(p for p in self.perturb if p.param is not None)
+
+    @property
     def dims(self) -> tuple[str, ...]:
         return tuple(k for k, _ in self.grid)
 
@@ -172,8 +212,10 @@ class Study:
             where = ", ".join(extra)
             raise ConfigError(f"{exc} (at grid point {where})" if where else str(exc)) from None
 
-    def member_streams(self, member: int) -> tuple[np.random.SeedSequence, np.random.SeedSequence]:
-        """Member ``member``'s two streams (initial offsets, disturbances):
-        ``SeedSequence(seed).spawn(members)[member].spawn(2)``, built directly from the spawn key
-        so that no chunk needs the others."""
-        return tuple(np.random.SeedSequence(int(self.seed), spawn_key=(int(member), j)) for j in (0, 1))
+    def member_streams(self, member: int) -> tuple[np.random.SeedSequence, ...]:
+        """Member ``member``'s three streams (initial offsets, disturbances, plant parameters):
+        ``SeedSequence(seed).spawn(members)[member].spawn(3)``, built directly from the spawn key
+        so that no chunk needs the others (the first two are those of ``.spawn(2)``: a plant
+        perturbation leaves the offsets and the sea of every member as they were)."""
+        return tuple(np.random.SeedSequence(int(self.seed), spawn_key=(int(member), j))
+                     for j in (0, 1, 2))

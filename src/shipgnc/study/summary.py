@@ -14,7 +14,8 @@ QUANTILES = {"median": 0.5, "p5": 0.05, "p95": 0.95}
 
 
 def metric_names(ds) -> list[str]:
-    """The per-member summary metrics (every variable but the ``series_*`` time series)."""
+    """The per-member summary metrics (every variable but the ``series_*`` time series; a plant
+    perturbation's draws ``param_*`` are among them, so the summary shows their spread)."""
     return [str(k) for k in ds.data_vars if not str(k).startswith("series_")]
 
 
@@ -83,10 +84,11 @@ def load_dataset(path: str | Path):
 
 def spread_figure(ds, path: Path, *, max_metrics: int = 6) -> Path:
     """Each metric against the first grid key: the median line and the p5–p95 band of the members
-    (one line per value of the other grid keys and controllers); a histogram without a grid."""
+    (one line per value of the other grid keys and controllers); a histogram without a grid. The
+    members' drawn plant parameters (``param_*``) are inputs, not metrics: left out."""
     from shipgnc.viz.style import DPI, new_figure
 
-    names = [n for n in metric_names(ds) if n != "diverged"
+    names = [n for n in metric_names(ds) if n != "diverged" and not n.startswith("param_")
              and np.isfinite(np.asarray(ds[n].values, dtype=float)).any()][:max_metrics]
     if not names:
         names = ["diverged"]
