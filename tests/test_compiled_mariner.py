@@ -407,14 +407,16 @@ def setup_of(**kw):
 
 
 def test_unsupported_reasons():
-    from shipgnc.routing.fields import UniformCurrent
+    from shipgnc.routing.fields import GriddedCurrent, UniformCurrent, sample_field
+
+    gridded = GriddedCurrent(sample_field(UniformCurrent(0.5, 0.0), [0.0, 1e5], [0.0, 1e5]))
 
     reason = compose.unsupported_reason
     assert reason(setup_of()) is None
     assert reason(setup_of(disturbance=doc_disturbance(DOC_PATH), controller=None)) is None
     cases = {
-        "current UniformCurrent has no kernel": {
-            "disturbance": MarinerDisturbance(current=UniformCurrent(0.5, 0.0))},
+        "current GriddedCurrent has no kernel": {
+            "disturbance": MarinerDisturbance(current=gridded)},
         "solve_ivp": {"integrator": "solve_ivp"},
         "observer": {"observer": lambda t, x, c, u: None},
     }

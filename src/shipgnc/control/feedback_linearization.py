@@ -317,7 +317,7 @@ def path_kinematics(x, z, p):
     z[0] = leg
     psi_r = wrap(x[I_PSI] - leg_value(p, _FL_LEGS, LEG_ANGLE, leg))
     u, r = x[I_U], x[I_R]
-    v = r1 * r + r2 * r ** 3.0
+    v = r1 * r + r2 * r * r * r
     d_cross = d_y * leg_value(p, _FL_LEGS, LEG_COS, leg) if frame_global != 0.0 else d_y
     s, c = math.sin(psi_r), math.cos(psi_r)
     y_dot = u * s + v * c + d_cross
@@ -344,7 +344,7 @@ def output_fl_step(t, x, ref, z, p, cmd, sig):
     out = y_r + l * s
     out_dot = y_dot + l * r * c
     m = r1 + l + r2_3 * (r * r)
-    f = (u * c - lateral * s) * r + m * c * (b_r - (a * r + b * r ** 3.0))
+    f = (u * c - lateral * s) * r + m * c * (b_r - (a * r + b * r * r * r))
     g = m * c_rudder * c
     nu = -k1 * out - k2 * out_dot
     if abs(g) < tiny:  # the g_safe guard of OutputFL.step (NaN passes through)
@@ -368,7 +368,7 @@ def los_fl_step(t, x, ref, z, p, cmd, sig):
     psi_d_dot = -D * y_dot / (D2 + y_r * y_r)
     e = wrap(psi_r - psi_d)
     nu = -kp * e - kd * (r - psi_d_dot)
-    raw = (nu + (a * r + b * r ** 3.0) - b_r) / c_rudder
+    raw = (nu + (a * r + b * r * r * r) - b_r) / c_rudder
     _log_path(z, sig, y_r, psi_r, leg, psi_d)
     cmd[0] = clip(raw, -delta_max, delta_max)
 
@@ -411,3 +411,20 @@ class HeadingFL:
         nu = -self.kp * e - self.kd * (r - reference[..., 1])
         raw = (nu + self.a * r + self.b * r**3 - self.b_r) / self.c
         return np.clip(raw, -self.delta_max, self.delta_max)[..., None]
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`step` for the composed loop (:func:`heading_fl_step`); no per-ship state."""
+        return Kernel(heading_fl_step, flat(self.delta_max, self.a, self.b, self.c, self.kp, self.kd,
+                                            self.b_r))
+
+
+@kernel_function
+def heading_fl_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`HeadingFL.step` for one ship: e = wrap(ψ − ψ_d), ν = −k_p e − k_d (r − r_d),
+    δ = clip((ν + a r + b r³ − b_r)/c). ``p`` = [δ_max, a, b, c, k_p, k_d, b_r]."""
+    delta_max, a, b, c_rudder, kp, kd, b_r = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
+    psi, r = x[I_PSI], x[I_R]
+    e = wrap(psi - ref[0])
+    nu = -kp * e - kd * (r - ref[1])
+    raw = (nu + a * r + b * r * r * r - b_r) / c_rudder
+    cmd[0] = clip(raw, -delta_max, delta_max)

@@ -11,6 +11,13 @@ One protocol serves the router and the simulation loop:
 
 ``north`` and ``east`` broadcast against each other (leading batch axes); ``t`` is a scalar or broadcasts
 too. Positive ω and Γ turn clockwise on a north-up chart (positive about NED's down axis).
+
+**Compiled form.** ``current_kernel(t0=0.0)`` → ``(field_velocity, params)``: the field as data for the
+composed loop (:mod:`shipgnc.kernels`): :func:`field_velocity` evaluates ``velocity(t0 + t, north, east)``
+of one point from the flat ``params`` (a list of terms, each one field of this module with an optional tidal
+factor), operation for operation as the numpy methods (which stay the reference). Uniform, affine (shear),
+rigid-rotation, Lamb–Oseen and Rankine fields, their sums and a :class:`Modulated` factor over them have
+it; a gridded field, or a factor over a factor, raises :class:`~shipgnc.kernels.NotCompiled`.
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from shipgnc.errors import ConfigError, require
+from shipgnc.kernels import NotCompiled, flat, kernel_function
 
 __all__ = [
     "AffineCurrent",
@@ -87,6 +95,20 @@ class CurrentField:
     def __add__(self, other: CurrentField) -> SumField:
         return SumField([self, other])
 
+    # --- compiled form (module docstring) ---
+    def _terms(self) -> list[tuple[int, tuple[float, ...]]]:
+        """``[(code, numbers)]``: this field as terms of :func:`field_velocity` (one here)."""
+        raise NotCompiled(f"current {type(self).__name__} has no kernel (no compiled form)")
+
+    def current_kernel(self, t0: float = 0.0):
+        """``(field_velocity, params)``: :func:`field_velocity` evaluates this field at ``t0 + t`` from
+        ``params``; raises :class:`~shipgnc.kernels.NotCompiled` for a field without a compiled form."""
+        terms = []
+        for code, numbers in self._terms():
+            numbers = tuple(float(v) for v in numbers)
+            terms.append(flat(code, numbers, np.zeros(_TERM - 1 - len(numbers))))
+        return field_velocity, flat(float(t0), len(terms), *terms)
+
     def max_speed(self, bounds, t=0.0, n: int = 81) -> float:
         """Largest |v| [m/s] sampled on an n×n grid over ``bounds`` (a CFL and scale estimate)."""
         (n0, n1), (e0, e1) = bounds
@@ -116,6 +138,9 @@ class UniformCurrent(CurrentField):
 
     def describe(self):
         return f"uniform current ({self.north:.6g}, {self.east:.6g}) m/s"
+
+    def _terms(self):
+        return [(_UNIFORM, (self.north, self.east))]
 
 
 @dataclass(frozen=True)
@@ -148,6 +173,11 @@ class AffineCurrent(CurrentField):
             return f"shear v_E = k·(x_N − {self.ref[0]:g} m), k = {g[1, 0]:.6g} 1/s"
         return f"affine current v0 = {tuple(self.v0)} m/s, G = {g.tolist()} 1/s"
 
+    def _terms(self):
+        g = np.asarray(self.gradient, dtype=float)
+        return [(_AFFINE, (self.v0[0], self.v0[1], g[0, 0], g[0, 1], g[1, 0], g[1, 1], self.ref[0],
+                           self.ref[1]))]
+
 
 def shear(k: float, s: float = 0.0) -> AffineCurrent:
     """The document's linear shear v = (0, k (x_N − s)) [k in 1/s, s in m] (spec 002 §2.5)."""
@@ -177,6 +207,9 @@ class RigidRotation(CurrentField):
 
     def describe(self):
         return f"rigid rotation ω = {self.omega:.6g} rad/s about {tuple(self.centre)} m"
+
+    def _terms(self):
+        return [(_ROTATION, (self.omega, self.centre[0], self.centre[1]))]
 
 
 class _Vortex(CurrentField):
@@ -243,6 +276,9 @@ class LambOseenVortex(_Vortex):
         return (f"Lamb–Oseen vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m "
                 f"at {tuple(self.centre)} m")
 
+    def _terms(self):  # a = Γ/2π and c = r_c² as _f forms them
+        return [(_LAMB_OSEEN, (self.gamma / (2 * math.pi), self.rc**2, self.centre[0], self.centre[1]))]
+
 
 @dataclass(frozen=True)
 class RankineVortex(_Vortex):
@@ -265,6 +301,9 @@ class RankineVortex(_Vortex):
     def describe(self):
         return (f"Rankine vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m "
                 f"at {tuple(self.centre)} m")
+
+    def _terms(self):
+        return [(_RANKINE, (self.gamma / (2 * math.pi), self.rc**2, self.centre[0], self.centre[1]))]
 
 
 class SumField(CurrentField):
@@ -297,6 +336,9 @@ class SumField(CurrentField):
 
     def describe(self):
         return " + ".join(f.describe() for f in self.fields)
+
+    def _terms(self):
+        return [term for f in self.fields for term in f._terms()]
 
 
 class Modulated(CurrentField):
@@ -342,6 +384,17 @@ class Modulated(CurrentField):
     def describe(self):
         return (f"({self.field.describe()}) × ({self.mean:g} + {self.amplitude:g}·cos(2πt/"
                 f"{self.period:g} s + {self.phase:g}))")
+
+    def _terms(self):
+        # m(t)·(w₁ + w₂ + …) as m(t)·w₁ + m(t)·w₂ + … (the same up to round-off)
+        terms = []
+        for code, numbers in self.field._terms():
+            if code >= _MODULATED:
+                raise NotCompiled("a tidal factor over a tidal factor has no compiled form")
+            terms.append((code + _MODULATED, (*numbers, *[0.0] * (_FACTOR - len(numbers)),
+                                              self.mean, self.amplitude, 2 * np.pi / self.period,
+                                              self.phase)))
+        return terms
 
 
 class GriddedCurrent(CurrentField):
@@ -474,6 +527,63 @@ class GriddedCurrent(CurrentField):
         dn = ((1 - b) * (f10 - f00) + b * (f11 - f01)) / hn[:, None]
         de = ((1 - a) * (f01 - f00) + a * (f11 - f10)) / he[:, None]
         return np.stack([dn, de], axis=-1)
+
+
+# ----------------------------------------------------------------------------------------------
+# compiled form: one point of a field from its terms (CurrentField.current_kernel)
+# ----------------------------------------------------------------------------------------------
+
+#: term codes of :func:`field_velocity`; a :class:`Modulated` term adds ``_MODULATED`` to its code
+_UNIFORM, _AFFINE, _ROTATION, _LAMB_OSEEN, _RANKINE, _MODULATED = 1, 2, 3, 4, 5, 8
+#: numbers per term (code first), and where among a term's numbers a modulated term's factor
+#: [mean, amplitude, ω = 2π/period, phase] starts
+_TERM, _FACTOR = 13, 8
+
+
+@kernel_function
+def field_velocity(t, north, east, p, o):
+    """``velocity(t0 + t, north, east)`` of one point, ``(v_N, v_E)``, from the terms in ``p[o:]`` =
+    [t0, n, n × (code, 12 numbers)] (:meth:`CurrentField.current_kernel`); each term follows its
+    class's numpy method operation for operation, a sum adds them in order from 0."""
+    tt = p[o] + t
+    n = int(p[o + 1])
+    vn = 0.0
+    ve = 0.0
+    for j in range(n):
+        b = o + 2 + j * _TERM
+        code = int(p[b])
+        q = p[b + 1:b + _TERM]
+        kind = code - _MODULATED if code > _MODULATED else code
+        if kind == _UNIFORM:
+            wn, we = q[0], q[1]
+        elif kind == _AFFINE:
+            dn, de = north - q[6], east - q[7]
+            wn = q[0] + q[2] * dn + q[3] * de
+            we = q[1] + q[4] * dn + q[5] * de
+        elif kind == _ROTATION:
+            wn = -q[0] * (east - q[2])
+            we = q[0] * (north - q[1])
+        else:  # _Vortex: v = f(r²)·(−r_E, r_N)
+            a, c = q[0], q[1]
+            rn, re = north - q[2], east - q[3]
+            r2 = rn * rn + re * re
+            if kind == _LAMB_OSEEN:
+                if r2 < 1e-6 * c:
+                    f = (1 - r2 / (2 * c) + r2 * r2 / (6 * c * c)) / c
+                else:
+                    f = -math.expm1(-r2 / c) / r2
+            else:
+                f = 1 / c if r2 <= c else 1 / r2
+            f = a * f
+            wn = -f * re
+            we = f * rn
+        if code > _MODULATED:
+            m = q[_FACTOR] + q[_FACTOR + 1] * math.cos(q[_FACTOR + 2] * tt + q[_FACTOR + 3])
+            wn = m * wn
+            we = m * we
+        vn = vn + wn
+        ve = ve + we
+    return vn, ve
 
 
 def sample_field(field: CurrentField, north, east, times=None):

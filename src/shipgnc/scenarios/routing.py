@@ -8,6 +8,11 @@ programme ψ(t) (:class:`~shipgnc.guidance.schedule.HeadingProfile`), and again 
 constant-heading legs; the current is the route's own field object, added to the ship's kinematics
 at every RK stage (one current model for router and ship). Arrival = the closest approach to the
 target; the miss distance is that distance.
+
+``sail.backend`` chooses the loop as ``simulation.backend`` does elsewhere: ``compiled`` runs the
+composed loop (the heading programme tabulated at the control samples, the field by its compiled
+form :meth:`~shipgnc.routing.fields.CurrentField.current_kernel`), ``numpy`` the reference loop,
+``auto`` lets :func:`~shipgnc.sim.simulator.simulate` decide by the size of the run.
 """
 
 from __future__ import annotations
@@ -47,11 +52,12 @@ def solve(cfg):
     return field, result
 
 
-def sail(route, field, heading, *, dt: float, t_end: float, seed: int = 0):
+def sail(route, field, heading, *, dt: float, t_end: float, seed: int = 0,
+         backend: str = "auto"):
     """Simulate the Mariner steering ``heading(t)`` [rad] from the route's start through ``field``.
 
     Returns ``(dataset, arrival_s, miss_m)``: the run, the time of the closest approach to the
-    route's target and that distance.
+    route's target and that distance. ``backend`` as :func:`~shipgnc.sim.simulator.simulate`'s.
     """
     from shipgnc.control.feedback_linearization import HeadingFL
     from shipgnc.guidance.schedule import HeadingProfile
@@ -63,10 +69,13 @@ def sail(route, field, heading, *, dt: float, t_end: float, seed: int = 0):
     t0 = route.t0
     x0 = np.array([route.start[0], route.start[1], float(heading(t0)), p.U, 0.0])
     steps = max(1, math.ceil(t_end / dt))
+    # the autopilot samples every step (Ts = dt): the programme's table for the compiled loop
+    samples = np.arange(steps + 1) * dt
     ds = simulate(model, x0, t_end=steps * dt, dt=dt, controller=HeadingFL(p, Ts=dt),
-                  actuator=rudder(p), guidance=HeadingProfile(lambda t: heading(t0 + t)),
+                  actuator=rudder(p),
+                  guidance=HeadingProfile(lambda t: heading(t0 + t), samples=samples),
                   disturbance=MarinerDisturbance(0.0, current=_shifted(field, t0)), seed=seed,
-                  backend="numpy")
+                  backend=backend)
     distance = np.hypot(ds["north"].values - route.target[0], ds["east"].values - route.target[1])
     k = int(np.argmin(distance))
     return ds, float(ds["time"].values[k]), float(distance[k])
@@ -85,6 +94,15 @@ class _shifted:
     def __call__(self, t, x):
         return self.field(self.t0 + t, x)
 
+    def current_kernel(self):
+        """The field's compiled form evaluated at t0 + t (raises NotCompiled without one)."""
+        make = getattr(self.field, "current_kernel", None)
+        if not callable(make):
+            from shipgnc.kernels import NotCompiled
+
+            raise NotCompiled(f"current {type(self.field).__name__} has no kernel")
+        return make(t0=self.t0)
+
 
 def run(scenario: Scenario, *, seed: int):
     """Solve the route (and sail it when ``sail`` is given); a
@@ -102,10 +120,11 @@ def run(scenario: Scenario, *, seed: int):
     if scenario.sail is not None and route.reachable:
         cfg = scenario.sail
         t_end = route.time_s * (1.0 + cfg.margin)
-        ds, arrival, miss = sail(route, field, route.heading, dt=cfg.dt, t_end=t_end, seed=seed)
+        ds, arrival, miss = sail(route, field, route.heading, dt=cfg.dt, t_end=t_end, seed=seed,
+                                 backend=cfg.backend)
         plan = route.constant_heading_legs(n_legs=cfg.legs)
         ds_legs, arrival_legs, miss_legs = sail(route, field, plan.heading, dt=cfg.dt, t_end=t_end,
-                                                seed=seed)
+                                                seed=seed, backend=cfg.backend)
         metrics.update({
             "sail_arrival_s": arrival, "sail_miss_m": miss,
             "sail_arrival_ratio": arrival / route.time_s,

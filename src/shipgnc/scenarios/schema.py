@@ -524,6 +524,9 @@ class SailConfig(Strict):
     dt: Positive = 0.3
     #: run this long past the optimal arrival time (fraction of it) to find the closest approach
     margin: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.2
+    #: the simulation loop of the sailed runs, as ``simulation.backend`` (a route scenario has no
+    #: simulation section): auto, numpy, or compiled (the composed loop, or an error naming why not)
+    backend: Literal["auto", "numpy", "compiled"] = "auto"
 
 
 METRIC_SETS = ("stern-kick", "heading-steps", "waypoints", "course-quality", "path-tracking",

@@ -72,9 +72,13 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
                     if bad:
                         event[i] = 2 * k
                         break
-            if has_lag or rate_limited:
+            if has_lag:
                 plan_kernel(applied, cmd, pa, dt, rate_limited, hold_mode, start, end)
                 input_at_kernel(start, end, 0.0, lag, pa, has_lag, rate_limited, u)
+            elif rate_limited:  # Actuator.input_at without lag: from start to end over the step
+                plan_kernel(applied, cmd, pa, dt, rate_limited, hold_mode, start, end)
+                for j in range(nu):
+                    u[j] = start[j]
             else:  # a static actuator (Actuator.saturate): the input is constant over the step
                 for j in range(nu):
                     u[j] = clip(cmd[j], pa[j], pa[nu + j])
@@ -125,8 +129,11 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
                             u[j] = ls[j]
                         else:
                             u[j] = clip(cs[j], pa[j], pa[nu + j])
-                elif has_lag or rate_limited:
+                elif has_lag:
                     input_at_kernel(start, end, theta, ls, pa, has_lag, rate_limited, u)
+                elif rate_limited:
+                    for j in range(nu):
+                        u[j] = end[j] if theta == 1.0 else start[j] + theta * (end[j] - start[j])
                 if has_dist and per_stage:
                     dist_fn(ts, xs, zdi, pd, W[k - k0, i], d)
                 model_fn(xs, u, d, pm, kx)
@@ -152,7 +159,7 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
                 x[j] = x[j] + sixth * ax[j]
             for j in range(nl):
                 lag[j] = lag[j] + sixth * al[j]
-            if has_lag or rate_limited:
+            if has_lag:
                 input_at_kernel(start, end, 1.0, lag, pa, has_lag, rate_limited, applied)
             else:
                 for j in range(nu):
