@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass
 from dataclasses import field as dc_field
 
+import numba
 import numpy as np
 
 from shipgnc.errors import require
@@ -76,52 +77,48 @@ def _pad3(phi):
     return g
 
 
-_KERNEL = None
-
-
 def _compiled_rate():
-    """The numba twin of :func:`front_rate` (held equal to it by the tests); compiled once, cached on disk."""
-    global _KERNEL
-    if _KERNEL is not None:
-        return _KERNEL
-    import numba
+    """The numba twin of :func:`front_rate` (held equal to it by the tests): module-level functions,
+    so numba's disk cache serves every later process (nested jitted closures recompiled ≈ 4 s in
+    each process and left a new cache file each time)."""
+    return _front_rate_kernel
 
-    @numba.njit(cache=True, inline="always", error_model="numpy", fastmath=True)
-    def weno(v1, v2, v3, v4, v5):
-        p1 = v1 / 3 - 7 * v2 / 6 + 11 * v3 / 6
-        p2 = -v2 / 6 + 5 * v3 / 6 + v4 / 3
-        p3 = v3 / 3 + 5 * v4 / 6 - v5 / 6
-        s1 = 13 / 12 * (v1 - 2 * v2 + v3) ** 2 + 0.25 * (v1 - 4 * v2 + 3 * v3) ** 2
-        s2 = 13 / 12 * (v2 - 2 * v3 + v4) ** 2 + 0.25 * (v2 - v4) ** 2
-        s3 = 13 / 12 * (v3 - 2 * v4 + v5) ** 2 + 0.25 * (3 * v3 - 4 * v4 + v5) ** 2
-        eps = 1e-6 * max(v1 * v1, v2 * v2, v3 * v3, v4 * v4, v5 * v5) + 1e-99
-        a1, a2, a3 = 0.1 / (eps + s1) ** 2, 0.6 / (eps + s2) ** 2, 0.3 / (eps + s3) ** 2
-        return (a1 * p1 + a2 * p2 + a3 * p3) / (a1 + a2 + a3)
 
-    @numba.njit(cache=True, error_model="numpy", fastmath=True)
-    def kernel(g, h, speed, vn, ve, out):
-        n, m = out.shape
-        for i in range(n):
-            for j in range(m):
-                gi, gj = i + 3, j + 3
-                c0, c1, c2 = g[gi - 3, gj], g[gi - 2, gj], g[gi - 1, gj]
-                c3, c4, c5, c6 = g[gi, gj], g[gi + 1, gj], g[gi + 2, gj], g[gi + 3, gj]
-                d0, d1, d2 = (c1 - c0) / h, (c2 - c1) / h, (c3 - c2) / h
-                d3, d4, d5 = (c4 - c3) / h, (c5 - c4) / h, (c6 - c5) / h
-                nm = weno(d0, d1, d2, d3, d4)
-                np_ = weno(d5, d4, d3, d2, d1)
-                c0, c1, c2 = g[gi, gj - 3], g[gi, gj - 2], g[gi, gj - 1]
-                c4, c5, c6 = g[gi, gj + 1], g[gi, gj + 2], g[gi, gj + 3]
-                d0, d1, d2 = (c1 - c0) / h, (c2 - c1) / h, (c3 - c2) / h
-                d3, d4, d5 = (c4 - c3) / h, (c5 - c4) / h, (c6 - c5) / h
-                em = weno(d0, d1, d2, d3, d4)
-                ep = weno(d5, d4, d3, d2, d1)
-                grad = np.sqrt(max(nm, 0.0) ** 2 + min(np_, 0.0) ** 2 + max(em, 0.0) ** 2 + min(ep, 0.0) ** 2)
-                a = vn[i, j] * (nm if vn[i, j] > 0 else np_) + ve[i, j] * (em if ve[i, j] > 0 else ep)
-                out[i, j] = -(speed[i, j] * grad + a)
+@numba.njit(cache=True, inline="always", error_model="numpy", fastmath=True)
+def _weno(v1, v2, v3, v4, v5):
+    """WENO5 reconstruction of a one-sided derivative from five differences (Jiang & Shu)."""
+    p1 = v1 / 3 - 7 * v2 / 6 + 11 * v3 / 6
+    p2 = -v2 / 6 + 5 * v3 / 6 + v4 / 3
+    p3 = v3 / 3 + 5 * v4 / 6 - v5 / 6
+    s1 = 13 / 12 * (v1 - 2 * v2 + v3) ** 2 + 0.25 * (v1 - 4 * v2 + 3 * v3) ** 2
+    s2 = 13 / 12 * (v2 - 2 * v3 + v4) ** 2 + 0.25 * (v2 - v4) ** 2
+    s3 = 13 / 12 * (v3 - 2 * v4 + v5) ** 2 + 0.25 * (3 * v3 - 4 * v4 + v5) ** 2
+    eps = 1e-6 * max(v1 * v1, v2 * v2, v3 * v3, v4 * v4, v5 * v5) + 1e-99
+    a1, a2, a3 = 0.1 / (eps + s1) ** 2, 0.6 / (eps + s2) ** 2, 0.3 / (eps + s3) ** 2
+    return (a1 * p1 + a2 * p2 + a3 * p3) / (a1 + a2 + a3)
 
-    _KERNEL = kernel
-    return kernel
+
+@numba.njit(cache=True, error_model="numpy", fastmath=True)
+def _front_rate_kernel(g, h, speed, vn, ve, out):
+    n, m = out.shape
+    for i in range(n):
+        for j in range(m):
+            gi, gj = i + 3, j + 3
+            c0, c1, c2 = g[gi - 3, gj], g[gi - 2, gj], g[gi - 1, gj]
+            c3, c4, c5, c6 = g[gi, gj], g[gi + 1, gj], g[gi + 2, gj], g[gi + 3, gj]
+            d0, d1, d2 = (c1 - c0) / h, (c2 - c1) / h, (c3 - c2) / h
+            d3, d4, d5 = (c4 - c3) / h, (c5 - c4) / h, (c6 - c5) / h
+            nm = _weno(d0, d1, d2, d3, d4)
+            np_ = _weno(d5, d4, d3, d2, d1)
+            c0, c1, c2 = g[gi, gj - 3], g[gi, gj - 2], g[gi, gj - 1]
+            c4, c5, c6 = g[gi, gj + 1], g[gi, gj + 2], g[gi, gj + 3]
+            d0, d1, d2 = (c1 - c0) / h, (c2 - c1) / h, (c3 - c2) / h
+            d3, d4, d5 = (c4 - c3) / h, (c5 - c4) / h, (c6 - c5) / h
+            em = _weno(d0, d1, d2, d3, d4)
+            ep = _weno(d5, d4, d3, d2, d1)
+            grad = np.sqrt(max(nm, 0.0) ** 2 + min(np_, 0.0) ** 2 + max(em, 0.0) ** 2 + min(ep, 0.0) ** 2)
+            a = vn[i, j] * (nm if vn[i, j] > 0 else np_) + ve[i, j] * (em if ve[i, j] > 0 else ep)
+            out[i, j] = -(speed[i, j] * grad + a)
 
 
 @dataclass
