@@ -85,8 +85,9 @@ def _compiled_rate():
 
 
 @numba.njit(cache=True, inline="always", error_model="numpy", fastmath=True)
-def _weno(v1, v2, v3, v4, v5):
-    """WENO5 reconstruction of a one-sided derivative from five differences (Jiang & Shu)."""
+def _weno_scalar(v1, v2, v3, v4, v5):
+    """:func:`_weno` for one point: WENO5 reconstruction of a one-sided derivative from five
+    differences (Jiang & Shu)."""
     p1 = v1 / 3 - 7 * v2 / 6 + 11 * v3 / 6
     p2 = -v2 / 6 + 5 * v3 / 6 + v4 / 3
     p3 = v3 / 3 + 5 * v4 / 6 - v5 / 6
@@ -108,14 +109,14 @@ def _front_rate_kernel(g, h, speed, vn, ve, out):
             c3, c4, c5, c6 = g[gi, gj], g[gi + 1, gj], g[gi + 2, gj], g[gi + 3, gj]
             d0, d1, d2 = (c1 - c0) / h, (c2 - c1) / h, (c3 - c2) / h
             d3, d4, d5 = (c4 - c3) / h, (c5 - c4) / h, (c6 - c5) / h
-            nm = _weno(d0, d1, d2, d3, d4)
-            np_ = _weno(d5, d4, d3, d2, d1)
+            nm = _weno_scalar(d0, d1, d2, d3, d4)
+            np_ = _weno_scalar(d5, d4, d3, d2, d1)
             c0, c1, c2 = g[gi, gj - 3], g[gi, gj - 2], g[gi, gj - 1]
             c4, c5, c6 = g[gi, gj + 1], g[gi, gj + 2], g[gi, gj + 3]
             d0, d1, d2 = (c1 - c0) / h, (c2 - c1) / h, (c3 - c2) / h
             d3, d4, d5 = (c4 - c3) / h, (c5 - c4) / h, (c6 - c5) / h
-            em = _weno(d0, d1, d2, d3, d4)
-            ep = _weno(d5, d4, d3, d2, d1)
+            em = _weno_scalar(d0, d1, d2, d3, d4)
+            ep = _weno_scalar(d5, d4, d3, d2, d1)
             grad = np.sqrt(max(nm, 0.0) ** 2 + min(np_, 0.0) ** 2 + max(em, 0.0) ** 2 + min(ep, 0.0) ** 2)
             a = vn[i, j] * (nm if vn[i, j] > 0 else np_) + ve[i, j] * (em if ve[i, j] > 0 else ep)
             out[i, j] = -(speed[i, j] * grad + a)
