@@ -32,8 +32,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--quick", action="store_true", help="fewer ships, shorter comparison runs")
     args = parser.parse_args(argv)
     from shipgnc.analysis.catamaran_metrics import comparison_metrics
-    from shipgnc.cases.catamaran import montecarlo
-    from shipgnc.control.catamaran_baselines import comparison_cases
+    from shipgnc.cases.catamaran import comparison_cases, montecarlo
 
     n_ships = 100 if args.quick else 1000
     steps = round(MC_T_END / DT)

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from shipgnc.cases import catamaran as C
-from shipgnc.control.catamaran_baselines import HeadingLQR, YawRatePI, comparison_cases
+from shipgnc.cases.catamaran import comparison_cases
+from shipgnc.control.catamaran_baselines import HeadingLQR, YawRatePI
 from shipgnc.control.finite_state import ConstantRate, HeadingCapture, SineRate, YawRateFSM
 from shipgnc.models.catamaran import Catamaran, catamaran_yaw_acceleration
 from shipgnc.scenarios.runner import run_scenario

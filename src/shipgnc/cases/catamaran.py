@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from shipgnc.control.catamaran_baselines import HeadingLQR, YawRatePI
 from shipgnc.control.finite_state import (
     ConstantRate,
     HeadingCapture,
@@ -229,6 +230,39 @@ SCENARIOS = {
 
 def compare(preset_name: str = "si", vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """``catamaran-compare``: FSM laws against the baselines on S3, S4 (ω* = 0.008) and S7."""
-    from shipgnc.control.catamaran_baselines import comparison_cases
-
     return comparison_cases(preset_name, vessel=vessel)
+
+
+def comparison_cases(preset_name: str = "si", t_end_rate: float = 300.0, t_end_heading: float = 600.0,
+                     vessel: dict | None = None):
+    """``catamaran-compare``: FSM laws against the baselines on S3 (ω* = 0.08), S4 (ω* = 0.008) and S7
+    (K* = 0.8 rad, ω_c = 0.0022 rad/s). Returns ``{"S3/law20": case, ...}``."""
+    T_u, h = default_gains(preset_name)
+    cases = {}
+    for label, w in (("S3", 0.08), ("S4", 0.008)):
+        for law in (20, 21):
+            cases[f"{label}/law{law}"] = yaw_rate_case(f"compare/{label}/law{law}", preset_name, law, w,
+                                                       t_end=t_end_rate, vessel=vessel)
+        model = Catamaran.from_preset(preset_name, **(vessel or {}))
+        ref = ConstantRate(w)
+        cases[f"{label}/pi"] = CatamaranCase(f"compare/{label}/pi", model, initial_state(),
+                                             YawRatePI(model, T_u=T_u, h=h, omega_ref=ref), ref, t_end_rate)
+    cases["S7/law21"] = heading(preset_name, 21, 0.8, 0.0022, t_end=t_end_heading, vessel=vessel)
+    model = Catamaran.from_preset(preset_name, **(vessel or {}))
+    lqr = HeadingLQR(model, 0.8, 0.0022)
+    cases["S7/lqr"] = CatamaranCase("compare/S7/lqr", model, initial_state(), lqr, None, t_end_heading,
+                                    heading_target=0.8)
+    return cases
+
+
+def run_comparison(preset_name: str = "si", **kwargs) -> dict[str, dict]:
+    """Run every comparison case; returns run key → comparison metrics (IAE, travel, peak rate...)."""
+    from shipgnc.analysis.catamaran_metrics import comparison_metrics
+
+    out = {}
+    for key, case in comparison_cases(preset_name, **kwargs).items():
+        ds = case.run()
+        out[key] = comparison_metrics(ds, case.heading_target)
+        out[key]["final_yaw_rate_rad_s"] = float(ds.r[-1])
+        out[key]["final_delta_deg"] = math.degrees(float(ds.delta[-1]))
+    return out

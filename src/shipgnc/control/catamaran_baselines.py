@@ -26,7 +26,6 @@ from shipgnc.control.finite_state import (
     N_RATE_STATE,
     HeadingCapture,
     as_rate_reference,
-    default_gains,
     np_sign,
     rate_value,
     source_reason,
@@ -218,41 +217,3 @@ def heading_lqr_step(t, x, ref, z, p, cmd, sig):
     z[1] = psi_ref
     sig[0] = psi_ref
     cmd[0] = -total
-
-
-def comparison_cases(preset_name: str = "si", t_end_rate: float = 300.0, t_end_heading: float = 600.0,
-                     vessel: dict | None = None):
-    """``catamaran-compare``: FSM laws against the baselines on S3 (ω* = 0.08), S4 (ω* = 0.008) and S7
-    (K* = 0.8 rad, ω_c = 0.0022 rad/s). Returns ``{"S3/law20": case, ...}``."""
-    from shipgnc.cases.catamaran import CatamaranCase, heading, initial_state, yaw_rate_case
-    from shipgnc.control.finite_state import ConstantRate
-
-    T_u, h = default_gains(preset_name)
-    cases = {}
-    for label, w in (("S3", 0.08), ("S4", 0.008)):
-        for law in (20, 21):
-            cases[f"{label}/law{law}"] = yaw_rate_case(f"compare/{label}/law{law}", preset_name, law, w,
-                                                       t_end=t_end_rate, vessel=vessel)
-        model = Catamaran.from_preset(preset_name, **(vessel or {}))
-        ref = ConstantRate(w)
-        cases[f"{label}/pi"] = CatamaranCase(f"compare/{label}/pi", model, initial_state(),
-                                             YawRatePI(model, T_u=T_u, h=h, omega_ref=ref), ref, t_end_rate)
-    cases["S7/law21"] = heading(preset_name, 21, 0.8, 0.0022, t_end=t_end_heading, vessel=vessel)
-    model = Catamaran.from_preset(preset_name, **(vessel or {}))
-    lqr = HeadingLQR(model, 0.8, 0.0022)
-    cases["S7/lqr"] = CatamaranCase("compare/S7/lqr", model, initial_state(), lqr, None, t_end_heading,
-                                    heading_target=0.8)
-    return cases
-
-
-def run_comparison(preset_name: str = "si", **kwargs) -> dict[str, dict]:
-    """Run every comparison case; returns run key → comparison metrics (IAE, travel, peak rate...)."""
-    from shipgnc.analysis.catamaran_metrics import comparison_metrics
-
-    out = {}
-    for key, case in comparison_cases(preset_name, **kwargs).items():
-        ds = case.run()
-        out[key] = comparison_metrics(ds, case.heading_target)
-        out[key]["final_yaw_rate_rad_s"] = float(ds.r[-1])
-        out[key]["final_delta_deg"] = math.degrees(float(ds.delta[-1]))
-    return out

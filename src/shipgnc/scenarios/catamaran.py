@@ -31,7 +31,7 @@ def _compare(preset_name: str = "si", t_end: float = 600.0, t_end_rate: float = 
              vessel: dict | None = None):
     """FSM laws against the PI / LQR baselines on S3, S4 (``t_end_rate``) and S7 (``t_end``)
     (spec 004 §4.11.3)."""
-    from shipgnc.control.catamaran_baselines import comparison_cases
+    from shipgnc.cases.catamaran import comparison_cases
 
     return comparison_cases(preset_name, t_end_rate=min(t_end_rate, t_end), t_end_heading=t_end,
                             vessel=vessel)
@@ -96,15 +96,20 @@ def run(scenario: Scenario, *, seed: int, progress=None, on_divergence: str = "r
     Ctrl-C as :func:`~shipgnc.scenarios.runner.run_scenario`)."""
     from shipgnc.analysis.catamaran_metrics import attach_events
     from shipgnc.scenarios.runner import ScenarioRun, Setup, combine, interruptible
-    from shipgnc.sim.simulator import simulate
+    from shipgnc.sim.simulator import scoring_log_every, simulate, thin
 
     runs = cases(scenario)
+    log_every = scenario.simulation.log_every
     results, metrics, setups = {}, {}, {}
     several = len(runs) > 1
     for key, case in runs.items():
+        # the metrics see every step: an unthinned record, thinned to log_every once scored
+        every = scoring_log_every(case.model, np.asarray(case.x0, dtype=float), case.t_end, case.dt,
+                                  log_every)
         with interruptible(keep_interrupted) as run:
             run.result = simulate(case.model, case.x0, **case.simulate_kwargs(), seed=seed,
                                   progress=progress, backend=scenario.simulation.backend,
+                                  log_every=every,
                                   on_divergence="stop" if several else on_divergence,
                                   attrs={"scenario": scenario.name, "controller": key, "seed": seed,
                                          "vessel": "catamaran", "preset": scenario.vessel.preset})
@@ -112,7 +117,7 @@ def run(scenario: Scenario, *, seed: int, progress=None, on_divergence: str = "r
         attach_events(ds, case.controller)
         m = run.metrics(lambda ds, case=case: score(scenario, ds, case, case.controller))
         m["diverged"] = bool(ds.attrs.get("diverged", 0))
-        results[key], metrics[key] = ds, m
+        results[key], metrics[key] = thin(ds, log_every // every), m
         setups[key] = Setup(case.model, case.x0, case.actuator, case.controller, case.guidance, None,
                             case=case)
         if run.interrupted:
