@@ -201,7 +201,7 @@ def _assert_same_runs(ref, got):
 @pytest.mark.parametrize(("scenario", "controllers", "t_end"), [
     ("cybership-calm", ("pd", "smc_consistent", "smc_tuned"), 300.0),
     ("cybership-calm", ("smc_printed",), 12.0),
-    ("cybership-waves", ("pd", "smc_printed", "smc_consistent", "smc_tuned"), 20.0),
+    ("cybership-waves", ("pd", "smc_printed", "smc_consistent", "smc_tuned"), 15.0),
     ("cybership-waves", ("smc_consistent",), 150.0),
 ])
 def test_scenario_compiled_equals_numpy(scenario, controllers, t_end):

@@ -47,7 +47,9 @@ def test_defaults_are_table1_and_spec_3_5():
                                                                   -0.4304, 0.2363)
     assert P.rudder_model == "table1"
     assert P.delta_max == pytest.approx(math.radians(35.0))
-    assert P.delta_rate == pytest.approx(math.radians(19.4))
+    # spec 003 B8: IMO's 2.32°/s Froude-scaled by √70 = 19.4105°/s (the spec rounds it to 19.4)
+    assert P.delta_rate == pytest.approx(math.radians(2.32 * math.sqrt(70.0)), rel=1e-12)
+    assert math.degrees(P.delta_rate) == pytest.approx(19.4105, abs=5e-5)
     # N_δ/Y_δ = x_R: the table's rudder sits at the model's rudder position
     assert P.N_delta / P.Y_delta == pytest.approx(P.x_rudder, abs=2e-4)
 
@@ -218,9 +220,9 @@ def test_steering_machine():
     assert act.names == ("n", "delta")
     np.testing.assert_allclose(act.lower, [0.0, -math.radians(35)])
     np.testing.assert_allclose(act.upper, [30.0, math.radians(35)])
-    assert math.isinf(act.rate[0]) and act.rate[1] == pytest.approx(math.radians(19.4))
+    assert math.isinf(act.rate[0]) and act.rate[1] == pytest.approx(math.radians(19.4105), rel=1e-5)
     _, end = act.begin_step(np.array([8.13, 0.0]), np.array([8.13, 1.0]), 0.1)
-    assert end[1] == pytest.approx(math.radians(1.94))
+    assert end[1] == pytest.approx(math.radians(1.94105), rel=1e-5)
     assert not steering_machine(P, rate_limit=False).has_rate_limit
 
 

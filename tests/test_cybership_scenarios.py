@@ -155,3 +155,41 @@ def test_no_rudder_rate_limit_and_a_single_controller(tmp_path):
     assert result.exit_code == 0, result.stderr
     assert "J" in json.loads(result.stdout)
     assert (tmp_path / "comparison.png").stat().st_size > 10_000
+
+
+def test_start_surge_and_rudder_rate_are_the_exact_values():
+    """Spec 003 §3.8/B8 round them to 0.2958 m/s and 19.4°/s; the scenarios use the exact ones: the
+    surge equilibrium of the propeller model at the scenario's rps (``initial_state.u: null``,
+    computed at validation, so ``shipgnc show`` prints it) and 2.32·√70 °/s (issue 15)."""
+    from shipgnc.models.cybership2 import DELTA_RATE_DEG_S, CyberShip2Params, surge_equilibrium
+    from shipgnc.scenarios.registry import scenario_yaml
+
+    params = CyberShip2Params()
+    for name in ("cybership-calm", "cybership-waves"):
+        scenario = load_scenario(name)
+        u = scenario.simulation.initial_state.u
+        assert u == surge_equilibrium(params, 8.13)
+        assert u == pytest.approx(0.295838, abs=5e-7) and u != 0.2958
+        assert scenario.vessel.rudder_rate_deg_s == DELTA_RATE_DEG_S == 2.32 * math.sqrt(70.0)
+        assert DELTA_RATE_DEG_S == pytest.approx(19.41051, abs=5e-6)
+        shown = scenario_yaml(scenario)
+        assert f"u: {u!r}" in shown and f"rudder_rate_deg_s: {DELTA_RATE_DEG_S!r}" in shown
+        assert load_scenario(name, []).model_dump() == scenario.model_dump()  # stable reload
+    # the equilibrium follows the scenario's rps; a number given is kept (the spec's rounded run)
+    slower = load_scenario("cybership-calm", ["vessel.propeller_rps=7"])
+    assert slower.simulation.initial_state.u == surge_equilibrium(params, 7.0)
+    rounded = load_scenario("cybership-calm", ["simulation.initial_state.u=0.2958",
+                                               "vessel.rudder_rate_deg_s=19.4"])
+    assert rounded.simulation.initial_state.u == 0.2958 and rounded.vessel.rudder_rate_deg_s == 19.4
+    # the run starts there: straight running at the equilibrium stays at it
+    run = run_scenario("cybership-calm", overrides=[
+        "simulation.t_end=5", "controllers={pd: {type: course, variant: pd, Ts: 0.1}}",
+        "guidance.schedule=[{t: 0, psi_deg: 0}]"])
+    np.testing.assert_allclose(run.result["u"].values, surge_equilibrium(params, 8.13), rtol=1e-9)
+
+
+def test_equilibrium_start_is_refused_where_it_is_not_defined():
+    from shipgnc.errors import ConfigError
+
+    with pytest.raises(ConfigError, match=r"initial_state\.u = null"):
+        load_scenario("boat-autopilot", ["simulation.initial_state.u=null"])

@@ -19,12 +19,19 @@ def realisation(noise, h, n, ships=1, seed=1):
 
 
 @pytest.mark.parametrize("h", [0.3, 1.0, 2.5])
-def test_stationary_rms_is_sigma_for_any_step(h):
-    """The exact discretisation keeps var(w) = σ² whatever the step (A11's scaling of q)."""
+def test_held_rms_is_the_step_average_of_sigma(h):
+    """The filter keeps var(w) = σ² (A11's scaling of q); the value held over a step is w's exact
+    average over it, whose variance 2(P₁₁ − (ΦP)₁₁)/h² is σ² less what the averaging removes."""
     noise = SecondOrderNoise(sigma=2.0, period=8.0, zeta=0.1)
-    w = realisation(noise, h, 4000, ships=50)
+    assert noise.held_variance(1e-3) == pytest.approx(4.0, rel=1e-4)  # h → 0: the point value
+    # the same variance from the spectrum side: S_w·sinc²(ωh/2), folded, integrated to Nyquist
+    f = np.linspace(0.0, 0.5 / h, 200_001)
+    assert noise.held_variance(h) == pytest.approx(
+        np.trapezoid(noise.step_average_psd(f, h), f), rel=1e-3)
+    assert noise.held_variance(h) < 4.0
+    w = realisation(noise, h, 4000, ships=50)[1:]  # the first value is the point sample w(0)
     # 200 000 correlated samples; the relative standard error of the variance is a few per cent
-    assert np.sqrt(np.mean(w**2)) == pytest.approx(2.0, rel=0.03)
+    assert np.sqrt(np.mean(w**2)) == pytest.approx(math.sqrt(noise.held_variance(h)), rel=0.03)
     assert abs(np.mean(w)) < 0.1
 
 

@@ -153,7 +153,6 @@ def test_show_prints_the_yaml():
     ("vessel.params_paper={S: 1.0e300}", ["S", "1e+300"]),
     ("vessel.params_paper={c: -1}", ["c = -1.0 1/min^2", "rudder gain"]),
     ("guidance.points_nm=[[0, 0], [0, 0], [1, 1]]", ["points_nm", "repeated"]),
-    ("simulation.log_every=5", ["log_every", "every sample"]),
 ])
 def test_bad_settings_name_the_field(override, words):
     with pytest.raises(ConfigError) as info:
@@ -207,6 +206,57 @@ def test_metric_definitions_on_a_synthetic_run():
     assert a["crosstrack_rms_after_leg1_nm"][0] == pytest.approx(0.2)
     assert a["saturation_fraction"][0] == pytest.approx(56 / 61)
     assert a["stable"][0]
+
+
+def test_a_ship_sailing_its_leg_backwards_is_reversed_not_stable():
+    """The look-ahead FL has a second stable equilibrium, ψ_r = π (spec 000 §0.5): started heading
+    opposite to the leg it settles there, |y_r| bounded (l·d_y/U) but sailing the leg backwards.
+    That is ``reversed`` and not ``stable`` (issue 15); the same start heading along the leg is
+    neither."""
+    backwards = run("mariner-fl-lookahead", *STRAIGHT, "simulation.initial_state.psi_deg=180").metrics
+    assert backwards["reversed"] is True and backwards["stable"] is False
+    assert backwards["final_heading_error_deg"] == pytest.approx(-180.0 - PSI_SS_DEG, abs=0.01)
+    assert abs(backwards["final_crosstrack_nm"]) < 0.05  # bounded: only the heading tells
+    ahead = run("mariner-fl-lookahead", *STRAIGHT).metrics
+    assert ahead["reversed"] is False and ahead["stable"] is True
+
+
+def test_reversed_on_hand_built_arrays():
+    """``reversed`` is |circular mean of ψ_r over the last 10 min| > 90°, whatever came before."""
+    t = np.arange(0.0, 61.0) * MIN
+    n = t.size
+    y = np.full((n, 4), 0.01 * NM)
+    late = t >= 45 * MIN
+    psi = np.zeros((n, 4))
+    psi[:, 0] = math.radians(10.0)  # on the leg
+    psi[:, 1] = np.where(np.arange(n) % 2, math.radians(179.0), math.radians(-179.0))  # ≈ ±180°
+    psi[:, 2] = np.where(late, math.radians(-95.0), 0.0)  # ends just beyond 90°
+    psi[:, 3] = np.where(late, 0.0, math.pi)  # backwards for 45 min, then turned round
+    a = path_tracking_arrays(t, y, psi, np.zeros((n, 4)), np.zeros((n, 4)),
+                             delta_max=math.radians(35.0), reached_end=True)
+    np.testing.assert_array_equal(a["reversed"], [False, True, True, False])
+    np.testing.assert_array_equal(a["stable"], [True, False, False, True])
+    b = path_tracking_arrays(t, y, psi, np.zeros((n, 4)), np.zeros((n, 4)),
+                             delta_max=math.radians(35.0), reached_end=False)
+    assert not b["stable"].any()  # a stopped run is never stable, reversed or not
+
+
+def test_a_batch_records_reversed_for_each_member():
+    """``runner.metric_arrays`` (a study's scores) carries ``reversed`` for every member."""
+    from shipgnc.scenarios.runner import metric_arrays
+    from shipgnc.sim.simulator import simulate
+
+    scenario = load_scenario("mariner-fl-lookahead", list(STRAIGHT))
+    setup = build(scenario, seed=0)
+    x0 = np.tile(setup.x0, (2, 1))
+    x0[1, 2] = math.pi  # the second member starts heading opposite to the leg
+    sim = scenario.simulation
+    result = simulate(setup.model, x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
+                      actuator=setup.actuator, guidance=setup.guidance,
+                      disturbance=setup.disturbance, u0=setup.u0, seed=0, batch_dims=("member",))
+    arrays = metric_arrays(scenario, result, setup)
+    np.testing.assert_array_equal(arrays["reversed"], [0.0, 1.0])
+    np.testing.assert_array_equal(arrays["stable"], [1.0, 0.0])
 
 
 @pytest.mark.parametrize(("overrides", "words"), [

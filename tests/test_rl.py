@@ -138,8 +138,12 @@ def test_hold_mode_rudder_earns_the_spec_J():
     hold-mode value). The last sample's rudder is the policy's last action held, where the loop
     asks the controller once more, so the return is −J up to one sample's change of the command:
     δ² there is ≈ 7e-5 rad² of J ≈ 266, and one sample changes δ by ≈ 0.1 % (δ ≈ −0.0084 rad,
-    slewing ~6e-6 rad per sample), so the gap is ≲ 1e-9 relative; 1e-6 leaves room."""
-    scenario = load_scenario("cybership-calm", ["vessel.rudder_rate_mode=hold"])
+    slewing ~6e-6 rad per sample), so the gap is ≲ 1e-9 relative; 1e-6 leaves room. The spec's
+    figure was computed with its rounded start surge 0.2958 m/s and rudder rate 19.4°/s (the
+    defaults are the exact 0.295838 m/s and 2.32·√70 = 19.4105°/s), so this run sets them."""
+    scenario = load_scenario("cybership-calm", ["vessel.rudder_rate_mode=hold",
+                                                "vessel.rudder_rate_deg_s=19.4",
+                                                "simulation.initial_state.u=0.2958"])
     run = run_scenario(scenario)
     total, _ = _episode_with_controller(ShipEnv(scenario), build(scenario, "pd").controller)
     assert -total == pytest.approx(run.metrics["pd"]["J"], rel=1e-6)

@@ -307,10 +307,18 @@ def test_chunks_from_different_loops_are_flagged():
     assert ds.attrs["backend"] == "compiled, numpy"
 
 
-def test_a_run_table_in_the_output_directory_is_kept(tmp_path, local_result):
+def test_a_foreign_output_directory_is_refused_not_mixed(tmp_path, local_result):
+    # outputs are atomic (issue 16): a directory holding files that are not a shipgnc run is
+    # refused (its files untouched) unless overwrite, which replaces it whole
     from shipgnc.cli_sweep import write_study
+    from shipgnc.errors import ConfigError
 
-    (tmp_path / "table.csv").write_text("a run's comparison\n")
-    write_study(local_result, tmp_path, figures=False)
-    assert (tmp_path / "table.csv").read_text() == "a run's comparison\n"
-    assert (tmp_path / "summary.csv").exists() and (tmp_path / "summary.md").exists()
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "table.csv").write_text("a run's comparison\n")
+    with pytest.raises(ConfigError, match="not a shipgnc run"):
+        write_study(local_result, out, figures=False)
+    assert (out / "table.csv").read_text() == "a run's comparison\n"
+    write_study(local_result, out, figures=False, overwrite=True)
+    assert not (out / "table.csv").exists()
+    assert (out / "summary.csv").exists() and (out / "summary.md").exists()

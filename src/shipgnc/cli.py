@@ -117,13 +117,22 @@ def run_command(
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write PNG figures.")] = True,
     keep_partial: Annotated[bool, typer.Option(
         "--keep-partial", help="If the run diverges (exit 3) or is interrupted by Ctrl-C (exit 130), "
-                               "still write the partial result.")] = False,
+                               "still write the partial result (metrics.json marks it 'diverged' / "
+                               "'interrupted'); without it an earlier run in --out stays "
+                               "untouched.")] = False,
+    overwrite: Annotated[bool, typer.Option(
+        "--overwrite", help="Replace --out whole even when it holds files that are not a shipgnc "
+                            "run (a directory of an earlier run is always replaced whole).")] = False,
 ) -> None:
-    """Run a scenario: write result.nc, metrics.json and figures; print the metrics."""
+    """Run a scenario: write result.nc, metrics.json and figures; print the metrics.
+
+    The outputs are written into a temporary directory beside --out and moved into place when
+    complete, with a marker file .shipgnc-run (see shipgnc.outputs)."""
     with friendly_errors(), ExitStack() as stack:
         from shipgnc.errors import ConfigError
+        from shipgnc.outputs import check_out
         from shipgnc.scenarios.registry import load_scenario
-        from shipgnc.scenarios.runner import metrics_json, run_scenario, write_outputs
+        from shipgnc.scenarios.runner import divergence_message, metrics_json, run_scenario, write_outputs
 
         if realtime is not None and not (realtime > 0 and realtime < float("inf")):
             raise ConfigError(f"--realtime = {realtime}: must be a number > 0 (1.0 = real time)")
@@ -138,7 +147,8 @@ def run_command(
         if live and (sc.vessel.model != "vectored-thrust-boat" or sc.controllers is not None):
             raise ConfigError(f"--live: the live dashboard shows the vectored-thrust boat; scenario "
                               f"{sc.name!r} ({sc.vessel.model}) writes its figures after the run")
-        out_dir = out if out is not None else Path("runs") / sc.name
+        out_dir = check_out(out if out is not None else Path("runs") / sc.name,
+                            overwrite=overwrite)  # before any work
         observer = _live_observer(sc, realtime) if live else None
         with _progress(enabled=not live) as progress:
             run = run_scenario(sc, observer=observer, progress=progress,
@@ -146,7 +156,13 @@ def run_command(
                                keep_interrupted=keep_partial)
         if observer is not None:
             observer.finish()  # draw the last samples (a LOS run may end before t_end)
-        written = write_outputs(run, out_dir, figures=figures, figure_process=figure_process)
+        diverged = run.result is not None and bool(run.result.attrs.get("diverged"))
+        if diverged and not keep_partial:  # a comparison keeps going: its outputs are not written
+            stderr.print(f"[bold red]error:[/] {_one_line(divergence_message(run))}; --keep-partial "
+                         "writes the partial result", soft_wrap=True)
+            raise typer.Exit(3)
+        written = write_outputs(run, out_dir, figures=figures, figure_process=figure_process,
+                                overwrite=overwrite)
         if json_:
             sys.stdout.write(metrics_json(run.metrics) + "\n")
         else:
@@ -161,9 +177,8 @@ def run_command(
         if run.route is not None and not run.metrics.get("reachable"):
             stderr.print(f"[bold red]unreachable:[/] {run.metrics.get('reason', '')}", soft_wrap=True)
             raise typer.Exit(3)
-        if run.result is not None and run.result.attrs.get("diverged"):
-            message = run.result.attrs.get("message") or "the simulation diverged"
-            stderr.print(f"[bold red]error:[/] {message}", soft_wrap=True)
+        if diverged:
+            stderr.print(f"[bold red]error:[/] {_one_line(divergence_message(run))}", soft_wrap=True)
             raise typer.Exit(3)
 
 

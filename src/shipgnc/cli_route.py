@@ -62,6 +62,10 @@ def route(
         from shipgnc.routing.field_spec import parse_field
         from shipgnc.routing.router import METHODS, solve_route
 
+        if out is not None:
+            from shipgnc.outputs import check_out
+
+            check_out(out)  # before any work
         require(units in ("si", "nautical"), "--units", units, "allowed: si, nautical")
         require(method in METHODS, "--method", method, f"allowed: {', '.join(METHODS)}")
         nautical = units == "nautical"
@@ -83,12 +87,13 @@ def route(
                           grid_spacing=None if grid is None else grid * length)
         payload = res.to_json()
         text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
-        if out is not None:
-            out.mkdir(parents=True, exist_ok=True)
-            (out / "route.json").write_text(text + "\n", encoding="utf-8")
+        if out is not None:  # atomic: a temporary directory moved into place when complete
+            from shipgnc.outputs import atomic_dir
             from shipgnc.routing.figures import route_figure
 
-            route_figure(res, out / "route.png", nautical=nautical)
+            with atomic_dir(out, command="route") as tmp:
+                (tmp / "route.json").write_text(text + "\n", encoding="utf-8")
+                route_figure(res, tmp / "route.png", nautical=nautical)
             stderr.print(f"wrote route.json, route.png to {out}", soft_wrap=True)
         if json_:
             sys.stdout.write(text + "\n")

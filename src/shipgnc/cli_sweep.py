@@ -46,6 +46,12 @@ def sweep(
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output directory "
                                              "[default: runs/sweep-<scenario>].")] = None,
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write sweep.png.")] = True,
+    keep_partial: Annotated[bool, typer.Option(
+        "--keep-partial", help="If every member diverges (exit 3), still write the study "
+                               "(the marker file .shipgnc-run says 'diverged').")] = False,
+    overwrite: Annotated[bool, typer.Option(
+        "--overwrite", help="Replace --out whole even when it holds files that are not a shipgnc "
+                            "run (a directory of an earlier run is always replaced whole).")] = False,
 ) -> None:
     """Sweep a scenario over a grid of settings and a Monte Carlo of seeded members."""
     from rich.markup import escape
@@ -63,7 +69,10 @@ def sweep(
         study = Study(scenario, grid=tuple(parse_grid(g) for g in grid or []), members=mc, seed=seed,
                       perturb=tuple(Perturbation.parse(p) for p in perturb or []),
                       overrides=tuple(set_ or []), series=series)
-        out_dir = out if out is not None else Path("runs") / f"sweep-{Path(scenario).stem}"
+        from shipgnc.outputs import check_out
+
+        out_dir = check_out(out if out is not None else Path("runs") / f"sweep-{Path(scenario).stem}",
+                            overwrite=overwrite)  # before any work
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ShipGNCWarning)
             run = _run_with_progress(study, workers, scheduler, chunk_size)
@@ -73,10 +82,35 @@ def sweep(
             else:
                 warnings.warn_explicit(warning.message, warning.category, warning.filename,
                                        warning.lineno)
-        written = write_study(run.dataset, out_dir, figures=figures)
+        diverged, total = diverged_count(run.dataset)
+        if diverged == total:
+            stderr.print(f"[bold red]error:[/] every member diverged ({diverged} of {total}); "
+                         + ("writing the study" if keep_partial else
+                            "--keep-partial writes the study"), soft_wrap=True)
+            if not keep_partial:
+                raise typer.Exit(3)
+        elif diverged:
+            share = diverged / total
+            stderr.print(f"[yellow]warning:[/] {diverged} of {total} members diverged "
+                         f"({share:.0%}); the summary leaves them out (diverged_members)",
+                         soft_wrap=True)
+        written = write_study(run.dataset, out_dir, figures=figures, overwrite=overwrite,
+                              status="diverged" if diverged == total else "complete")
         _print_summary(run)
         stderr.print(f"{run.chunks} chunks on {run.workers} in {run.seconds:.1f} s; wrote "
                      f"{', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
+        if diverged == total:
+            raise typer.Exit(3)
+
+
+def diverged_count(ds) -> tuple[int, int]:
+    """(members that diverged, members) over every grid point and controller of a study."""
+    import numpy as np
+
+    if "diverged" not in ds:
+        return 0, 0
+    flags = np.asarray(ds["diverged"].values, dtype=float)
+    return int(np.sum(flags > 0)), int(flags.size)
 
 
 def _run_with_progress(study, workers, scheduler, chunk_size):
@@ -96,21 +130,22 @@ def _run_with_progress(study, workers, scheduler, chunk_size):
                          on_chunk=update)
 
 
-def write_study(ds, out: Path, *, figures: bool = True) -> list[Path]:
-    """The study's Dataset, summary table and figure in ``out``."""
-    from shipgnc.errors import ConfigError
+def write_study(ds, out: Path, *, figures: bool = True, overwrite: bool = False,
+                status: str = "complete") -> list[Path]:
+    """The study's Dataset, summary table and figure in ``out``, written atomically (see
+    :func:`shipgnc.outputs.atomic_dir`: a temporary directory beside ``out`` moved into place
+    when complete, replacing an earlier shipgnc run whole)."""
+    from shipgnc.outputs import atomic_dir, moved
     from shipgnc.scenarios.runner import write_table
     from shipgnc.study.summary import save_dataset, spread_figure, summary_rows
 
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ConfigError(f"--out {str(out)!r}: cannot create the directory ({exc.strerror})") from None
-    written = [save_dataset(ds, out)]
-    written += write_table(summary_rows(ds), out, stem="summary")
-    if figures:
-        written.append(spread_figure(ds, out / "sweep.png"))
-    return written
+    out = Path(out)
+    with atomic_dir(out, overwrite=overwrite, command="sweep", status=status) as tmp:
+        written = [save_dataset(ds, tmp)]
+        written += write_table(summary_rows(ds), tmp, stem="summary")
+        if figures:
+            written.append(spread_figure(ds, tmp / "sweep.png"))
+    return moved(written, tmp, out)
 
 
 def _print_summary(run, max_columns: int = 8) -> None:
@@ -128,7 +163,7 @@ def _print_summary(run, max_columns: int = 8) -> None:
     ds = run.dataset
     rows = summary_rows(ds)
     suffixes = ("_median", "_p5", "_p95", "_missing")
-    cell_keys = [k for k in rows[0] if not k.endswith(suffixes)]
+    cell_keys = [k for k in rows[0] if not k.endswith(suffixes) and k != "diverged_members"]
     metrics = [k.removesuffix("_median") for k in rows[0] if k.endswith("_median")]
     shown = rows[:max_columns]
     title = f"{ds.attrs['scenario']}: median [p5, p95] over {ds.attrs['members']} members"

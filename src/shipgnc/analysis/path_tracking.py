@@ -15,8 +15,11 @@ time before the first leg switch.
   10 min (signed; the heading error's is the circular mean, so a ship near ψ_r = ±180° reads
   ±180°, not 0);
 * ``rudder_rms_deg``; ``saturation_fraction``: share of samples with |δ| at δ_max;
-* ``stable``: the run reached its end without the divergence guard and |y_r| stayed below
-  max(3 nm, 2|y_r(0)|) (spec 000 §0.8, [A]).
+* ``stable``: the run reached its end without the divergence guard, |y_r| stayed below
+  max(3 nm, 2|y_r(0)|) (spec 000 §0.8, [A]) and the ship is not ``reversed``;
+* ``reversed``: the run ends with |heading error| > 90° (the final heading error above, the
+  circular mean over the last 10 min): the reversed equilibrium ψ_r = π of spec 000 §0.5, a ship
+  sailing its leg backwards with y_r bounded, which is not tracking (issue 15).
 """
 
 from __future__ import annotations
@@ -40,12 +43,17 @@ ON_LINE = 1e-3
 PATH_TRACKING_KEYS = ("settle_time_min", "overshoot_nm", "crosstrack_max_after_leg1_nm",
                       "crosstrack_rms_after_leg1_nm", "final_crosstrack_nm",
                       "final_heading_error_deg", "final_rudder_deg", "rudder_rms_deg",
-                      "saturation_fraction", "stable")
+                      "saturation_fraction", "stable", "reversed")
+#: the keys reported as true|false
+BOOL_KEYS = ("stable", "reversed")
+#: |final heading error| beyond which a run counts as ``reversed`` [deg]
+REVERSED_DEG = 90.0
 
 
 def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reached_end) -> dict:
     """The metrics for every ship at once: arrays ``(time, ship)`` in SI → dict of ``(ship,)``
-    float arrays in the reported units (NaN where a figure does not exist; ``stable`` as bool),
+    float arrays in the reported units (NaN where a figure does not exist; ``stable`` and
+    ``reversed`` as bool),
     plus ``final_abs_crosstrack_nm``, the mean |y_r| over the last 10 min.
 
     ``reached_end``: bool per ship (or one bool), False when the run stopped early (divergence).
@@ -95,7 +103,10 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
         saturation = saturated.sum(axis=0) / applied.sum(axis=0)
         peak = np.max(np.where(valid, np.abs(y), 0.0), axis=0)
     bound = np.maximum(STABLE_BOUND, 2.0 * np.abs(y0))
-    stable = np.broadcast_to(np.asarray(reached_end, dtype=bool), (n_ships,)) & (peak < bound)
+    final_heading = to_deg(np.arctan2(final_mean(np.sin(psi)), final_mean(np.cos(psi))))
+    reversed_ = np.abs(final_heading) > REVERSED_DEG  # NaN (no valid sample) compares False
+    stable = (np.broadcast_to(np.asarray(reached_end, dtype=bool), (n_ships,)) & (peak < bound)
+              & ~reversed_)
     return {
         "settle_time_min": settle,
         "overshoot_nm": overshoot,
@@ -103,11 +114,12 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
         "crosstrack_rms_after_leg1_nm": rms_after / NAUTICAL_MILE,
         "final_crosstrack_nm": final_mean(y) / NAUTICAL_MILE,
         "final_abs_crosstrack_nm": final_mean(np.abs(y)) / NAUTICAL_MILE,
-        "final_heading_error_deg": to_deg(np.arctan2(final_mean(np.sin(psi)), final_mean(np.cos(psi)))),
+        "final_heading_error_deg": final_heading,
         "final_rudder_deg": to_deg(final_mean(np.where(np.isfinite(d), d, 0.0))),
         "rudder_rms_deg": to_deg(rudder_rms),
         "saturation_fraction": saturation,
         "stable": stable,
+        "reversed": reversed_,
     }
 
 
@@ -125,7 +137,7 @@ def path_tracking_metrics(ds, *, delta_max: float, diverged: bool = False) -> di
     out = {}
     for key in PATH_TRACKING_KEYS:
         value = arrays[key][0]
-        out[key] = bool(value) if key == "stable" else (
+        out[key] = bool(value) if key in BOOL_KEYS else (
             float(value) if math.isfinite(value) else None)
     return out
 

@@ -340,7 +340,7 @@ def smc_tuned(design_model: tuple[float, float] | None = None, *, Ts: float = 0.
       yaw-rate error η_δ h₂/φ_h = 9.8.
 
     Total g = 76.5 + 9.8 = 86.4, g·|(M⁻¹b)_r|·Ts = 0.79 (the PD's K_D = 50 gives 0.46): well
-    below 2 and below 1. On the B7 course sequence (calm water, ``table1`` rudder, 35°, 19.4°/s)
+    below 2 and below 1. On the B7 course sequence (calm water, ``table1`` rudder, 35°, 19.4105°/s)
     it follows ψ_z within 7.6° (Σ wrap(ψ_z − ψ)² = 7.9 rad²), settles, and costs about the same
     as the PD (J ≈ 272 vs 264). The residual lag is the design model's doing: its feed-forward
     (ṙ_z − a₂₂r_z)/b₂ is 23 × too large at the start of a turn and, because a₂₂ > 0, opposes a

@@ -6,14 +6,30 @@ the output w = ẋ₁ of the linear wave-response filter (Fossen's linear wave m
     ẋ₁ = x₂,   ẋ₂ = −ω₀² x₁ − 2ζω₀ x₂ + q ξ(t),   w = x₂,                        (A11)
 
 ξ white with unit intensity, ω₀ = 2π/T₀, q chosen so that the stationary RMS of w is σ:
-var(x₂) = q²/(4ζω₀), so q = σ √(4ζω₀). The filter starts in its stationary distribution and
-is propagated with the exact discretisation of the stochastic system over each step h::
+var(x₂) = q²/(4ζω₀), so q = σ √(4ζω₀). The filter starts in its stationary distribution.
 
-    x(t + h) = Φ x(t) + L n,   Φ = exp(A h),   L Lᵀ = P − Φ P Φᵀ,   n ~ N(0, I)
+**What is held over a step.** The simulator samples a disturbance at each step's start and holds
+it over the step. Holding the *point* value w(t_k) would alias the narrow band: the held sequence
+then has a white floor ≈ q²h²/(12π) at low frequencies, far above the filter's own spectrum, and
+the yaw rate it drives random-walks (issue 15). The value held over [t_k, t_k + h] is therefore
+the **exact step average** w̄_k = (1/h)∫ w dt of the filtered process over that step: the
+filter is augmented with y' = w and propagated exactly in distribution over each step::
 
-(P the stationary covariance, diag(q²/(4ζω₀³), q²/(4ζω₀))), so the statistics do not depend on
-the step. Draws come from the simulator's seeded generator: same seed, same sea. Each ship of a
-batch gets its own realisation.
+    [x(t+h); y] = Φₐ [x(t); 0] + Lₐ n,   Φₐ = exp(Aₐ h),   Lₐ Lₐᵀ = ∫₀ʰ e^{Aₐs} b bᵀ e^{Aₐᵀs} ds,
+
+n ~ N(0, I₃) per ship, b = (0, q, 0), w̄ = y/h; the covariance from Van Loan's matrix exponential.
+The held sequence is then an exact sample of the step averages of the continuous process: its
+spectrum is S_w(ω)·sinc²(ωh/2) folded at the Nyquist frequency (the low-frequency floor gone), and
+its statistics do not depend on the step beyond that average.
+
+The step h of the call at t_k is t_k − t_{k−1} (the toolkit's loops call at t_k = k·dt). The
+first call after :meth:`SecondOrderNoise.reset` does not know its step: it uses ``step`` when
+given, else it holds the point value w(t₀) (the average over a vanishing step; its variance σ²
+instead of the average's, e.g. 0.5 % more at dt = 0.3 s, T₀ = 8 s), and every later value is an
+exact step average. A call earlier than the end of the step drawn before it (an irregular call
+sequence; no loop of the toolkit does this) restarts from the state at that step's start.
+Draws come from the simulator's seeded generator, shape (*batch, 3) per step: same seed, same
+sea; each ship of a batch gets its own realisation.
 """
 
 from __future__ import annotations
@@ -31,29 +47,38 @@ class SecondOrderNoise:
     """Seeded narrow-band noise w(t) of RMS ``sigma`` around ω₀ = 2π/``period`` (eq. A11).
 
     ``sigma`` in the unit of the channel it drives (e.g. rad/s² for a yaw acceleration),
-    ``period`` T₀ [s], ``zeta`` the filter's damping ratio. ``__call__(t, x)`` returns w (...,)
-    at sample time t (held over the step, ``per_stage = False``); ``sequence(times, batch_shape,
-    rng)`` the same values for a whole run at once.
+    ``period`` T₀ [s], ``zeta`` the filter's damping ratio, ``step`` the loop's step [s] when
+    known (only the first call needs it; see the module notes). ``__call__(t, x)`` returns the
+    exact average of w (...,) over the step starting at t (held over the step, ``per_stage =
+    False``); ``sequence(times, batch_shape, rng)`` the same values for a whole run at once.
     """
 
     per_stage = False
 
-    def __init__(self, sigma: float, period: float, zeta: float):
+    def __init__(self, sigma: float, period: float, zeta: float, step: float | None = None):
         for name, value, rule in (("sigma", sigma, ">= 0"), ("period", period, "> 0 s"),
                                   ("zeta", zeta, "> 0")):
             ok = isinstance(value, (int, float)) and math.isfinite(value) and (
                 value >= 0 if name == "sigma" else value > 0)
             require(ok, f"disturbance.wave_{name}", value, f"must be a finite number {rule}")
+        require(step is None or (isinstance(step, (int, float)) and math.isfinite(step)
+                                 and step > 0), "disturbance.wave_step", step,
+                "must be None or a finite step > 0 s")
         self.sigma, self.period, self.zeta = float(sigma), float(period), float(zeta)
+        self.step = None if step is None else float(step)
         self.omega0 = 2.0 * math.pi / self.period
         self.q = self.sigma * math.sqrt(4.0 * self.zeta * self.omega0)
         w0, z = self.omega0, self.zeta
         self.A = np.array([[0.0, 1.0], [-w0 * w0, -2.0 * z * w0]])
         self.P = np.diag([self.q**2 / (4.0 * z * w0**3), self.q**2 / (4.0 * z * w0)])
         self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        self._avg_cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         self._rng: np.random.Generator | None = None
-        self._x: np.ndarray | None = None
+        self._x: np.ndarray | None = None  # the state at self._t_end
+        self._x_start: np.ndarray | None = None  # the state at the held step's start self._t
         self._t: float | None = None
+        self._t_end: float | None = None
+        self._held: np.ndarray | None = None
 
     def transition(self, h: float) -> tuple[np.ndarray, np.ndarray]:
         """(Φ, L) of one step of length ``h`` [s]: x ← Φ x + L n (exact in distribution)."""
@@ -61,27 +86,91 @@ class SecondOrderNoise:
         if key not in self._cache:
             phi = scipy.linalg.expm(self.A * h)
             Qd = self.P - phi @ self.P @ phi.T
-            vals, vecs = np.linalg.eigh(0.5 * (Qd + Qd.T))
-            self._cache[key] = (phi, vecs * np.sqrt(np.clip(vals, 0.0, None)))
+            self._cache[key] = (phi, _factor(Qd))
         return self._cache[key]
+
+    def averaged_transition(self, h: float) -> tuple[np.ndarray, np.ndarray]:
+        """(G, L) of one step of length ``h`` > 0 [s] with the step's integral of w:
+        [x(t+h); ∫w] = G x(t) + L n, n ~ N(0, I₃) (exact in distribution; G is 3×2, L 3×3).
+        Van Loan: exp([[−Aₐ, b bᵀ], [0, Aₐᵀ]] h) = [[·, Φₐ⁻¹ Q], [0, Φₐᵀ]], Q = Φₐ (Φₐ⁻¹ Q)."""
+        key = round(h, 12)
+        if key not in self._avg_cache:
+            Aa = np.zeros((3, 3))
+            Aa[:2, :2] = self.A
+            Aa[2, 1] = 1.0  # y' = w = x₂
+            bbT = np.zeros((3, 3))
+            bbT[1, 1] = self.q**2
+            M = np.zeros((6, 6))
+            M[:3, :3], M[:3, 3:], M[3:, 3:] = -Aa, bbT, Aa.T
+            E = scipy.linalg.expm(M * h)
+            phi_a = E[3:, 3:].T
+            Q = phi_a @ E[:3, 3:]
+            self._avg_cache[key] = (phi_a[:, :2].copy(), _factor(Q))
+        return self._avg_cache[key]
+
+    def held_variance(self, h: float) -> float:
+        """Variance of the value held over a step of length ``h`` [s]: the step average of w,
+        ∫w = x₁(t+h) − x₁(t), so 2(P₁₁ − (Φ(h) P)₁₁)/h² (σ² in the limit h → 0)."""
+        phi, _ = self.transition(h)
+        return float(2.0 * (self.P[0, 0] - (phi @ self.P)[0, 0]) / h**2)
+
+    def step_average_psd(self, f, h: float) -> np.ndarray:
+        """One-sided PSD of the held sequence at frequencies ``f`` [Hz] ≤ 1/(2h), for a step ``h``
+        (σ²'s unit per Hz; what ``scipy.signal.welch`` estimates): the step average's spectrum
+        S_w(ω)·sinc²(ωh/2), folded at the Nyquist frequency, with S_w(ω) = q²ω² / ((ω₀² − ω²)² +
+        (2ζω₀ω)²) the filter output's two-sided density (∫S_w dω/2π = σ²)."""
+        f = np.asarray(f, dtype=float)
+        fs = 1.0 / h
+        total = np.zeros_like(f)
+        for m in range(-200, 201):  # the aliases f + m·fs; the tail decays like 1/f⁴
+            om = 2.0 * math.pi * (f + m * fs)
+            s_w = self.q**2 * om**2 / ((self.omega0**2 - om**2) ** 2
+                                       + (2.0 * self.zeta * self.omega0 * om) ** 2)
+            total = total + s_w * np.sinc((f + m * fs) * h) ** 2
+        return 2.0 * total  # S_w(2πf) is the two-sided density per Hz; one-sided: twice that
 
     def reset(self, batch_shape, rng: np.random.Generator) -> None:
         self._rng = rng
         shape = (*tuple(batch_shape), 2)
         self._x = rng.standard_normal(shape) * np.sqrt(np.diag(self.P))
-        self._t = None
+        self._x_start = self._x
+        self._t = self._t_end = None
+        self._held = None
 
     def __call__(self, t: float, x=None) -> np.ndarray:
         require(self._x is not None, "disturbance", "SecondOrderNoise", "call reset() first")
-        if self._t is not None and t > self._t:
-            phi, L = self.transition(t - self._t)
-            n = self._rng.standard_normal(self._x.shape)
-            self._x = matvec(phi, self._x) + matvec(L, n)
-        self._t = t
-        return self._x[..., 1]
+        if self._t is not None and t <= self._t:  # the same step (times only increase)
+            return self._held
+        if self._t is None:  # first call: the step, if known
+            h = self.step
+        else:
+            # t_k − t_{k−1} added back to t_{k−1} may miss t_k by a rounding: that is the step end
+            tol = 1e-9 * max(1.0, abs(t))
+            if t < self._t_end - tol:  # inside the step drawn last: restart from its start
+                self._x, self._t_end = self._x_start, self._t
+            if t > self._t_end + tol:
+                phi, L = self.transition(t - self._t_end)
+                n = self._rng.standard_normal(self._x.shape)
+                self._x = matvec(phi, self._x) + matvec(L, n)
+            h = t - self._t
+        self._t, self._x_start = t, self._x
+        if h is None:  # the point value w(t₀): the average over a vanishing step
+            self._t_end, self._held = t, self._x[..., 1]
+            return self._held
+        G, L = self.averaged_transition(h)
+        n = self._rng.standard_normal((*self._x.shape[:-1], 3))
+        z = matvec(G, self._x) + matvec(L, n)  # [x(t + h), ∫ w over the step]
+        self._x, self._t_end, self._held = z[..., :2], t + h, z[..., 2] / h
+        return self._held
 
     def sequence(self, times, batch_shape, rng: np.random.Generator) -> np.ndarray:
         """w at every time of ``times`` (ascending), shape (len(times), *batch_shape): the values
         ``__call__`` would return after ``reset(batch_shape, rng)``, with the same draws."""
         self.reset(batch_shape, rng)
         return np.stack([self(float(t)) for t in np.asarray(times, dtype=float)])
+
+
+def _factor(Q: np.ndarray) -> np.ndarray:
+    """L with L Lᵀ = Q for a symmetric positive semi-definite Q (eigen-decomposition, clipped)."""
+    vals, vecs = np.linalg.eigh(0.5 * (Q + Q.T))
+    return vecs * np.sqrt(np.clip(vals, 0.0, None))

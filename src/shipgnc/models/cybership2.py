@@ -52,6 +52,9 @@ from shipgnc.params import Params
 RUDDER_MODELS = ("table1", "skjetne")
 #: propeller speed of document 003 (both main propellers) [rps]; cruise ≈ 0.3 m/s in calm water
 CRUISE_RPS = 8.13
+#: rudder rate limit of spec 003 B8 [°/s]: IMO's 2.32°/s at full scale, Froude-scaled to 1:70 by
+#: √70 = 19.4105…°/s (the spec rounds it to 19.4)
+DELTA_RATE_DEG_S = 2.32 * math.sqrt(70.0)
 
 
 @dataclass(frozen=True)
@@ -96,7 +99,7 @@ class CyberShip2Params(Params):
     y_prop              0.078 m      propellers at y = ±0.078 m (equal n: no yaw moment)
     rudder_model        "table1"     ``table1`` (document, default) or ``skjetne``
     delta_max           35°          steering machine (spec B8, assumption)  [rad]
-    delta_rate          19.4°/s      IMO 2.32°/s Froude-scaled by √70 (B8)  [rad/s]
+    delta_rate          19.4105°/s   IMO 2.32°/s Froude-scaled by √70 (B8)  [rad/s]
     n_min, n_max        0, 30 rps    propeller-speed limits (toolkit choice)
     ==================  ===========  ==============================================================
 
@@ -139,7 +142,7 @@ class CyberShip2Params(Params):
     y_prop: float = 0.078
     rudder_model: str = "table1"
     delta_max: float = math.radians(35.0)
-    delta_rate: float = math.radians(19.4)
+    delta_rate: float = math.radians(DELTA_RATE_DEG_S)
     n_min: float = 0.0
     n_max: float = 30.0
 
@@ -252,7 +255,7 @@ def surge_damping(params: CyberShip2Params, u):
 def surge_equilibrium(params: CyberShip2Params, n: float) -> float:
     """Straight-run speed u [m/s] at propeller speed ``n`` [rps] with δ = 0: 2T(n, u) = d₁₁(u)u.
 
-    At 8.13 rps this is 0.2958 m/s (spec §3.5; the document's 0.3 m/s).
+    At 8.13 rps this is 0.295838 m/s (spec §3.5 rounds it to 0.2958; the document's 0.3 m/s).
     """
     from scipy.optimize import brentq
 
@@ -399,7 +402,8 @@ def cybership2_rhs(x, u, d, p, xdot):
 def steering_machine(params: CyberShip2Params, *, rate_limit: bool = True,
                      rate_mode: str = "ramp") -> Actuator:
     """The actuator of CyberShip II: propeller speed within [n_min, n_max] (no rate limit) and the
-    steering machine, δ within ±delta_max slewing at most delta_rate (35°, 19.4°/s; spec B8).
+    steering machine, δ within ±delta_max slewing at most delta_rate (35°, 2.32·√70 =
+    19.4105°/s; spec B8).
     ``rate_limit=False`` drops the rudder rate limit (B8's comparison); ``rate_mode="hold"`` applies
     the slewed rudder over the whole step instead of ramping within it (see :class:`Actuator`)."""
     p = params

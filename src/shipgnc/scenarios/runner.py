@@ -337,7 +337,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     ``result.attrs["diverged"]`` and ``metrics["diverged"]``) instead of raising; comparisons
     always keep going, since a controller that diverges is a finding, not an error.
     """
-    from shipgnc.sim.simulator import simulate
+    from shipgnc.sim.simulator import scoring_log_every, simulate, thin
 
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario, overrides)
@@ -360,18 +360,21 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     results, all_metrics, setups = {}, {}, {}
     for name in scenario.variants:
         setup = build(scenario, name, seed=seed)
+        # the metrics see every step: an unthinned record, thinned to log_every once scored
+        every = scoring_log_every(setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every,
+                                  scored=scenario.metrics is not None)
         with interruptible(keep_interrupted) as run:
             run.result = simulate(
                 setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
                 actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
                 u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
                 atol=sim.atol, seed=seed, observer=observer, progress=progress,
-                log_every=sim.log_every, backend="numpy" if observer is not None else sim.backend,
+                log_every=every, backend="numpy" if observer is not None else sim.backend,
                 on_divergence="stop" if compare else on_divergence,
                 attrs={"scenario": scenario.name, "controller": name, "seed": seed,
                        **_vessel_attrs(setup.model, scenario)})
-        results[name], setups[name] = run.result, setup
         all_metrics[name] = run.metrics(lambda r, s=setup: compute_metrics(scenario, r, s))
+        results[name], setups[name] = thin(run.result, sim.log_every // every), setup
         if run.interrupted:
             break
     first = next(iter(results))
@@ -454,21 +457,52 @@ def figure_title(run: ScenarioRun) -> str:
     return f"{label}: " + ", ".join(shown) if shown else label
 
 
+def divergence_message(run: ScenarioRun) -> str:
+    """The divergence of a run said once: the first diverged run's message, and for a comparison
+    the other controllers that diverged too."""
+    if run.setups is None or not isinstance(run.metrics, dict):
+        return run.result.attrs.get("message") or "the simulation diverged"
+    names = [n for n, m in run.metrics.items() if isinstance(m, dict) and m.get("diverged")]
+    if not names:
+        return run.result.attrs.get("message") or "the simulation diverged"
+    first = run.result.attrs.get("message", "").split("; ")[0].split(": ", 1)[-1] or "diverged"
+    also = f"; also diverged: {', '.join(names[1:])}" if len(names) > 1 else ""
+    return f"controller {names[0]}: {first}{also}"
+
+
+def run_status(run: ScenarioRun) -> str:
+    """``interrupted``, ``diverged`` or ``complete``: what the outputs of ``run`` hold."""
+    if run.interrupted:
+        return "interrupted"
+    if run.result is not None and run.result.attrs.get("diverged", 0):
+        return "diverged"
+    return "complete"
+
+
 def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True,
-                  figure_process=None) -> list[Path]:
+                  figure_process=None, overwrite: bool = False) -> list[Path]:
     """Write ``result.nc``, ``metrics.json`` and the figures into ``out_dir``; return the paths.
+
+    Atomic (:func:`shipgnc.outputs.atomic_dir`): the files are written into a temporary directory
+    beside ``out_dir`` and moved into place together, replacing an earlier shipgnc run whole; a
+    non-empty directory that is not a shipgnc run is refused unless ``overwrite``. A failed write
+    (a full disk, a read-only target) is one error and leaves ``out_dir`` as it was.
 
     ``figure_process`` (a :class:`shipgnc.viz.background.FigureProcess`) draws the figures in a
     worker process while this one writes the data files.
     """
+    from shipgnc.outputs import atomic_dir, moved
+
+    out = Path(out_dir)
+    with atomic_dir(out, overwrite=overwrite, command="run", status=run_status(run)) as tmp:
+        written = _write_files(run, tmp, figures=figures, figure_process=figure_process)
+    return moved(written, tmp, out)
+
+
+def _write_files(run: ScenarioRun, out: Path, *, figures: bool, figure_process) -> list[Path]:
     from shipgnc.sim.result import save
     from shipgnc.viz.figures import render_figures
 
-    out = Path(out_dir)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ConfigError(f"--out {str(out)!r}: cannot create the directory ({exc.strerror})") from None
     if run.route is not None:
         from shipgnc.scenarios import routing
 
@@ -481,12 +515,17 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
     figures = job is not None
     if figures and figure_process is not None:
         pending = figure_process.submit(render_figures, job)
-    written = [save(run.result, out / "result.nc")]
-    metrics_path = out / "metrics.json"
-    metrics_path.write_text(metrics_json(run.metrics) + "\n", encoding="utf-8")
-    written.append(metrics_path)
-    if run.setups is not None:
-        written.extend(write_table(comparison_table(run), out))
+    try:
+        written = [save(run.result, out / "result.nc")]
+        metrics_path = out / "metrics.json"
+        metrics_path.write_text(metrics_json(run.metrics) + "\n", encoding="utf-8")
+        written.append(metrics_path)
+        if run.setups is not None:
+            written.extend(write_table(comparison_table(run), out))
+    except BaseException:
+        if pending is not None:
+            pending.cancel()
+        raise
     if pending is not None:
         written.extend(pending.result())
     elif figures:

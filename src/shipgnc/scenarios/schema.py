@@ -8,6 +8,7 @@ what is allowed (:func:`format_validation_error`).
 from __future__ import annotations
 
 import itertools
+import math
 from typing import Annotated, Literal
 
 from pydantic import (
@@ -59,6 +60,10 @@ class VesselConfig(Strict):
         return params
 
 
+#: spec 003 B8's rudder rate [°/s], 2.32·√70 (the same number as models.cybership2.DELTA_RATE_DEG_S)
+CYBERSHIP_RUDDER_RATE_DEG_S = 2.32 * math.sqrt(70.0)
+
+
 class CyberShipVesselConfig(Strict):
     """``vessel`` for CyberShip II (document 003): rudder force model, steering machine, propellers."""
 
@@ -66,8 +71,10 @@ class CyberShipVesselConfig(Strict):
     rudder_model: Literal["table1", "skjetne"] = "table1"
     propeller_rps: Positive = 8.13
     rudder_max_deg: Annotated[float, Field(gt=0, le=90, allow_inf_nan=False)] = 35.0
-    #: steering-machine rate limit; null for none (spec 003 B8 compares both)
-    rudder_rate_deg_s: Positive | None = 19.4
+    #: steering-machine rate limit; null for none (spec 003 B8 compares both). Default IMO's
+    #: 2.32°/s Froude-scaled by √70: 19.4105…°/s (``models.cybership2.DELTA_RATE_DEG_S``; the
+    #: spec's indicative figures used it rounded to 19.4)
+    rudder_rate_deg_s: Positive | None = CYBERSHIP_RUDDER_RATE_DEG_S
     #: ``ramp``: the rudder slews linearly within a step; ``hold``: the slewed value is held over
     #: the step (a discrete rate limiter, the setting of spec 003's indicative figures)
     rudder_rate_mode: Literal["ramp", "hold"] = "ramp"
@@ -177,10 +184,15 @@ class ActuatorConfig(Strict):
 
 
 class InitialState(Strict):
+    """``simulation.initial_state``. ``u: null``: the vessel's straight-run surge equilibrium,
+    computed when the scenario is validated (``shipgnc show`` prints the number): CyberShip II's
+    at ``vessel.propeller_rps`` (2T(n, u) = d₁₁(u)u, δ = 0; 0.29583… m/s at 8.13 rps, spec 003
+    §3.5), the Mariner's U = S/f."""
+
     north: Finite = 0.0
     east: Finite = 0.0
     psi_deg: Finite = 0.0
-    u: Finite = 0.0
+    u: Finite | None = 0.0
     v: Finite = 0.0
     r_deg_s: Finite = 0.0
 
@@ -591,6 +603,32 @@ class Scenario(Strict):
         """Controllers by name (one unnamed controller is called ``controller``)."""
         return dict(self.controllers) if self.controllers else {"controller": self.controller}
 
+    @model_validator(mode="wrap")
+    @classmethod
+    def _equilibrium_surge(cls, data, handler) -> Scenario:
+        """``simulation.initial_state.u: null`` → the vessel's surge equilibrium (InitialState)."""
+        scenario = handler(data)
+        sim = scenario.simulation
+        if sim is None or sim.initial_state.u is not None:
+            return scenario
+        vessel = scenario.vessel
+        if vessel.model == "cybership2":
+            from shipgnc.models.cybership2 import CyberShip2Params, surge_equilibrium
+
+            u = surge_equilibrium(CyberShip2Params(rudder_model=vessel.rudder_model),
+                                  vessel.propeller_rps)
+        elif vessel.model == "mariner":
+            from shipgnc.models.mariner import MarinerParams
+
+            u = MarinerParams.from_paper_units(**vessel.params_paper).U
+        else:
+            raise ValueError(f"simulation.initial_state.u = null (the surge equilibrium) is "
+                             f"defined for vessel models 'cybership2' and 'mariner', not "
+                             f"{vessel.model!r}; give u in m/s")
+        init = sim.initial_state.model_copy(update={"u": float(u)})
+        return scenario.model_copy(
+            update={"simulation": sim.model_copy(update={"initial_state": init})})
+
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
         if self.route is not None or self.sail is not None:
@@ -648,14 +686,6 @@ class Scenario(Strict):
         if vessel == "mariner" and self.simulation.initial_state.v != 0:
             raise ValueError("simulation.initial_state.v: the Mariner's sway is algebraic "
                              "(v = r1 r + r2 r^3); leave v at 0")
-        if self.metrics == "path-tracking":  # spec 000 §0.8: metrics on every sample (dt)
-            every = self.simulation.log_every
-            if self.montecarlo is None and every != 1:
-                raise ValueError(f"simulation.log_every = {every}: the path-tracking metrics of a "
-                                 "single run use every sample; keep 1")
-            if every * self.simulation.dt > 60.0:
-                raise ValueError(f"simulation.log_every = {every}: a batch's metrics need a sample "
-                                 f"at least every minute (log_every * dt <= 60 s)")
         if self.montecarlo is not None and vessel != "mariner":
             raise ValueError("montecarlo: batches of random initial states are built for vessel "
                              "model 'mariner' in this release")

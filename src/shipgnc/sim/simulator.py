@@ -223,8 +223,7 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
         s = model.states[i]
         raise ConfigError(f"initial_state.{s.name} = {float(x0[tuple(outside[0])]):g}: beyond the "
                           f"model's range |{s.name}| <= {limits[i]:g} {s.unit}")
-    logged = (n_steps // log_every + 2) * max(1, math.prod(x0.shape[:-1])) * (
-        2 * len(model.states) + 3 * len(model.inputs))
+    logged = logged_numbers(model, x0.shape[:-1], n_steps, log_every)
     require(logged <= MAX_LOGGED, "log size", f"{logged * 8 / 2**30:.1f} GiB",
             "too large: log fewer samples (log_every), shorten t_end or use fewer ships")
     if actuator is None:
@@ -259,6 +258,47 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
                     solver_options={"method": method, "rtol": rtol, "atol": atol}, rng=rng,
                     on_divergence=on_divergence, observer=observer, progress=progress,
                     log_every=log_every, u0=u0)
+
+
+def logged_numbers(model, batch_shape: tuple[int, ...], n_steps: int, log_every: int = 1) -> int:
+    """An estimate of the numbers a run logs (the :data:`MAX_LOGGED` guard's measure)."""
+    return (int(n_steps) // int(log_every) + 2) * max(1, math.prod(batch_shape)) * (
+        2 * len(model.states) + 3 * len(model.inputs))
+
+
+def scoring_log_every(model, x0, t_end: float, dt: float, log_every: int, *,
+                      scored: bool = True, what: str = "simulation.log_every",
+                      fewer: str = "use fewer ships") -> int:
+    """The ``log_every`` to simulate with so that metrics see every step: 1 when the run is
+    ``scored`` (thin the written result afterwards with :func:`thin`), else ``log_every``. An
+    unthinned record beyond :data:`MAX_LOGGED` is a ConfigError naming ``what`` (thinning the
+    written result does not thin the record the metrics are computed from)."""
+    if not scored or log_every == 1:
+        return log_every
+    steps = t_end / dt
+    if not math.isfinite(steps) or steps > MAX_STEPS:
+        return log_every  # simulate's own check names it
+    batch = np.shape(x0)[:-1]
+    numbers = logged_numbers(model, batch, round(steps), 1)
+    if numbers > MAX_LOGGED:
+        raise ConfigError(f"{what} = {log_every}: the metrics are computed from every step, and "
+                          f"this run's unthinned record ({numbers * 8 / 2**30:.1f} GiB) exceeds the "
+                          f"{MAX_LOGGED * 8 / 2**30:.0f} GiB log limit ({what} thins only the written "
+                          f"result): shorten simulation.t_end, raise simulation.dt or {fewer}")
+    return 1
+
+
+def thin(result, log_every: int):
+    """``result`` (logged at every step) on the log grid of ``log_every``: every ``log_every``-th
+    sample and the last one, the samples a run with ``log_every`` logs itself (for a run that
+    diverged or was interrupted, the last sample before it stopped is kept too)."""
+    n = result.sizes.get("time", 0)
+    if log_every <= 1 or n == 0:
+        return result
+    keep = np.flatnonzero((np.arange(n) % log_every == 0) | (np.arange(n) == n - 1))
+    out = result.isel(time=keep)
+    out.attrs = dict(result.attrs)
+    return out
 
 
 def log_signals(setup: SimSetup) -> dict[str, Signal]:

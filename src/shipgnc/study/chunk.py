@@ -181,10 +181,16 @@ def route_series(series, scenario, done_at: np.ndarray):
 
 def _run_batch(setup, scenario, x0, seeds, backend: str, route: bool):
     """One loop call for ``x0``'s members: the result and, for a route, each member's completion
-    time (NaN: not completed). A route batch is logged at every step (see :func:`run_chunk`)."""
+    time (NaN: not completed). A batch is logged at every step, so that its metrics see every
+    step whatever ``log_every`` (see :func:`run_chunk`)."""
+    from shipgnc.sim.simulator import scoring_log_every
+
+    sim = scenario.simulation
+    if not route:  # an unthinned record beyond the log limit: name log_every and --chunk-size
+        scoring_log_every(setup.model, x0, sim.t_end, sim.dt, sim.log_every,
+                          fewer="lower --chunk-size")
     try:
-        result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend,
-                           1 if route else scenario.simulation.log_every)
+        result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend, 1)
     except ConfigError as exc:
         if route and str(exc).startswith("log size"):
             raise ConfigError(f"{exc} (a route study logs every step of a chunk, so that each "
@@ -209,9 +215,11 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """Run one chunk; an ``xarray.Dataset`` with a ``member`` dimension: every scalar metric, and
     with ``study.series`` every time series; ``attrs["backend"]`` says which code ran it.
 
-    The batch runs in one call of the loop. If a member diverges (which stops a batch), the chunk
-    is run again member by member, so that every member's figures are its own run's whatever
-    chunk it shares (a diverged member is flagged ``diverged = 1`` with its figures up to then).
+    The batch runs in one call of the loop, logged at every step: the metrics see every step,
+    and only the series kept with ``study.series`` are thinned to ``simulation.log_every``. If a
+    member diverges (which stops a batch), the chunk is run again member by member, so that every
+    member's figures are its own run's whatever chunk it shares (a diverged member is flagged
+    ``diverged = 1`` with its figures up to then).
 
     A route (guidance that finishes at its last waypoint) ends a batch when its last member
     completes; the others keep sailing until then, and the step the batch ends on depends on its
@@ -258,6 +266,8 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
         series.attrs = {}
         if route:
             series = route_series(series, scenario, done_at)
+        else:  # the series on the log grid (the metrics above saw every step)
+            series = series.isel(time=np.flatnonzero(on_log_grid(series.time.values, scenario)))
         out = xr.merge([out, series.rename({k: f"series_{k}" for k in series.data_vars})],
                        combine_attrs="override")
     return out

@@ -22,7 +22,9 @@ def metric_names(ds) -> list[str]:
 def summary_rows(ds) -> list[dict]:
     """Median, p5 and p95 over the members of each metric, one row per grid point (and controller);
     NaN members (a figure that does not exist, e.g. a run that never settles) are left out and
-    counted in ``<metric>_missing``."""
+    counted in ``<metric>_missing``. Members that diverged are left out of every metric's figures
+    (their figures are those of a partial run; ``diverged`` itself and the drawn ``param_*`` keep
+    every member) and counted in ``diverged_members``."""
     cell_dims = [d for d in ds[metric_names(ds)[0]].dims if d != "member"] if metric_names(ds) else []
     stacked = ds[metric_names(ds)]
     if cell_dims:
@@ -34,8 +36,13 @@ def summary_rows(ds) -> list[dict]:
     for c in cells:
         cell = stacked if c is None else stacked.isel(cell=c)
         row = {d: _plain(cell[d].values) for d in cell_dims}
+        diverged = (np.asarray(cell["diverged"].values, dtype=float) > 0 if "diverged" in cell
+                    else np.zeros(cell.sizes.get("member", 1), dtype=bool))
+        row["diverged_members"] = int(np.sum(diverged))
         for name in metric_names(ds):
             values = np.asarray(cell[name].values, dtype=float)
+            if name != "diverged" and not name.startswith("param_") and values.shape == diverged.shape:
+                values = values[~diverged]
             finite = values[np.isfinite(values)]
             for label, q in QUANTILES.items():
                 row[f"{name}_{label}"] = float(np.quantile(finite, q)) if finite.size else None

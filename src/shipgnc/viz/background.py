@@ -72,6 +72,16 @@ class _Pending:
     def __init__(self, future, fn: Callable, args: tuple):
         self._future, self._fn, self._args = future, fn, args
 
+    def cancel(self, timeout: float = 10.0) -> None:
+        """Give up on the result: cancel the job, or let a running one end (so that it no longer
+        writes where the caller is about to clean up); its outcome is ignored."""
+        if self._future is None or self._future.cancel():
+            return
+        try:
+            concurrent.futures.wait([self._future], timeout=timeout)
+        except BaseException:  # a second Ctrl-C: stop waiting
+            pass
+
     def result(self):
         if self._future is not None:
             try:

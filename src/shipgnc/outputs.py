@@ -1,0 +1,223 @@
+"""Atomic output directories: a run's files appear together, or not at all.
+
+Every command that writes (``run``, ``sweep``, ``route --out``) writes into a temporary directory
+beside ``--out`` (``.<name>.tmp-XXXX``) and moves it into place only once every file is complete.
+The finished directory holds a marker file, :data:`MARKER` (``.shipgnc-run``, a small JSON object:
+the tool, its version, the command, the run's status and the files written), by which a later
+command recognises "a directory holding an earlier shipgnc run" (as does a directory holding
+nothing but files shipgnc writes, :data:`OUTPUT_FILES`: a run from before the marker): such a
+directory is replaced whole, never mixed with the new files. Any other non-empty directory is
+refused unless ``overwrite`` (``--overwrite``) is given, and then replaced whole too.
+
+:func:`check_out` checks ``--out`` before any work (a file, an unwritable parent, a foreign
+directory: a :class:`~shipgnc.errors.ConfigError`, exit 2). :func:`atomic_dir` turns a failing
+write into one line: a read-only or unwritable target is a ConfigError (exit 2), a disk that fills
+during the write an :class:`OutputError` (exit 1); the temporary directory is removed, and an
+earlier run in ``--out`` stays untouched.
+"""
+
+from __future__ import annotations
+
+import errno
+import fnmatch
+import json
+import os
+import secrets
+import shutil
+import signal
+import tempfile
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from shipgnc.errors import ConfigError, ShipGNCError
+
+#: the marker file written with every run's outputs
+MARKER = ".shipgnc-run"
+#: errno values of a target that cannot be written (exit 2)
+UNWRITABLE = {errno.EACCES, errno.EPERM, errno.EROFS}
+#: errno values of a disk that filled during the write (exit 1)
+FULL = {errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC), errno.EFBIG}
+
+
+class OutputError(ShipGNCError):
+    """Writing the outputs failed midway (e.g. the disk filled): nothing was left half-written."""
+
+    exit_code = 1
+
+
+#: the files shipgnc writes: a directory holding only these (a run written before the marker
+#: existed) counts as an earlier shipgnc run too
+OUTPUT_FILES = ("result.nc", "metrics.json", "table.csv", "table.md", "sweep.nc", "sweep.zarr",
+                "summary.csv", "summary.md", "route.json", "*.png")
+
+
+def is_shipgnc_run(path: Path) -> bool:
+    """Whether ``path`` is a directory holding an earlier shipgnc run: it has :data:`MARKER`, or
+    it holds nothing but files shipgnc writes (:data:`OUTPUT_FILES`)."""
+    path = Path(path)
+    if (path / MARKER).is_file():
+        return True
+    entries = list(path.iterdir())
+    return bool(entries) and all(any(fnmatch.fnmatch(p.name, pattern) for pattern in OUTPUT_FILES)
+                                 for p in entries)
+
+
+def check_out(out: Path, *, overwrite: bool = False, option: str = "--out") -> Path:
+    """Check an output directory before any work; return it. A ConfigError (exit 2) when it is a
+    file, the current directory (or holds it), a non-empty directory that is not a shipgnc run
+    (unless ``overwrite``), or when its parent cannot be written."""
+    out = Path(out)
+    if str(out) == "":
+        raise ConfigError(f"{option} '': name a directory")
+    shown = str(out)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"{option} {shown!r}: is a file, not a directory")
+    resolved = out.resolve()
+    if Path.cwd().resolve().is_relative_to(resolved):
+        raise ConfigError(f"{option} {shown!r}: is the current directory (or holds it): name a "
+                          "directory for the outputs")
+    if out.is_dir():
+        try:
+            entries = sorted(p.name for p in out.iterdir())
+        except OSError as exc:
+            raise ConfigError(f"{option} {shown!r}: cannot read the directory ({_reason(exc)})") from None
+        if entries and not overwrite and not is_shipgnc_run(out):
+            listed = ", ".join(entries[:3]) + (", ..." if len(entries) > 3 else "")
+            raise ConfigError(f"{option} {shown!r}: holds files that are not a shipgnc run ({listed}); "
+                              "name another directory, or pass --overwrite to replace it whole")
+    parent = _existing_ancestor(resolved.parent)
+    if not parent.is_dir():
+        raise ConfigError(f"{option} {shown!r}: {str(parent)!r} is not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ConfigError(f"{option} {shown!r}: cannot write in {str(parent)!r} (permission denied)")
+    return out
+
+
+def _existing_ancestor(path: Path) -> Path:
+    while not path.exists() and path != path.parent:
+        path = path.parent
+    return path
+
+
+def _reason(exc: OSError) -> str:
+    return exc.strerror or str(exc) or type(exc).__name__
+
+
+def _errno(exc: BaseException) -> int | None:
+    """The errno of an OSError, also when a library (h5py) only names it in its message."""
+    if isinstance(exc, OSError) and exc.errno is not None:
+        return exc.errno
+    text = str(exc)
+    if "No space left" in text or "errno = 28" in text:
+        return errno.ENOSPC
+    if "Read-only file system" in text or "errno = 30" in text:
+        return errno.EROFS
+    if "Permission denied" in text or "errno = 13" in text:
+        return errno.EACCES
+    return None
+
+
+def output_error(out: Path, exc: BaseException, option: str = "--out") -> ShipGNCError:
+    """The one-line error of a failed write into ``out``."""
+    code = _errno(exc)
+    reason = os.strerror(code) if code is not None else _reason(exc) if isinstance(exc, OSError) else str(exc)
+    if code in UNWRITABLE:
+        return ConfigError(f"{option} {str(out)!r}: cannot write ({reason}); nothing was written")
+    if code in FULL:
+        return OutputError(f"{option} {str(out)!r}: the disk filled while writing ({reason}); "
+                           "nothing was written, an earlier run there is untouched")
+    return OutputError(f"{option} {str(out)!r}: writing failed ({reason}); nothing was written")
+
+
+@contextmanager
+def atomic_dir(out: Path, *, overwrite: bool = False, command: str = "run", status: str = "complete",
+               option: str = "--out") -> Iterator[Path]:
+    """Yield a temporary directory beside ``out``; when the block ends normally, write the marker
+    and move the directory into place (replacing an earlier shipgnc run, or with ``overwrite``
+    any directory, whole). On any error or Ctrl-C the temporary directory is removed and ``out``
+    is left as it was; an OSError becomes one line (see :func:`output_error`)."""
+    out = check_out(Path(out), overwrite=overwrite, option=option)
+    parent = out.resolve().parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        tmp = _new_dir(parent, f".{out.name}.tmp-")
+    except OSError as exc:
+        raise output_error(out, exc, option) from None
+    try:
+        yield tmp
+        marker = {"tool": "shipgnc", "version": _version(), "command": command, "status": status,
+                  "files": sorted(p.name for p in tmp.iterdir())}
+        (tmp / MARKER).write_text(json.dumps(marker, indent=2) + "\n", encoding="utf-8")
+        with _sigint_deferred():
+            _replace(tmp, out.resolve())
+    except OSError as exc:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise output_error(out, exc, option) from None
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def _new_dir(parent: Path, prefix: str) -> Path:
+    """A new directory ``parent/<prefix><random>`` with the usual permissions (the umask's;
+    ``tempfile.mkdtemp`` would make it private, and the run's directory keeps its mode)."""
+    for _ in range(100):
+        path = parent / f"{prefix}{secrets.token_hex(4)}"
+        try:
+            path.mkdir()
+        except FileExistsError:
+            continue
+        return path
+    raise FileExistsError(errno.EEXIST, "no free temporary name", str(parent))
+
+
+def _replace(tmp: Path, out: Path) -> None:
+    """Move ``tmp`` to ``out``; an existing ``out`` is set aside first and removed after."""
+    if not out.exists():
+        os.rename(tmp, out)
+        return
+    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
+    os.rmdir(old)
+    os.rename(out, old)
+    try:
+        os.rename(tmp, out)
+    except OSError:
+        os.rename(old, out)  # put the earlier run back
+        raise
+    shutil.rmtree(old, ignore_errors=True)
+
+
+@contextmanager
+def _sigint_deferred():
+    """Hold a Ctrl-C that arrives while the directories are swapped until the swap is done."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught = []
+    previous = signal.signal(signal.SIGINT, lambda *args: caught.append(args))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if caught:
+        raise KeyboardInterrupt
+
+
+def moved(paths: list[Path], tmp: Path, out: Path) -> list[Path]:
+    """``paths`` written under ``tmp`` as their final paths under ``out``."""
+    out = Path(out)
+    result = []
+    for p in paths:
+        try:
+            result.append(out / Path(p).relative_to(tmp))
+        except ValueError:
+            result.append(Path(p))
+    return result
+
+
+def _version() -> str:
+    from shipgnc import __version__
+
+    return __version__
