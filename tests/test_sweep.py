@@ -315,10 +315,10 @@ def test_a_foreign_output_directory_is_refused_not_mixed(tmp_path, local_result)
 
     out = tmp_path / "out"
     out.mkdir()
-    (out / "table.csv").write_text("a run's comparison\n")
+    (out / "notes.txt").write_text("a user's notes\n")
     with pytest.raises(ConfigError, match="not a shipgnc run"):
         write_study(local_result, out, figures=False)
-    assert (out / "table.csv").read_text() == "a run's comparison\n"
+    assert (out / "notes.txt").read_text() == "a user's notes\n"
     write_study(local_result, out, figures=False, overwrite=True)
-    assert not (out / "table.csv").exists()
+    assert not (out / "notes.txt").exists()
     assert (out / "summary.csv").exists() and (out / "summary.md").exists()
