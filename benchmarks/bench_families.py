@@ -5,9 +5,10 @@ side in one run.
 
 For each family (the setup of a built-in scenario's first controller, its initial state repeated
 over the batch) and each batch size (1 000 and 10 000 ships; ``--quick``: 1 000), times
-``simulate(..., backend="compiled")`` and ``backend="numpy"`` over the same number of steps (the
-scenario's own, capped so the numpy run stays short; the log thinned to about 100 samples) and
-prints ship-steps/s and the ratio. The first-compile cost of each family is measured in a fresh
+``simulate(..., backend="compiled")`` (the scenario's steps, at most 4 000 or about 6 s) and
+``backend="numpy"`` (as many steps as fit in about 8 s, from a short probe run: numpy's rate does
+not depend on the run length), the log thinned to about 100 samples, and prints ship-steps/s and
+the ratio. The first-compile cost of each family is measured in a fresh
 process with empty numba and shipgnc caches (``NUMBA_CACHE_DIR``, ``SHIPGNC_CACHE_DIR``), and
 ``shipgnc run NAME --no-figures`` end to end in a fresh process with warm caches. Targets (issue
 "speed for every combination"): ≥ 1e7 ship-steps/s compiled (wave loads ≥ 1e6) and ≥ 20× numpy.
@@ -42,8 +43,10 @@ FAMILIES = {
     "catamaran yaw rate": "catamaran-turn",
     "catamaran heading": "catamaran-heading",
 }
-#: most numpy ship-steps per timing (≈ 10 s at 1e6 ship-steps/s)
-NUMPY_WORK = 1e7
+#: seconds a compiled timing may take (the wave loads: ≈ 3e5 ship-steps/s)
+COMPILED_SECONDS = 6.0
+#: seconds a numpy timing may take (its steps are chosen from a short probe run)
+NUMPY_SECONDS = 8.0
 #: most steps of one timing
 MAX_STEPS = 4000
 
@@ -138,9 +141,11 @@ def main(argv=None) -> dict:
         compile_s = first_compile(name)
         run_s = cli_seconds(name)
         for n in sizes:
-            n_steps = int(min(steps, MAX_STEPS))
+            probe = time_run(model, x0, kwargs, n, 20, "compiled", 1)
+            n_steps = int(max(20, min(steps, MAX_STEPS, COMPILED_SECONDS * probe / n)))
             compiled = time_run(model, x0, kwargs, n, n_steps, "compiled", repeats)
-            numpy_steps = int(max(2, min(n_steps, NUMPY_WORK // n)))
+            probe = time_run(model, x0, kwargs, n, 3, "numpy", 1)  # ship-steps/s, roughly
+            numpy_steps = int(max(3, min(n_steps, NUMPY_SECONDS * probe / n)))
             numpy = time_run(model, x0, kwargs, n, numpy_steps, "numpy", 1)
             row = {"family": family, "scenario": name, "ships": n, "steps": n_steps,
                    "compiled_ship_steps_per_s": compiled, "numpy_ship_steps_per_s": numpy,

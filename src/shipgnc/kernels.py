@@ -56,7 +56,13 @@ def kernel_function(function):
     on disk when it is defined in a file; a kernel typed into a notebook or ``exec``-ed compiles
     once per process). Kernels are called, not inlined, by the composed loop: numba's IR-level
     inlining (``inline="always"``) ran the boat ≈ 25 % faster but tripled the loop's first compile
-    and defeated its disk cache."""
+    and defeated its disk cache.
+
+    Developers: numba's cache of a kernel is keyed to its own file only, so after editing a helper
+    that kernels in *other* files call (``wrap``, ``guidance.path.track_leg``), delete the
+    ``__pycache__/*.nbi`` files (the composed loops are keyed to every file of the package and
+    regenerate by themselves). Without the per-kernel cache every new combination would compile
+    twice as long; an installed package never meets the case."""
     in_a_file = os.path.isfile(function.__code__.co_filename)
     return numba.njit(**{**JIT_OPTIONS, "cache": in_a_file})(function)
 
@@ -132,6 +138,18 @@ def clip(value, lower, upper):
         value = lower
     if value > upper:
         value = upper
+    return value
+
+
+@kernel_function
+def sign(value):
+    """``np.sign`` for one float (NaN passes through)."""
+    if value > 0.0:
+        return 1.0
+    if value < 0.0:
+        return -1.0
+    if value == 0.0:
+        return 0.0
     return value
 
 

@@ -26,13 +26,12 @@ from shipgnc.control.finite_state import (
     N_RATE_STATE,
     HeadingCapture,
     as_rate_reference,
-    np_sign,
     rate_value,
     source_reason,
 )
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
-from shipgnc.kernels import Kernel, NotCompiled, clip, flat, kernel_function, wrap
+from shipgnc.kernels import Kernel, NotCompiled, clip, flat, kernel_function, sign, wrap
 from shipgnc.models.base import Signal
 from shipgnc.models.catamaran import (
     DELTA,
@@ -209,7 +208,7 @@ def heading_lqr_step(t, x, ref, z, p, cmd, sig):
     psi0 = z[4] if z[3] != 0.0 else math.nan  # numpy: K(t0) unknown is an error (t0 = 0 here)
     diff = wrap(psi_target - psi0)
     t_star = t0 + abs(diff) / omega_c
-    psi_ref = psi0 + np_sign(diff) * omega_c * clip(t - t0, 0.0, t_star - t0)
+    psi_ref = psi0 + sign(diff) * omega_c * clip(t - t0, 0.0, t_star - t0)
     total = x[V] * p[0]
     total = total + (x[R] - r_ref) * p[1]
     total = total + wrap(x[PSI] - psi_ref) * p[2]

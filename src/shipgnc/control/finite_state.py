@@ -54,7 +54,7 @@ import numpy as np
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
-from shipgnc.kernels import Kernel, NotCompiled, clip, flat, kernel_function, wrap
+from shipgnc.kernels import Kernel, NotCompiled, clip, flat, kernel_function, sign, wrap
 from shipgnc.models.base import Signal
 from shipgnc.models.catamaran import (
     DELTA,
@@ -349,18 +349,6 @@ def _block(kind: float, *values: float) -> np.ndarray:
 
 
 @kernel_function
-def np_sign(value):
-    """``np.sign`` for one float (NaN for NaN)."""
-    if value > 0.0:
-        return 1.0
-    if value < 0.0:
-        return -1.0
-    if value == 0.0:
-        return 0.0
-    return value
-
-
-@kernel_function
 def rate_value(t, x, ref, p, o, z, oz):
     """ω*(t) of one ship, operation for operation as the numpy sources' ``value``: ``p[o:]`` a
     parameter block of :meth:`_RateReference.rate_block`, ``z[oz:]`` its per-ship state (the
@@ -384,7 +372,7 @@ def rate_value(t, x, ref, p, o, z, oz):
             frac = clip((t_star + ramp / 2 - t) / ramp, 0.0, 1.0)
         else:
             frac = 1.0 if t < t_star else 0.0
-        return np_sign(diff) * omega_c * frac
+        return sign(diff) * omega_c * frac
     return ref[0]
 
 
@@ -648,7 +636,7 @@ def yaw_rate_fsm_step(t, x, ref, z, p, cmd, sig):
     if p[7] != 0.0:
         frozen = clip(delta, -p[8], p[8])
         u = u * (math.cos(delta) / math.cos(frozen))
-    if p[9] != 0.0 and abs(delta) >= p[10] and np_sign(u) == np_sign(delta):
+    if p[9] != 0.0 and abs(delta) >= p[10] and sign(u) == sign(delta):
         _first(z, 2, t, 0.0)
         u = 0.0
     sig[0], sig[1] = w, u

@@ -46,7 +46,7 @@ from shipgnc.guidance.path import (
     leg_value,
     track_leg,
 )
-from shipgnc.kernels import Kernel, clip, flat, kernel_function, wrap
+from shipgnc.kernels import Kernel, clip, flat, kernel_function, sign, wrap
 from shipgnc.models.base import Signal
 from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
 
@@ -312,18 +312,6 @@ def restore_path_state(ctrl, batch_shape, z: np.ndarray, *, e_I: bool = False) -
         first = 2
     if np.all(z[..., -1] > 0):
         ctrl._logged = {s.name: z[..., first + j].copy() for j, s in enumerate(ctrl.signals)}
-
-
-@kernel_function
-def sign(value):
-    """``np.sign`` for one float (NaN passes through)."""
-    if value > 0.0:
-        return 1.0
-    if value < 0.0:
-        return -1.0
-    if value == 0.0:
-        return 0.0
-    return value
 
 
 #: where :func:`path_lqr_step` finds the leg table in its parameters

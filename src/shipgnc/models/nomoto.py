@@ -21,13 +21,14 @@ a₁ = 60 a, a₃ = 60 b (spec §0.3: T = 1 min, K = c, H_N = a r + b r³, in mi
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from shipgnc.errors import ConfigError, require
+from shipgnc.errors import require
 from shipgnc.frames import body_to_ned
 from shipgnc.models.base import Signal
+from shipgnc.params import Params
 
 STATES = (
     Signal("north", "m", "north position (NED x)"),
@@ -44,7 +45,7 @@ DISTURBANCES = (
 )
 
 
-class _SteeringModel:
+class _SteeringModel(Params):
     """Shared pieces of the constant-speed steering models (validation, kinematics, limits)."""
 
     states = STATES
@@ -70,18 +71,6 @@ class _SteeringModel:
     def input_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper bounds of ``[delta]`` (±delta_max)."""
         return np.array([-self.delta_max]), np.array([self.delta_max])
-
-    def with_(self, **changes: float):
-        """A copy with some parameters changed (validated; unknown names rejected)."""
-        known = {fl.name for fl in fields(self)}
-        for key in changes:
-            if key not in known:
-                raise ConfigError(f"vessel.params.{key}: unknown parameter; allowed: "
-                                  f"{', '.join(sorted(known))}")
-        return replace(self, **changes)
-
-    def as_dict(self) -> dict[str, float]:
-        return asdict(self)
 
     def yaw_acceleration(self, r, delta):
         raise NotImplementedError

@@ -35,7 +35,6 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from shipgnc.actuators import Actuator
 from shipgnc.errors import ConfigError
 from shipgnc.kernels import Kernel, NotCompiled, kernel_function
 
@@ -111,15 +110,15 @@ def cache_dir() -> Path:
 
 
 def _cache_file(source: str, functions) -> Path | None:
-    """The module file of ``source`` in :func:`cache_dir`, named by a hash of it, of the files that
-    define its kernels and of the numba version (an edited kernel gets a new file); written once,
-    atomically (concurrent processes may race to write the same file). None if not writable."""
+    """The module file of ``source`` in :func:`cache_dir`, named by a hash of it, of the package's
+    sources (and of a user's kernel files) and of the numba version (an edited kernel gets a new
+    file); written once, atomically (concurrent processes may race to write the same file). None
+    if not writable."""
     digest = hashlib.sha256(source.encode())
+    digest.update(_sources_digest())
     files = {inspect.getsourcefile(getattr(fn, "py_func", fn)) for fn in functions}
-    files |= {__file__, str(TEMPLATE), inspect.getsourcefile(kernel_function),
-              inspect.getsourcefile(Actuator)}
-    for name in sorted(f for f in files if f):
-        digest.update(Path(name).read_bytes())
+    for name in sorted(f for f in files if f and not f.startswith(str(PACKAGE))):
+        digest.update(Path(name).read_bytes())  # a user's kernels outside the package
     digest.update(numba.__version__.encode())
     path = cache_dir() / f"shipgnc_loop_{digest.hexdigest()[:24]}.py"
     try:
@@ -131,6 +130,24 @@ def _cache_file(source: str, functions) -> Path | None:
     except OSError:
         return None
     return path
+
+
+#: the package's source folder: the composed loops are keyed on every file in it
+PACKAGE = Path(__file__).resolve().parents[1]
+_DIGEST: list[bytes] = []
+
+
+def _sources_digest() -> bytes:
+    """A hash of every source file of the package (once per process): a kernel's helper may live
+    in another file than the kernel (``guidance.path.track_leg`` in the Mariner's controllers), so
+    any edit of the package gives every loop a new module."""
+    if not _DIGEST:
+        digest = hashlib.sha256()
+        for path in sorted(PACKAGE.rglob("*.py")):
+            digest.update(str(path.relative_to(PACKAGE)).encode())
+            digest.update(path.read_bytes())
+        _DIGEST.append(digest.digest())
+    return _DIGEST[0]
 
 
 def _source(model_fn, ctrl_fn, guid_fn, dist_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc, nzg,
@@ -195,7 +212,7 @@ def unsupported_reason(setup) -> str | None:
 def run(setup):
     """Run ``setup`` in its composed loop; returns the same ``Log`` as ``run_numpy(setup)``."""
     from shipgnc.sim.compiled import drive, log_length, make_log
-    from shipgnc.sim.simulator import log_signals
+    from shipgnc.sim.simulator import log_signals, reset_components
 
     reason = unsupported_reason(setup)
     if reason:
@@ -204,13 +221,7 @@ def run(setup):
                                   setup.disturbance)
     batch = setup.batch_shape
     n = math.prod(batch)
-    # the same side effects on the components as the numpy loop, then their kernels
-    if ctrl is not None:
-        ctrl.reset(batch)
-    if gd is not None:
-        gd.reset(batch, model)
-    if dist is not None:
-        dist.reset(batch, setup.rng)
+    reset_components(setup)  # the same side effects on the components as the numpy loop
     try:
         km = model.kernel()
         kc = ctrl.kernel(batch) if ctrl is not None else None

@@ -399,6 +399,18 @@ def advance_plant(setup: SimSetup, t0: float, x: np.ndarray, lag: np.ndarray | N
     return z[..., :n], (z[..., n:] if lag is not None else None)
 
 
+def reset_components(setup: SimSetup) -> None:
+    """Reset the controller, guidance and disturbance for the run's batch (every loop starts so;
+    the disturbance draws its initial state from the run's generator)."""
+    batch = setup.batch_shape
+    if setup.controller is not None:
+        setup.controller.reset(batch)
+    if setup.guidance is not None:
+        setup.guidance.reset(batch, setup.model)
+    if setup.disturbance is not None:
+        setup.disturbance.reset(batch, setup.rng)
+
+
 def run_numpy(setup: SimSetup) -> Log:
     """The reference loop in plain numpy (readable; batched over ships)."""
     model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller, setup.guidance,
@@ -406,12 +418,7 @@ def run_numpy(setup: SimSetup) -> Log:
     batch = setup.batch_shape
     dt = setup.dt
     continuous = bool(getattr(ctrl, "continuous", False))
-    if ctrl is not None:
-        ctrl.reset(batch)
-    if gd is not None:
-        gd.reset(batch, model)
-    if dist is not None:
-        dist.reset(batch, setup.rng)
+    reset_components(setup)
 
     signals = log_signals(setup)
     n_log = setup.n_steps // setup.log_every + 2
