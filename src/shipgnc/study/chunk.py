@@ -110,7 +110,7 @@ def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> 
     state_names = names(model.states)
     batch = np.tile(np.asarray(x0, dtype=float), (chunk.size, 1))
     for row, member in enumerate(range(chunk.start, chunk.stop)):
-        rng = np.random.default_rng(study.member_streams(member)[0])
+        rng = np.random.default_rng(study.member_stream(member, 0))
         for p in study.offsets:
             state, scale = PERTURBABLE[p.field]
             batch[row, state_names.index(state)] += scale * p.draw(rng)
@@ -238,7 +238,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     drawn = member_params(study, setup.model, chunk.start, chunk.stop)  # the plant's parameters
     if drawn:  # each member's own plant; the controller keeps its nominal design
         setup = replace(setup, model=member_plant(study, setup.model, chunk.start, chunk.stop, drawn))
-    seeds = [study.member_streams(m)[1] for m in range(chunk.start, chunk.stop)]
+    seeds = [study.member_stream(m, 1) for m in range(chunk.start, chunk.stop)]
     route = ends_early(setup)
     result, done_at = _run_batch(setup, scenario, x0, seeds, backend, route)
     arrays = None

@@ -112,7 +112,7 @@ def member_params(study: Study, model, start: int, stop: int) -> dict[str, np.nd
     nominal = model.params.as_dict()
     values = {p.param: np.empty(stop - start) for p in plant}
     for row, member in enumerate(range(start, stop)):
-        rng = np.random.default_rng(study.member_streams(member)[2])
+        rng = np.random.default_rng(study.member_stream(member, 2))
         for p in plant:
             values[p.param][row] = p.apply(float(nominal[p.param]), p.draw(rng))
     return values

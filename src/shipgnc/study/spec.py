@@ -217,5 +217,8 @@ class Study:
         ``SeedSequence(seed).spawn(members)[member].spawn(3)``, built directly from the spawn key
         so that no chunk needs the others (the first two are those of ``.spawn(2)``: a plant
         perturbation leaves the offsets and the sea of every member as they were)."""
-        return tuple(np.random.SeedSequence(int(self.seed), spawn_key=(int(member), j))
-                     for j in (0, 1, 2))
+        return tuple(self.member_stream(member, j) for j in (0, 1, 2))
+
+    def member_stream(self, member: int, which: int) -> np.random.SeedSequence:
+        """One of :meth:`member_streams` (0 offsets, 1 disturbances, 2 plant), built alone."""
+        return np.random.SeedSequence(int(self.seed), spawn_key=(int(member), int(which)))
