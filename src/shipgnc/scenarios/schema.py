@@ -29,6 +29,8 @@ Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 OffsetNm = Annotated[float, Field(ge=-1000, le=1000, allow_inf_nan=False)]
 OffsetDeg = Annotated[float, Field(ge=-180, le=180, allow_inf_nan=False)]
+#: a commanded heading: up to ten turns either way (beyond that a float's degrees lose meaning)
+HeadingDeg = Annotated[float, Field(ge=-3600, le=3600, allow_inf_nan=False)]
 
 
 class Strict(BaseModel):
@@ -206,7 +208,7 @@ class SimulationConfig(Strict):
     method: Literal["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"] = "RK45"
     rtol: Positive = 1e-3
     atol: Positive = 1e-6
-    seed: Annotated[int, Field(ge=0)] | None = None
+    seed: Annotated[int, Field(ge=0, lt=2**63)] | None = None  # an int64: what NetCDF stores
     backend: Literal["auto", "numpy", "compiled"] = "auto"
     #: keep every n-th sample in the result (large batches); metrics use the kept samples
     log_every: Annotated[int, Field(ge=1)] = 1
@@ -364,7 +366,7 @@ ControllerConfig = Annotated[OpenLoopConfig | HeadingSpeedConfig | CourseControl
 
 class ReferenceEntry(Strict):
     t: NonNegative
-    psi_deg: Finite
+    psi_deg: HeadingDeg
     u: Positive
 
 
@@ -396,7 +398,7 @@ class LOSConfig(Strict):
 
 class CourseEntry(Strict):
     t: NonNegative
-    psi_deg: Finite
+    psi_deg: HeadingDeg
 
 
 class CourseScheduleConfig(Strict):

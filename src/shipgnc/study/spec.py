@@ -166,7 +166,8 @@ class Study:
         require(isinstance(self.members, (int, np.integer)) and not isinstance(self.members, bool)
                 and self.members >= 1, "--mc", self.members, "must be an integer >= 1")
         require(isinstance(self.seed, (int, np.integer)) and not isinstance(self.seed, bool)
-                and self.seed >= 0, "--seed", self.seed, "must be an integer >= 0")
+                and 0 <= self.seed < 2**63, "--seed", self.seed,
+                "must be an integer from 0 to 2**63 - 1 (what the result files store)")
         keys = [k for k, _ in self.grid]
         repeated = sorted({k for k in keys if keys.count(k) > 1})
         require(not repeated, "--grid", ", ".join(repeated), "each key may be gridded once")

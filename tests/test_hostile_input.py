@@ -1,0 +1,90 @@
+"""Hostile scenario files and values: each refused with one line and exit 2, before any work,
+in bounded time and memory (issue: nothing silently wrong; rows 8, 15, 16, 20 and the smaller
+ones)."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+from typer.testing import CliRunner
+
+from shipgnc.cli import app
+from shipgnc.errors import ConfigError
+from shipgnc.scenarios.registry import MAX_NESTING, MAX_SCENARIO_BYTES, load_scenario
+from shipgnc.study.spec import Study
+
+runner = CliRunner()
+
+BOAT = """name: mine
+vessel: {model: vectored-thrust-boat}
+simulation: {dt: 0.05, t_end: 1.0}
+controller: {type: open-loop, schedule: [{t: 0.0, T: 10.0, alpha_deg: 0.0}]}
+"""
+
+
+def _refused(tmp_path, text: str | bytes, *words: str) -> str:
+    path = tmp_path / "bad.yaml"
+    path.write_bytes(text if isinstance(text, bytes) else text.encode())
+    result = runner.invoke(app, ["show", str(path)])
+    assert result.exit_code == 2, (result.exit_code, result.stdout, result.stderr)
+    message = result.stderr.strip()
+    assert len(message.splitlines()) == 1, message
+    for word in words:
+        assert word in message, message
+    return message
+
+
+def test_the_well_formed_boat_file_loads(tmp_path):
+    path = tmp_path / "ok.yaml"
+    path.write_text(BOAT)
+    assert load_scenario(str(path)).name == "mine"
+
+
+def test_non_utf8_file(tmp_path):
+    _refused(tmp_path, BOAT.encode() + b"# caf\xe9\n", "not UTF-8", "0xe9")
+
+
+def test_nesting_is_bounded_before_parsing(tmp_path):
+    _refused(tmp_path, "a: " + "[" * 5000 + "]" * 5000 + "\n", "nested more than", str(MAX_NESTING))
+
+
+def test_alias_bomb_is_refused_quickly(tmp_path):
+    """Nine levels of ten aliases (~10⁹ values when expanded) in under a kilobyte."""
+    lines = ["l0: &l0 [x, x, x, x, x, x, x, x, x, x]"]
+    lines += [f"l{i}: &l{i} [{', '.join([f'*l{i - 1}'] * 10)}]" for i in range(1, 10)]
+    start = time.perf_counter()
+    _refused(tmp_path, "\n".join(lines) + "\n", "aliases expand")
+    assert time.perf_counter() - start < 5.0  # bounded work, not the expansion (a generous bound)
+
+
+def test_duplicate_section_is_refused(tmp_path):
+    _refused(tmp_path, BOAT + "simulation: {dt: 0.1, t_end: 2.0}\n", "'simulation' given twice",
+             "lines 3 and 5")
+
+
+def test_oversized_file(tmp_path):
+    _refused(tmp_path, BOAT + "#" * (MAX_SCENARIO_BYTES + 10) + "\n", "bytes", "limited")
+
+
+def test_device_file_is_read_only_up_to_the_cap():
+    with pytest.raises(ConfigError, match="more than"):
+        load_scenario("/dev/zero")
+
+
+def test_directory_is_named_as_a_directory(tmp_path):
+    with pytest.raises(ConfigError, match="is a directory"):
+        load_scenario(str(tmp_path))
+
+
+@pytest.mark.parametrize("seed", [2**64, 2**63])
+def test_seed_beyond_int64(seed):
+    with pytest.raises(ConfigError, match="seed"):
+        load_scenario("boat-autopilot", [f"simulation.seed={seed}"])
+    with pytest.raises(ConfigError, match="--seed"):
+        Study(scenario=load_scenario("boat-autopilot"), members=2, seed=seed)
+
+
+def test_heading_reference_beyond_ten_turns():
+    with pytest.raises(ConfigError, match="psi_deg"):
+        load_scenario("boat-autopilot", ["guidance.schedule.1.psi_deg=1e300"])
