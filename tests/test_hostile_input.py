@@ -88,3 +88,33 @@ def test_seed_beyond_int64(seed):
 def test_heading_reference_beyond_ten_turns():
     with pytest.raises(ConfigError, match="psi_deg"):
         load_scenario("boat-autopilot", ["guidance.schedule.1.psi_deg=1e300"])
+
+
+def _boat():
+    from shipgnc.models.fossen3dof import VectoredThrustBoat
+
+    return VectoredThrustBoat.from_preset("otter")
+
+
+@pytest.mark.parametrize("role", ["controller", "guidance", "disturbance", "actuator"])
+def test_api_component_of_the_wrong_kind(role):
+    from shipgnc.sim.simulator import simulate
+
+    with pytest.raises(ConfigError, match=f"{role} = 'pid': not a {role} object"):
+        simulate(_boat(), [0.0] * 6, t_end=1.0, dt=0.1, **{role: "pid"})
+
+
+@pytest.mark.parametrize("dims, words", [(("a", "a"), "distinct"), (("a", "b"), "need 1 names"),
+                                         ("ship", "tuple of names")])
+def test_api_batch_dims_checked_before_the_run(dims, words):
+    from shipgnc.sim.simulator import simulate
+
+    with pytest.raises(ConfigError, match=words):
+        simulate(_boat(), [[0.0] * 6], t_end=1.0, dt=0.1, batch_dims=dims)
+
+
+def test_api_autopilot_given_a_preset_name():
+    from shipgnc.control.heading_speed import HeadingSpeedAutopilot
+
+    with pytest.raises(ConfigError, match="must be BoatParams"):
+        HeadingSpeedAutopilot("otter")

@@ -60,8 +60,11 @@ class HeadingSpeedAutopilot:
 
     def __init__(self, params: BoatParams, *, Ts: float = 0.05, omega_ref: float = 1.0,
                  omega: float = 1.0, omega_u: float = 1.0, yaw_feedforward: bool = True):
+        require(isinstance(params, BoatParams), "params", repr(params)[:40],
+                "must be BoatParams (e.g. VectoredThrustBoat.from_preset('otter').params)")
         for name, value in (("Ts", Ts), ("omega", omega), ("omega_u", omega_u)):
-            require(np.isfinite(value) and value > 0, f"controller.{name}", value, "must be > 0")
+            require(isinstance(value, (int, float)) and np.isfinite(value) and value > 0,
+                    f"controller.{name}", value, "must be a number > 0")
         self.params = params
         self.Ts = float(Ts)
         self.omega, self.omega_u = float(omega), float(omega_u)

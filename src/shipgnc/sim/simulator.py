@@ -138,6 +138,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
                       on_divergence=on_divergence, observer=observer, progress=progress,
                       log_every=log_every)
     require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
+    _require_batch_dims(batch_dims, setup.batch_shape)
     log, ran_on = None, "numpy"
     n_ships = math.prod(setup.batch_shape)
     wants_compiled = backend in ("compiled", "compiled-or-numpy") or (backend == "auto" and (
@@ -184,9 +185,41 @@ def _compiled_twin(setup: SimSetup):
     return None, reasons
 
 
+def _require_component(role: str, obj, methods: tuple[str, ...], example: str) -> None:
+    """A clear ConfigError when ``obj`` lacks what the loop calls (``controller="pid"``)."""
+    missing = [m for m in methods if not hasattr(obj, m)]
+    if missing:
+        shown = repr(obj) if len(repr(obj)) <= 40 else type(obj).__name__
+        raise ConfigError(f"{role} = {shown}: not a {role} object (it has no "
+                          f"{', '.join(missing)}); {example}")
+
+
+def _require_batch_dims(batch_dims, batch_shape: tuple[int, ...]) -> None:
+    """``batch_dims``: one distinct, non-empty name per batch axis (checked before the run)."""
+    if batch_dims is None:
+        return
+    ok = (isinstance(batch_dims, (tuple, list)) and all(isinstance(d, str) and d and d != "time"
+                                                        for d in batch_dims))
+    require(ok, "batch_dims", batch_dims, "must be a tuple of names (strings other than 'time')")
+    require(len(set(batch_dims)) == len(batch_dims), "batch_dims", tuple(batch_dims),
+            "names must be distinct")
+    require(len(batch_dims) == len(batch_shape), "batch_dims", tuple(batch_dims),
+            f"need {len(batch_shape)} names for a batch of shape {batch_shape}")
+
+
 def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturbance, u0,
               integrator, method, rtol, atol, seed, on_divergence, observer, progress,
               log_every) -> SimSetup:
+    _require_component("model", model, ("states", "inputs", "derivatives"), "e.g. CyberShip2()")
+    for role, obj, methods, example in (
+            ("controller", controller,
+             ("reset", "law" if getattr(controller, "continuous", False) else "step"),
+             "e.g. CoursePD(...), or None"),
+            ("guidance", guidance, ("reset", "reference"), "e.g. ReferenceSchedule(...)"),
+            ("disturbance", disturbance, ("reset", "__call__"), "e.g. GaussianForceNoise(...)"),
+            ("actuator", actuator, ("n", "saturate"), "e.g. Actuator.for_model(model)")):
+        if obj is not None:
+            _require_component(role, obj, methods, example)
     for name, value in (("dt", dt), ("t_end", t_end)):
         require(isinstance(value, (int, float)) and math.isfinite(value) and value > 0,
                 name, value, "must be a finite number > 0 s")
