@@ -118,3 +118,13 @@ def test_api_autopilot_given_a_preset_name():
 
     with pytest.raises(ConfigError, match="must be BoatParams"):
         HeadingSpeedAutopilot("otter")
+
+
+def test_api_schedule_lengths_and_complex_state():
+    from shipgnc.guidance.schedule import ReferenceSchedule
+    from shipgnc.sim.simulator import simulate
+
+    with pytest.raises(ConfigError, match="times: 3, psi_d: 2, u_d: 3"):
+        ReferenceSchedule([0, 1, 2], [0.0, 0.1], [1, 1, 1])
+    with pytest.raises(ConfigError, match="complex"):
+        simulate(_boat(), [1j, 0, 0, 0, 0, 0], t_end=1.0, dt=0.1)

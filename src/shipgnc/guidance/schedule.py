@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from shipgnc.errors import require
 from shipgnc.kernels import (
     Kernel,
     NotCompiled,
@@ -28,6 +29,11 @@ class ReferenceSchedule:
     outputs = ()
 
     def __init__(self, times, psi_d, u_d):
+        lengths = {name: np.size(v) for name, v in (("times", times), ("psi_d", psi_d),
+                                                     ("u_d", u_d))}
+        require(len(set(lengths.values())) == 1, "guidance.schedule",
+                ", ".join(f"{k}: {n}" for k, n in lengths.items()),
+                "times, psi_d and u_d need one value each per set-point")
         values = np.column_stack([np.asarray(psi_d, float), np.asarray(u_d, float)])
         self.schedule = PiecewiseConstant(times, values, field="guidance.schedule")
         self._batch_shape: tuple[int, ...] = ()

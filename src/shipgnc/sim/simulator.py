@@ -241,6 +241,8 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
     require(isinstance(log_every, int) and log_every >= 1, "log_every", log_every,
             "must be an integer >= 1")
     n_states = len(model.states)
+    if np.iscomplexobj(np.asarray(x0)):
+        raise ConfigError("x0: complex values given; the state is real (north, east, ... in SI)")
     try:
         x0 = np.array(x0, dtype=float)
     except (TypeError, ValueError) as exc:
