@@ -82,7 +82,7 @@ def test_seed_beyond_int64(seed):
     with pytest.raises(ConfigError, match="seed"):
         load_scenario("boat-autopilot", [f"simulation.seed={seed}"])
     with pytest.raises(ConfigError, match="--seed"):
-        Study(scenario=load_scenario("boat-autopilot"), members=2, seed=seed)
+        Study("boat-autopilot", members=2, seed=seed)
 
 
 def test_heading_reference_beyond_ten_turns():
@@ -128,3 +128,26 @@ def test_api_schedule_lengths_and_complex_state():
         ReferenceSchedule([0, 1, 2], [0.0, 0.1], [1, 1, 1])
     with pytest.raises(ConfigError, match="complex"):
         simulate(_boat(), [1j, 0, 0, 0, 0, 0], t_end=1.0, dt=0.1)
+
+
+def test_sweep_memory_estimated_before_any_chunk_is_planned():
+    """Row 3: a trillion members is refused at once, naming the estimate and what to change."""
+    from shipgnc.study.execute import run_study
+
+    start = time.perf_counter()
+    with pytest.raises(ConfigError, match=r"needs about .* GiB.*\(--mc\)"):
+        run_study(Study("boat-autopilot", members=10**12, overrides=("simulation.t_end=5",)))
+    assert time.perf_counter() - start < 5.0
+
+
+def test_sweep_series_total_counts_against_max_memory():
+    """Row 4: each chunk fits, the total of every member's series does not."""
+    from shipgnc.study.execute import estimate_memory, run_study
+
+    study = Study("boat-autopilot", members=1_000_000, series=True)
+    need = estimate_memory(study, None, 1000)
+    assert need["result"] > 100 * need["chunk"]
+    with pytest.raises(ConfigError, match="drop --series"):
+        run_study(study, max_memory=need["chunk"] * 2)
+    with pytest.raises(ConfigError, match="smaller --chunk-size"):
+        run_study(Study("boat-autopilot", members=10), max_memory=1e5)

@@ -190,19 +190,84 @@ def assemble(study: Study, chunks: list[Chunk], parts: list, variants: list[str]
     return ds
 
 
+#: numbers kept per member and cell besides the series: its metrics, parameters and offsets
+#: (a generous bound: the richest metric set holds about forty)
+NUMBERS_PER_MEMBER = 64
+
+
+def available_memory() -> int:
+    """Bytes the machine can give a new allocation now (``MemAvailable``; else physical memory)."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as handle:
+            for line in handle:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return 1 << 62
+
+
+def estimate_memory(study: Study, variants: list[str] | None, chunk_size: int) -> dict[str, int]:
+    """Bytes a study holds at its peak, estimated before any work: ``result`` (every member's
+    metrics, with ``--series`` every member's thinned series) and ``chunk`` (one chunk's
+    every-step record that the metrics are computed from, about twice for the arrays derived
+    from it). The measure of a series is :func:`shipgnc.sim.simulator.logged_numbers`."""
+    from shipgnc.scenarios.runner import VESSELS
+    from shipgnc.sim.simulator import logged_numbers
+
+    scenario = study.scenario_at(study.points[0])
+    model = VESSELS[scenario.vessel.model](scenario)[0]
+    sim = scenario.simulation
+    n_steps = round(sim.t_end / sim.dt)
+    cells = len(study.points) * len(variants or [None])
+    per_member = NUMBERS_PER_MEMBER
+    if study.series:
+        per_member += logged_numbers(model, (1,), n_steps, sim.log_every)
+    chunk = 2 * logged_numbers(model, (min(chunk_size, study.members),), n_steps)
+    return {"result": 8 * cells * study.members * per_member, "chunk": 8 * chunk}
+
+
+def check_memory(study: Study, variants: list[str] | None, chunk_size: int,
+                 max_memory: float | None = None) -> None:
+    """A ConfigError naming the estimate and what to change when a study would need more than
+    ``max_memory`` bytes (default: the memory available now)."""
+    need = estimate_memory(study, variants, chunk_size)
+    limit = available_memory() if max_memory is None else max_memory
+    what = "the memory available" if max_memory is None else "--max-memory"
+    gib = 2.0 ** 30
+    if need["chunk"] > limit:
+        raise ConfigError(f"--chunk-size {chunk_size}: one chunk's record needs about "
+                          f"{need['chunk'] / gib:.1f} GiB, more than {what} "
+                          f"({limit / gib:.1f} GiB); use a smaller --chunk-size")
+    if need["result"] + need["chunk"] > limit:
+        hint = "drop --series or use fewer members (--mc)" if study.series else \
+            "use fewer members (--mc) or grid points, or split the study by --seed"
+        raise ConfigError(f"the study needs about {(need['result'] + need['chunk']) / gib:,.1f} GiB "
+                          f"({study.members:,} members x {len(study.points)} grid points"
+                          f"{' x ' + str(len(variants)) + ' controllers' if variants else ''}), "
+                          f"more than {what} ({limit / gib:.1f} GiB): {hint}")
+
+
 def run_study(study: Study, *, workers: str = "local", scheduler: str | None = None,
               chunk_size: int = DEFAULT_CHUNK_SIZE, client=None,
-              on_chunk: Callable[[int, int], None] | None = None) -> StudyRun:
+              on_chunk: Callable[[int, int], None] | None = None,
+              max_memory: float | None = None) -> StudyRun:
     """Run ``study`` and return its Dataset (see :func:`assemble`).
 
     ``workers``: ``"local"`` or ``"dask"`` (a new LocalCluster); ``scheduler``: an existing dask
     cluster's address (implies dask); ``client``: an existing ``dask.distributed.Client`` (tests).
+    ``max_memory``: bytes the study may hold (default: the memory available); checked with
+    :func:`check_memory` before any work.
     """
     import time
 
     if workers not in WORKERS:
         raise ConfigError(f"--workers {workers!r}: allowed: {', '.join(WORKERS)}")
     variants = variants_of(study)
+    check_memory(study, variants, chunk_size, max_memory)
     chunks = plan_chunks(study, variants, chunk_size)
     start = time.perf_counter()
     owned = None
