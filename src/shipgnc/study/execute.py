@@ -196,18 +196,36 @@ NUMBERS_PER_MEMBER = 64
 
 
 def available_memory() -> int:
-    """Bytes the machine can give a new allocation now (``MemAvailable``; else physical memory)."""
+    """Bytes this process can allocate now: the machine's ``MemAvailable`` (else its physical
+    memory), and no more than what an address-space limit (``ulimit -v``) leaves."""
+    machine = _proc_kib("/proc/meminfo", "MemAvailable:")
+    if machine is None:
+        try:
+            machine = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+        except (ValueError, OSError, AttributeError):
+            machine = 1 << 62
     try:
-        with open("/proc/meminfo", encoding="ascii") as handle:
+        import resource
+
+        soft, unlimited = resource.getrlimit(resource.RLIMIT_AS)[0], resource.RLIM_INFINITY
+    except (ImportError, OSError, ValueError):  # no address-space limits here (Windows)
+        return machine
+    used = _proc_kib("/proc/self/status", "VmSize:")
+    if soft != unlimited and used is not None:
+        machine = min(machine, max(0, soft - used))
+    return machine
+
+
+def _proc_kib(path: str, key: str) -> int | None:
+    """A ``key: N kB`` line of a /proc file, in bytes (None where there is no /proc)."""
+    try:
+        with open(path, encoding="ascii") as handle:
             for line in handle:
-                if line.startswith("MemAvailable:"):
+                if line.startswith(key):
                     return int(line.split()[1]) * 1024
-    except OSError:
+    except (OSError, ValueError):
         pass
-    try:
-        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        return 1 << 62
+    return None
 
 
 def estimate_memory(study: Study, variants: list[str] | None, chunk_size: int) -> dict[str, int]:
