@@ -45,7 +45,19 @@ class Interrupted(KeyboardInterrupt):
         text = message or ("interrupted" if time is None else f"interrupted at t = {time:.6g} s")
         super().__init__(text)
         self.time = time
-        self.partial = partial
+        self._partial = partial
+
+    @property
+    def partial(self):
+        """The partial result; given as a callable it is built on first use (building it can
+        import xarray, a second or more: a command that exits does not wait for it)."""
+        if callable(self._partial):
+            self._partial = self._partial()
+        return self._partial
+
+    @partial.setter
+    def partial(self, value) -> None:
+        self._partial = value
 
 
 class ShipGNCWarning(UserWarning):

@@ -163,11 +163,11 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
 
     run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold,
                  "t_end": t_end, "model": type(model).__name__, **(attrs or {})}
-    result = build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
-    if log.status.get("interrupted"):
+    if log.status.get("interrupted"):  # the partial Dataset is built only if someone reads it
         last = float(log.time[-1]) if log.time.size else 0.0
-        raise Interrupted(last, partial=result)
-    return result
+        raise Interrupted(last, partial=lambda: build_dataset(log, setup.batch_shape, batch_dims,
+                                                               run_attrs))
+    return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
 
 
 def _compiled_twin(setup: SimSetup):

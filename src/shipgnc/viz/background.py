@@ -54,28 +54,46 @@ class FigureProcess:
                 future = self._pool.submit(fn, *args)
             except (concurrent.futures.process.BrokenProcessPool, RuntimeError, OSError):
                 self.close()
-        return _Pending(future, fn, args)
+        return _Pending(future, fn, args, self)
 
     def close(self) -> None:
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
 
+    def terminate(self) -> None:
+        """Stop the worker now (Ctrl-C, a failed run): a figure half-drawn is abandoned and
+        nothing more is written; the command does not wait for the drawing to end."""
+        if self._pool is None:
+            return
+        for process in list(getattr(self._pool, "_processes", {}).values()):
+            process.terminate()
+        self._pool.shutdown(wait=False, cancel_futures=True)
+        self._pool = None
+
     def __enter__(self) -> FigureProcess:
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is not None and issubclass(exc_type, BaseException) and not issubclass(
+                exc_type, Exception):  # KeyboardInterrupt, SystemExit: do not wait for figures
+            self.terminate()
+        else:
+            self.close()
 
 
 class _Pending:
-    def __init__(self, future, fn: Callable, args: tuple):
-        self._future, self._fn, self._args = future, fn, args
+    def __init__(self, future, fn: Callable, args: tuple, owner: FigureProcess | None = None):
+        self._future, self._fn, self._args, self._owner = future, fn, args, owner
 
     def cancel(self, timeout: float = 10.0) -> None:
-        """Give up on the result: cancel the job, or let a running one end (so that it no longer
-        writes where the caller is about to clean up); its outcome is ignored."""
+        """Give up on the result: cancel the job, or stop the worker running it (so that it no
+        longer writes where the caller is about to clean up); its outcome is ignored. Without
+        a worker to stop, wait up to ``timeout`` s for the running job to end."""
         if self._future is None or self._future.cancel():
+            return
+        if self._owner is not None and self._owner._pool is not None:
+            self._owner.terminate()
             return
         try:
             concurrent.futures.wait([self._future], timeout=timeout)
