@@ -23,6 +23,12 @@ Ships are the outer loop (``numba.prange``), time the inner one. A run is one ke
 several (progress, bounded log chunks) that carry each ship's state in its row of ``S`` and give
 bit-identical results (:func:`shipgnc.sim.compiled.drive`). :func:`unsupported_reason` names the
 first component without a kernel; ``simulate`` then runs the numpy loop.
+
+A disturbance with ``kernel_current(batch_shape, dt)`` (a force disturbance and an earth-fixed
+current, :class:`~shipgnc.environment.current_field.CurrentDisturbance`) gives the loop a second
+kernel, called right after the disturbance's own wherever that one is (step start or every RK
+stage), with its own parameters and per-step table: the current channels of the model's
+disturbance vector are filled once for every force disturbance.
 """
 
 from __future__ import annotations
@@ -61,13 +67,16 @@ def _no_disturbance(t, x, z, p, w, d):
     pass
 
 
-def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, *, nx: int, nu: int, nd: int, nref: int,
-             nout: int, nsig: int, nerr: int, nzc: int, nzg: int, nzd: int, has_ctrl: bool,
-             continuous: bool, has_guid: bool, has_dist: bool, per_stage: bool, has_lag: bool,
-             rate_limited: bool, hold_mode: bool):
-    """The composed loop of one combination (compiled on first use, memoised per process)."""
-    key = (model_fn, ctrl_fn, guid_fn, dist_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc, nzg, nzd,
-           has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited, hold_mode)
+def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx: int, nu: int,
+             nd: int, nref: int, nout: int, nsig: int, nerr: int, nzc: int, nzg: int, nzd: int,
+             has_ctrl: bool, continuous: bool, has_guid: bool, has_dist: bool, per_stage: bool,
+             has_lag: bool, rate_limited: bool, hold_mode: bool, has_cur: bool = False):
+    """The composed loop of one combination (compiled on first use, memoised per process).
+    ``cur_fn``: a disturbance's current part (``kernel_current``), called right after ``dist_fn``
+    with the same arguments and its own parameters, table and (empty) state."""
+    key = (model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
+           nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
+           hold_mode, has_cur)
     if key not in _LOOPS:
         _LOOPS[key] = _generate(*key)
     return _LOOPS[key]
@@ -77,7 +86,7 @@ def _generate(*key):
     """The combination's loop: from a module written to the disk cache and compiled with numba's
     cache (loaded in ≈ 0.1 s by later processes) when every kernel is importable by name; else
     compiled in memory, once per process (a kernel defined in a script or a notebook)."""
-    functions = key[:4]
+    functions = key[:5]
     importable = all(_importable(fn) for fn in functions)
     source = _source(*key, imports=importable)
     path = _cache_file(source, functions) if importable else None
@@ -85,7 +94,8 @@ def _generate(*key):
         if str(path.parent) not in sys.path:
             sys.path.append(str(path.parent))
         return importlib.import_module(path.stem).loop
-    namespace = dict(zip(("model_fn", "ctrl_fn", "guid_fn", "dist_fn"), functions, strict=True))
+    namespace = dict(zip(("model_fn", "ctrl_fn", "guid_fn", "dist_fn", "cur_fn"), functions,
+                         strict=True))
     exec(compile(source.replace("CACHE = True", "CACHE = False"), "<shipgnc composed loop>",
                  "exec"), namespace)
     return namespace["loop"]
@@ -148,9 +158,9 @@ def _sources_digest() -> bytes:
     return _DIGEST[0]
 
 
-def _source(model_fn, ctrl_fn, guid_fn, dist_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc, nzg,
-            nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-            hold_mode, *, imports: bool):
+def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
+            nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
+            hold_mode, has_cur, *, imports: bool):
     """Source of the combination's module: constants, the components' kernels, the loop body."""
     nl = nu if has_lag else 0
     lay = row_layout(nx, nl, nu, nref, nout, nsig, nd, nzc, nzg, nzd)
@@ -159,7 +169,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, nx, nu, nd, nref, nout, nsig, n
         "nzc": nzc, "nzg": nzg, "nzd": nzd, "nl": nl, "nz": nx + nl,
         "has_ctrl": has_ctrl, "continuous": continuous, "has_guid": has_guid,
         "has_dist": has_dist, "per_stage": per_stage, "has_lag": has_lag,
-        "rate_limited": rate_limited, "hold_mode": hold_mode,
+        "rate_limited": rate_limited, "hold_mode": hold_mode, "has_cur": has_cur,
         **{f"o_{name}": lay[key] for name, key in (
             ("x", "x"), ("lag", "lag"), ("app", "applied"), ("cmd", "cmd"), ("ref", "ref"),
             ("out", "out"), ("sig", "sig"), ("d", "d"), ("done", "done"), ("zc", "zc"),
@@ -171,7 +181,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, nx, nu, nd, nref, nout, nsig, n
     lines = ["# generated by shipgnc.sim.compose: the loop of one combination of components",
              "CACHE = True"]
     for alias, fn in (("model_fn", model_fn), ("ctrl_fn", ctrl_fn), ("guid_fn", guid_fn),
-                      ("dist_fn", dist_fn)):
+                      ("dist_fn", dist_fn), ("cur_fn", cur_fn)):
         py = getattr(fn, "py_func", fn)
         if imports:
             lines.append(f"from {py.__module__} import {py.__qualname__} as {alias}")
@@ -195,6 +205,8 @@ def unsupported_reason(setup) -> str | None:
         return f"integrator {setup.integrator!r} is not compiled (only 'rk4')"
     if setup.observer is not None:
         return "an observer callback needs the Python loop"
+    if getattr(setup, "navigation", None) is not None:
+        return "navigation has no kernel yet"
     for role, component in _roles(setup):
         if component is None:
             continue
@@ -225,6 +237,9 @@ def run(setup):
         kc = ctrl.kernel(batch) if ctrl is not None else None
         kg = gd.kernel(batch) if gd is not None else None
         kd = dist.kernel(batch, dt=setup.dt) if dist is not None else None
+        # a disturbance with a current part (environment.current_field.CurrentDisturbance)
+        cur = getattr(dist, "kernel_current", None)
+        ku = cur(batch, dt=setup.dt) if callable(cur) else None
     except NotCompiled as exc:  # a setting only known after reset: the caller falls back
         raise ConfigError(f"compiled loop: {exc}") from None
     empty = Kernel(_no_controller)
@@ -246,7 +261,8 @@ def run(setup):
                     nzc=zc0.shape[1], nzg=zg0.shape[1], nzd=zd0.shape[1], has_ctrl=ctrl is not None,
                     continuous=continuous, has_guid=gd is not None, has_dist=dist is not None,
                     per_stage=bool(getattr(dist, "per_stage", False)), has_lag=act.has_lag,
-                    rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold")
+                    rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold",
+                    cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None)
     lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd, zc0.shape[1],
                      zg0.shape[1], zd0.shape[1])
 
@@ -272,18 +288,20 @@ def run(setup):
     params = [_param_rows(k, n) for k in (km, kc_, kg_, kd_)]
     pa = act.kernel_params()
     limits = np.asarray(model.state_limits, dtype=np.float64)
-    table = {"W": np.zeros((1, n, 0))}
+    table = {"W": np.zeros((1, n, 0)), "Wu": np.zeros((1, n, 0))}
+    pu = _param_rows(ku or empty, n)
 
     def prepare(k0: int, k1: int) -> None:
-        if kd is not None and kd.table is not None:
-            table["W"] = np.ascontiguousarray(kd.table(k0, k1), dtype=np.float64)
-        else:
-            table["W"] = np.zeros((k1 - k0, n, 0))
+        for name, k in (("W", kd), ("Wu", ku)):
+            if k is not None and k.table is not None:
+                table[name] = np.ascontiguousarray(k.table(k0, k1), dtype=np.float64)
+            else:
+                table[name] = np.zeros((k1 - k0, n, 0))
 
     def call(k0: int, k1: int, k_last: int) -> None:
         loop(k0, k1, k_last, int(setup.hold), int(setup.log_every), float(setup.dt), S, table["W"],
              params[0], pa, params[1], params[2], params[3], limits, err, out, event_at,
-             done_at if done_at is not None else np.zeros(n, dtype=np.int64))
+             done_at if done_at is not None else np.zeros(n, dtype=np.int64), table["Wu"], pu)
 
     stop = drive(setup, call, S, event_at, prepare=prepare, done_at=done_at)
     for k, key, width in ((kc, "zc", zc0.shape[1]), (kg, "zg", zg0.shape[1]), (kd, "zd", zd0.shape[1])):

@@ -82,6 +82,7 @@ class SimSetup:
     progress: Callable | None
     log_every: int
     u0: np.ndarray
+    navigation: object | None = None  # sensors and estimator (shipgnc.navigation), numpy loop only
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
@@ -94,7 +95,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
              on_divergence: str = "raise", observer: Callable | None = None,
              progress: Callable | None = None, log_every: int = 1,
              batch_dims: tuple[str, ...] | None = None, backend: str = "auto",
-             attrs: dict | None = None):
+             attrs: dict | None = None, navigation=None):
     """Simulate ``model`` from ``x0`` (shape ``(..., n)``) for ``t_end`` seconds.
 
     Parameters
@@ -115,6 +116,11 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     progress : ``progress(k, n_steps)`` called about a hundred times per run.
     log_every : keep every n-th sample (large batches); the final sample is always kept.
     batch_dims : names of the batch dimensions (default ``("ship",)`` for one batch axis).
+    navigation : :class:`~shipgnc.navigation.Navigation` (sensors and an estimator) or None. At
+        each control sample ``navigation.observe(t, x, applied)`` turns the true state into the
+        state the guidance and the controller see (the estimate, else the measurements); its
+        signals (``<state>_meas``, ``<state>_hat``, ...) are logged. None: they read the truth.
+        Only this numpy loop runs it (``backend="compiled"`` refuses; ``"auto"`` runs numpy).
     backend : ``"numpy"`` (this loop), ``"compiled"`` (a numba twin; ConfigError naming each twin's
         reason when none covers the setup), ``"auto"``: a twin that covers the setup when the
         batch has ≥ :data:`COMPILED_MIN_BATCH` ships or the run ≥ :data:`COMPILED_MIN_WORK`
@@ -136,7 +142,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
                       guidance=guidance, disturbance=disturbance, u0=u0, integrator=integrator,
                       method=method, rtol=rtol, atol=atol, seed=seed,
                       on_divergence=on_divergence, observer=observer, progress=progress,
-                      log_every=log_every)
+                      log_every=log_every, navigation=navigation)
     require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
     _require_batch_dims(batch_dims, setup.batch_shape)
     log, ran_on = None, "numpy"
@@ -209,7 +215,7 @@ def _require_batch_dims(batch_dims, batch_shape: tuple[int, ...]) -> None:
 
 def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturbance, u0,
               integrator, method, rtol, atol, seed, on_divergence, observer, progress,
-              log_every) -> SimSetup:
+              log_every, navigation=None) -> SimSetup:
     _require_component("model", model, ("states", "inputs", "derivatives"), "e.g. CyberShip2()")
     for role, obj, methods, example in (
             ("controller", controller,
@@ -217,7 +223,9 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
              "e.g. CoursePD(...), or None"),
             ("guidance", guidance, ("reset", "reference"), "e.g. ReferenceSchedule(...)"),
             ("disturbance", disturbance, ("reset", "__call__"), "e.g. GaussianForceNoise(...)"),
-            ("actuator", actuator, ("n", "saturate"), "e.g. Actuator.for_model(model)")):
+            ("actuator", actuator, ("n", "saturate"), "e.g. Actuator.for_model(model)"),
+            ("navigation", navigation, ("reset", "observe", "signal_values"),
+             "e.g. Navigation(sensors=[GNSS(), Compass()])")):
         if obj is not None:
             _require_component(role, obj, methods, example)
     for name, value in (("dt", dt), ("t_end", t_end)):
@@ -280,6 +288,10 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
         require(bool(np.all(actuator.tau[limited] > 0)), "actuator.rate",
                 actuator.rate.tolist(), "a continuous controller needs a lag (tau > 0) on "
                 "every rate-limited channel")
+    if navigation is not None and getattr(controller, "continuous", False):
+        raise ConfigError(f"navigation: the continuous controller {type(controller).__name__} is "
+                          "evaluated at every RK stage on the true state; navigation needs a "
+                          "sampled controller (step at Ts)")
     if seed is not None and not is_generator(seed):
         require(isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and seed >= 0,
                 "seed", seed, "must be a non-negative integer, a numpy Generator or MemberStreams")
@@ -292,7 +304,7 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
                     disturbance=disturbance, integrator=integrator,
                     solver_options={"method": method, "rtol": rtol, "atol": atol}, rng=rng,
                     on_divergence=on_divergence, observer=observer, progress=progress,
-                    log_every=log_every, u0=u0)
+                    log_every=log_every, u0=u0, navigation=navigation)
 
 
 def logged_numbers(model, batch_shape: tuple[int, ...], n_steps: int, log_every: int = 1) -> int:
@@ -355,6 +367,8 @@ def log_signals(setup: SimSetup) -> dict[str, Signal]:
         out.update({s.name: s for s in gd.outputs})
     if ctrl is not None:
         out.update({s.name: s for s in getattr(ctrl, "signals", ())})
+    if setup.navigation is not None:
+        out.update({s.name: s for s in setup.navigation.signals})
     return out
 
 
@@ -444,12 +458,15 @@ def reset_components(setup: SimSetup) -> None:
         setup.guidance.reset(batch, setup.model)
     if setup.disturbance is not None:
         setup.disturbance.reset(batch, setup.rng)
+    if setup.navigation is not None:  # draws from child streams of rng, not from rng itself
+        setup.navigation.reset(batch, setup.rng, setup.model, setup.dt * setup.hold)
 
 
 def run_numpy(setup: SimSetup) -> Log:
     """The reference loop in plain numpy (readable; batched over ships)."""
     model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller, setup.guidance,
                                   setup.disturbance)
+    nav = setup.navigation
     batch = setup.batch_shape
     dt = setup.dt
     continuous = bool(getattr(ctrl, "continuous", False))
@@ -477,11 +494,15 @@ def run_numpy(setup: SimSetup) -> Log:
         for k in range(setup.n_steps + 1):
             t = k * dt
             if k % setup.hold == 0:
+                # the state guidance and controller see: the truth, or navigation's estimate
+                seen = x if nav is None else nav.observe(t, x, applied)
                 if gd is not None:
-                    ref = gd.reference(t, x)
+                    ref = gd.reference(t, seen)
                     extra = dict(gd.output_values())
+                if nav is not None:
+                    extra.update(nav.signal_values())
                 if ctrl is not None:
-                    command = (ctrl.law(t, x, ref) if continuous else ctrl.step(t, x, ref))
+                    command = (ctrl.law(t, x, ref) if continuous else ctrl.step(t, seen, ref))
                     command = np.asarray(command, dtype=float)
                     act.check_command_shape(command)
                     extra.update(ctrl.signal_values())

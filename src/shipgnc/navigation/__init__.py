@@ -1,0 +1,43 @@
+"""Navigation, the N in GNC: sensor models and state estimators between the true state and the
+controller (issue 18; docs/navigation.md).
+
+    true state x ──▶ sensors (GNSS, compass, rate gyro, speed log) ──▶ estimator (KF | EKF |
+    passive observer) ──▶ x̂ ──▶ guidance and controller
+
+The interface the simulation loop calls (:func:`shipgnc.sim.simulator.simulate`, ``navigation=``):
+
+``Navigation(sensors=[...], estimator=None | KalmanFilter | ExtendedKalmanFilter | PassiveObserver)``
+
+* ``signals: tuple[Signal, ...]`` — what the loop logs (complete after ``reset``):
+  ``<state>_meas`` (held measurement, NaN while not valid) and ``<sensor>_valid`` (1/0) per
+  sensor; with an estimator ``<state>_hat`` for every estimated quantity, and for the Kalman
+  filters ``<state>_std`` (√ of the covariance diagonal) and ``nees``
+  ((x − x̂)ᵀP⁻¹(x − x̂) against the true state, over the estimated model states).
+* ``reset(batch_shape, rng, model, Ts) -> None`` — validates against the model (measured states
+  found by name in ``model.states``) and the control period ``Ts`` (every sensor period a whole
+  multiple of it), draws the initial error states. Random numbers come from child streams
+  ``rng.spawn(...)`` of the run's generator (one per sensor and one for the estimator; per ship
+  when ``rng`` is a :class:`~shipgnc.sim.streams.MemberStreams`): the run's disturbance draws are
+  the same with or without navigation, and the same seed gives the same run.
+* ``observe(t, x, u) -> x_seen`` — at every control sample, with the TRUE state ``x``
+  (*batch, n_states) and the input ``u`` (*batch, n_inputs) applied over the last sample. Returns
+  the state the guidance and the controller see (*batch, n_states): with an estimator its estimate
+  for the states it estimates; every other state measured by a valid sensor is replaced by the
+  held measurement; a state nobody measures or estimates (and a measured one before its sensor's
+  first valid sample) stays the true value.
+* ``signal_values() -> dict[str, np.ndarray]`` — the last values of ``signals`` for the log.
+
+No navigation (``navigation=None``) is today's loop unchanged: the controller reads the truth.
+Only the numpy loop runs navigation ("navigation has no kernel yet").
+"""
+
+from shipgnc.navigation.core import Navigation, spawn_streams
+from shipgnc.navigation.ekf import ExtendedKalmanFilter, force_psd_to_state_psd
+from shipgnc.navigation.estimator import Estimator, GaussianFilter
+from shipgnc.navigation.kalman import KalmanFilter, heading_wave_kf, van_loan
+from shipgnc.navigation.passive_observer import PassiveObserver
+from shipgnc.navigation.sensors import GNSS, SENSOR_TYPES, Compass, RateGyro, Sensor, SpeedLog
+
+__all__ = ["GNSS", "SENSOR_TYPES", "Compass", "Estimator", "ExtendedKalmanFilter",
+           "GaussianFilter", "KalmanFilter", "Navigation", "PassiveObserver", "RateGyro", "Sensor",
+           "SpeedLog", "force_psd_to_state_psd", "heading_wave_kf", "spawn_streams", "van_loan"]

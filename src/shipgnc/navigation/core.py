@@ -1,0 +1,128 @@
+"""``Navigation``: sensors and an optional estimator between the true state and the controller.
+
+See :mod:`shipgnc.navigation` for the interface the simulation loop calls.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+from shipgnc.models.base import Signal, names
+from shipgnc.navigation.estimator import Estimator
+from shipgnc.navigation.sensors import Sensor
+from shipgnc.sim.streams import MemberStreams
+
+
+def spawn_streams(rng, n: int) -> list:
+    """``n`` independent child streams of the run's generator without drawing from it (so that
+    adding sensors does not change the disturbance's draws): ``Generator.spawn`` for a generator,
+    one child per ship (a new :class:`MemberStreams`) for member streams."""
+    if isinstance(rng, MemberStreams):
+        per_ship = [g.spawn(n) for g in rng.streams]
+        return [MemberStreams([children[i] for children in per_ship]) for i in range(n)]
+    try:
+        return list(rng.spawn(n))
+    except (AttributeError, TypeError, ValueError):  # a generator without a seed sequence
+        seeds = rng.integers(0, 2**63, size=n)
+        return [np.random.default_rng(int(s)) for s in seeds]
+
+
+class Navigation:
+    """Sensors and an optional estimator (:mod:`shipgnc.navigation`).
+
+    ``Navigation(sensors=[GNSS(...), Compass(...)], estimator=ExtendedKalmanFilter(...))``.
+    """
+
+    def __init__(self, sensors=(), estimator: Estimator | None = None):
+        self.sensors = tuple(sensors)
+        for i, s in enumerate(self.sensors):
+            if not isinstance(s, Sensor):
+                raise ConfigError(f"navigation.sensors[{i}] = {s!r}: not a sensor (GNSS, Compass, "
+                                  "RateGyro, SpeedLog)")
+        sensor_names = [s.name for s in self.sensors]
+        dup = sorted({n for n in sensor_names if sensor_names.count(n) > 1})
+        require(not dup, "navigation.sensors", sensor_names,
+                f"sensor names must be distinct (repeated: {', '.join(dup)}; give name=...)")
+        measured = [m for s in self.sensors for m in s.measures]
+        twice = sorted({m for m in measured if measured.count(m) > 1})
+        require(not twice, "navigation.sensors", sensor_names,
+                f"each state may be measured by one sensor only ({', '.join(twice)} twice)")
+        if estimator is not None and not isinstance(estimator, Estimator):
+            raise ConfigError(f"navigation.estimator = {estimator!r}: not an estimator "
+                              "(KalmanFilter, ExtendedKalmanFilter, PassiveObserver)")
+        if estimator is not None and not self.sensors:
+            raise ConfigError("navigation.estimator: an estimator needs at least one sensor")
+        self.estimator = estimator
+        self._signals: tuple[Signal, ...] | None = None
+        self._values: dict[str, np.ndarray] = {}
+
+    # ---- the interface the loop calls ---------------------------------------------------------
+    @property
+    def signals(self) -> tuple[Signal, ...]:
+        """The logged signals (complete after :meth:`reset`: ``<state>_meas`` and
+        ``<sensor>_valid`` per sensor; ``<state>_hat``, ``<state>_std``, ``nees`` (Kalman
+        filters) and the estimator's own)."""
+        if self._signals is not None:
+            return self._signals
+        out = [sig for s in self.sensors for sig in s.signals()]
+        if self.estimator is not None and hasattr(self.estimator, "state_names"):
+            out += list(self.estimator.signals())
+        return tuple(out)
+
+    def reset(self, batch_shape, rng, model, Ts: float) -> None:
+        """Check the configuration against ``model`` and ``Ts`` and draw the initial error states
+        from child streams of ``rng`` (one per sensor, one for the estimator)."""
+        self.batch_shape = tuple(batch_shape)
+        self.model = model
+        self.Ts = float(Ts)
+        streams = spawn_streams(rng, len(self.sensors) + 1)
+        for sensor, stream in zip(self.sensors, streams[:-1], strict=True):
+            sensor.reset(self.batch_shape, stream, model, Ts)
+        self._est_rng = streams[-1]
+        self.state_names = names(model.states)
+        self.measured = {m: float(v) for s in self.sensors
+                         for m, v in zip(s.measures, s.variances(), strict=True)}
+        if self.estimator is not None:
+            self.estimator.prepare(model, Ts, self.measured)
+        out = [sig for s in self.sensors for sig in s.signals()]
+        if self.estimator is not None:
+            out += list(self.estimator.signals())
+        self._signals = tuple(out)
+        self._first = True
+        self._values = {}
+
+    def observe(self, t: float, x: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """The state the controller sees at control sample ``t`` given the true state ``x``
+        (*batch, n_states) and the input ``u`` applied over the last sample."""
+        x = np.asarray(x, dtype=float)
+        meas = {}
+        for sensor in self.sensors:
+            sensor.sample(t, x)
+            for k, name in enumerate(sensor.measures):
+                meas[name] = (sensor.held[..., k], sensor.fresh, sensor.valid,
+                              self.measured[name])
+        out = x.copy()
+        for name, (value, _fresh, valid, _var) in meas.items():
+            j = self.state_names.index(name)
+            out[..., j] = np.where(valid, value, x[..., j])
+        if self.estimator is not None:
+            if self._first:
+                self.estimator.start(x, self._est_rng)
+            self.estimator.update(t, np.asarray(u, dtype=float), meas, self._first)
+            for name, value in self.estimator.model_estimate().items():
+                out[..., self.state_names.index(name)] = value
+        self._first = False
+        values = {}
+        for sensor in self.sensors:
+            for k, name in enumerate(sensor.measures):
+                values[f"{name}_meas"] = np.where(sensor.valid, sensor.held[..., k], np.nan)
+            values[f"{sensor.name}_valid"] = sensor.valid.astype(float)
+        if self.estimator is not None:
+            values.update(self.estimator.signal_values(x))
+        self._values = values
+        return out
+
+    def signal_values(self) -> dict[str, np.ndarray]:
+        """The values of :attr:`signals` at the last :meth:`observe`."""
+        return dict(self._values)

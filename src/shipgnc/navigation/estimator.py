@@ -1,0 +1,188 @@
+"""What every estimator shares: the protocol :class:`~shipgnc.navigation.Navigation` calls, and
+:class:`GaussianFilter`, the batched mean/covariance bookkeeping of the Kalman filters
+(sequential measurement update, NEES, initialisation).
+
+An estimator is told the model, the control period and which states the sensors measure
+(:meth:`Estimator.prepare`), started on the first control sample (:meth:`Estimator.start`, from the
+true initial state plus a stated offset: the simulation knows the truth, a test or a study chooses
+the initial error), then updated once per control sample (:meth:`Estimator.update`: predict with
+the input applied over the last sample, then correct with the measurements delivered now).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+from shipgnc.frames import wrap_angle
+from shipgnc.models.base import Signal, names
+
+#: measurement dictionary handed to :meth:`Estimator.update`: state name → (held value (*batch,),
+#: fresh mask (*batch,), valid mask (*batch,), default noise variance)
+Measurements = dict
+
+
+class Estimator:
+    """Protocol (and common helpers) of the estimators."""
+
+    kind = "estimator"
+    #: model states the sensors must measure (filled in by :meth:`prepare`)
+    requires: tuple[str, ...] = ()
+
+    def prepare(self, model, Ts: float, measured: dict[str, float]) -> None:
+        """``measured``: model state name → the sensors' noise variance for it."""
+        raise NotImplementedError
+
+    def start(self, x_true: np.ndarray, rng) -> None:
+        raise NotImplementedError
+
+    def update(self, t: float, u: np.ndarray, meas: Measurements, first: bool) -> None:
+        raise NotImplementedError
+
+    def model_estimate(self) -> dict[str, np.ndarray]:
+        """Model state name → estimate (*batch,), for the states this estimator estimates."""
+        raise NotImplementedError
+
+    def signals(self) -> tuple[Signal, ...]:
+        raise NotImplementedError
+
+    def signal_values(self, x_true: np.ndarray) -> dict[str, np.ndarray]:
+        raise NotImplementedError
+
+    def _require_measured(self, model, measured) -> None:
+        missing = [s for s in self.requires if s not in measured]
+        if missing:
+            have = ", ".join(measured) or "none"
+            raise ConfigError(f"estimator {self.kind} needs a sensor measuring "
+                              f"{', '.join(missing)} (measured by the sensors: {have})")
+
+
+def as_std_vector(field: str, value, state_names: tuple[str, ...], default: float) -> np.ndarray:
+    """A per-state vector from a dict name → value, a sequence, a scalar or None (default)."""
+    n = len(state_names)
+    if value is None:
+        out = np.full(n, float(default))
+    elif isinstance(value, dict):
+        unknown = [k for k in value if k not in state_names]
+        require(not unknown, field, value, f"unknown state(s) {unknown}; states: "
+                f"{', '.join(state_names)}")
+        out = np.array([float(value.get(s, default)) for s in state_names])
+    else:
+        out = np.broadcast_to(np.asarray(value, dtype=float), (n,)).astype(float)
+    require(bool(np.all(np.isfinite(out))), field, out.tolist(), "must be finite")
+    return out
+
+
+class GaussianFilter(Estimator):
+    """Mean ``z`` (*batch, n) and covariance ``P`` (*batch, n, n) of a Kalman-type filter whose
+    state vector has names ``state_names``; the ones that are model states (same name) are its
+    estimates of the vessel. Subclasses implement :meth:`predict` and the measurement rows."""
+
+    def __init__(self, *, P0_std=None, x0_offset=None, sample_initial: bool = False,
+                 measurement_std=None):
+        self._P0_std_arg = P0_std
+        self._x0_offset_arg = x0_offset
+        require(isinstance(sample_initial, bool), f"{self.kind}.sample_initial", sample_initial,
+                "must be true or false")
+        self.sample_initial = sample_initial
+        self._meas_std_arg = measurement_std
+        if measurement_std is not None:
+            require(isinstance(measurement_std, dict), f"{self.kind}.measurement_std",
+                    measurement_std, "must map state names to noise std")
+            for k, v in measurement_std.items():
+                require(isinstance(v, (int, float)) and math.isfinite(v) and v >= 0,
+                        f"{self.kind}.measurement_std.{k}", v, "must be a finite number >= 0")
+
+    # ---- set up by subclasses in prepare ------------------------------------------------------
+    def _setup_states(self, model, state_names, units, angles, z0=None):
+        self.state_names = tuple(state_names)
+        self.units = tuple(units)
+        self.angles = np.array(angles, dtype=bool)
+        model_names = names(model.states)
+        self.model_names = model_names
+        self.map = {i: model_names.index(s) for i, s in enumerate(self.state_names)
+                    if s in model_names}
+        n = len(self.state_names)
+        self.P0_std = as_std_vector(f"{self.kind}.P0_std", self._P0_std_arg, self.state_names, 1.0)
+        require(bool(np.all(self.P0_std >= 0)), f"{self.kind}.P0_std", self.P0_std.tolist(),
+                "standard deviations must be >= 0")
+        self.x0_offset = as_std_vector(f"{self.kind}.x0_offset", self._x0_offset_arg,
+                                       self.state_names, 0.0)
+        self.z0 = np.zeros(n) if z0 is None else np.asarray(z0, dtype=float)
+
+    def start(self, x_true, rng) -> None:
+        batch = x_true.shape[:-1]
+        n = len(self.state_names)
+        z = np.broadcast_to(self.z0, (*batch, n)).copy()
+        for i, j in self.map.items():
+            z[..., i] = x_true[..., j]
+        z = z + self.x0_offset
+        if self.sample_initial:
+            z = z + self.P0_std * np.asarray(rng.standard_normal((*batch, n)), dtype=float)
+        self.z = z
+        self.P = np.broadcast_to(np.diag(self.P0_std**2), (*batch, n, n)).copy()
+
+    # ---- the measurement update ---------------------------------------------------------------
+    def correct_row(self, c: np.ndarray, y: np.ndarray, var: float, fresh: np.ndarray,
+                    angle: bool) -> None:
+        """Scalar update with y = c·z + v, v ~ N(0, var), for the ships where ``fresh``
+        (sequential processing of independent measurements equals the joint update)."""
+        if not np.any(fresh):
+            return
+        Pc = self.P @ c                                   # (*batch, n)
+        S = Pc @ c + var                                  # (*batch,)
+        ok = fresh & (S > 0)
+        S = np.where(ok, S, 1.0)
+        K = Pc / S[..., None]
+        innov = y - self.z @ c
+        if angle:
+            innov = wrap_angle(innov)
+        innov = np.where(ok, innov, 0.0)
+        self.z = self.z + K * innov[..., None]
+        P_new = self.P - K[..., :, None] * Pc[..., None, :]
+        P_new = 0.5 * (P_new + np.swapaxes(P_new, -1, -2))
+        self.P = np.where(ok[..., None, None], P_new, self.P)
+
+    def measurement_variance(self, name: str, default: float) -> float:
+        if self._meas_std_arg and name in self._meas_std_arg:
+            return float(self._meas_std_arg[name]) ** 2
+        return float(default)
+
+    # ---- outputs ------------------------------------------------------------------------------
+    def model_estimate(self) -> dict[str, np.ndarray]:
+        return {self.state_names[i]: self.z[..., i] for i in self.map}
+
+    def nees(self, x_true: np.ndarray) -> np.ndarray:
+        """(x − x̂)ᵀ P⁻¹ (x − x̂) over the filter states that are model states (the marginal
+        covariance of that block; angles wrapped)."""
+        idx = list(self.map)
+        err = np.stack([x_true[..., self.map[i]] - self.z[..., i] for i in idx], axis=-1)
+        for k, i in enumerate(idx):
+            if self.angles[i]:
+                err[..., k] = wrap_angle(err[..., k])
+        Psub = self.P[..., idx, :][..., :, idx]
+        with np.errstate(all="ignore"):
+            try:
+                sol = np.linalg.solve(Psub, err[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                return np.full(err.shape[:-1], np.nan)
+        return np.sum(err * sol, axis=-1)
+
+    def signals(self) -> tuple[Signal, ...]:
+        out = []
+        for s, u, a in zip(self.state_names, self.units, self.angles, strict=True):
+            out.append(Signal(f"{s}_hat", u, f"{s} estimated by the {self.kind}", bool(a)))
+        for s, u in zip(self.state_names, self.units, strict=True):
+            out.append(Signal(f"{s}_std", u, f"standard deviation of the {self.kind}'s {s}"))
+        out.append(Signal("nees", "1", "normalised estimation error squared (estimated model "
+                                       "states)"))
+        return tuple(out)
+
+    def signal_values(self, x_true) -> dict[str, np.ndarray]:
+        out = {f"{s}_hat": self.z[..., i] for i, s in enumerate(self.state_names)}
+        std = np.sqrt(np.maximum(np.diagonal(self.P, axis1=-2, axis2=-1), 0.0))
+        out.update({f"{s}_std": std[..., i] for i, s in enumerate(self.state_names)})
+        out["nees"] = self.nees(x_true) if self.map else np.full(x_true.shape[:-1], np.nan)
+        return out

@@ -1,0 +1,295 @@
+"""Sensor models between the true state and the controller: GNSS, compass, rate gyro, speed log.
+
+Every sensor measures one or more states of the model, found by name in ``model.states``
+(``north``/``east`` for a GNSS receiver, ``psi`` for a compass, ``r`` for a rate gyro, ``u`` for a
+speed log; the boat, CyberShip II, the catamaran and the Mariner all name them so, in their own
+order). A sensor is sampled every ``1/rate_hz`` seconds, a whole multiple ``m`` of the control
+period ``Ts`` (``rate_hz=None``: every control sample); anything else is refused with a
+:class:`~shipgnc.errors.ConfigError`. Its output is held between samples. A sample taken at
+``t_j`` is delivered ``latency`` control samples later (``latency`` a whole number ≥ 0); a sample
+taken inside a dropout interval ``[t0, t1]`` is lost. Before the first delivery, and while the
+samples are lost, the sensor's ``valid`` flag is false (its held value is the last one delivered,
+NaN before the first).
+
+Error models (per ship, independent draws; w ~ N(0, 1) white):
+
+* :class:`GNSS` position: y = p + b + σ w with a first-order Gauss–Markov bias per axis,
+  ḃ = −b/T_b + √(2σ_b²/T_b) w, sampled exactly at the receiver's period h:
+  b_{k+1} = e^{−h/T_b} b_k + σ_b √(1 − e^{−2h/T_b}) w_k, started in its stationary distribution
+  N(0, σ_b²) (Farrell, *Aided Navigation*, 2008, §4.9; Fossen 2021 §14.1 for GNSS error levels).
+* :class:`Compass` heading: y = ψ + b + σ w, b a constant (``bias``) plus an optional per-ship
+  constant drawn N(0, ``bias_std``²) at reset. The heading is reported on the model's unwrapped
+  scale (as after an unwrapping front end); every estimator wraps its heading innovations.
+* :class:`RateGyro` yaw rate: y = r + b + σ w with a random-walk bias b_{k+1} = b_k +
+  σ_rw √h w_k (``bias_walk`` σ_rw in rad/s/√s; ``bias`` its initial value).
+* :class:`SpeedLog` surge speed (or any velocity state, ``state=``): y = u + σ w.
+
+Random numbers come from the generator the navigation system hands to :meth:`Sensor.reset`: a
+``numpy.random.Generator`` (draws of shape ``(*batch, k)``, the convention of
+:class:`~shipgnc.environment.disturbance.GaussianForceNoise`) or a
+:class:`~shipgnc.sim.streams.MemberStreams` (one stream per ship: a ship's noise does not depend on
+the batch it shares).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+from shipgnc.models.base import Signal, names
+
+
+def _nonneg(field: str, value, what: str = "") -> float:
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    require(ok and math.isfinite(value) and value >= 0, field, value,
+            f"must be a finite number >= 0{what}")
+    return float(value)
+
+
+def _finite(field: str, value, what: str = "") -> float:
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    require(ok and math.isfinite(value), field, value, f"must be a finite number{what}")
+    return float(value)
+
+
+def sample_every(field: str, rate_hz, Ts: float) -> int:
+    """The number m of control samples per sensor sample: 1/rate_hz = m·Ts (m ≥ 1 whole)."""
+    if rate_hz is None:
+        return 1
+    ok = isinstance(rate_hz, (int, float)) and not isinstance(rate_hz, bool)
+    require(ok and math.isfinite(rate_hz) and rate_hz > 0, field, rate_hz,
+            "must be a number > 0 Hz (or None: every control sample)")
+    m = round(1.0 / (rate_hz * Ts))
+    allowed = ", ".join(f"{1.0 / (k * Ts):g}" for k in range(1, 6))
+    require(m >= 1 and abs(m * Ts * rate_hz - 1.0) <= 1e-9 * max(1, m), field, rate_hz,
+            f"the sample period 1/rate_hz must be a whole multiple of the control period "
+            f"Ts = {Ts:g} s (allowed: {allowed}, ... Hz)")
+    return m
+
+
+class Sensor:
+    """Common sampling, hold, latency and dropout logic; subclasses define :meth:`_measure`.
+
+    ``measures``: the model state names this sensor measures, in the order of its output.
+    """
+
+    kind = "sensor"
+    measures: tuple[str, ...] = ()
+    units: tuple[str, ...] = ()
+
+    def __init__(self, *, rate_hz=None, latency: int = 0, dropouts=(), name: str | None = None):
+        self.name = name or self.kind
+        require(isinstance(self.name, str) and self.name.isidentifier(), f"{self.kind}.name",
+                self.name, "must be a name (letters, digits, _)")
+        self.rate_hz = rate_hz
+        require(isinstance(latency, (int, np.integer)) and not isinstance(latency, bool)
+                and latency >= 0, f"{self.name}.latency", latency,
+                "must be a whole number >= 0 of control samples")
+        self.latency = int(latency)
+        intervals = []
+        try:
+            for pair in dropouts or ():
+                t0, t1 = (float(v) for v in pair)
+                intervals.append((t0, t1))
+        except (TypeError, ValueError):
+            raise ConfigError(f"{self.name}.dropouts = {dropouts!r}: must be a list of "
+                              f"[t0, t1] intervals in s") from None
+        for t0, t1 in intervals:
+            require(math.isfinite(t0) and math.isfinite(t1) and 0 <= t0 <= t1,
+                    f"{self.name}.dropouts", [t0, t1], "each interval needs 0 <= t0 <= t1 (s)")
+        self.dropouts = tuple(intervals)
+        self.every = 1
+        self.period = None
+
+    # ---- the run ------------------------------------------------------------------------------
+    def reset(self, batch_shape, rng, model, Ts: float) -> None:
+        """Check the rate against ``Ts``, find the measured states in ``model`` and draw the
+        initial error states from ``rng``."""
+        self.every = sample_every(f"{self.name}.rate_hz", self.rate_hz, Ts)
+        self.period = self.every * Ts
+        state_names = names(model.states)
+        missing = [s for s in self.measures if s not in state_names]
+        if missing:
+            raise ConfigError(f"{self.name}: measures {', '.join(missing)}, not a state of "
+                              f"{type(model).__name__} (states: {', '.join(state_names)})")
+        self.index = tuple(state_names.index(s) for s in self.measures)
+        self.batch_shape = tuple(batch_shape)
+        self.rng = rng
+        k = len(self.measures)
+        self.held = np.full((*self.batch_shape, k), np.nan)
+        self.valid = np.zeros(self.batch_shape, dtype=bool)
+        self.fresh = np.zeros(self.batch_shape, dtype=bool)
+        self._pipe: deque = deque()
+        self._j = 0
+        self._reset_errors()
+
+    def _draw(self, k: int | None = None) -> np.ndarray:
+        shape = (*self.batch_shape, len(self.measures) if k is None else k)
+        return np.asarray(self.rng.standard_normal(shape), dtype=float)
+
+    def _reset_errors(self) -> None:
+        pass
+
+    def _measure(self, x_true: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def in_dropout(self, t: float) -> bool:
+        return any(t0 <= t <= t1 for t0, t1 in self.dropouts)
+
+    def sample(self, t: float, x: np.ndarray) -> None:
+        """One control sample at time ``t`` with the true state ``x``: take a measurement when
+        due, deliver the one taken ``latency`` samples ago (``fresh``), hold otherwise. A lost
+        sample (dropout) clears ``valid`` at its delivery time."""
+        due = self._j % self.every == 0
+        value = None
+        if due:  # the error states advance through a dropout too
+            value = self._measure(x[..., list(self.index)])
+            if self.in_dropout(t):
+                value = None
+        self._j += 1
+        self._pipe.append((due, value))
+        self.fresh = np.zeros(self.batch_shape, dtype=bool)
+        if len(self._pipe) > self.latency:
+            was_due, value = self._pipe.popleft()
+            if was_due and value is None:
+                self.valid = np.zeros(self.batch_shape, dtype=bool)
+            elif was_due:
+                self.held = value
+                self.valid = np.ones(self.batch_shape, dtype=bool)
+                self.fresh = np.ones(self.batch_shape, dtype=bool)
+
+    # ---- what the estimators read -------------------------------------------------------------
+    def variances(self) -> np.ndarray:
+        """The stationary variance of each channel's error (white noise + random bias), the
+        default measurement-noise variance R an estimator uses."""
+        raise NotImplementedError
+
+    def signals(self) -> tuple[Signal, ...]:
+        out = tuple(Signal(f"{s}_meas", u, f"{s} measured by {self.name}", s == "psi")
+                    for s, u in zip(self.measures, self.units, strict=True))
+        return (*out, Signal(f"{self.name}_valid", "1", f"{self.name} measurement valid (1/0)"))
+
+
+class GNSS(Sensor):
+    """GNSS position fix (north, east) [m]: white noise ``noise_std`` σ [m], Gauss–Markov bias of
+    stationary std ``bias_std`` σ_b [m] and time constant ``bias_time_constant`` T_b [s]; default
+    1 Hz (see the module docstring)."""
+
+    kind = "gnss"
+    measures = ("north", "east")
+    units = ("m", "m")
+
+    def __init__(self, noise_std: float = 1.5, *, bias_std: float = 0.0,
+                 bias_time_constant: float = 300.0, rate_hz=1.0, latency: int = 0, dropouts=(),
+                 name: str | None = None):
+        super().__init__(rate_hz=rate_hz, latency=latency, dropouts=dropouts, name=name)
+        self.noise_std = _nonneg(f"{self.name}.noise_std", noise_std, " m")
+        self.bias_std = _nonneg(f"{self.name}.bias_std", bias_std, " m")
+        T = bias_time_constant
+        ok = isinstance(T, (int, float)) and not isinstance(T, bool) and math.isfinite(T) and T > 0
+        require(ok, f"{self.name}.bias_time_constant", T, "must be a number > 0 s")
+        self.bias_time_constant = float(T)
+
+    def _reset_errors(self) -> None:
+        self.bias = self.bias_std * self._draw() if self.bias_std > 0 else np.zeros(
+            (*self.batch_shape, 2))
+        self._first = True
+
+    def _measure(self, p):
+        if self.bias_std > 0:
+            if not self._first:
+                a = math.exp(-self.period / self.bias_time_constant)
+                self.bias = a * self.bias + self.bias_std * math.sqrt(1 - a * a) * self._draw()
+            self._first = False
+        noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
+        return p + self.bias + noise
+
+    def variances(self):
+        return np.full(2, self.noise_std**2 + self.bias_std**2)
+
+
+class Compass(Sensor):
+    """Compass / gyrocompass heading ψ [rad]: white noise ``noise_std`` [rad], constant ``bias``
+    [rad] plus a per-ship constant of std ``bias_std`` [rad] drawn at reset."""
+
+    kind = "compass"
+    measures = ("psi",)
+    units = ("rad",)
+
+    def __init__(self, noise_std: float = math.radians(0.5), *, bias: float = 0.0,
+                 bias_std: float = 0.0, rate_hz=None, latency: int = 0, dropouts=(),
+                 name: str | None = None):
+        super().__init__(rate_hz=rate_hz, latency=latency, dropouts=dropouts, name=name)
+        self.noise_std = _nonneg(f"{self.name}.noise_std", noise_std, " rad")
+        self.bias = _finite(f"{self.name}.bias", bias, " rad")
+        self.bias_std = _nonneg(f"{self.name}.bias_std", bias_std, " rad")
+
+    def _reset_errors(self) -> None:
+        self._b = self.bias + (self.bias_std * self._draw() if self.bias_std > 0 else 0.0)
+
+    def _measure(self, psi):
+        noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
+        return psi + self._b + noise
+
+    def variances(self):
+        return np.full(1, self.noise_std**2 + self.bias_std**2)
+
+
+class RateGyro(Sensor):
+    """Rate gyro r [rad/s]: white noise ``noise_std`` [rad/s], bias ``bias`` [rad/s] drifting as a
+    random walk of ``bias_walk`` [rad/s/√s]."""
+
+    kind = "gyro"
+    measures = ("r",)
+    units = ("rad/s",)
+
+    def __init__(self, noise_std: float = math.radians(0.1), *, bias: float = 0.0,
+                 bias_walk: float = 0.0, rate_hz=None, latency: int = 0, dropouts=(),
+                 name: str | None = None):
+        super().__init__(rate_hz=rate_hz, latency=latency, dropouts=dropouts, name=name)
+        self.noise_std = _nonneg(f"{self.name}.noise_std", noise_std, " rad/s")
+        self.bias = _finite(f"{self.name}.bias", bias, " rad/s")
+        self.bias_walk = _nonneg(f"{self.name}.bias_walk", bias_walk, " rad/s/sqrt(s)")
+
+    def _reset_errors(self) -> None:
+        self._b = np.full((*self.batch_shape, 1), self.bias)
+        self._first = True
+
+    def _measure(self, r):
+        if self.bias_walk > 0:
+            if not self._first:
+                self._b = self._b + self.bias_walk * math.sqrt(self.period) * self._draw()
+            self._first = False
+        noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
+        return r + self._b + noise
+
+    def variances(self):
+        return np.full(1, self.noise_std**2)
+
+
+class SpeedLog(Sensor):
+    """Speed log: the surge speed ``u`` [m/s] (or another velocity ``state``) with white noise
+    ``noise_std`` [m/s]."""
+
+    kind = "log"
+
+    def __init__(self, noise_std: float = 0.05, *, state: str = "u", rate_hz=None,
+                 latency: int = 0, dropouts=(), name: str | None = None):
+        super().__init__(rate_hz=rate_hz, latency=latency, dropouts=dropouts, name=name)
+        self.noise_std = _nonneg(f"{self.name}.noise_std", noise_std, " m/s")
+        require(isinstance(state, str), f"{self.name}.state", state, "must be a state name")
+        self.measures = (state,)
+        self.units = ("m/s",)
+
+    def _measure(self, u):
+        noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
+        return u + noise
+
+    def variances(self):
+        return np.full(1, self.noise_std**2)
+
+
+SENSOR_TYPES = {"gnss": GNSS, "compass": Compass, "gyro": RateGyro, "log": SpeedLog}
