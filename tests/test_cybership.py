@@ -88,7 +88,8 @@ def test_model_protocol_and_signals():
     assert isinstance(ship, Model)
     assert tuple(s.name for s in ship.states) == ("north", "east", "psi", "u", "v", "r")
     assert tuple(s.name for s in ship.inputs) == ("n", "delta")
-    assert tuple(s.name for s in ship.disturbances) == ("X_env", "Y_env", "N_env")
+    assert tuple(s.name for s in ship.disturbances) == ("X_env", "Y_env", "N_env", "current_north",
+                                                        "current_east")
     assert len(ship.state_limits) == 6
     lower, upper = ship.input_limits()
     np.testing.assert_allclose(lower, [0.0, -math.radians(35)])

@@ -47,6 +47,7 @@ from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, NotCompiled, kernel_function
 from shipgnc.models.base import Signal
+from shipgnc.models.fossen3dof import CURRENT, body_current
 from shipgnc.params import Params
 
 #: resistance fit R_K(V) = a0 + a1 V + a2 V² [kN, one hull] of eq. (8)
@@ -88,6 +89,9 @@ class CatamaranParams(Params):
     low_speed     "continued"     R below V_m: quadratic continuation, or the literal fit
     delta_row     "rate"          δ̇ = u_δ (rate) or the lag (22) with T_t, k_t
     T_t, k_t      2 s, 1          true thruster lag time constant and gain (``lag`` row)
+    Y_vV          0 kg/m          hull lift in sway, Y += Y_vV V v (preset ``si-consistent``)
+    Y_rV          0 kg            hull lift in yaw, Y += Y_rV V r (preset ``si-consistent``)
+    Y_vv          0 kg/m          cross-flow drag, Y += Y_vv |v| v (preset ``si-consistent``)
     m_x_factor…   1               plant-uncertainty multipliers of m_x, m_y, J (floats or
                                   per-ship arrays broadcasting against the batch)
     ============  ==============  ======================================================
@@ -108,6 +112,9 @@ class CatamaranParams(Params):
     delta_row: str = "rate"
     T_t: float = 2.0
     k_t: float = 1.0
+    Y_vV: float = 0.0
+    Y_rV: float = 0.0
+    Y_vv: float = 0.0
     m_x_factor: float | np.ndarray = 1.0
     m_y_factor: float | np.ndarray = 1.0
     J_factor: float | np.ndarray = 1.0
@@ -199,17 +206,74 @@ class CatamaranParams(Params):
 
 
 
-#: named parameter sets (spec 004 §4.4); ``coriolis="consistent"`` is an override of either
+#: density of sea water for the lateral-lift terms of ``si-consistent`` [kg/m³]
+RHO_SEA = 1025.0
+#: demihull beam assumed for Clarke's regression [m] [A] (the document gives the overall beam only)
+DEMIHULL_BEAM = 2.5
+#: cross-flow drag coefficient of a demihull section [A]
+CROSS_FLOW_CD = 0.8
+
+
+def clarke_lateral(L: float = 22.3, T_m: float = 1.55, C_B: float = 0.697, B: float = DEMIHULL_BEAM,
+                   hulls: int = 2, rho: float = RHO_SEA, C_Dy: float = CROSS_FLOW_CD) -> dict[str, float]:
+    """Lateral hull lift and cross-flow drag of the physically consistent preset (spec 004 §4.11.7) [A].
+
+    Linear sway derivatives per demihull from Clarke, Gedling & Hine (1983),
+    Y'_v = −π(T/L)²(1 + 0.40 C_B B/T), Y'_r = −π(T/L)²(−1/2 + 2.2 B/L − 0.080 B/T), made dimensional
+    (Y_v = ½ρL²U Y'_v, Y_r = ½ρL³U Y'_r) and summed over the ``hulls``; cross-flow drag
+    Y = −½ρ C_Dy (hulls·L T_m)|v|v. The yaw derivatives are left to the document's own M_K, Munk
+    moment and M_D, which already have Clarke's size (N'_v, N'_r; spec 004 §4.4). Returns the
+    :class:`CatamaranParams` fields ``Y_vV`` [kg/m], ``Y_rV`` [kg], ``Y_vv`` [kg/m].
+    """
+    t2 = math.pi * (T_m / L) ** 2
+    Yv = -t2 * (1.0 + 0.40 * C_B * B / T_m)
+    Yr = -t2 * (-0.5 + 2.2 * B / L - 0.080 * B / T_m)
+    return {"Y_vV": hulls * 0.5 * rho * L**2 * Yv, "Y_rV": hulls * 0.5 * rho * L**3 * Yr,
+            "Y_vv": -0.5 * rho * C_Dy * hulls * L * T_m}
+
+
+#: named parameter sets (spec 004 §4.4). ``si-consistent`` (the scenarios' default) is the
+#: physically consistent hull: SI units, the sway Coriolis sign of the rigid-body equations
+#: (σ = −1) and a lateral hull force (:func:`clarke_lateral`, [A]) so that it is directionally
+#: stable with the drift of a real turn (bow into the circle). ``si`` (units fixed, printed sign)
+#: and ``paper`` (the listing's mixed units, printed sign) are reproductions of the document.
 PRESETS: dict[str, dict] = {
+    "si-consistent": {"coriolis": "consistent", **clarke_lateral()},
     "si": {},
     "paper": {"rho_MD": 1.025, "J_zz": 0.05 * 1.025 * 155_000.0 * 22.3**2 / 1000.0},
 }
+#: the preset of every scenario unless one is named
+DEFAULT_PRESET = "si-consistent"
+#: what each preset is, for figure titles and the metrics' ``model_note``
+PRESET_NOTES: dict[str, str] = {
+    "si-consistent": "physically consistent (SI units, sway Coriolis sign corrected, hull lift [A])",
+    "si": "printed Coriolis sign (reproduction)",
+    "paper": "paper units (unit-inconsistent), printed Coriolis sign (reproduction)",
+}
 #: the document's finite-state gains per preset: (T_u [s], h [s]) (spec 004 §4.4)
-FSM_GAINS: dict[str, tuple[float, float]] = {"paper": (0.1, 0.0625), "si": (2.5, 2.5)}
+FSM_GAINS: dict[str, tuple[float, float]] = {"paper": (0.1, 0.0625), "si": (2.5, 2.5),
+                                             "si-consistent": (2.5, 2.5)}
 
 
-def preset(name: str = "si", **overrides) -> CatamaranParams:
-    """Parameters of preset ``si`` or ``paper`` with optional overrides (e.g. ``coriolis=...``)."""
+def model_note(params: CatamaranParams, preset_name: str | None = None) -> tuple[str, bool]:
+    """(note, reproduction?) describing the hull ``params`` (of preset ``preset_name``): whether it
+    is a reproduction of the document (printed Coriolis sign, paper units) or physically consistent."""
+    paper = preset_name == "paper" or float(np.max(np.asarray(params.J_zz))) < 1e5
+    parts = []
+    if paper:
+        parts.append("paper units (unit-inconsistent)")
+    if params.coriolis == "printed":
+        parts.append("printed Coriolis sign (reproduction)")
+    elif params.Y_vV == 0.0 and params.Y_vv == 0.0:
+        parts.append("consistent Coriolis sign without hull lift (directionally unstable)")
+    if parts:
+        return ", ".join(parts), True
+    return PRESET_NOTES["si-consistent"], False
+
+
+def preset(name: str = DEFAULT_PRESET, **overrides) -> CatamaranParams:
+    """Parameters of preset ``si-consistent`` (default), ``si`` or ``paper`` with optional
+    overrides (e.g. ``coriolis=...``)."""
     if name not in PRESETS:
         raise ConfigError(f"vessel.preset = {name!r}: unknown preset; allowed: {', '.join(PRESETS)}")
     return CatamaranParams().with_(**{**PRESETS[name], **overrides})
@@ -234,21 +298,42 @@ DISTURBANCES = (
 U, V, R, NORTH, EAST, PSI, DELTA = range(7)
 
 
+def relative_state(x, d):
+    """(x with u, v through the water, the body-axis current (u_c, v_c) or None): the state the
+    hull's forces see in an earth-fixed current ``d[..., 3:5]`` [m/s] (Fossen 2021 §10.3).
+
+    The document's hull forces — resistance R(V_r) along −ν_r/V_r, its moment at x_p(β_r), the
+    yaw damping c_D V_r r, the Coriolis and Munk terms with the total masses m_x, m_y (rigid plus
+    added: Δ and k₁₁Δ, k₂₂Δ) and the lateral lift — are evaluated at ν_r = ν − ν_c and
+    ν̇ = ν̇_r + (r v_c, −r u_c, 0). With the consistent Coriolis sign the Coriolis terms are C(ν)ν of
+    M = diag(m_x, m_y, J) with x_g = 0, so Property 10.1 makes this Fossen's M_RB ν̇ + C_RB(ν)ν +
+    M_A ν̇_r + C_A(ν_r)ν_r + D(ν_r)ν_r = τ exactly for a constant current; with the printed sign
+    (not a rigid-body Coriolis term) the same substitution is applied as a reproduction. The
+    thrust does not depend on speed."""
+    current = body_current(x[..., PSI], d)
+    if current is None:
+        return x, None
+    xr = np.array(x, dtype=float, copy=True)
+    xr[..., U] = x[..., U] - current[0]
+    xr[..., V] = x[..., V] - current[1]
+    return xr, current
+
+
 @dataclass(frozen=True, eq=False)
 class Catamaran:
     """Document 004's twin-azimuth catamaran in NED form (see the module docstring)."""
 
     params: CatamaranParams = field(default_factory=CatamaranParams)
-    preset_name: str = "si"
+    preset_name: str = DEFAULT_PRESET
     length: float = 22.3  #: drawing outline only [m]
     beam: float = 9.0  #: drawing outline only [m] (thrusters at ±3 m)
 
     states = STATES
-    disturbances = DISTURBANCES
+    disturbances = (*DISTURBANCES, *CURRENT)
     state_limits = (50.0, 50.0, 50.0, 1e8, 1e8, 1e6, 1e4)
 
     @classmethod
-    def from_preset(cls, name: str = "si", **overrides) -> Catamaran:
+    def from_preset(cls, name: str = DEFAULT_PRESET, **overrides) -> Catamaran:
         return cls(params=preset(name, **overrides), preset_name=name)
 
     @property
@@ -269,14 +354,17 @@ class Catamaran:
         x_p = 0.4 * p.L * (0.5 - np.abs(beta) / np.pi)
         X = -r_over_v * u + p.m_y * v * r
         Y = -r_over_v * v + p.sigma * p.m_x * u * r
+        Y = Y + (p.Y_vV * speed * v + p.Y_rV * speed * r + p.Y_vv * np.abs(v) * v)  # lift (si-consistent)
         N = -x_p * r_over_v * v - p.c_D * speed * r + (p.m_x - p.m_y) * u * v
         return X, Y, N
 
     def derivatives(self, x, u, d=None):
-        """ẋ for ``x`` (..., 7), ``u`` (..., 1) = [δ̇] or [v_a], ``d`` (..., 3) or None."""
+        """ẋ for ``x`` (..., 7), ``u`` (..., 1) = [δ̇] or [v_a], ``d`` (..., 3) (forces), (..., 5)
+        (forces and an earth-fixed current [m/s], :func:`relative_state`) or None."""
         p = self.params
         delta = x[..., DELTA]
-        X, Y, N = self.hull_forces(x)
+        xr, current = relative_state(x, d)
+        X, Y, N = self.hull_forces(xr)
         cd, sd = np.cos(delta), np.sin(delta)
         X = X + 2.0 * p.T_v * cd
         Y = Y - 2.0 * p.T_v * sd
@@ -288,13 +376,16 @@ class Catamaran:
             delta_dot = np.broadcast_to(u[..., 0], delta.shape)
         else:
             delta_dot = (-delta + p.k_t * u[..., 0]) / p.T_t
-        return np.stack([X / p.m_x, Y / p.m_y, N / p.J, north_dot, east_dot, x[..., R], delta_dot],
+        u_dot, v_dot = X / p.m_x, Y / p.m_y
+        if current is not None:  # ν̇ = ν̇_r + ν̇_c, ν̇_c = (r v_c, −r u_c, 0)
+            u_dot, v_dot = u_dot + x[..., R] * current[1], v_dot - x[..., R] * current[0]
+        return np.stack([u_dot, v_dot, N / p.J, north_dot, east_dot, x[..., R], delta_dot],
                         axis=-1)
 
     def yaw_acceleration(self, x, d=None):
-        """Φ₃ = ṙ at state ``x`` (it does not depend on the input)."""
+        """Φ₃ = ṙ at state ``x`` (it does not depend on the input; a current in ``d`` acts on ν_r)."""
         p = self.params
-        _, _, N = self.hull_forces(x)
+        _, _, N = self.hull_forces(relative_state(x, d)[0])
         N = N + p.L * p.T_v * np.sin(x[..., DELTA])
         if d is not None:
             N = N + d[..., 2]
@@ -314,7 +405,7 @@ class Catamaran:
 #: fields that may hold one value per ship (a Monte Carlo over the plant, check 16 / S10)
 FACTORS = ("m_x_factor", "m_y_factor", "J_factor")
 #: length of :func:`kernel_params`
-N_KERNEL_PARAMS = 15
+N_KERNEL_PARAMS = 18
 
 
 def kernel_params_reason(params: CatamaranParams) -> str | None:
@@ -330,7 +421,7 @@ def kernel_params_reason(params: CatamaranParams) -> str | None:
 def kernel_params(params: CatamaranParams) -> np.ndarray:
     """The parameters of :func:`catamaran_rhs` and :func:`catamaran_yaw_acceleration`:
     ``[m_x, m_y, J, σ m_x, m_x − m_y, c_D, 0.4 L, 2 T_v, L T_v, literal, V_m, 2000 R_K(V_m)/V_m²,
-    lag row, k_t, T_t]`` (each product formed as :meth:`Catamaran.hull_forces` and
+    lag row, k_t, T_t, Y_vV, Y_rV, Y_vv]`` (each product formed as :meth:`Catamaran.hull_forces` and
     :meth:`Catamaran.derivatives` form it, so the kernel repeats numpy's operations): a flat
     array, or one row per ship when the mass factors vary from ship to ship."""
     reason = kernel_params_reason(params)
@@ -343,7 +434,7 @@ def kernel_params(params: CatamaranParams) -> np.ndarray:
     columns = np.broadcast_arrays(
         m_x, m_y, J, p.sigma * m_x, m_x - m_y, p.c_D, 0.4 * p.L, 2.0 * p.T_v, p.L * p.T_v,
         float(p.low_speed == "literal"), V_MIN_FIT, 2000.0 * rk_min / V_MIN_FIT**2,
-        float(p.delta_row == "lag"), p.k_t, p.T_t)
+        float(p.delta_row == "lag"), p.k_t, p.T_t, p.Y_vV, p.Y_rV, p.Y_vv)
     out = np.ascontiguousarray(np.stack(columns, axis=-1), dtype=np.float64)
     assert out.shape[-1] == N_KERNEL_PARAMS
     return out
@@ -369,6 +460,7 @@ def _hull_forces(x, p, o):
     x_p = x_p0 * (0.5 - abs(beta) / math.pi)
     X = -r_over_v * su + m_y * sv * sr
     Y = -r_over_v * sv + sig_m_x * su * sr
+    Y = Y + (p[o + 15] * speed * sv + p[o + 16] * speed * sr + p[o + 17] * abs(sv) * sv)
     N = -x_p * r_over_v * sv - c_D * speed * sr + munk * su * sv
     return X, Y, N
 
@@ -377,18 +469,34 @@ def _hull_forces(x, p, o):
 def catamaran_rhs(x, u, d, p, xdot):
     """ẋ of document 004 eq. (1)–(3) with δ̇ of eq. (2) (rate row) or of the lag (22) for one
     ship: :meth:`Catamaran.derivatives`, operation for operation (``p``: :func:`kernel_params`;
-    a zero ``d`` is ``d=None``)."""
+    forces ``d[0:3]``, earth-fixed current ``d[3:5]`` as relative velocity; a zero ``d`` is
+    ``d=None``)."""
     m_x, m_y, J, two_T_v, L_T_v = p[0], p[1], p[2], p[7], p[8]
     delta = x[6]
-    X, Y, N = _hull_forces(x, p, 0)
+    c, s = math.cos(x[5]), math.sin(x[5])
+    in_current = d.shape[0] > 4 and (d[3] != 0.0 or d[4] != 0.0)
+    uc = 0.0
+    vc = 0.0
+    if in_current:  # the hull sees ν_r = ν − R(ψ)ᵀ[V_N, V_E]
+        uc = c * d[3] + s * d[4]
+        vc = -s * d[3] + c * d[4]
+        xr = np.empty(3)
+        xr[0] = x[0] - uc
+        xr[1] = x[1] - vc
+        xr[2] = x[2]
+        X, Y, N = _hull_forces(xr, p, 0)
+    else:
+        X, Y, N = _hull_forces(x, p, 0)
     cd, sd = math.cos(delta), math.sin(delta)
     X = X + two_T_v * cd + d[0]
     Y = Y - two_T_v * sd + d[1]
     N = N + L_T_v * sd + d[2]
-    c, s = math.cos(x[5]), math.sin(x[5])
     xdot[0] = X / m_x
     xdot[1] = Y / m_y
     xdot[2] = N / J
+    if in_current:  # ν̇_c = (r v_c, −r u_c, 0)
+        xdot[0] = xdot[0] + x[2] * vc
+        xdot[1] = xdot[1] - x[2] * uc
     xdot[3] = c * x[0] - s * x[1]
     xdot[4] = s * x[0] + c * x[1]
     xdot[5] = x[2]
@@ -442,7 +550,8 @@ def document_derivatives(params: CatamaranParams, z, u_delta):
     s = p.sigma
     phi = [
         (2 * p.T_v * np.cos(delta) - Rx - p.m_y * w * Vy) / p.m_x,
-        (2 * p.T_v * np.sin(delta) - Ry - s * p.m_x * w * Vx) / p.m_y,
+        (2 * p.T_v * np.sin(delta) - Ry - s * p.m_x * w * Vx
+         + p.Y_vV * speed * Vy - p.Y_rV * speed * w + p.Y_vv * np.abs(Vy) * Vy) / p.m_y,
         (p.L * p.T_v * np.sin(delta) + M_K + M_D - (p.m_x - p.m_y) * Vx * Vy) / p.J,
         speed * np.cos(K - beta),
         speed * np.sin(K - beta),

@@ -30,7 +30,17 @@ sign. Linearised at (u₀, 0, 0) the sway–yaw equations are eq. (16) term by t
 (:func:`shipgnc.analysis.nomoto.davidson_schiff`).
 
 State ``[north, east, psi, u, v, r]`` (NED, ψ clockwise from north), input ``[n, delta]``,
-disturbance ``[X_env, Y_env, N_env]`` in body axes (N, N, N·m; e.g. wave loads).
+disturbance ``[X_env, Y_env, N_env, current_north, current_east]``: forces in body axes (N, N,
+N·m; e.g. wave loads) and an earth-fixed current [m/s] (the last two may be left out: no current).
+
+**Current** (Fossen 2021 §10.3, Property 10.1): u, v of the state are over ground (η̇ = J(ψ)ν);
+everything the water does acts on ν_r = ν − ν_c, ν_c = R(ψ)ᵀ[V_N, V_E, 0]ᵀ — the Coriolis matrix
+C(ν_r) (rigid-body and added mass: the products C(ν)ν above equal those of C_RB parametrised
+independently of the linear velocity, so Property 10.1 applies), the damping D(ν_r), the
+propeller's advance speed in T(n, u_r) and the rudder's inflow u_rud(u_r) — and
+ν̇ = ν̇_r + [r v_c, −r u_c, 0]ᵀ (exact for an irrotational current constant in NED; for a slowly
+varying one the water's own acceleration is neglected, as in Fossen's MSS models). See
+:mod:`shipgnc.models.fossen3dof`.
 """
 
 from __future__ import annotations
@@ -46,7 +56,7 @@ from shipgnc.errors import require
 from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, flat, kernel_function
 from shipgnc.models.base import Signal
-from shipgnc.models.fossen3dof import DISTURBANCES, STATES
+from shipgnc.models.fossen3dof import CURRENT, DISTURBANCES, STATES, body_current
 from shipgnc.params import Params
 
 RUDDER_MODELS = ("table1", "skjetne")
@@ -289,7 +299,7 @@ class CyberShip2:
 
     states = STATES
     inputs = INPUTS
-    disturbances = DISTURBANCES
+    disturbances = (*DISTURBANCES, *CURRENT)
     state_limits = (1e6, 1e6, 1e5, 10.0, 10.0, 20.0)
 
     def input_limits(self) -> tuple[np.ndarray, np.ndarray]:
@@ -298,9 +308,13 @@ class CyberShip2:
         return np.array([p.n_min, -p.delta_max]), np.array([p.n_max, p.delta_max])
 
     def derivatives(self, x, u, d=None):
-        """ẋ for ``x`` (..., 6), ``u`` (..., 2) = [n, δ], ``d`` (..., 3) or None."""
+        """ẋ for ``x`` (..., 6), ``u`` (..., 2) = [n, δ], ``d`` (..., 3) (forces), (..., 5) (forces
+        and current, module docstring) or None."""
         p = self.params
         psi, su, sv, sr = x[..., 2], x[..., 3], x[..., 4], x[..., 5]
+        current = body_current(psi, d)
+        if current is not None:  # the hull and its propellers and rudders see ν_r
+            su, sv = su - current[0], sv - current[1]
         n, delta = u[..., 0], u[..., 1]
         tau_x = 2.0 * propeller_thrust(p, n, su)
         tau_y, tau_n = rudder_forces(p, delta, su, n)
@@ -317,9 +331,12 @@ class CyberShip2:
         f_y = tau_y - c23 * sr - d22 * sv - d23 * sr
         f_n = tau_n + c13 * su + c23 * sv - d32 * sv - d33 * sr
         (a, b), (c, e) = self._sway_yaw_inverse
+        u_dot, v_dot, r_dot = f_x / p.M11, a * f_y + b * f_n, c * f_y + e * f_n
+        if current is not None:  # back over ground: ν = ν_r + ν_c, ν̇_c = (r v_c, −r u_c, 0)
+            su, sv = x[..., 3], x[..., 4]
+            u_dot, v_dot = u_dot + sr * current[1], v_dot - sr * current[0]
         north_dot, east_dot = body_to_ned(psi, su, sv)
-        return np.stack([north_dot, east_dot, sr, f_x / p.M11, a * f_y + b * f_n, c * f_y + e * f_n],
-                        axis=-1)
+        return np.stack([north_dot, east_dot, sr, u_dot, v_dot, r_dot], axis=-1)
 
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`cybership2_rhs`); the parameters
@@ -351,9 +368,10 @@ def _thrust(T_nn, T_nu, n, su):
 
 @kernel_function
 def cybership2_rhs(x, u, d, p, xdot):
-    """ẋ of spec 003 §3.5 for one ship: M ν̇ + C(ν)ν + D(ν)ν = τ + τ_env, η̇ = J(ψ)ν, with the
-    propeller thrust and both rudder models of :meth:`CyberShip2.derivatives`, operation for
-    operation (zero ``d`` is no disturbance). ``p`` from :meth:`CyberShip2.kernel`."""
+    """ẋ of spec 003 §3.5 for one ship: M ν̇_r + C(ν_r)ν_r + D(ν_r)ν_r = τ + τ_env, η̇ = J(ψ)ν,
+    with the propeller thrust and both rudder models of :meth:`CyberShip2.derivatives`, operation
+    for operation (forces ``d[0:3]``, earth-fixed current ``d[3:5]``; zero ``d`` is still water
+    without disturbance). ``p`` from :meth:`CyberShip2.kernel`."""
     T_nn, T_nu, skjetne, Y_delta, N_delta = p[0], p[1], p[2], p[3], p[4]
     L_delta, L_absdd, k_u, jet_den, x_rudder = p[5], p[6], p[7], p[8], p[9]
     m, x_G, Y_vdot, c13_r, c23_u = p[10], p[11], p[12], p[13], p[14]
@@ -361,6 +379,15 @@ def cybership2_rhs(x, u, d, p, xdot):
     N_v, N_absv_v, N_absr_v, N_r, N_absv_r, N_absr_r = p[21], p[22], p[23], p[24], p[25], p[26]
     X_u, X_absu_u, X_uuu, M11, a, b, c, e = p[27], p[28], p[29], p[30], p[31], p[32], p[33], p[34]
     psi, su, sv, sr = x[2], x[3], x[4], x[5]
+    cp, sp = math.cos(psi), math.sin(psi)
+    uc = 0.0
+    vc = 0.0
+    in_current = d.shape[0] > 4 and (d[3] != 0.0 or d[4] != 0.0)
+    if in_current:  # the earth-fixed current in body axes; the hull sees ν_r
+        uc = cp * d[3] + sp * d[4]
+        vc = -sp * d[3] + cp * d[4]
+        su = su - uc
+        sv = sv - vc
     n, delta = u[0], u[1]
     thrust = _thrust(T_nn, T_nu, n, su)
     tau_x = 2.0 * thrust
@@ -390,13 +417,17 @@ def cybership2_rhs(x, u, d, p, xdot):
     f_x = tau_x - c13 * sr - d11 * su
     f_y = tau_y - c23 * sr - d22 * sv - d23 * sr
     f_n = tau_n + c13 * su + c23 * sv - d32 * sv - d33 * sr
-    cp, sp = math.cos(psi), math.sin(psi)
-    xdot[0] = cp * su - sp * sv
-    xdot[1] = sp * su + cp * sv
-    xdot[2] = sr
     xdot[3] = f_x / M11
     xdot[4] = a * f_y + b * f_n
     xdot[5] = c * f_y + e * f_n
+    if in_current:  # over ground: ν = ν_r + ν_c, ν̇_c = (r v_c, −r u_c, 0)
+        su = x[3]
+        sv = x[4]
+        xdot[3] = xdot[3] + sr * vc
+        xdot[4] = xdot[4] - sr * uc
+    xdot[0] = cp * su - sp * sv
+    xdot[1] = sp * su + cp * sv
+    xdot[2] = sr
 
 
 def steering_machine(params: CyberShip2Params, *, rate_limit: bool = True,

@@ -11,7 +11,24 @@ Equations (spec 001 §1.3–1.5; document 001 eq. (1)–(11))::
 
 State ``[north, east, psi, u, v, r]`` (NED, ψ clockwise from north), input ``[T, alpha]``
 (thrust ≥ 0 [N]; angle of the thrust vector from body x, positive to starboard [rad]),
-disturbance ``[X_env, Y_env, N_env]`` in body axes. α < 0 turns the boat to starboard.
+disturbance ``[X_env, Y_env, N_env, current_north, current_east]``: a force and moment in body
+axes and an earth-fixed current [m/s] (the last two may be left out: no current). α < 0 turns the
+boat to starboard.
+
+**Current** (Fossen 2021 §10.3, Property 10.1; Fossen 2012, MCMC "How to incorporate wind, waves
+and ocean currents"): u, v of the state are velocities over ground (ν absolute, η̇ = R(ψ)ν); the
+hull's forces — added-mass Coriolis, Munk moment and damping — act on the velocity through the
+water ν_r = ν − ν_c, ν_c = R(ψ)ᵀ[V_N, V_E, 0]ᵀ::
+
+    M ν̇_r + C(ν_r) ν_r + D(ν_r) ν_r = τ + τ_env,     ν̇ = ν̇_r + ν̇_c,   ν̇_c = [r v_c, −r u_c, 0]ᵀ
+
+This is M_RB ν̇ + C_RB(ν)ν + M_A ν̇_r + C_A(ν_r)ν_r + D(ν_r)ν_r = τ exactly for an irrotational
+current constant in NED: with C_RB parametrised independently of the linear velocity (here x_g = 0:
+C_RB ν = m[−r v, r u, 0]), M_RB ν̇ + C_RB(ν)ν = M_RB ν̇_r + C_RB(ν_r)ν_r (Property 10.1), so
+eq. (9)–(11') hold with ν_r in place of ν and the rotation of ν_c with the hull added back. For a
+slowly varying current (Gauss–Markov, a field sampled along the track) the water's own
+acceleration R(ψ)ᵀ v̇_c is neglected, as in Fossen's MSS models. The thrust does not depend on
+speed, so it is unchanged.
 
 ``munk_factor`` c_M: +1 follows eq. (7) (energy-conserving), −1 the printed eq. (11), 0 (default)
 drops the Munk yaw moment as Fossen's Otter model did (spec 001 A2, A3).
@@ -183,11 +200,27 @@ INPUTS = (
     Signal("T", "N", "thrust"),
     Signal("alpha", "rad", "thruster angle from body x, positive to starboard", angle=True),
 )
+#: the force channels of the disturbance vector (also CyberShip II's)
 DISTURBANCES = (
     Signal("X_env", "N", "environmental surge force"),
     Signal("Y_env", "N", "environmental sway force"),
     Signal("N_env", "N m", "environmental yaw moment"),
 )
+#: the earth-fixed current channels that follow the forces (:mod:`shipgnc.environment.current_field`)
+CURRENT = (
+    Signal("current_north", "m/s", "current over ground, north component"),
+    Signal("current_east", "m/s", "current over ground, east component"),
+)
+
+
+def body_current(psi, d):
+    """(u_c, v_c) = R(ψ)ᵀ[V_N, V_E]: the current of ``d[..., 3:5]`` in body axes, or None when
+    ``d`` has no current channels (Fossen 2021 §10.3)."""
+    if d is None or d.shape[-1] < 5:
+        return None
+    c, s = np.cos(psi), np.sin(psi)
+    vn, ve = d[..., 3], d[..., 4]
+    return c * vn + s * ve, -s * vn + c * ve
 
 
 @dataclass(frozen=True)
@@ -201,7 +234,7 @@ class VectoredThrustBoat:
 
     states = STATES
     inputs = INPUTS
-    disturbances = DISTURBANCES
+    disturbances = (*DISTURBANCES, *CURRENT)
     state_limits = (1e7, 1e7, 1e5, 50.0, 50.0, 50.0)
 
     @classmethod
@@ -214,40 +247,79 @@ class VectoredThrustBoat:
         return np.array([p.T_min, -p.alpha_max]), np.array([p.T_max, p.alpha_max])
 
     def derivatives(self, x, u, d=None):
-        """ẋ of eq. (1)–(5), (9)–(11') for ``x`` (..., 6), ``u`` (..., 2), ``d`` (..., 3) or None."""
+        """ẋ of eq. (1)–(5), (9)–(11') for ``x`` (..., 6), ``u`` (..., 2), ``d`` (..., 3) (forces),
+        (..., 5) (forces and current, module docstring) or None."""
         p = self.params
         psi, su, sv, sr = x[..., 2], x[..., 3], x[..., 4], x[..., 5]
         tau_u, tau_v, tau_r = thrust_forces(u[..., 0], u[..., 1], p.L_m)
         if d is not None:
             tau_u, tau_v, tau_r = tau_u + d[..., 0], tau_v + d[..., 1], tau_r + d[..., 2]
         north_dot, east_dot = body_to_ned(psi, su, sv)
-        u_dot = (tau_u + p.M22 * sv * sr + p.X_u * su) / p.M11
-        v_dot = (tau_v - p.M11 * su * sr + p.Y_v * sv) / p.M22
-        r_dot = (tau_r + p.munk_coefficient * su * sv + p.N_r * sr
+        current = body_current(psi, d)
+        ur, vr = (su, sv) if current is None else (su - current[0], sv - current[1])
+        u_dot = (tau_u + p.M22 * vr * sr + p.X_u * ur) / p.M11
+        v_dot = (tau_v - p.M11 * ur * sr + p.Y_v * vr) / p.M22
+        r_dot = (tau_r + p.munk_coefficient * ur * vr + p.N_r * sr
                  + p.N_rr * np.abs(sr) * sr) / p.M33
+        if current is not None:  # ν̇ = ν̇_r + ν̇_c, ν̇_c = (r v_c, −r u_c, 0)
+            u_dot, v_dot = u_dot + sr * current[1], v_dot - sr * current[0]
         return np.stack([north_dot, east_dot, sr, u_dot, v_dot, r_dot], axis=-1)
 
     def kernel(self) -> Kernel:
-        """:meth:`derivatives` for the composed loop (:func:`boat_rhs`)."""
+        """:meth:`derivatives` for the composed loop (:func:`boat_current_rhs`)."""
         p = self.params
-        return Kernel(boat_rhs, flat(p.M11, p.M22, p.M33, p.X_u, p.Y_v, p.N_r, p.N_rr,
-                                     p.munk_coefficient, p.L_m))
+        return Kernel(boat_current_rhs, flat(p.M11, p.M22, p.M33, p.X_u, p.Y_v, p.N_r, p.N_rr,
+                                             p.munk_coefficient, p.L_m))
+
+
+@kernel_function
+def _boat_accelerations(ur, vr, sr, tau_u, tau_v, tau_r, p):
+    """(u̇_r, v̇_r, ṙ) of eq. (9)–(11') at the velocity through the water (u_r, v_r, r);
+    ``p`` = [M11, M22, M33, X_u, Y_v, N_r, N_rr, k_Munk, L_m]."""
+    M11, M22, M33, X_u, Y_v, N_r, N_rr, k_munk = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+    u_dot = (tau_u + M22 * vr * sr + X_u * ur) / M11
+    v_dot = (tau_v - M11 * ur * sr + Y_v * vr) / M22
+    r_dot = (tau_r + k_munk * ur * vr + N_r * sr + N_rr * abs(sr) * sr) / M33
+    return u_dot, v_dot, r_dot
 
 
 @kernel_function
 def boat_rhs(x, u, d, p, xdot):
-    """ẋ of eq. (1)–(5), (9)–(11') for one ship: :meth:`VectoredThrustBoat.derivatives`, operation
-    for operation; ``p`` = [M11, M22, M33, X_u, Y_v, N_r, N_rr, k_Munk, L_m]."""
-    M11, M22, M33, X_u, Y_v, N_r, N_rr, k_munk, L_m = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8]
+    """ẋ of eq. (1)–(5), (9)–(11') for one ship in still water: the forces ``d[0:3]`` only (any
+    further entries of ``d`` are not read); ``p`` = [M11, M22, M33, X_u, Y_v, N_r, N_rr, k_Munk,
+    L_m]."""
     su, sv, sr = x[3], x[4], x[5]
     lateral = u[0] * math.sin(u[1])
     tau_u = u[0] * math.cos(u[1]) + d[0]
     tau_v = lateral + d[1]
-    tau_r = -L_m * lateral + d[2]
+    tau_r = -p[8] * lateral + d[2]
     c, s = math.cos(x[2]), math.sin(x[2])
     xdot[0] = c * su - s * sv
     xdot[1] = s * su + c * sv
     xdot[2] = sr
-    xdot[3] = (tau_u + M22 * sv * sr + X_u * su) / M11
-    xdot[4] = (tau_v - M11 * su * sr + Y_v * sv) / M22
-    xdot[5] = (tau_r + k_munk * su * sv + N_r * sr + N_rr * abs(sr) * sr) / M33
+    xdot[3], xdot[4], xdot[5] = _boat_accelerations(su, sv, sr, tau_u, tau_v, tau_r, p)
+
+
+@kernel_function
+def boat_current_rhs(x, u, d, p, xdot):
+    """:meth:`VectoredThrustBoat.derivatives` for one ship, operation for operation: forces
+    ``d[0:3]``, earth-fixed current ``d[3:5]`` as relative velocity (module docstring; a zero
+    current is still water)."""
+    su, sv, sr = x[3], x[4], x[5]
+    lateral = u[0] * math.sin(u[1])
+    tau_u = u[0] * math.cos(u[1]) + d[0]
+    tau_v = lateral + d[1]
+    tau_r = -p[8] * lateral + d[2]
+    c, s = math.cos(x[2]), math.sin(x[2])
+    xdot[0] = c * su - s * sv
+    xdot[1] = s * su + c * sv
+    xdot[2] = sr
+    if d.shape[0] < 5 or (d[3] == 0.0 and d[4] == 0.0):  # still water (or forces only)
+        xdot[3], xdot[4], xdot[5] = _boat_accelerations(su, sv, sr, tau_u, tau_v, tau_r, p)
+        return
+    uc = c * d[3] + s * d[4]
+    vc = -s * d[3] + c * d[4]
+    du, dv, dr = _boat_accelerations(su - uc, sv - vc, sr, tau_u, tau_v, tau_r, p)
+    xdot[3] = du + sr * vc
+    xdot[4] = dv - sr * uc
+    xdot[5] = dr

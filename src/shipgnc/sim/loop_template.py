@@ -1,6 +1,7 @@
 """The composed loop's body, as source: :mod:`shipgnc.sim.compose` writes it under a header that
 binds the free names below (the components' kernels ``model_fn``, ``ctrl_fn``, ``guid_fn``,
-``dist_fn``; the sizes ``nx``, ``nu``, ...; the row offsets ``o_*`` and log columns ``c_*`` of
+``dist_fn`` and a disturbance's current part ``cur_fn``; the sizes ``nx``, ``nu``, ...; the row
+offsets ``o_*`` and log columns ``c_*`` of
 :func:`~shipgnc.sim.compose.row_layout`; the flags ``has_*``) as constants of one combination,
 and compiles it (so this module is never imported as itself). It is
 :func:`shipgnc.sim.simulator.run_numpy` step for step, for one ship at a time (see
@@ -18,7 +19,7 @@ from shipgnc.kernels import JIT_OPTIONS, clip, wrap  # noqa: F401  (JIT_OPTIONS:
 
 
 def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, pd_rows, limits,
-         err, out, event, done_at):
+         err, out, event, done_at, Wu, pu_rows):
     n_ships = S.shape[0]
     for i in numba.prange(n_ships):
         row = S[i]
@@ -28,6 +29,8 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
         pc = pc_rows[min(ship, pc_rows.shape[0] - 1)].copy()
         pg = pg_rows[min(ship, pg_rows.shape[0] - 1)].copy()
         pd = pd_rows[min(ship, pd_rows.shape[0] - 1)].copy()
+        pu = pu_rows[min(ship, pu_rows.shape[0] - 1)].copy()
+        zui = np.empty(0)  # the current part keeps no state
         # the ship's carried state as fresh local arrays (written back after its last step):
         # arrays that cannot alias each other let LLVM keep values in registers across the
         # components' calls (views into S, or a parameter row picked by index, run ≈ 2× slower)
@@ -85,6 +88,8 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
                     end[j] = u[j]
             if has_dist and not per_stage:
                 dist_fn(t, x, zdi, pd, W[k - k0, i], d)
+                if has_cur:
+                    cur_fn(t, x, zui, pu, Wu[k - k0, i], d)
             if done != 0.0 and done_at[i] < 0:
                 done_at[i] = k
             if il == 0 or k == k_last:
@@ -136,6 +141,8 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
                         u[j] = end[j] if theta == 1.0 else start[j] + theta * (end[j] - start[j])
                 if has_dist and per_stage:
                     dist_fn(ts, xs, zdi, pd, W[k - k0, i], d)
+                    if has_cur:
+                        cur_fn(ts, xs, zui, pu, Wu[k - k0, i], d)
                 model_fn(xs, u, d, pm, kx)
                 if has_lag:
                     lag_rate_kernel(cs if continuous else cmd, ls, pa, kl)
