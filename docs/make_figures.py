@@ -38,6 +38,7 @@ SETS = {
                    "catamaran-fig4-5-fixed.png", "catamaran-fig7-sine.png", "catamaran-fig8-heading.png",
                    "catamaran-characteristic.png")),
     "study": ("make_figures:study_figure", ("study-boat-autopilot.png",)),
+    "cybership-analysis": ("cybership_analysis:figure", ("cybership-analysis.png",)),
 }
 
 
@@ -65,6 +66,8 @@ def _generator(path: str):
     module, _, name = path.partition(":")
     if module == "make_figures":
         return globals()[name]
+    if module == "cybership_analysis":  # a script beside this one (docs/)
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
     return getattr(importlib.import_module(module), name)
 
 

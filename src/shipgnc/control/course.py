@@ -12,7 +12,12 @@ Controllers (names of spec 003 §3.8, built by :func:`course_controller`):
   with x = [ψ, r], x_z = [ψ_z, r_z], ẋ_hz = [r_z, ṙ_z] from the reference model (15).
 * ``smc_printed`` (alias ``printed``) — the law as printed: no (hᵀB_h)⁻¹ and
   σ_h = h₁(ψ_z − ψ) + h₂(r_z − r) (eq. (9)); it is stable only because hᵀB_h < 0 (h₂ > 0, b₂ < 0).
-* ``smc_tuned`` — :func:`smc_tuned`: the consistent law with gains for the nonlinear plant.
+* ``smc_tuned`` — :func:`smc_tuned`: the consistent law on the printed design model (18) with
+  gains retuned for the nonlinear plant (a work-around: the surface is slowed because b₂ is 23 ×
+  too small);
+* ``smc_identified`` — :func:`smc_identified`: the consistent law designed with the document's
+  rules on a first-order Nomoto model **identified from the plant** (a 20°/20° zig-zag fitted by
+  least squares, :mod:`shipgnc.analysis.identification`).
 
 Both printed-gain SMCs use λ₁ = −0.0005, λ₂ = −7.8128, η_h = 10, φ_h = 0.3 on the design model
 (18) as printed (a₂₂ = 0.1057, b₂ = −0.0040), :func:`design_smc` doing the pole placement (10),
@@ -44,7 +49,7 @@ from shipgnc.models.cybership2 import CRUISE_RPS
 #: eigenvalues of the document (§3 of seed 003) [1/s]
 PAPER_LAMBDAS = (-0.0005, -7.8128)
 SMC_FORMS = ("consistent", "printed")
-CONTROLLER_NAMES = ("pd", "smc_printed", "smc_consistent", "smc_tuned")
+CONTROLLER_NAMES = ("pd", "smc_printed", "smc_consistent", "smc_tuned", "smc_identified")
 ALIASES = {"fossen": "smc_consistent", "printed": "smc_printed"}
 
 
@@ -363,13 +368,67 @@ def smc_tuned(design_model: tuple[float, float] | None = None, *, Ts: float = 0.
                              phi=gains["phi"], Ts=Ts, propeller_rps=propeller_rps)
 
 
-DESIGN_MODELS = ("eq18", "eq17", "eq16")
+#: gains of ``smc_identified`` on the identified Nomoto model (see :func:`smc_identified`)
+IDENTIFIED = {"lam1": -0.0005, "lam2": -1.0, "eta_rudder": 0.3, "phi": 0.03}
 
 
-def design_model_of(params=None, which: str = "eq18", *, u0: float | None = None) -> tuple[float, float]:
+def smc_identified(params=None, *, Ts: float = 0.1, propeller_rps: float = CRUISE_RPS,
+                   design_model: tuple[float, float] | None = None,
+                   **changes: float) -> SlidingModeCourse:
+    """The consistent law (14) designed on a model **identified from the plant** (``smc_identified``).
+
+    Design model: the first-order Nomoto model r/δ = K/(1 + Ts) fitted by least squares to the
+    plant's 20°/20° zig-zag at ``propeller_rps`` (:func:`shipgnc.analysis.identification.identify_cybership2`;
+    for the published CyberShip II with the ``table1`` rudder, 35° and 19.4105°/s: K = −0.264 s⁻¹,
+    T = 8.70 s, so a₂₂ = −0.115 s⁻¹, b₂ = −0.0303 s⁻², 7.6 × the printed (18)'s b₂ and a third of
+    the instantaneous (M⁻¹b)_r = −0.0918 s⁻²). ``design_model`` = (a₂₂, b₂) skips the
+    identification (e.g. a fit of another manoeuvre).
+
+    Gains (``IDENTIFIED``, overridable by keyword), by the document's rules — pole placement (10)
+    with λ₁ the eigenvalue of smallest modulus (kept at the paper's −0.0005), h its eigenvector,
+    N from (13) — and one sampled-loop rule for λ₂:
+
+    * λ₂ = −1 /s: |λ₂|·Ts = 0.1 (the surface decays over ten samples), ten times the reference
+      model's ω_n = 0.1 rad/s, so σ → 0 well inside the reference manoeuvre. On this model
+      K = [−0.0165, −29.19], h = [0.7071, 0.7071], hᵀB_h = −0.02146; the inner-loop yaw-rate
+      gain g = |k₂| + η_δ h₂/φ_h = 29.19 + 7.07 = 36.3 rad/(rad/s), so g·|(M⁻¹b)_r|·Ts = 0.33
+      on the *plant's* instantaneous gain (well below 1; the paper's gains on this model give
+      12.4, its k₂ alone 2.3);
+    * switching gain as a rudder angle η_δ = η_h/|hᵀB_h| = 0.3 rad (half the 35° limit) and
+      boundary layer φ_h = 0.03 rad/s, as ``smc_tuned`` (the switching term carries what the
+      linear model misses: the course instability at small r and the speed loss).
+
+    The paper's λ₂ = −7.81 with η_h = 10, φ_h = 0.3 on the identified model still limit-cycles
+    (the switching rudder η_h/|hᵀB_h| is ≈ 2 600 rad). λ₂ from −0.7 to −1.5 gives nearly the same
+    cost; λ₂ ≥ −0.3 lets the course-unstable ship lag its reference (the identified a₂₂ < 0 is an
+    average over the zig-zag's large yaw rates; at small r the plant is unstable).
+    """
+    from shipgnc.analysis.identification import identify_cybership2
+
+    unknown = set(changes) - set(IDENTIFIED)
+    if unknown:
+        raise ConfigError(f"smc_identified: unknown option(s) {', '.join(sorted(unknown))}; "
+                          f"allowed: {', '.join(IDENTIFIED)}")
+    gains = {**IDENTIFIED, **changes}
+    _check_positive("eta_rudder", gains["eta_rudder"])
+    if design_model is None:
+        design_model = identify_cybership2(params, propeller_rps=propeller_rps).design_model
+    a22, b2 = design_model
+    design = design_smc(a22, b2, gains["lam1"], gains["lam2"])
+    return SlidingModeCourse(design, form="consistent", eta=gains["eta_rudder"] * abs(design.hB),
+                             phi=gains["phi"], Ts=Ts, propeller_rps=propeller_rps)
+
+
+DESIGN_MODELS = ("eq18", "eq17", "eq16", "identified")
+
+
+def design_model_of(params=None, which: str = "eq18", *, u0: float | None = None,
+                    propeller_rps: float | None = None) -> tuple[float, float]:
     """(a₂₂, b₂) of a row of spec §3.4: ``eq18`` the printed (18) (default, the document's),
     ``eq17`` the reduction of the printed (17), ``eq16`` the reduction of (16) from ``params``
-    (CyberShip2Params, default the published ones) at ``u0`` (default 0.3 m/s)."""
+    (CyberShip2Params, default the published ones) at ``u0`` (default 0.3 m/s), or
+    ``identified``: the first-order Nomoto model fitted to the plant's 20°/20° zig-zag at
+    ``propeller_rps`` (default 8.13 rps; :func:`shipgnc.analysis.identification.identify_cybership2`)."""
     from shipgnc.analysis.nomoto import (
         PRINTED_EQ17,
         PRINTED_EQ18,
@@ -384,6 +443,10 @@ def design_model_of(params=None, which: str = "eq18", *, u0: float | None = None
             f"allowed: {', '.join(DESIGN_MODELS)}")
     if which == "eq18":
         return PRINTED_EQ18
+    if which == "identified":
+        from shipgnc.analysis.identification import identify_cybership2
+
+        return identify_cybership2(params, propeller_rps=propeller_rps).design_model
     linear = PRINTED_EQ17 if which == "eq17" else davidson_schiff(
         params if params is not None else CyberShip2Params(), U0_EQ17 if u0 is None else u0)
     reduced = first_order_reduction(nomoto_second_order(*linear))
@@ -393,7 +456,8 @@ def design_model_of(params=None, which: str = "eq18", *, u0: float | None = None
 def course_controller(name: str, params_or_design_model=None, Ts: float = 0.1, *,
                       design_model: str = "eq18", propeller_rps: float = CRUISE_RPS):
     """The controller called ``name`` in spec 003 §3.8: ``pd``, ``smc_printed`` (alias ``printed``),
-    ``smc_consistent`` (alias ``fossen``) or ``smc_tuned``.
+    ``smc_consistent`` (alias ``fossen``), ``smc_tuned`` or ``smc_identified`` (designed on the
+    model identified from the plant ``params``; a design model given directly is used as is).
 
     ``params_or_design_model`` is either the plant's
     :class:`~shipgnc.models.cybership2.CyberShip2Params` (or None), in which case the SMCs are
@@ -409,6 +473,8 @@ def course_controller(name: str, params_or_design_model=None, Ts: float = 0.1, *
     if key == "pd":
         return CoursePD(Ts=Ts, propeller_rps=propeller_rps)
     source = params_or_design_model
+    if key == "smc_identified" and (source is None or isinstance(source, CyberShip2Params)):
+        return smc_identified(source, Ts=Ts, propeller_rps=propeller_rps)
     if source is None or isinstance(source, CyberShip2Params):
         model = design_model_of(source, design_model)
     else:
@@ -421,5 +487,7 @@ def course_controller(name: str, params_or_design_model=None, Ts: float = 0.1, *
         model = (a22, b2)
     if key == "smc_tuned":
         return smc_tuned(model, Ts=Ts, propeller_rps=propeller_rps)
+    if key == "smc_identified":
+        return smc_identified(design_model=model, Ts=Ts, propeller_rps=propeller_rps)
     form = "consistent" if key == "smc_consistent" else "printed"
     return smc_paper(form, model, Ts=Ts, propeller_rps=propeller_rps)

@@ -807,6 +807,54 @@ class FroudeKrylovWaveLoads:
         """
         return np.sqrt(0.5 * np.sum(self.load_amplitudes(psi) ** 2, axis=-2))
 
+    def linear_response(self, psi: float, speed: float, mass, damping) -> dict:
+        """Wave-frequency sway/yaw response of a linear model to these loads (a RAO estimate).
+
+        For the drawn sea, at a fixed heading ψ [rad] and speed U [m/s], each component i meets the
+        ship at ω_e,i = ωᵢ − kᵢU cos βᵢ (:func:`encounter_frequency`) with the sway force and yaw
+        moment phasors Yᵢ = −j·g_Y aᵢcYᵢ, Nᵢ = g_N aᵢcNᵢ (Y ∝ sin θᵢ, N ∝ cos θᵢ). The linear
+        sway–yaw model ``mass`` M ν̇ + ``damping`` N ν = [Y, N] (ν = [v, r], e.g. eq. (16) from
+        :func:`shipgnc.analysis.nomoto.davidson_schiff`) answers with
+        νᵢ = (jω_e,i M + N)⁻¹[Yᵢ, Nᵢ] and ψᵢ = rᵢ/(jω_e,i) (negative ω_e: the conjugate phasor at
+        |ω_e|). With random phases the variances are Σ|·ᵢ|²/2. Open loop: an autopilot acting
+        well below ω_e (course control ≲ 0.5 rad/s vs ω_e ≈ 10 rad/s here) leaves it unchanged.
+
+        Returns the RMS of v [m/s], r [rad/s] and ψ [rad] as ``v_rms``, ``r_rms``, ``psi_rms``,
+        per ship (shape = the batch shape) and the mean |ω_e| (energy weighted) as
+        ``omega_e_mean``. This is the response statistic the loads are calibrated against
+        (docs/003_cybership_autopilot.md, "Wave-load calibration").
+        """
+        r = self._require_reset()
+        M = np.asarray(mass, dtype=float)
+        Nd = np.asarray(damping, dtype=float)
+        require(M.shape == (2, 2) and Nd.shape == (2, 2), "waves.linear_response", (M.shape, Nd.shape),
+                "mass and damping must be 2 x 2 (sway, yaw)")
+        require(math.isfinite(speed), "waves.linear_response.speed", speed, "must be finite [m/s]")
+        psi = float(psi)
+        chi = self.direction if self.spreading is None else r.direction
+        beta = np.broadcast_to(chi - psi, r.omega.shape)
+        _, fY, fN = self._shape_factors(np.full(self._batch, psi))
+        Y = -1j * self._weights[1] * fY
+        Nm = self._weights[2] * fN + 0j
+        w_e = r.omega - r.wavenumber * speed * np.cos(beta)
+        neg = w_e < 0
+        Y, Nm, w = np.where(neg, np.conj(Y), Y), np.where(neg, np.conj(Nm), Nm), np.abs(w_e)
+        w = np.where(w < 1e-9, 1e-9, w)
+        # (jωM + N)⁻¹ f for 2 × 2, per component
+        a = 1j * w * M[0, 0] + Nd[0, 0]
+        b = 1j * w * M[0, 1] + Nd[0, 1]
+        c = 1j * w * M[1, 0] + Nd[1, 0]
+        d = 1j * w * M[1, 1] + Nd[1, 1]
+        det = a * d - b * c
+        v = (d * Y - b * Nm) / det
+        rr = (a * Nm - c * Y) / det
+        ps = rr / (1j * w)
+        energy = np.abs(ps) ** 2
+        return {"v_rms": np.sqrt(0.5 * np.sum(np.abs(v) ** 2, axis=-1)),
+                "r_rms": np.sqrt(0.5 * np.sum(np.abs(rr) ** 2, axis=-1)),
+                "psi_rms": np.sqrt(0.5 * np.sum(energy, axis=-1)),
+                "omega_e_mean": np.sum(w * energy, axis=-1) / np.sum(energy, axis=-1)}
+
     def elevation(self, t: float, x: np.ndarray) -> np.ndarray:
         """Wave elevation ζ [m] at the ship's position at time t (for logging), shape (*batch,)."""
         r = self._require_reset()
