@@ -20,7 +20,7 @@ from shipgnc.scenarios.runner import build, run_scenario
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 
 NM, MIN = NAUTICAL_MILE, MINUTE
-COMPARED = ("lqr_paper", "lqr", "fl_paper", "fl_lookahead", "los_fl")
+COMPARED = ("lqr_paper", "lqr", "fl_paper", "fl_lookahead", "los_fl", "los_fl_oracle")
 # the model's straight-leg equilibrium under the document's disturbances (spec 000 §0.4), from
 # (25) with r = 0 and the paper's numbers: sin ψ_ss = −d_y/U, c δ_ss = −b_r
 U_PAPER, D_Y, B_R, C_PAPER = 0.215 / 0.86, 0.04, 0.1, 3.553
@@ -84,7 +84,7 @@ def test_compare_writes_figures_and_table(tmp_path):
     assert metrics["lqr_paper"]["lqr_gain"] == pytest.approx([3.4, 3.2, 1.0, 0.45])
     assert metrics["lqr"]["lqr_gain"] == pytest.approx([2.4455, 2.3244, 0.8788, 0.3162], abs=1e-4)
     assert "lqr_gain" not in metrics["los_fl"]
-    for name in ("lqr_paper", "lqr", "fl_lookahead", "los_fl"):
+    for name in ("lqr_paper", "lqr", "fl_lookahead", "los_fl", "los_fl_oracle"):
         assert metrics[name]["stable"], name
         assert metrics[name]["crosstrack_max_after_leg1_nm"] < 1.5  # never beyond the start
     assert not metrics["fl_paper"]["stable"]
@@ -118,7 +118,9 @@ def test_every_parameter_is_settable():
         "disturbance.wave_sigma_rad_min2=0.3", "controllers.lqr.R=0.5",
         "controllers.fl_lookahead.lookahead_nm=0.2", "controllers.los_fl.delta_nm=0.8",
         "controllers.lqr.Ts=0.6", "controllers.lqr_paper.Ts=0.6", "controllers.fl_paper.Ts=0.6",
-        "controllers.fl_lookahead.Ts=0.6", "controllers.los_fl.Ts=0.6", "vessel.rudder_max_deg=30"])
+        "controllers.fl_lookahead.Ts=0.6", "controllers.los_fl.Ts=0.6",
+        "controllers.los_fl_oracle.Ts=0.6", "controllers.los_fl.integral_gain_nm_min=0.05",
+        "vessel.rudder_max_deg=30"])
     lqr = build(s, "lqr")
     assert lqr.x0[1] == -500.0
     assert lqr.controller.K_paper == pytest.approx([3.4172, 3.2080, 1.0729, 0.4472], abs=1e-4)
@@ -129,8 +131,11 @@ def test_every_parameter_is_settable():
     assert dist.waves.sigma == pytest.approx(0.3 / MIN**2)
     assert build(s, "fl_lookahead").controller.lookahead == pytest.approx(0.2 * NM)
     los = build(s, "los_fl").controller
-    assert los.delta_los == pytest.approx(0.8 * NM) and los.d_y == pytest.approx(0.02 * NM / MIN)
-    assert los.current_frame == "global"
+    assert los.delta_los == pytest.approx(0.8 * NM) and los.d_y == 0.0  # told nothing (issue 17)
+    assert los.integral_gain == pytest.approx(0.05 * NM / MIN) and los.rate_from_positions
+    oracle = build(s, "los_fl_oracle").controller  # the document's law, handed the disturbances
+    assert oracle.d_y == pytest.approx(0.02 * NM / MIN) and oracle.current_frame == "global"
+    assert oracle.integral_gain == 0.0 and not oracle.rate_from_positions
 
 
 def test_show_prints_the_yaml():
@@ -205,7 +210,7 @@ def test_metric_definitions_on_a_synthetic_run():
     assert a["crosstrack_max_after_leg1_nm"][0] == pytest.approx(0.2)
     assert a["crosstrack_rms_after_leg1_nm"][0] == pytest.approx(0.2)
     assert a["saturation_fraction"][0] == pytest.approx(56 / 61)
-    assert a["stable"][0]
+    assert not a["stable"][0]  # bounded, but y_r swings ±0.2 nm to the end: a limit cycle
 
 
 def test_a_ship_sailing_its_leg_backwards_is_reversed_not_stable():

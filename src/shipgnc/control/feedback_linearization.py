@@ -24,7 +24,10 @@ switching A6, ``reference_names = ()``):
 * :class:`LOSFL` — ``los_fl``: LOS guidance with crab compensation
   ψ_d,r = −atan(y_r/Δ) − asin(d_y/u) (Δ = 0.5 nm) feeding an exact FL of the yaw loop,
   δ = (ν + H_N(r) − b_r)/c, ν = −k_p e − k_d (r − ψ̇_d,r), e = wrap(ψ_r − ψ_d,r),
-  k_p = 1 /min², k_d = 2 /min.
+  k_p = 1 /min², k_d = 2 /min. With ``integral_gain`` κ > 0 the LOS is **integral LOS**
+  (Børhaug, Pavlov & Pettersen 2008; Fossen 2021 §12.4), which removes the steady cross-track
+  offset of an *unknown* current and yaw bias; ``rate_from_positions`` takes ẏ_r from successive
+  GPS positions instead of the known current (issue 17).
 
 With r₂ ≠ 0 the laws use ∂v/∂r = r₁ + 3r₂r² where the spec (r₂ = 0) has r₁; for the Mariner
 (r₂ = 0) they are the spec's formulas term by term.
@@ -68,6 +71,7 @@ from shipgnc.frames import wrap_angle
 from shipgnc.guidance.path import (
     LEG_ANGLE,
     LEG_COS,
+    LEG_SIN,
     LegTracker,
     WaypointPath,
     leg_table,
@@ -174,7 +178,8 @@ class _PathFL:
 
     def _kernel(self, function, batch_shape, *specific) -> Kernel:
         """The kernel of a path FL controller: ``p`` = [δ_max, a, b, c, r₁, r₂, b_r, d_y, global
-        frame, *specific, leg table]; per-ship state of :func:`~shipgnc.control.lqr.path_state`."""
+        frame, *specific (7 numbers), leg table]; per-ship state of
+        :func:`~shipgnc.control.lqr.path_state`."""
         params = flat(self.delta_max, self.a, self.b, self.c, self.r1, self.r2, self.b_r, self.d_y,
                       float(self.current_frame == "global"), *specific, leg_table(self.path))
         return Kernel(function, params, path_state(self, batch_shape),
@@ -243,7 +248,7 @@ class OutputFL(_PathFL):
         """:meth:`step` for the composed loop (:func:`output_fl_step`), after ``reset``."""
         tiny = 1e-12 * abs(self.c) * (abs(self.r1) + self.lookahead + NAUTICAL_MILE)
         return self._kernel(output_fl_step, batch_shape, self.lookahead, self.k1, self.k2, tiny,
-                            3.0 * self.r2)
+                            3.0 * self.r2, 0.0, 0.0)
 
 
 def fl_paper(params, path: WaypointPath, *, Ts: float, **options) -> OutputFL:
@@ -258,13 +263,33 @@ def fl_lookahead(params, path: WaypointPath, *, Ts: float, lookahead: float = LO
 
 
 class LOSFL(_PathFL):
-    """``los_fl``: LOS guidance with crab compensation feeding an exact FL of the yaw loop.
+    """``los_fl``: (integral) LOS guidance feeding an exact FL of the yaw loop (spec 000 §0.5)::
 
-    ψ_d,r = −atan(y_r/Δ) − asin(d_y/u);  ψ̇_d,r = −Δ ẏ_r/(Δ² + y_r²)  (u̇ neglected);
-    e = wrap(ψ_r − ψ_d,r);  ν = −k_p e − k_d (r − ψ̇_d,r);  δ = (ν + H_N(r) − b_r)/c.
+        ρ = y_r + κ y_int,   ẏ_int = Δ y_r/(ρ² + Δ²)                 (integral LOS, κ ≥ 0)
+        ψ_d,r = −atan(ρ/Δ) − asin(d_y/u);  ψ̇_d,r = −Δ (ẏ_r + κ ẏ_int)/(Δ² + ρ²)  (u̇ neglected)
+        e = wrap(ψ_r − ψ_d,r);  ν = −k_p e − k_d (r − ψ̇_d,r);  δ = (ν + H_N(r) − b_r)/c.
 
-    SI arguments: ``delta_los`` Δ [m] (0.5 nm), ``kp`` [1/s²] = 1/60², ``kd`` [1/s] = 2/60.
-    Logged besides the path errors: ``los_heading`` ψ_d,r [rad] (relative to the leg).
+    κ = 0 with b_r, d_y known is the spec's law (the document's oracle: ``knows_disturbance``).
+    Without that knowledge (b_r = d_y = 0 here) plain LOS keeps a standing offset: the heading
+    must settle at the crab angle −asin(d_y/U) plus the yaw loop's error b_r/k_p, which
+    −atan(y_r/Δ) supplies only with y_r ≠ 0 (0.21 nm for the document's disturbances). The
+    integral LOS of Børhaug, Pavlov & Pettersen (2008) (Fossen 2021 §12.4, eq. (12.108)–(12.109))
+    builds that heading from κ y_int instead, so y_r → 0 on a straight leg for any constant
+    current and yaw bias; the denominator (ρ² + Δ²) slows the integration far from the path
+    (wind-up limited). Linearised on a leg, ÿ_r + (U/Δ) ẏ_r + (Uκ/Δ²) y_r = 0 (yaw loop fast):
+    κ = U/4 (0.0625 nm/min for the Mariner, the scenarios' default) is critically damped: a
+    double pole at −U/(2Δ) = −0.25 /min.
+    y_int is a forward-Euler sum (the command at t_k uses y_int(t_k)) and is kept at a leg switch
+    (the path-frame current is the same on every leg, as A7 keeps the LQR's e_I).
+
+    ``rate_from_positions``: ẏ_r is the cross-track component of the ground velocity from the
+    last two positions, ((n_k − n_{k−1})(−sin π_p) + (e_k − e_{k−1}) cos π_p)/(t_k − t_{k−1})
+    (a GPS speed over ground; π_p the active leg's angle), instead of u sin ψ_r + v cos ψ_r + d_y
+    from the known current; the first sample uses the latter.
+
+    SI arguments: ``delta_los`` Δ [m] (0.5 nm), ``kp`` [1/s²] = 1/60², ``kd`` [1/s] = 2/60,
+    ``integral_gain`` κ [m/s] (0 = plain LOS). Logged besides the path errors: ``los_heading``
+    ψ_d,r [rad] (relative to the leg).
     """
 
     signals = (*PATH_SIGNALS,
@@ -273,37 +298,90 @@ class LOSFL(_PathFL):
     def __init__(self, params, path: WaypointPath, *, Ts: float, delta_los: float = LOS_DELTA,
                  kp: float = KP_PAPER / MINUTE**2, kd: float = KD_PAPER / MINUTE,
                  delta_max: float = DELTA_MAX, b_r: float = 0.0, d_y: float = 0.0,
-                 current_frame: str = "path"):
+                 current_frame: str = "path", integral_gain: float = 0.0,
+                 rate_from_positions: bool = False):
         super().__init__(params, path, Ts=Ts, delta_max=delta_max, b_r=b_r, d_y=d_y,
                          current_frame=current_frame)
         for name, value in (("delta_los", delta_los), ("kp", kp), ("kd", kd)):
             require(isinstance(value, (int, float, np.floating)) and np.isfinite(value) and value > 0,
                     f"controller.{name}", value, "must be a finite number > 0")
+        require(isinstance(integral_gain, (int, float, np.floating)) and np.isfinite(integral_gain)
+                and integral_gain >= 0, "controller.integral_gain", integral_gain,
+                "must be a finite speed >= 0 m/s (0 = plain LOS)")
         self.delta_los, self.kp, self.kd = float(delta_los), float(kp), float(kd)
+        self.integral_gain = float(integral_gain)
+        self.rate_from_positions = bool(rate_from_positions)
+        self._cos, self._sin = np.cos(path.leg_angles), np.sin(path.leg_angles)
+        self.y_int: np.ndarray | None = None
+        self._prev: tuple | None = None  # (t, north, east, ẏ_int) of the last sample
+
+    def reset(self, batch_shape) -> None:
+        super().reset(batch_shape)
+        self.y_int = np.zeros(tuple(batch_shape))
+        self._prev = None
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        k = self.kinematics(measurement)
-        D, y_r = self.delta_los, k["y_r"]
+        x = np.asarray(measurement, dtype=float)
+        k = self.kinematics(x)
+        D, y_r, kappa = self.delta_los, k["y_r"], self.integral_gain
+        y_dot = k["y_dot"]
+        if self._prev is not None:
+            t0, n0, e0, rate0 = self._prev
+            h = t - t0
+            self.y_int = self.y_int + h * rate0  # forward Euler: y_int(t_k)
+            if self.rate_from_positions:
+                leg = self.tracker.leg
+                y_dot = ((x[..., I_NORTH] - n0) * -self._sin[leg]
+                         + (x[..., I_EAST] - e0) * self._cos[leg]) / h
+        rho = y_r + kappa * self.y_int
+        den = D**2 + rho * rho
+        rate = D * y_r / den
         crab = np.arcsin(np.clip(k["d_cross"] / np.maximum(k["u"], 1e-6), -1.0, 1.0))
-        psi_d = -np.arctan(y_r / D) - crab
-        psi_d_dot = -D * k["y_dot"] / (D**2 + y_r**2)
+        psi_d = -np.arctan(rho / D) - crab
+        psi_d_dot = -D * (y_dot + kappa * rate) / den
         e = wrap_angle(k["psi_r"] - psi_d)
         nu = -self.kp * e - self.kd * (k["r"] - psi_d_dot)
         raw = (nu + self.H_N(k["r"]) - self.b_r) / self.c
+        self._prev = (t, x[..., I_NORTH], x[..., I_EAST], rate)
         return self._finish(raw, k, los_heading=psi_d)
 
     def kernel(self, batch_shape) -> Kernel:
-        """:meth:`step` for the composed loop (:func:`los_fl_step`), after ``reset``."""
-        return self._kernel(los_fl_step, batch_shape, self.delta_los, self.kp, self.kd,
-                            self.delta_los**2, 0.0)
+        """:meth:`step` for the composed loop (:func:`los_fl_step`), after ``reset``; per-ship
+        state :func:`~shipgnc.control.lqr.path_state` then [y_int, ẏ_int, t, north, east, has
+        previous sample]."""
+        shape = tuple(batch_shape)
+        if self._prev is None:
+            own = [self.y_int, 0.0, 0.0, 0.0, 0.0, 0.0]
+        else:
+            t0, n0, e0, rate0 = self._prev
+            own = [self.y_int, rate0, t0, n0, e0, 1.0]
+        own = np.stack([np.broadcast_to(np.asarray(v, dtype=float), shape) for v in own], axis=-1)
+        z = np.concatenate([path_state(self, shape), own], axis=-1)
+        params = flat(self.delta_max, self.a, self.b, self.c, self.r1, self.r2, self.b_r, self.d_y,
+                      float(self.current_frame == "global"), self.delta_los, self.kp, self.kd,
+                      self.delta_los**2, 0.0, self.integral_gain, float(self.rate_from_positions),
+                      leg_table(self.path))
+
+        def restore(zf: np.ndarray) -> None:
+            zf = zf.reshape(*shape, zf.shape[-1])
+            restore_path_state(self, shape, zf[..., :_LOS_OWN])
+            self.y_int = zf[..., _LOS_OWN].copy()
+            if np.all(zf[..., _LOS_OWN + 5] > 0):
+                self._prev = (float(zf.reshape(-1, zf.shape[-1])[0, _LOS_OWN + 2]),
+                              zf[..., _LOS_OWN + 3].copy(), zf[..., _LOS_OWN + 4].copy(),
+                              zf[..., _LOS_OWN + 1].copy())
+
+        return Kernel(los_fl_step, params, z, restore=restore)
 
 
 # ----------------------------------------------------------------------------------------------
 # kernels (shipgnc.kernels): one ship's step, operation for operation as the numpy methods
 # ----------------------------------------------------------------------------------------------
 
-#: where the FL kernels find the leg table in their parameters (9 common + 5 specific numbers)
-_FL_LEGS = 14
+#: where the FL kernels find the leg table in their parameters (9 common + 7 specific numbers)
+_FL_LEGS = 16
+#: where :func:`los_fl_step` finds its own per-ship state (after :func:`path_state`'s 6 numbers)
+_LOS_OWN = 6
 
 
 @kernel_function
@@ -336,7 +414,7 @@ def output_fl_step(t, x, ref, z, p, cmd, sig):
     """One :meth:`OutputFL.step` for one ship: z = y_r + l sin ψ_r, ż, f, g of
     :meth:`OutputFL.linearization` ((19)–(20) with r₁ → r₁ + l + 3r₂r²), δ = clip((ν − f)/g) with
     ν = −k₁ z − k₂ ż ((21)–(23)) and |g| kept ≥ tiny. ``p`` = [common 9, l, k₁, k₂, tiny, 3r₂,
-    leg table]."""
+    0, 0, leg table]."""
     delta_max, a, b, c_rudder, r1, b_r = p[0], p[1], p[2], p[3], p[4], p[6]
     l, k1, k2, tiny, r2_3 = p[9], p[10], p[11], p[12], p[13]
     leg, y_r, psi_r, u, r, v, y_dot, _, s, c = path_kinematics(x, z, p)
@@ -355,17 +433,30 @@ def output_fl_step(t, x, ref, z, p, cmd, sig):
 
 @kernel_function
 def los_fl_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`LOSFL.step` for one ship: ψ_d,r = −atan(y_r/Δ) − asin(clip(d_cross/max(u, 1e-6))),
-    ψ̇_d,r = −Δ ẏ_r/(Δ² + y_r²), e = wrap(ψ_r − ψ_d,r), ν = −k_p e − k_d (r − ψ̇_d,r),
-    δ = clip((ν + H_N(r) − b_r)/c) (spec 000 §0.5). ``p`` = [common 9, Δ, k_p, k_d, Δ², 0, leg
-    table]."""
+    """One :meth:`LOSFL.step` for one ship: y_int += h ẏ_int (forward Euler), ρ = y_r + κ y_int,
+    ẏ_int = Δ y_r/(Δ² + ρ²), ψ_d,r = −atan(ρ/Δ) − asin(clip(d_cross/max(u, 1e-6))),
+    ψ̇_d,r = −Δ (ẏ_r + κ ẏ_int)/(Δ² + ρ²) (ẏ_r from the last two positions when asked),
+    e = wrap(ψ_r − ψ_d,r), ν = −k_p e − k_d (r − ψ̇_d,r), δ = clip((ν + H_N(r) − b_r)/c)
+    (spec 000 §0.5). ``p`` = [common 9, Δ, k_p, k_d, Δ², 0, κ, rate from positions, leg table];
+    ``z`` = [path_state 6, y_int, ẏ_int, t, north, east, has previous]."""
     delta_max, a, b, c_rudder, b_r = p[0], p[1], p[2], p[3], p[6]
-    D, kp, kd, D2 = p[9], p[10], p[11], p[12]
+    D, kp, kd, D2, kappa, from_positions = p[9], p[10], p[11], p[12], p[14], p[15]
     leg, y_r, psi_r, u, r, _, y_dot, d_cross, _, _ = path_kinematics(x, z, p)
+    o = _LOS_OWN
+    if z[o + 5] != 0.0:
+        h = t - z[o + 2]
+        z[o] = z[o] + h * z[o + 1]
+        if from_positions != 0.0:
+            y_dot = ((x[I_NORTH] - z[o + 3]) * -leg_value(p, _FL_LEGS, LEG_SIN, leg)
+                     + (x[I_EAST] - z[o + 4]) * leg_value(p, _FL_LEGS, LEG_COS, leg)) / h
+    rho = y_r + kappa * z[o]
+    den = D2 + rho * rho
+    rate = D * y_r / den
     u_safe = u if (u > 1e-6 or u != u) else 1e-6  # np.maximum(u, 1e-6), NaN kept
     crab = math.asin(clip(d_cross / u_safe, -1.0, 1.0))
-    psi_d = -math.atan(y_r / D) - crab
-    psi_d_dot = -D * y_dot / (D2 + y_r * y_r)
+    psi_d = -math.atan(rho / D) - crab
+    psi_d_dot = -D * (y_dot + kappa * rate) / den
+    z[o + 1], z[o + 2], z[o + 3], z[o + 4], z[o + 5] = rate, t, x[I_NORTH], x[I_EAST], 1.0
     e = wrap(psi_r - psi_d)
     nu = -kp * e - kd * (r - psi_d_dot)
     raw = (nu + (a * r + b * r * r * r) - b_r) / c_rudder

@@ -170,6 +170,43 @@ class SecondOrderNoise:
         return np.stack([self(float(t)) for t in np.asarray(times, dtype=float)])
 
 
+#: Pierson–Moskowitz modal frequency ω₀ = 0.40·√(g/H_s) (Fossen 2021 §10.2.1) [-]
+PM_MODAL = 0.40
+GRAVITY = 9.81
+
+
+def pm_significant_height(period: float) -> float:
+    """H_s [m] of the fully developed Pierson–Moskowitz sea whose peak period is ``period`` [s]:
+    ω₀ = 2π/T₀ = 0.40·√(g/H_s) (Fossen 2021 §10.2.1), so H_s = g (0.40/ω₀)²; 2.55 m for 8 s."""
+    require(isinstance(period, (int, float)) and math.isfinite(period) and period > 0,
+            "disturbance.wave_period", period, "must be a finite period > 0 s")
+    return GRAVITY * (PM_MODAL * period / (2.0 * math.pi)) ** 2
+
+
+def calibrated_yaw_sigma(heading_sigma: float, period: float) -> float:
+    """RMS σ_w [rad/s²] of the yaw acceleration (A11) that gives a wave-frequency heading of RMS
+    ``heading_sigma`` σ_ψw [rad] at peak period ``period`` T₀ [s] (issue 17)::
+
+        σ_w = ω₀² σ_ψw,   ω₀ = 2π/T₀.
+
+    Why. Added to ṙ = −a r + … the noise w = ẋ₁ of (A11) drives the yaw rate r = x₁ − a∫r. At
+    the wave frequency the hull's damping is negligible (a = 0.018 1/s ≪ ω₀ = 0.785 1/s for the
+    Mariner at 8 s), so r ≈ x₁ with var(x₁) = q²/(4ζω₀³) = σ_w²/ω₀² exactly: σ_r = σ_w/ω₀
+    (the Mariner's damping lowers it by 0.26 %, the step averaging by ≈ 0.5 % at dt = 0.3 s). The
+    narrow-band heading oscillation has amplitude r/ω₀, hence σ_ψw = σ_r/ω₀ = σ_w/ω₀². This is
+    Fossen's linear wave-frequency model (2021 §10.2.3): the heading's wave-frequency part is white
+    noise through K_w s/(s² + 2λω₀s + ω₀²), here λ = ζ, with K_w fixed by the response's RMS
+    rather than by the wave elevation (the model has no yaw RAO). The slow heading wander the same
+    noise causes below ω₀ (its x₁ has a flat low-frequency spectrum) is the autopilot's to remove.
+    """
+    for name, value in (("wave_heading_sigma", heading_sigma), ("wave_period", period)):
+        require(isinstance(value, (int, float)) and math.isfinite(value) and value >= 0,
+                f"disturbance.{name}", value, "must be a finite number >= 0")
+    require(period > 0, "disturbance.wave_period", period, "must be > 0 s")
+    omega0 = 2.0 * math.pi / period
+    return omega0 * omega0 * float(heading_sigma)
+
+
 def _factor(Q: np.ndarray) -> np.ndarray:
     """L with L Lᵀ = Q for a symmetric positive semi-definite Q (eigen-decomposition, clipped)."""
     vals, vecs = np.linalg.eigh(0.5 * (Q + Q.T))

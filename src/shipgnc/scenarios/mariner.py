@@ -63,7 +63,9 @@ def controller(cfg, model, path: WaypointPath, scenario: Scenario):
                            delta_max=p.delta_max, **known)
     return fl.LOSFL(p, path, Ts=cfg.Ts, delta_los=cfg.delta_nm * NAUTICAL_MILE,
                     kp=cfg.kp_per_min2 / MINUTE**2, kd=cfg.kd_per_min / MINUTE,
-                    delta_max=p.delta_max, **known)
+                    delta_max=p.delta_max,
+                    integral_gain=cfg.integral_gain * NAUTICAL_MILE / MINUTE,
+                    rate_from_positions=not cfg.knows_disturbance, **known)
 
 
 def disturbance(d, path: WaypointPath):
@@ -74,6 +76,6 @@ def disturbance(d, path: WaypointPath):
 
     current = CrossCurrent(d.d_y, path, frame=d.current_frame)
     waves = None
-    if d.wave_sigma_rad_min2 > 0:
-        waves = SecondOrderNoise(d.wave_sigma_rad_min2 / MINUTE**2, d.wave_period, d.wave_zeta)
+    if d.wave_sigma > 0:  # the literal σ_w, or calibrated to a wave-frequency heading RMS
+        waves = SecondOrderNoise(d.wave_sigma, d.wave_period, d.wave_zeta)
     return MarinerDisturbance(d.b_r, current=current, waves=waves)
