@@ -151,3 +151,20 @@ def test_sweep_series_total_counts_against_max_memory():
         run_study(study, max_memory=need["chunk"] * 2)
     with pytest.raises(ConfigError, match="smaller --chunk-size"):
         run_study(Study("boat-autopilot", members=10), max_memory=1e5)
+
+
+def test_obstacles_from_an_endless_device_are_refused():
+    """Row 17: ``--obstacles /dev/zero`` is read up to a cap, then refused."""
+    from shipgnc.routing.obstacles import load_geojson
+
+    with pytest.raises(ConfigError, match="MiB"):
+        load_geojson("/dev/zero")
+
+
+def test_obstacle_ring_with_nan_is_one_line(tmp_path):
+    from shipgnc.routing.obstacles import load_geojson
+
+    path = tmp_path / "o.geojson"
+    path.write_text('{"type": "Polygon", "coordinates": [[[0, 0], [1, NaN], [1, 1], [0, 0]]]}')
+    with pytest.raises(ConfigError, match="finite numbers"):
+        load_geojson(path)

@@ -56,7 +56,9 @@ def test_auto_runs_the_levelset_check_and_writes_files(tmp_path):
     r = invoke("--start=-1.86,3.66", "--target", "0,0", "--speed", "0.5", "--field", "uniform:east=0.3",
                "--units", "nautical", "--out", tmp_path)
     assert r.exit_code == 0, r.stderr
-    assert "t_f" in r.stdout and "h" in r.stdout
+    # route table rows named in words with units: a heading is a heading, t_f − t0 is the time to target
+    assert "time to target" in r.stdout and "initial heading [deg]" in r.stdout
+    assert "u(t0)" not in r.stdout and "ETA" not in r.stdout and "(F" not in r.stdout
     js = json.loads((tmp_path / "route.json").read_text())
     assert js["global_check"]["method"] == "levelset" and abs(js["global_check"]["rel_diff"]) < 5e-3
     assert (tmp_path / "route.png").stat().st_size > 20_000
@@ -120,3 +122,14 @@ def test_obstacles_geojson(tmp_path):
     assert r.exit_code == 0, r.stderr
     js = json.loads(r.stdout)
     assert js["time_h"] == pytest.approx(8.368651, abs=5e-7) and len(js["via_m"]) == 1
+
+
+def test_arrival_time_is_departure_plus_time_to_target():
+    """Uniform 0.3 kn east, V = 0.5 kn: t_f = 19.209115 h (spec 002 §2.10) whatever the departure
+    (a steady field); the arrival clock time is departure + t_f, printed only for a departure."""
+    args = ("--start=-1.86,3.66", "--target", "0,0", "--speed", "0.5", "--field", "uniform:east=0.3",
+            "--units", "nautical", "--method", "pmp")
+    r = invoke(*args, "--depart", "2")
+    assert r.exit_code == 0, r.stderr
+    assert "19.209115 h" in r.stdout and "21.2091 h" in r.stdout and "arrival time" in r.stdout
+    assert "arrival time" not in invoke(*args).stdout

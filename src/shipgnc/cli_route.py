@@ -115,32 +115,48 @@ def _jsonable(x):
 
 
 def _print(console, res, nautical: bool) -> None:
+    """The route as a quantity/value table, every row named in words with its unit.
+
+    "time to target" is t_f − t₀ (the route's duration); "arrival time" is the clock time of arrival,
+    departure + time to target, printed only when ``--depart`` is not 0 (else it equals the former).
+    """
+    from rich.markup import escape
     from rich.table import Table
 
     js = res.to_json()
     table = Table(title="route", title_justify="left")
     table.add_column("quantity", style="bold")
     table.add_column("value", justify="right")
-    table.add_row("reachable", str(js["reachable"]))
+
+    def row(name: str, value: str) -> None:  # "[deg]" is a unit, not rich markup
+        table.add_row(escape(name), escape(value))
+
+    row("reachable", "yes" if js["reachable"] else "no")
     if res.reachable:
         t = js["time_s"]
-        table.add_row("t_f", f"{t:.2f} s = {t / 3600:.6f} h")
-        table.add_row("ETA", f"{res.t0 + t:.2f} s" + (f" = {(res.t0 + t) / 3600:.4f} h" if nautical else ""))
+        row("time to target", f"{t:.2f} s = {t / 3600:.6f} h")
+        if res.t0:
+            eta = res.t0 + t
+            row("arrival time (departure + time to target)",
+                f"{eta:.2f} s" + (f" = {eta / 3600:.4f} h" if nautical else ""))
         if js["heading_start_deg"] is not None:
-            table.add_row("u(t0)", f"{js['heading_start_deg']:.4f}°")
-            table.add_row("u(tf)", f"{js['heading_end_deg']:.4f}°")
-        table.add_row("miss", f"{js['miss_m']:.3g} m")
-    table.add_row("method", js["method"])
+            row("initial heading [deg]", f"{js['heading_start_deg']:.4f}")
+            row("final heading [deg]", f"{js['heading_end_deg']:.4f}")
+        row("miss distance [m]", f"{js['miss_m']:.3g}")
+    row("method", {"pmp": "extremals (maximum principle)", "levelset": "level set",
+                   "graph": "graph search"}.get(js["method"], js["method"]))
     if res.grid_spacing:
         g = res.grid_spacing
-        table.add_row("grid spacing", f"{g:.1f} m" + (f" = {g / NAUTICAL_MILE:.4f} nm" if nautical else ""))
+        row("grid spacing", f"{g:.1f} m" + (f" = {g / NAUTICAL_MILE:.4f} nm" if nautical else ""))
     if js["extremals"]:
-        table.add_row("extremals", ", ".join(f"{t:.1f} s" + (f" ({t / 3600:.4f} h)" if nautical else "")
-                                             for t in js["extremals"]))
+        row("extremals: time to target [s]" + (" ([h])" if nautical else ""),
+            ", ".join(f"{t:.1f}" + (f" ({t / 3600:.4f})" if nautical else "") for t in js["extremals"]))
     gc = js["global_check"]
     if gc:
-        val = "—" if gc["time_s"] is None else f"{gc['time_s']:.1f} s (rel. diff {gc['rel_diff']:+.2e})"
-        table.add_row(f"global check ({gc['method']})", val)
+        name = {"levelset": "level set", "graph": "graph search"}.get(gc["method"], gc["method"])
+        val = ("—" if gc["time_s"] is None
+               else f"{gc['time_s']:.1f} s (relative difference {gc['rel_diff']:+.2e})")
+        row(f"global check by {name}: time to target", val)
     console.print(table)
     for note in js["notes"]:
         console.print(f"note: {note}", soft_wrap=True)

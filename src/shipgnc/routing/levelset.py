@@ -309,7 +309,7 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
                      np.min(res.route.xy[:, 1] - east[0]), np.min(east[-1] - res.route.xy[:, 1]))
         if margin < 5 * spacing:
             notes.append(f"the recovered route passes {margin:.0f} m from the level-set domain's edge: "
-                         "enlarge the domain (F9)")
+                         "enlarge the domain")
     return res
 
 

@@ -55,25 +55,63 @@ def as_polygons(obstacles) -> list:
     return out
 
 
+#: an obstacle file larger than this is refused before it is read (a chart of many islands is
+#: a few megabytes; ``/dev/zero`` is endless)
+MAX_GEOJSON_BYTES = 64 << 20
+
+
 def load_geojson(path, units: str = "si") -> list:
-    """Polygons from a GeoJSON file ([east, north] coordinates in m, or nm with ``units="nautical"``)."""
+    """Polygons from a GeoJSON file ([east, north] coordinates in m, or nm with ``units="nautical"``).
+
+    Every coordinate must be a pair of finite numbers; anything else is a one-line ConfigError
+    naming the feature, never a shapely or GEOS error."""
     shapely = _shapely()
+    where = f"--obstacles = {str(path)!r}"
     try:
-        data = json.loads(open(path, encoding="utf-8").read())
-    except (OSError, ValueError) as exc:
-        raise ConfigError(f"--obstacles = {str(path)!r}: cannot read GeoJSON ({exc})") from None
+        with open(path, "rb") as handle:  # a device reports size 0: read at most the cap
+            raw = handle.read(MAX_GEOJSON_BYTES + 1)
+    except OSError as exc:
+        raise ConfigError(f"{where}: cannot read ({exc.strerror or exc})") from None
+    if len(raw) > MAX_GEOJSON_BYTES:
+        raise ConfigError(f"{where}: more than {MAX_GEOJSON_BYTES >> 20} MiB; obstacle files are "
+                          f"limited to that")
+    try:
+        data = json.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError) as exc:
+        reason = str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__
+        raise ConfigError(f"{where}: not GeoJSON ({reason})") from None
     feats = data.get("features", [data]) if isinstance(data, dict) else []
+    if not isinstance(feats, list):
+        raise ConfigError(f"{where}: 'features' must be a list")
     scale = NAUTICAL_MILE if units == "nautical" else 1.0
     polys = []
-    for f in feats:
+    for k, f in enumerate(feats):
         geom = f.get("geometry", f) if isinstance(f, dict) else None
-        if not geom or geom.get("type") not in ("Polygon", "MultiPolygon"):
+        if not isinstance(geom, dict) or geom.get("type") not in ("Polygon", "MultiPolygon"):
             continue
-        g = shapely.geometry.shape(geom)
+        depth = 3 if geom["type"] == "Polygon" else 4
+        if not _finite_pairs(geom.get("coordinates"), depth):
+            raise ConfigError(f"{where}: feature {k} ({geom['type']}): coordinates must be "
+                              f"rings of [east, north] pairs of finite numbers")
+        try:
+            g = shapely.geometry.shape(geom)
+        except (ValueError, TypeError, IndexError, AttributeError, shapely.errors.ShapelyError) as exc:
+            raise ConfigError(f"{where}: feature {k} ({geom['type']}): not a polygon "
+                              f"({str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__})"
+                              ) from None
         g = shapely.affinity.affine_transform(g, [0, scale, scale, 0, 0, 0])  # (east, north) -> (north, east)
         polys.append(g)
     require(len(polys) > 0, "--obstacles", str(path), "holds no Polygon or MultiPolygon feature")
     return as_polygons(polys)
+
+
+def _finite_pairs(node, depth: int) -> bool:
+    """Nested lists ``depth`` deep ending in [east, north] pairs of finite numbers."""
+    if depth == 1:
+        return (isinstance(node, list) and len(node) >= 2
+                and all(isinstance(c, (int, float)) and not isinstance(c, bool)
+                        and math.isfinite(c) for c in node[:2]))
+    return isinstance(node, list) and len(node) > 0 and all(_finite_pairs(n, depth - 1) for n in node)
 
 
 def inside_any(polys, north, east) -> np.ndarray:
@@ -174,7 +212,7 @@ def route_around(res, polys, *, horizon, n_angles=1440, leg_angles=360, leg_step
         best = (ext.duration, [ext], None)
         break
     if free:
-        res.notes.append(f"free extremals crossing obstacles rejected: {', '.join(free)} (2.9.3)")
+        res.notes.append(f"free extremals crossing obstacles rejected: {', '.join(free)}")
 
     def leg(p, q, t_start):
         d = float(np.hypot(*(q - p)))
@@ -222,7 +260,7 @@ def route_around(res, polys, *, horizon, n_angles=1440, leg_angles=360, leg_step
         jump = math.degrees(math.remainder(legs[1].theta0 - legs[0].heading_end, 2 * math.pi))
         res.notes.append(f"route touches the obstacle vertex ({via[0]:.1f}, {via[1]:.1f}) m; the heading "
                          "jumps "
-                         f"by {jump:+.2f}° there (2.9.3)")
+                         f"by {jump:+.2f}° there")
     return res
 
 

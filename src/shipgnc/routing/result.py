@@ -56,6 +56,8 @@ class RouteResult:
     miss_m: float | None = None
     method: str = "pmp"
     extremals: list[dict] = dc_field(default_factory=list)  #: every extremal found: time_s, headings, status
+    #: the extremals themselves (``pmp.Extremal``: ``sample``, ``position``), for figures; not in JSON
+    extremal_paths: list = dc_field(default_factory=list, repr=False)
     global_check: dict | None = None  #: {"method", "time_s", "rel_diff"} or None
     reason: str | None = None
     notes: list[str] = dc_field(default_factory=list)  #: failure modes and remarks, in words (§2.8)

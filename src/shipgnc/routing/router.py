@@ -128,7 +128,7 @@ def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0
     if dist <= radius:  # F10: nothing to do
         res.reachable, res.time_s, res.miss_m = True, 0.0, max(dist - radius, 0.0)
         res.method = "pmp" if method == "auto" else method
-        res.notes.append("start and target coincide: t_f = 0 and an empty route (F10)")
+        res.notes.append("start and target coincide: t_f = 0 and an empty route")
         return res
     if horizon is None:
         horizon = 4.0 * dist / speed
@@ -180,7 +180,7 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps):
             res.reason = f"target unreachable: {sol.reason}"
             res.closest_approach_m, res.closest_time_s = sol.closest_approach, sol.closest_time
             res.notes.append(f"closest approach {sol.closest_approach:.1f} m at t = "
-                             f"{sol.closest_time:.1f} s (F1)")
+                             f"{sol.closest_time:.1f} s")
             return res
         e = np.array([math.cos(sol.heading), math.sin(sol.heading)])
         res.reachable, res.time_s = True, sol.duration
@@ -192,18 +192,20 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps):
                           "conjugate_point_s": None}]
         if sol.exit_time is not None:
             res.notes.append(f"reachable only during a window: the target leaves the reachable set at "
-                             f"t = {sol.exit_time:.1f} s; a later arrival is infeasible (F1b)")
+                             f"t = {sol.exit_time:.1f} s; a later arrival is infeasible")
         return res
     sw = pmp.sweep(fld, V, A, B, t0=res.t0, horizon=horizon, n_angles=n_angles, n_steps=n_steps,
                    radius=res.radius)
     res.method = "pmp"
     res.extremals = [_ext_dict(e, V) for e in sw.extremals]
+    res.extremal_paths = list(sw.extremals)
     if sw.n_inadmissible:
         res.notes.append(f"{sw.n_inadmissible} of {sw.n_angles} initial headings inadmissible "
-                         "(V + e·v(A) ≤ 0) and skipped (F5)")
+                         "(against them the current at the start is at least the ship's speed, "
+                         "V + e·v(A) ≤ 0) and skipped")
     if sw.n_left_domain:
         res.notes.append(f"{sw.n_left_domain} of {sw.n_angles} extremals left the gridded field's domain "
-                         f"{_extent(fld)} and were stopped there (F9)")
+                         f"{_extent(fld)} and were stopped there")
     optimal = [e for e in sw.extremals if e.conjugate_at is None]
     if not optimal:
         res.closest_approach_m, res.closest_time_s = sw.closest_approach, sw.closest_time
@@ -218,9 +220,10 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps):
     if len(sw.extremals) > 1:
         others = ", ".join(f"{e['time_s']:.0f} s" for e in res.extremals[1:])
         res.notes.append(f"{len(sw.extremals)} extremals reach the target; the global optimum is returned, "
-                         f"others: {others} (F2)")
+                         f"others: {others}")
     if not res.field.steady:
-        res.notes.append("time-varying current: H is not conserved, only H(t_f) = 0 holds (2.9.5)")
+        res.notes.append("time-varying current: the Hamiltonian is not conserved along the route, "
+                         "only zero at arrival")
     return res
 
 
@@ -348,7 +351,7 @@ def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angl
     res.grid_spacing = g.spacing
     if g.time_s is None:
         res.notes.append(f"graph search ({directions} directions) found no route; a graph's 'unreachable' is "
-                         "not final and is checked by the PMP sweep (F7)")
+                         "not final and is checked by the sweep of extremals")
         if polys:  # the sweep must honour the obstacles too
             from shipgnc.routing.obstacles import route_around
 
@@ -370,7 +373,7 @@ def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angl
         return
     res.reachable, res.method, res.time_s = True, "graph", float(g.time_s)
     res.heading_start, res.heading_end, res.miss_m, res.path = g.heading_start, g.heading_end, g.miss, g
-    res.notes.append("graph route (a coarse seed, not polished) (F7)")
+    res.notes.append("graph route (a coarse seed, not polished)")
 
 
 __all__ = ["METHODS", "ConfigError", "default_domain", "solve_route"]

@@ -1,18 +1,25 @@
 """Document 002's scenarios: a routing problem solved as ``shipgnc route`` solves it, and the route
-sailed by a ship through the same current field (spec 002 §2.9.6).
+sailed by a ship through the same current field (spec 002 §2.9.7).
 
-The sailing ship is document 000's Mariner (:class:`~shipgnc.models.mariner.MarinerWitOppe`,
-U = 15 kn) under a feedback-linearising heading autopilot
-(:class:`~shipgnc.control.feedback_linearization.HeadingFL`) that follows the route's heading
-programme ψ(t) (:class:`~shipgnc.guidance.schedule.HeadingProfile`), and again a programme of
-constant-heading legs; the current is the route's own field object, added to the ship's kinematics
-at every RK stage (one current model for router and ship). Arrival = the closest approach to the
-target; the miss distance is that distance.
+The sailing ship (``sail.vessel``) is, by default, document 001's Otter-class boat
+(:class:`~shipgnc.routing.sailing.BoatInCurrent`: the current as relative velocity) under its heading and
+speed autopilot, sailing the route as a path (LOS through waypoints on the route's track), by the optimal
+heading programme ψ(t) and by constant-heading legs (:func:`~shipgnc.routing.sailing.boat_sail`); or
+document 000's Mariner (:class:`~shipgnc.models.mariner.MarinerWitOppe`, U = 15 kn) under a
+feedback-linearising heading autopilot (:class:`~shipgnc.control.feedback_linearization.HeadingFL`)
+following the programme (:class:`~shipgnc.guidance.schedule.HeadingProfile`) and the legs, the earlier
+default kept as ``zermelo-sail-mariner``. The current is the route's own field object, evaluated at every
+RK stage (one current model for router and ship).
+
+Arrival: a ship has arrived when it comes within ``sail.acceptance_radius`` of the target (default
+``acceptance_lengths`` = 2 vessel lengths); its arrival time is the first such instant. A ship that never
+does has ``<run>_arrived: false``, ``<run>_arrival_s`` and ``<run>_arrival_ratio`` None (JSON null), and
+``<run>_miss_m`` its closest approach.
 
 ``sail.backend`` chooses the loop as ``simulation.backend`` does elsewhere: ``compiled`` runs the
-composed loop (the heading programme tabulated at the control samples, the field by its compiled
-form :meth:`~shipgnc.routing.fields.CurrentField.current_kernel`), ``numpy`` the reference loop,
-``auto`` lets :func:`~shipgnc.sim.simulator.simulate` decide by the size of the run.
+composed loop (the programme tabulated at the control samples, the field by its compiled form
+:meth:`~shipgnc.routing.fields.CurrentField.current_kernel`), ``numpy`` the reference loop, ``auto`` lets
+:func:`~shipgnc.sim.simulator.simulate` decide by the size of the run.
 """
 
 from __future__ import annotations
@@ -56,8 +63,9 @@ def sail(route, field, heading, *, dt: float, t_end: float, seed: int = 0,
          backend: str = "auto"):
     """Simulate the Mariner steering ``heading(t)`` [rad] from the route's start through ``field``.
 
-    Returns ``(dataset, arrival_s, miss_m)``: the run, the time of the closest approach to the
-    route's target and that distance. ``backend`` as :func:`~shipgnc.sim.simulator.simulate`'s.
+    Returns ``(dataset, closest_s, miss_m)``: the run, the time of the closest approach to the
+    route's target and that distance (the scenario's arrival is the acceptance radius instead,
+    :func:`~shipgnc.routing.sailing.arrival`). ``backend`` as :func:`~shipgnc.sim.simulator.simulate`'s.
     """
     from shipgnc.control.feedback_linearization import HeadingFL
     from shipgnc.guidance.schedule import HeadingProfile
@@ -104,12 +112,74 @@ class _shifted:
         return make(t0=self.t0)
 
 
+#: the vessels that can sail a route, with their default simulation step [s]
+SAIL_DT = {"vectored-thrust-boat": 0.1, "mariner": 0.3}
+
+
+def sail_vessel(cfg):
+    """``(length [m], speed through the water it can hold [m/s] or None)`` of ``sail.vessel``."""
+    if cfg.vessel == "mariner":
+        from shipgnc.models.mariner import MarinerWitOppe
+
+        model = MarinerWitOppe()
+        return model.length, model.params.U
+    from shipgnc.models.fossen3dof import VectoredThrustBoat
+
+    boat = VectoredThrustBoat.from_preset(cfg.preset)
+    return boat.length, None
+
+
+def _check_speed(cfg, route_cfg) -> None:
+    """The route's speed through the water must be one the vessel sails at (checked before solving)."""
+    from shipgnc.errors import ConfigError
+    from shipgnc.models.fossen3dof import VectoredThrustBoat
+
+    V = route_cfg.speed * (KNOT if route_cfg.units == "nautical" else 1.0)
+    if cfg.vessel == "mariner":
+        U = sail_vessel(cfg)[1]
+        if abs(V - U) > 1e-6 * U:
+            raise ConfigError(
+                f"route.speed = {V / KNOT:.4g} kn: the sailing Mariner runs at its straight-running "
+                f"speed U = {U / KNOT:.4g} kn; scale the route's speed and current by the same factor "
+                "(as zermelo-sail-mariner does) or sail it with sail.vessel=vectored-thrust-boat")
+        return
+    top = VectoredThrustBoat.from_preset(cfg.preset).params.top_speed(
+        VectoredThrustBoat.from_preset(cfg.preset).params.T_max)
+    if not V <= 0.9 * top:
+        raise ConfigError(
+            f"route.speed = {V:.4g} m/s ({V / KNOT:.3g} kn): the boat (preset {cfg.preset}) reaches "
+            f"{top:.3g} m/s at full thrust; a route for it needs a speed through the water of at most "
+            f"{0.9 * top:.3g} m/s (90 % of that, a thrust margin for steering)")
+
+
+def _outcome(prefix: str, ds, route, radius: float) -> dict:
+    """``{prefix}_arrived``, ``_arrival_s`` and ``_arrival_ratio`` (None when not arrived) and
+    ``_miss_m`` (the closest approach) of one sailed run."""
+    from shipgnc.routing.sailing import arrival
+
+    a = arrival(ds, route.target, radius)
+    return {f"{prefix}_arrived": a.arrived,
+            f"{prefix}_arrival_s": a.time_s,
+            f"{prefix}_arrival_ratio": None if a.time_s is None else a.time_s / route.time_s,
+            f"{prefix}_miss_m": a.miss_m}
+
+
 def run(scenario: Scenario, *, seed: int):
     """Solve the route (and sail it when ``sail`` is given); a
-    :class:`~shipgnc.scenarios.runner.ScenarioRun` whose ``route`` holds the solved route."""
+    :class:`~shipgnc.scenarios.runner.ScenarioRun` whose ``route`` holds the solved route.
+
+    Sailed runs (``sail``): for the boat, ``path`` (LOS through the route's waypoints), the heading
+    programme and the constant-heading legs; for the Mariner the last two. Each reports
+    ``<run>_arrived`` (within ``acceptance_radius`` of the target), ``<run>_arrival_s`` and
+    ``<run>_arrival_ratio`` (the time to the target and its ratio to the optimum; None when the ship
+    did not arrive) and ``<run>_miss_m`` (the closest approach). ``<run>`` is ``path``, ``sail``
+    (the heading programme; its historical name) and ``legs``.
+    """
     from shipgnc.routing.result import RouteResult
     from shipgnc.scenarios.runner import ScenarioRun, Setup
 
+    if scenario.sail is not None:
+        _check_speed(scenario.sail, scenario.route)
     field, route = solve(scenario.route)
     js = route.to_json()
     metrics = {key: js.get(key) for key in ROUTE_KEYS}
@@ -119,21 +189,47 @@ def run(scenario: Scenario, *, seed: int):
     sailed = {}
     if scenario.sail is not None and route.reachable:
         cfg = scenario.sail
+        length, _ = sail_vessel(cfg)
+        radius = cfg.acceptance_radius if cfg.acceptance_radius is not None \
+            else cfg.acceptance_lengths * length
+        dt = cfg.dt if cfg.dt is not None else SAIL_DT[cfg.vessel]
         t_end = route.time_s * (1.0 + cfg.margin)
-        ds, arrival, miss = sail(route, field, route.heading, dt=cfg.dt, t_end=t_end, seed=seed,
-                                 backend=cfg.backend)
         plan = route.constant_heading_legs(n_legs=cfg.legs)
-        ds_legs, arrival_legs, miss_legs = sail(route, field, plan.heading, dt=cfg.dt, t_end=t_end,
-                                                seed=seed, backend=cfg.backend)
-        metrics.update({
-            "sail_arrival_s": arrival, "sail_miss_m": miss,
-            "sail_arrival_ratio": arrival / route.time_s,
-            "legs": cfg.legs, "legs_arrival_s": arrival_legs, "legs_miss_m": miss_legs,
-            "legs_arrival_ratio": arrival_legs / route.time_s,
-            "legs_plan_penalty_s": float(plan.penalty), "legs_plan_miss_m": float(plan.miss),
-        })
-        sailed = {"optimal heading": ds, f"{cfg.legs} constant-heading legs": ds_legs}
-        result = ds
+        metrics.update({"vessel": cfg.vessel, "vessel_length_m": float(length),
+                        "acceptance_radius_m": float(radius)})
+        runs = {}
+        if cfg.vessel == "mariner":
+            runs["sail"] = ("optimal heading programme",
+                            sail(route, field, route.heading, dt=dt, t_end=t_end, seed=seed,
+                                 backend=cfg.backend)[0])
+            runs["legs"] = (f"{cfg.legs} constant-heading legs",
+                            sail(route, field, plan.heading, dt=dt, t_end=t_end, seed=seed,
+                                 backend=cfg.backend)[0])
+        else:
+            from shipgnc.routing.sailing import boat_sail
+
+            common = {"preset": cfg.preset, "dt": dt, "t_end": t_end, "seed": seed,
+                      "backend": cfg.backend}
+            runs["path"] = ("LOS through the route's waypoints",
+                            boat_sail(route, field, "path", n_points=cfg.path_points,
+                                      lookahead=cfg.lookahead, integral_gain=cfg.integral_gain,
+                                      **common))
+            runs["sail"] = ("optimal heading programme",
+                            boat_sail(route, field, "heading", heading=route.heading, **common))
+            runs["legs"] = (f"{cfg.legs} constant-heading legs",
+                            boat_sail(route, field, "heading", heading=plan.heading, **common))
+        for prefix, (label, ds) in runs.items():
+            metrics.update(_outcome(prefix, ds, route, radius))
+            sailed[label] = ds
+        if "path" in runs:
+            e = runs["path"][1]["cross_track_error"].values
+            e = e[np.isfinite(e)]
+            metrics.update({"path_waypoints": int(cfg.path_points),
+                            "path_crosstrack_rms_m": float(np.sqrt(np.mean(e**2))),
+                            "path_crosstrack_max_m": float(np.max(np.abs(e)))})
+        metrics.update({"legs": cfg.legs, "legs_plan_penalty_s": float(plan.penalty),
+                        "legs_plan_miss_m": float(plan.miss)})
+        result = runs["sail"][1]
     setup = Setup(model=None, x0=np.asarray(route.start), actuator=None, controller=None,
                   guidance=None, disturbance=None)
     return ScenarioRun(scenario, setup, result, metrics, route=route if isinstance(route, RouteResult)
@@ -152,37 +248,57 @@ def write_figures(run, out) -> list:
         rows = [f"{key:<18} {value:>10.4g} {run.metrics.get(key) or float('nan'):>12.6g}"
                 for key, value in document.items()]
         text = "\n".join([f"{'':<18} {'document':>10} {'shipgnc':>12}", *rows])
-    written = [route_figure(run.route, out / "route.png", nautical=nautical, extra_text=text)]
+    written = [route_figure(run.route, out / "route.png", nautical=nautical, extra_text=text,
+                            title=run.scenario.name)]
     if run.sailed:
         written.append(_sail_figure(run, out / "sail.png", nautical))
     return [p for p in written if p is not None]
 
 
+#: the metric prefix of each sailed run's label (see :func:`run`)
+def _prefix(label: str) -> str:
+    return "path" if label.startswith("LOS") else "legs" if "legs" in label else "sail"
+
+
+def sail_summary(metrics: dict, prefix: str) -> str:
+    """One run's outcome in words: time to the target and its ratio to the optimum, or not arrived
+    with the miss distance."""
+    if metrics.get(f"{prefix}_arrived"):
+        return (f"time to target {metrics[f'{prefix}_arrival_s']:.1f} s "
+                f"({metrics[f'{prefix}_arrival_ratio']:.3f}× optimum)")
+    return f"not arrived, miss {metrics[f'{prefix}_miss_m']:.3g} m"
+
+
 def _sail_figure(run, path, nautical: bool):
     from matplotlib.figure import Figure
+    from matplotlib.patches import Circle
 
     from shipgnc.viz import style
     from shipgnc.viz.dashboard import save_figure
 
+    m = run.metrics
     scale = NAUTICAL_MILE if nautical else 1.0
     unit = "nm" if nautical else "m"
     fig = Figure(figsize=(7.5, 7.0))
     ax = fig.subplots()
     _, north, east, _ = run.route.sample(400)
     ax.plot(east / scale, north / scale, color=style.COLORS["path"], linestyle="--", linewidth=2.0,
-            label=f"optimal route ({run.route.time_s / 3600:.3f} h)")
+            label=f"optimal route ({run.route.time_s:.1f} s)")
     for i, (label, ds) in enumerate(run.sailed.items()):
         ax.plot(ds["east"].values / scale, ds["north"].values / scale, color=f"C{i}", linewidth=1.3,
-                label=label)
-    ax.plot(run.route.target[1] / scale, run.route.target[0] / scale, "*", markersize=12,
+                label=f"{label}: {sail_summary(m, _prefix(label))}")
+    target = run.route.target
+    radius = m["acceptance_radius_m"]
+    ax.add_patch(Circle((target[1] / scale, target[0] / scale), radius / scale, fill=False,
+                        linestyle=":", color="k", label=f"acceptance radius {radius:.3g} m"))
+    ax.plot(target[1] / scale, target[0] / scale, "*", markersize=12,
             color=style.COLORS["waypoint"], label="target")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(f"east [{unit}]", fontsize=style.LABEL_SIZE)
     ax.set_ylabel(f"north [{unit}]", fontsize=style.LABEL_SIZE)
     ax.grid(True, linewidth=0.4, alpha=0.5)
-    ax.legend(loc="best", **style.LEGEND)
-    m = run.metrics
-    ax.set_title(f"{run.scenario.name}: arrival {m['sail_arrival_ratio']:.4f}× optimum, miss "
-                 f"{m['sail_miss_m']:.0f} m; legs {m['legs_arrival_ratio']:.4f}×, miss "
-                 f"{m['legs_miss_m']:.0f} m", fontsize=style.LABEL_SIZE)
+    ax.legend(loc="best", **{**style.LEGEND, "fontsize": 7})
+    vessel = {"mariner": "the Mariner", "vectored-thrust-boat": "the Otter-class boat"}[m["vessel"]]
+    ax.set_title(f"{run.scenario.name}: {len(run.sailed)} runs of {vessel} at "
+                 f"{run.route.speed:.3g} m/s through the water", fontsize=style.LABEL_SIZE)
     return save_figure(fig, path)

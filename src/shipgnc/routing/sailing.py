@@ -1,0 +1,227 @@
+"""Sailing a solved route in the simulation loop (spec 002 §2.9.7 ``zermelo-sail``).
+
+A route gives a heading programme ψ(t) and a ground track; a ship sails it through the *same* current
+field object the router used:
+
+* ``path`` — LOS guidance (:class:`~shipgnc.guidance.los.LOSGuidance`, integral LOS against the crab
+  angle, spec 001 §1.17) through waypoints sampled on the route's track, with the vessel's heading
+  autopilot (closed loop on position);
+* ``programme`` — the optimal heading programme ψ(t) as the autopilot's set-point (open loop on
+  position, closed on heading);
+* ``legs`` — a few constant-heading legs (:meth:`~shipgnc.routing.result.RouteResult.constant_heading_legs`),
+  open loop on position too.
+
+**The boat in a current** (:class:`BoatInCurrent`). Document 001's boat with the current as relative
+velocity (Fossen 2021 §10.3; spec 001 §1.17): the state's u, v are the velocities through the water,
+ν_r = ν − ν_c, and
+
+    η̇ = J(ψ) ν_r + [v_N, v_E, 0]ᵀ(η, t),     M ν̇_r + C(ν_r) ν_r + D(ν_r) ν_r = τ
+
+(the body equations (9)–(11') of document 001 in ν_r). This is Fossen's model for an irrotational,
+slowly varying current; the current's spatial acceleration and the water's rotation (k/2 for a shear)
+are left out — both small against the boat's own dynamics here (k/2 ≈ 4·10⁻³ rad/s, yaw time
+constant 1 s). The disturbance vector is document 001's ``[X_env, Y_env, N_env]`` plus the current
+``[current_north, current_east]`` [m/s], filled by :class:`FieldCurrent` at every RK stage.
+
+**Arrival** (:func:`arrival`). A ship has arrived when it comes within the acceptance radius R of the
+target; its arrival time is the first such instant (interpolated between samples). A ship that never
+comes within R has *not arrived*: no arrival time, only its closest approach (the miss distance).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from shipgnc.kernels import Kernel, NotCompiled, kernel_function
+from shipgnc.models.base import Signal
+from shipgnc.models.fossen3dof import DISTURBANCES, VectoredThrustBoat, boat_rhs
+from shipgnc.routing.fields import field_velocity
+
+CURRENT = (
+    Signal("current_north", "m/s", "current over ground, north component"),
+    Signal("current_east", "m/s", "current over ground, east component"),
+)
+
+
+class BoatInCurrent:
+    """Document 001's boat with a current as relative velocity (see the module docstring).
+
+    States as :class:`~shipgnc.models.fossen3dof.VectoredThrustBoat`'s, with u and v the surge and
+    sway velocities *through the water*; disturbances ``[X_env, Y_env, N_env, current_north,
+    current_east]``."""
+
+    disturbances = (*DISTURBANCES, *CURRENT)
+
+    def __init__(self, boat: VectoredThrustBoat):
+        self.boat = boat
+        self.params = boat.params
+        self.preset_name = boat.preset_name
+        self.length = boat.length
+        self.beam = boat.beam
+        self.states = boat.states
+        self.inputs = boat.inputs
+        self.state_limits = boat.state_limits
+
+    def input_limits(self):
+        return self.boat.input_limits()
+
+    def derivatives(self, x, u, d=None):
+        """ẋ: the boat's own equations with ν_r, plus the current in the kinematics."""
+        xdot = self.boat.derivatives(x, u, None if d is None else d[..., :3])
+        if d is not None:
+            xdot[..., 0] = xdot[..., 0] + d[..., 3]
+            xdot[..., 1] = xdot[..., 1] + d[..., 4]
+        return xdot
+
+    def kernel(self) -> Kernel:
+        """:meth:`derivatives` for the composed loop (:func:`boat_current_rhs`)."""
+        return Kernel(boat_current_rhs, self.boat.kernel().params)
+
+
+@kernel_function
+def boat_current_rhs(x, u, d, p, xdot):
+    """:meth:`BoatInCurrent.derivatives` for one ship: :func:`boat_rhs` plus d[3:5] in η̇."""
+    boat_rhs(x, u, d, p, xdot)
+    xdot[0] = xdot[0] + d[3]
+    xdot[1] = xdot[1] + d[4]
+
+
+class FieldCurrent:
+    """The disturbance ``[0, 0, 0, v_N, v_E]`` of :class:`BoatInCurrent`: a routing current field
+    (:mod:`shipgnc.routing.fields`) at the ship's position, at time ``t0 + t`` (the ship's clock starts
+    at the route's departure t0); evaluated at every RK stage."""
+
+    per_stage = True
+
+    def __init__(self, field, t0: float = 0.0):
+        self.field, self.t0 = field, float(t0)
+
+    def reset(self, batch_shape, rng=None) -> None:
+        pass
+
+    def __call__(self, t, x):
+        v = self.field.velocity(self.t0 + t, x[..., 0], x[..., 1])
+        zeros = np.zeros((*v.shape[:-1], 3))
+        return np.concatenate([zeros, v], axis=-1)
+
+    def kernel_reason(self) -> str | None:
+        try:
+            self._params()
+        except NotCompiled as exc:
+            return str(exc)
+        return None
+
+    def _params(self):
+        make = getattr(self.field, "current_kernel", None)
+        if not callable(make):
+            raise NotCompiled(f"current {type(self.field).__name__} has no kernel")
+        function, params = make(t0=self.t0)
+        if function is not field_velocity:
+            raise NotCompiled(f"current {type(self.field).__name__}: its current_kernel() is not "
+                              "shipgnc.routing.fields.field_velocity")
+        return params
+
+    def kernel(self, batch_shape, dt: float | None = None) -> Kernel:
+        """:meth:`__call__` for the composed loop (:func:`field_current_sample`)."""
+        return Kernel(field_current_sample, self._params())
+
+
+@kernel_function
+def field_current_sample(t, x, z, p, w, d):
+    """:meth:`FieldCurrent.__call__` for one ship."""
+    vn, ve = field_velocity(t, x[0], x[1], p, 0)
+    d[0] = 0.0
+    d[1] = 0.0
+    d[2] = 0.0
+    d[3] = vn
+    d[4] = ve
+
+
+@dataclass
+class Arrival:
+    """How a sailed run ended against the acceptance radius (module docstring)."""
+
+    arrived: bool
+    time_s: float | None  #: first time within the radius, after departure [s]; None if not arrived
+    miss_m: float  #: closest approach to the target [m]
+    closest_time_s: float  #: when the closest approach happened, after departure [s]
+    radius_m: float
+
+
+def arrival(ds, target, radius: float) -> Arrival:
+    """First entry into the disc of ``radius`` [m] about ``target`` (linear between samples), and the
+    closest approach over the whole run."""
+    time = ds["time"].values
+    dist = np.hypot(ds["north"].values - target[0], ds["east"].values - target[1])
+    ok = np.isfinite(dist)
+    k_min = int(np.argmin(np.where(ok, dist, np.inf)))
+    miss, t_min = float(dist[k_min]), float(time[k_min])
+    inside = np.flatnonzero(ok & (dist <= radius))
+    if inside.size == 0:
+        return Arrival(False, None, miss, t_min, float(radius))
+    k = int(inside[0])
+    t_in = float(time[k])
+    if k > 0 and dist[k - 1] > radius:  # interpolate the crossing of the radius
+        f = (dist[k - 1] - radius) / (dist[k - 1] - dist[k])
+        t_in = float(time[k - 1] + f * (time[k] - time[k - 1]))
+    return Arrival(True, t_in, miss, t_min, float(radius))
+
+
+def route_waypoints(route, n: int) -> np.ndarray:
+    """``n`` points on the route's ground track, equally spaced in time from start to target [m]."""
+    _, north, east, _ = route.sample(max(int(n), 2))
+    pts = np.column_stack([north, east])
+    keep = np.concatenate([[True], np.hypot(*np.diff(pts, axis=0).T) > 1e-6])
+    return pts[keep]
+
+
+def boat_sail(route, field, mode: str, *, preset: str = "otter", dt: float = 0.05,
+              t_end: float, heading=None, n_points: int = 40, lookahead: float | None = None,
+              integral_gain: float = 0.0, seed: int = 0, backend: str = "auto"):
+    """One run of the Otter-class boat (:class:`BoatInCurrent`) under its heading and speed autopilot
+    (:class:`~shipgnc.control.heading_speed.HeadingSpeedAutopilot`, as in ``boat-los``) at the route's
+    speed through the water, through ``field`` from the route's start.
+
+    ``mode``: ``"path"`` (LOS through ``n_points`` route waypoints, ``lookahead`` [m], default four boat
+    lengths; ``integral_gain`` σ of integral LOS) or ``"heading"`` (``heading(t)`` [rad], absolute time,
+    as the set-point at every control sample). Starts on the route's initial heading at speed V through
+    the water. Returns the ``xarray.Dataset`` of the run.
+    """
+    from shipgnc.actuators import Actuator
+    from shipgnc.control.heading_speed import HeadingSpeedAutopilot
+    from shipgnc.guidance.los import LOSGuidance
+    from shipgnc.guidance.path import WaypointPath
+    from shipgnc.guidance.schedule import ReferenceSchedule
+    from shipgnc.sim.simulator import simulate
+
+    boat = VectoredThrustBoat.from_preset(preset)
+    model = BoatInCurrent(boat)
+    V, t0 = float(route.speed), float(route.t0)
+    steps = max(1, math.ceil(t_end / dt))
+    x0 = np.array([route.start[0], route.start[1], float(route.heading(t0)), V, 0.0, 0.0])
+    if mode == "path":
+        guidance = LOSGuidance(WaypointPath(route_waypoints(route, n_points)),
+                               lookahead=4.0 * boat.length if lookahead is None else lookahead,
+                               speed=V, integral_gain=integral_gain)
+    elif mode == "heading":
+        samples = np.arange(steps + 1) * dt
+        psi = np.asarray([float(heading(t0 + t)) for t in samples]) if not _takes_arrays(heading) \
+            else np.asarray(heading(t0 + samples), dtype=float)
+        guidance = ReferenceSchedule(samples, psi, np.full(samples.size, V))
+    else:
+        raise ValueError(f"mode = {mode!r}: allowed path, heading")
+    return simulate(model, x0, t_end=steps * dt, dt=dt,
+                    controller=HeadingSpeedAutopilot(boat.params, Ts=dt),
+                    actuator=Actuator.for_model(model), guidance=guidance,
+                    disturbance=FieldCurrent(field, t0), seed=seed, backend=backend)
+
+
+def _takes_arrays(fn) -> bool:
+    try:
+        out = np.asarray(fn(np.array([0.0, 1.0])), dtype=float)
+    except Exception:
+        return False
+    return out.shape == (2,)
