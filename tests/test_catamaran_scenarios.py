@@ -97,7 +97,7 @@ def test_vessel_options_change_plant_and_design():
     """The sway-sign question of spec 004 §4.3 is a scenario setting. With the sign-consistent
     Coriolis term the drag-only hull is directionally unstable (spec 004 C3): law (20) still holds
     ω*, on the opposite thruster angle (counter-steering), unlike the printed sign's positive angle."""
-    base = ["simulation.t_end=300", "case.options.omega=0.04"]
+    base = ["simulation.t_end=300", "case.options.omega=0.04", "vessel.preset=si"]
     printed = run_scenario("catamaran-turn", overrides=base).metrics["law20"]
     consistent = run_scenario("catamaran-turn", overrides=[*base, "vessel.coriolis=consistent"])
     law20 = consistent.metrics["law20"]

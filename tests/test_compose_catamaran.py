@@ -15,7 +15,7 @@ from shipgnc.cases import catamaran as C
 from shipgnc.cases.catamaran import comparison_cases
 from shipgnc.control.catamaran_baselines import HeadingLQR, YawRatePI
 from shipgnc.control.finite_state import ConstantRate, HeadingCapture, SineRate, YawRateFSM
-from shipgnc.models.catamaran import Catamaran, catamaran_yaw_acceleration
+from shipgnc.models.catamaran import N_KERNEL_PARAMS, Catamaran, catamaran_yaw_acceleration
 from shipgnc.scenarios.runner import run_scenario
 from shipgnc.sim.simulator import simulate
 
@@ -64,7 +64,7 @@ def test_per_ship_plant_parameters_are_one_row_per_ship():
     """A Monte Carlo over the plant (check 16 / S10): each ship its own masses in the kernel."""
     model = Catamaran.from_preset("si", J_factor=np.array([0.9, 1.1]), m_y_factor=np.array([1.0, 1.1]))
     assert model.kernel_reason() is None
-    assert model.kernel().params.shape == (2, 15)
+    assert model.kernel().params.shape == (2, N_KERNEL_PARAMS)
     kw = {"t_end": 20.0, "dt": 0.0625, "u0": [0.3]}
     ref = simulate(model, C.initial_state(batch=2), backend="numpy", **kw)
     got = simulate(model, C.initial_state(batch=2), backend="compiled", **kw)

@@ -12,8 +12,10 @@ t_end, dt`` and, for heading runs, ``heading_target``. A runner calls::
 or simply ``ds = case.run()`` (``backend="auto"``: the composed compiled loop when the run is long
 or batched and every component has a kernel, see ``simulate``). Common settings: u(0) = 4 m/s,
 everything else 0; RK4 with dt = 0.0625 s; t_f = 1500 s; gains per preset (``paper``:
-T_u = 0.1 s, h = 0.0625 s; ``si``: T_u = h = 2.5 s); the laws in continuous mode; preset ``si``
-unless given. ``vessel`` (a dict of :class:`~shipgnc.models.catamaran.CatamaranParams` overrides,
+T_u = 0.1 s, h = 0.0625 s; ``si`` and ``si-consistent``: T_u = h = 2.5 s); the laws in continuous
+mode; preset ``si-consistent`` (the physically consistent hull, issue 17) unless given — ``si``
+(printed Coriolis sign) and ``paper`` (the listing's units) are the document's reproductions.
+``vessel`` (a dict of :class:`~shipgnc.models.catamaran.CatamaranParams` overrides,
 e.g. ``{"coriolis": "consistent"}``) changes the catamaran itself — plant and the controller's
 model alike — for every builder.
 """
@@ -25,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from shipgnc.control.catamaran_baselines import HeadingLQR, YawRatePI
+from shipgnc.control.catamaran_baselines import DesignedPI, HeadingLQR, PolePlacementRate, YawRatePI
 from shipgnc.control.finite_state import (
     ConstantRate,
     HeadingCapture,
@@ -34,13 +36,16 @@ from shipgnc.control.finite_state import (
     default_gains,
 )
 from shipgnc.errors import require
-from shipgnc.models.catamaran import Catamaran
+from shipgnc.models.catamaran import DEFAULT_PRESET, Catamaran
 
 DT = 0.0625
 T_END = 1500.0
 U0 = 4.0
 #: fixed thruster angle of S5 [rad]
 FIXED_ANGLE = 0.6
+#: S5 on the consistent hull: the yaw rate of the 0.6 rad run of ``si`` [rad/s] (the consistent hull
+#: has no steady turn at 0.6 rad: it turns ever tighter), so the fixed angle is the one that gives it
+FIXED_ANGLE_RATE_SI = 0.036434
 
 
 @dataclass
@@ -75,9 +80,10 @@ class CatamaranCase:
         return ds
 
     def metrics(self, ds) -> dict:
-        from shipgnc.analysis.catamaran_metrics import catamaran_metrics
+        from shipgnc.analysis.catamaran_metrics import catamaran_metrics, model_fields
 
-        return catamaran_metrics(ds, None, self.heading_target)
+        return {**catamaran_metrics(ds, None, self.heading_target),
+                **model_fields(self.model, self.notes.get("preset"))}
 
 
 def initial_state(u0: float = U0, delta0: float = 0.0, batch: int | None = None) -> np.ndarray:
@@ -90,8 +96,9 @@ def _gains(preset_name: str, T_u, h):
     return (T_u0 if T_u is None else T_u), (h0 if h is None else h)
 
 
-def yaw_rate_case(name: str, preset_name: str = "si", law: int = 21, omega_ref=0.08, *, t_end: float = T_END,
-                  dt: float = DT, Ts: float | None = None, T_u: float | None = None, h: float | None = None,
+def yaw_rate_case(name: str, preset_name: str = DEFAULT_PRESET, law: int = 21, omega_ref=0.08, *,
+                  t_end: float = T_END, dt: float = DT, Ts: float | None = None, T_u: float | None = None,
+                  h: float | None = None,
                   plant: dict | None = None, actuator_model: tuple[float, float] | None = None,
                   batch: int | None = None, delta_max: float | None = None, vessel: dict | None = None,
                   **controller_options) -> CatamaranCase:
@@ -111,20 +118,21 @@ def yaw_rate_case(name: str, preset_name: str = "si", law: int = 21, omega_ref=0
 
 
 # --- S1–S10 -----------------------------------------------------------------------------------------
-def straight(preset_name: str = "si", t_end: float = 300.0, vessel: dict | None = None) -> CatamaranCase:
+def straight(preset_name: str = DEFAULT_PRESET, t_end: float = 300.0,
+             vessel: dict | None = None) -> CatamaranCase:
     """S1: straight run from 4 m/s with δ = 0 (no controller): the speed rises to 4.42306 m/s."""
     return CatamaranCase("catamaran-straight", Catamaran.from_preset(preset_name, **(vessel or {})),
                          initial_state(), None, None, t_end, DT, notes={"preset": preset_name})
 
 
-def turn(preset_name: str = "si", omega: float = 0.08, t_end: float = T_END, dt: float = DT,
+def turn(preset_name: str = DEFAULT_PRESET, omega: float = 0.08, t_end: float = T_END, dt: float = DT,
          Ts: float | None = None, vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """S3 ``catamaran-turn``: ω* = 0.08 rad/s with laws (20) and (21)."""
     return {f"law{law}": yaw_rate_case(f"catamaran-turn/law{law}", preset_name, law, omega, t_end=t_end,
                                        dt=dt, Ts=Ts, vessel=vessel) for law in (20, 21)}
 
 
-def steps(preset_name: str = "paper", t_end: float = T_END,
+def steps(preset_name: str = DEFAULT_PRESET, t_end: float = T_END,
           vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """S4 ``catamaran-steps``: ω* = 0.008 and 0.00072 with both laws (Figs. 1–3, 5–6)."""
     return {f"law{law}@{w:g}": yaw_rate_case(f"catamaran-steps/law{law}@{w:g}", preset_name, law, w,
@@ -132,17 +140,24 @@ def steps(preset_name: str = "paper", t_end: float = T_END,
             for w in (0.008, 0.00072) for law in (20, 21)}
 
 
-def fixed_angle(preset_name: str = "paper", t_end: float = T_END,
+def fixed_angle(preset_name: str = DEFAULT_PRESET, t_end: float = T_END, delta: float | None = None,
                 vessel: dict | None = None) -> dict[str, CatamaranCase]:
-    """S5 ``catamaran-fixed-angle``: δ = 0.6 rad held (no controller), the FSM at the same steady
-    angle (ω* = the fixed run's steady r) and the document's pairing ω* = 0.00072 (C10)."""
-    from shipgnc.analysis.steady_turn import steady_state_at_angle
+    """S5 ``catamaran-fixed-angle``: δ held (no controller), the FSM at the same steady angle
+    (ω* = the fixed run's steady r) and the document's pairing ω* = 0.00072 (C10).
+
+    ``delta`` [rad]: the document's 0.6 rad for the printed-sign presets; on a hull with the
+    consistent sign (no steady turn at 0.6 rad) the angle of the steady turn at r = 0.036434 rad/s,
+    the 0.6 rad run's rate in ``si``."""
+    from shipgnc.analysis.steady_turn import steady_state_at_angle, steady_turn
 
     model = Catamaran.from_preset(preset_name, **(vessel or {}))
-    same = steady_state_at_angle(model, FIXED_ANGLE).r
+    if delta is None:
+        delta = (FIXED_ANGLE if model.params.coriolis == "printed"
+                 else steady_turn(model, FIXED_ANGLE_RATE_SI).delta)
+    same = steady_state_at_angle(model, delta).r
     return {
-        "fixed": CatamaranCase("catamaran-fixed-angle/fixed", model, initial_state(delta0=FIXED_ANGLE), None,
-                               None, t_end, DT, notes={"preset": preset_name, "delta": FIXED_ANGLE}),
+        "fixed": CatamaranCase("catamaran-fixed-angle/fixed", model, initial_state(delta0=delta), None,
+                               None, t_end, DT, notes={"preset": preset_name, "delta": delta}),
         "law20_same_angle": yaw_rate_case("catamaran-fixed-angle/law20_same_angle", preset_name, 20, same,
                                           t_end=t_end, vessel=vessel),
         "law20@0.00072": yaw_rate_case("catamaran-fixed-angle/law20@0.00072", preset_name, 20, 0.00072,
@@ -150,15 +165,16 @@ def fixed_angle(preset_name: str = "paper", t_end: float = T_END,
     }
 
 
-def sine(preset_name: str = "si", law: int = 21, reading: str = "pi", t_end: float = T_END,
+def sine(preset_name: str = DEFAULT_PRESET, law: int = 21, reading: str = "pi", t_end: float = T_END,
          vessel: dict | None = None) -> CatamaranCase:
     """S6 ``catamaran-sine``: ω* = 0.0072 sin(8πt/t_f) (reading C11; ``"literal"``: sin(8t/t_f))."""
     return yaw_rate_case(f"catamaran-sine/law{law}", preset_name, law, SineRate.document(reading, T_END),
                          t_end=t_end, vessel=vessel)
 
 
-def heading(preset_name: str = "si", law: int = 21, psi_target: float = 0.8, omega_c: float = 0.0022,
-            t_end: float | None = None, ramp_s: float = 0.0, vessel: dict | None = None) -> CatamaranCase:
+def heading(preset_name: str = DEFAULT_PRESET, law: int = 21, psi_target: float = 0.8,
+            omega_c: float = 0.0022, t_end: float | None = None, ramp_s: float = 0.0,
+            vessel: dict | None = None) -> CatamaranCase:
     """S7 ``catamaran-heading``: heading capture (17) from K(0) = 0 to K*.
 
     t_end: 1500 s for ω_c < 0.02 rad/s, else 600 s.
@@ -177,7 +193,7 @@ ACTUATOR_RUNS = {"T2_k1": (2.0, 1.0), "T3_k1": (3.0, 1.0), "T1_k1": (1.0, 1.0), 
                  "T2_k1.2": (2.0, 1.2)}
 
 
-def actuator(preset_name: str = "si", omega: float = 0.08, t_end: float = 600.0,
+def actuator(preset_name: str = DEFAULT_PRESET, omega: float = 0.08, t_end: float = 600.0,
              T_a: float = 2.0, k_a: float = 1.0, vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """S8 ``catamaran-actuator``: law (21) through the inverse (23) on a plant with the lag (22)."""
     cases = {"ideal": yaw_rate_case("catamaran-actuator/ideal", preset_name, 21, omega, t_end=t_end,
@@ -196,7 +212,7 @@ def limit(preset_name: str = "paper", law: int = 21, omega: float = 0.081, t_end
                          delta_max=delta_max, vessel=vessel)
 
 
-def robustness(preset_name: str = "si", n: int = 40, seed: int = 10, omega: float = 0.06,
+def robustness(preset_name: str = DEFAULT_PRESET, n: int = 40, seed: int = 10, omega: float = 0.06,
                t_end: float = T_END, law: int = 21, vessel: dict | None = None) -> CatamaranCase:
     """S10 / ``catamaran-montecarlo``: plant J uniform ±30 %, m_x and m_y uniform ±10 % each, the
     controller nominal, law (21); one batched run (the ship axis) with per-ship plant parameters."""
@@ -211,9 +227,10 @@ def robustness(preset_name: str = "si", n: int = 40, seed: int = 10, omega: floa
     return case
 
 
-def montecarlo(n: int = 1000, seed: int = 16, t_end: float = 300.0) -> CatamaranCase:
-    """Check 16: 1000 draws, ``si``, law (21), ω* = 0.06, 300 s."""
-    return robustness("si", n=n, seed=seed, t_end=t_end)
+def montecarlo(n: int = 1000, seed: int = 16, t_end: float = 300.0,
+               preset_name: str = "si") -> CatamaranCase:
+    """Check 16: 1000 draws, ``si`` (the spec's check; any preset by name), law (21), ω* = 0.06, 300 s."""
+    return robustness(preset_name, n=n, seed=seed, t_end=t_end)
 
 
 #: scenario name → builder (spec 004 §4.7 names); each returns a case or a dict of cases
@@ -221,41 +238,79 @@ SCENARIOS = {
     "catamaran-turn": turn,
     "catamaran-steps": steps,
     "catamaran-fixed-angle": fixed_angle,
-    "catamaran-sine": lambda preset_name="si": {"law21": sine(preset_name, 21)},
-    "catamaran-heading": lambda preset_name="si": {"law21": heading(preset_name, 21)},
+    "catamaran-sine": lambda preset_name=DEFAULT_PRESET: {"law21": sine(preset_name, 21)},
+    "catamaran-heading": lambda preset_name=DEFAULT_PRESET: {"law21": heading(preset_name, 21)},
     "catamaran-actuator": actuator,
-    "catamaran-montecarlo": lambda preset_name="si": {"montecarlo": montecarlo()},
+    "catamaran-montecarlo": lambda preset_name=DEFAULT_PRESET: {
+        "montecarlo": montecarlo(preset_name=preset_name)},
 }
 
 
-def compare(preset_name: str = "si", vessel: dict | None = None) -> dict[str, CatamaranCase]:
+def compare(preset_name: str = DEFAULT_PRESET, vessel: dict | None = None) -> dict[str, CatamaranCase]:
     """``catamaran-compare``: FSM laws against the baselines on S3, S4 (ω* = 0.008) and S7."""
     return comparison_cases(preset_name, vessel=vessel)
 
 
-def comparison_cases(preset_name: str = "si", t_end_rate: float = 300.0, t_end_heading: float = 600.0,
-                     vessel: dict | None = None):
+#: ``catamaran-compare``'s baseline sets: the equal-bandwidth designs (issue 17), the spec's
+#: §4.11.3 baselines kept as reproductions (run keys ``pi``, ``lqr``), or both
+BASELINES = ("all", "designed", "reproduction")
+#: what each comparison run is (figure legends, docs)
+RUN_LABELS = {
+    "law20": "FSM law (20)", "law21": "FSM law (21)",
+    "place": "pole placement at the FSM poles", "pi_design": "PI designed for the FSM poles",
+    "pi": "law (20) with cos δ frozen (reproduction)", "lqr": "LQR of spec §4.11.3 (reproduction)",
+}
+
+
+def comparison_cases(preset_name: str = DEFAULT_PRESET, t_end_rate: float = 300.0,
+                     t_end_heading: float = 600.0, vessel: dict | None = None,
+                     baselines: str = "all"):
     """``catamaran-compare``: FSM laws against the baselines on S3 (ω* = 0.08), S4 (ω* = 0.008) and S7
-    (K* = 0.8 rad, ω_c = 0.0022 rad/s). Returns ``{"S3/law20": case, ...}``."""
+    (K* = 0.8 rad, ω_c = 0.0022 rad/s). Returns ``{"S3/law20": case, ...}``.
+
+    ``baselines``: ``designed`` — pole placement (``place``) and the designed PI (``pi_design``) at
+    the FSM's poles −1/T_u, −1/h; ``reproduction`` — the spec's PI (law (20) with cos δ frozen,
+    ``pi``) and LQR (``lqr``); ``all`` (default) — both, the designed ones first."""
+    require(baselines in BASELINES, "case.options.baselines", baselines, f"allowed: {', '.join(BASELINES)}")
+    designed, reproduction = baselines in ("all", "designed"), baselines in ("all", "reproduction")
     T_u, h = default_gains(preset_name)
+
+    def model():
+        return Catamaran.from_preset(preset_name, **(vessel or {}))
+
     cases = {}
     for label, w in (("S3", 0.08), ("S4", 0.008)):
         for law in (20, 21):
             cases[f"{label}/law{law}"] = yaw_rate_case(f"compare/{label}/law{law}", preset_name, law, w,
                                                        t_end=t_end_rate, vessel=vessel)
-        model = Catamaran.from_preset(preset_name, **(vessel or {}))
-        ref = ConstantRate(w)
-        cases[f"{label}/pi"] = CatamaranCase(f"compare/{label}/pi", model, initial_state(),
-                                             YawRatePI(model, T_u=T_u, h=h, omega_ref=ref), ref, t_end_rate)
+        if designed:
+            ref = ConstantRate(w)
+            cases[f"{label}/place"] = CatamaranCase(
+                f"compare/{label}/place", model(), initial_state(),
+                PolePlacementRate(model(), T_u=T_u, h=h, omega_ref=ref), ref, t_end_rate)
+            ref = ConstantRate(w)
+            cases[f"{label}/pi_design"] = CatamaranCase(
+                f"compare/{label}/pi_design", model(), initial_state(),
+                DesignedPI(model(), T_u=T_u, h=h, omega_ref=ref), ref, t_end_rate)
+        if reproduction:
+            ref = ConstantRate(w)
+            cases[f"{label}/pi"] = CatamaranCase(f"compare/{label}/pi", model(), initial_state(),
+                                                 YawRatePI(model(), T_u=T_u, h=h, omega_ref=ref), ref,
+                                                 t_end_rate)
     cases["S7/law21"] = heading(preset_name, 21, 0.8, 0.0022, t_end=t_end_heading, vessel=vessel)
-    model = Catamaran.from_preset(preset_name, **(vessel or {}))
-    lqr = HeadingLQR(model, 0.8, 0.0022)
-    cases["S7/lqr"] = CatamaranCase("compare/S7/lqr", model, initial_state(), lqr, None, t_end_heading,
-                                    heading_target=0.8)
+    if designed:
+        cap = HeadingCapture(0.8, 0.0022)
+        cases["S7/place"] = CatamaranCase("compare/S7/place", model(), initial_state(),
+                                          PolePlacementRate(model(), T_u=T_u, h=h, omega_ref=cap), cap,
+                                          t_end_heading, heading_target=0.8)
+    if reproduction:
+        lqr = HeadingLQR(model(), 0.8, 0.0022)
+        cases["S7/lqr"] = CatamaranCase("compare/S7/lqr", model(), initial_state(), lqr, None,
+                                        t_end_heading, heading_target=0.8)
     return cases
 
 
-def run_comparison(preset_name: str = "si", **kwargs) -> dict[str, dict]:
+def run_comparison(preset_name: str = DEFAULT_PRESET, **kwargs) -> dict[str, dict]:
     """Run every comparison case; returns run key → comparison metrics (IAE, travel, peak rate...)."""
     from shipgnc.analysis.catamaran_metrics import comparison_metrics
 

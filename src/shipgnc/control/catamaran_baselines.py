@@ -9,7 +9,23 @@
   the law δ̇ = −K x is a PID on the heading error (I on e_ψ, P through r, D through ṙ ~ δ) with
   sway feedback. The heading reference is the ramp of the capture profile (17).
 
-Both are stateless continuous laws (their integral is the physical δ), like the FSM laws, so the
+Both are kept as named reproductions (the spec's §4.11.3 baselines): the "PI" is law (20) with
+cos δ frozen, and the LQR's dominant poles (−0.043 ± 0.006j s⁻¹) are ten times slower than the
+FSM. The comparison's baselines of record are designed for the FSM's bandwidth (issue 17):
+
+* :class:`PolePlacementRate` — state feedback on the linearised sway–yaw model about straight
+  running, augmented with the yaw-rate error integral ξ = ∫(r − ω*) dt (= ψ − ψ_ref), the
+  closed-loop poles placed with ``control.acker`` at the FSM's time constants −1/T_u, −1/h and a
+  non-dominant sway pole at −2/min(T_u, h) (:func:`place_rate_gain`). In rate form
+  δ̇ = −k_v v̇ − k_r ṙ − k_ξ (r − ω*) (stateless; its integral is the physical δ), so it runs the
+  yaw-rate cases (S3, S4) and, with the capture's ω*(t) of (17), the heading case S7.
+* :class:`DesignedPI` — a PI on the first-order (Nomoto) yaw-rate model T ṙ + r = K δ fitted to the
+  same linearisation (:func:`nomoto_model`), its two closed-loop poles placed at −1/T_u, −1/h
+  (:func:`designed_pi_gains`), in I-P velocity form δ̇ = K_i (ω* − r) − K_p ṙ with anti-windup
+  at the thruster-angle limit δ_max (the integrator — δ itself — stops when |δ| ≥ δ_max and the
+  command pushes further).
+
+All are stateless continuous laws (their integral is the physical δ), like the FSM laws, so the
 comparison runs them in the same ``continuous`` mode. Each has a kernel for the composed compiled
 loop (:func:`yaw_rate_pi_step`, :func:`heading_lqr_step`; ω* and the heading capture's latch by
 :func:`~shipgnc.control.finite_state.rate_value`, as the FSM laws).
@@ -40,6 +56,7 @@ from shipgnc.models.catamaran import (
     Catamaran,
     R,
     V,
+    _hull_forces,
     catamaran_yaw_acceleration,
     kernel_params,
     kernel_params_reason,
@@ -216,3 +233,241 @@ def heading_lqr_step(t, x, ref, z, p, cmd, sig):
     z[1] = psi_ref
     sig[0] = psi_ref
     cmd[0] = -total
+
+
+# --- equal-bandwidth baselines (issue 17) ----------------------------------------------------------
+#: default thruster-angle limit of :class:`DesignedPI`'s anti-windup [rad] (85°, spec 004 §4.11.1 [A])
+DELTA_LIMIT = math.radians(85.0)
+
+
+def sway_yaw_linearisation(model: Catamaran) -> tuple[np.ndarray, np.ndarray]:
+    """(A, B) of [v, r] with the thruster angle δ as the input, linearised about straight running
+    at the top speed (δ = 0): A = ∂(v̇, ṙ)/∂(v, r), B = ∂(v̇, ṙ)/∂δ (:func:`linearize`)."""
+    A, _ = linearize(model, straight_running_state(model.params))
+    keep = [V, R]
+    return A[np.ix_(keep, keep)], A[keep, DELTA][:, None]
+
+
+def fsm_poles(T_u: float, h: float) -> tuple[float, float]:
+    """The FSM's closed-loop poles: the criterion's −1/T_u and the prediction's −1/h [1/s]
+    (law (20): the predicted rate ω̄ = ω + h ω̇ approaches ω* with time constant T_u, so
+    ω/ω* ≈ 1/((1 + T_u s)(1 + h s)); spec 004 §4.5–4.6)."""
+    return -1.0 / T_u, -1.0 / h
+
+
+def place_rate_gain(model: Catamaran, T_u: float, h: float, sway_pole: float | None = None) -> np.ndarray:
+    """Gain K = [k_v, k_r, k_ξ] of δ = −K [v, r, ξ], ξ̇ = r − ω*, placing the poles of the augmented
+    linear model at −1/T_u, −1/h and ``sway_pole`` (default −2/min(T_u, h)) with ``control.acker``."""
+    import control
+
+    A2, B2 = sway_yaw_linearisation(model)
+    Aa = np.zeros((3, 3))
+    Aa[:2, :2] = A2
+    Aa[2, 1] = 1.0
+    Ba = np.vstack([B2, [[0.0]]])
+    poles = [*fsm_poles(T_u, h), -2.0 / min(T_u, h) if sway_pole is None else sway_pole]
+    return np.asarray(control.acker(Aa, Ba, poles), dtype=float).ravel()
+
+
+def place_rate_closed_loop(model: Catamaran, gain) -> np.ndarray:
+    """Eigenvalues of the augmented linear model [v, r, ξ] under δ = −K [v, r, ξ] (sorted)."""
+    A2, B2 = sway_yaw_linearisation(model)
+    Aa = np.zeros((3, 3))
+    Aa[:2, :2] = A2
+    Aa[2, 1] = 1.0
+    Ba = np.vstack([B2, [[0.0]]])
+    eig = np.linalg.eigvals(Aa - Ba @ np.asarray(gain, dtype=float)[None, :])
+    return eig[np.lexsort((eig.imag, eig.real))]
+
+
+def nomoto_model(model: Catamaran) -> tuple[float, float]:
+    """First-order (Nomoto) fit (K [1/s], T [s]) of δ → r of :func:`sway_yaw_linearisation`:
+    K the DC gain, T the time at which the linear step response reaches 1 − e⁻¹ of K (a fit that
+    holds for the consistent hull's real poles and the printed-sign hulls' complex pair alike)."""
+    A2, B2 = sway_yaw_linearisation(model)
+    K = float(-(np.array([[0.0, 1.0]]) @ np.linalg.solve(A2, B2))[0, 0])
+    require(K > 0, "nomoto_model", K, "the yaw-rate DC gain must be > 0 (a directionally stable hull)")
+    slowest = float(np.min(np.abs(np.linalg.eigvals(A2).real)))
+    t = np.linspace(0.0, 12.0 / slowest, 24001)
+    # r(t) of the unit step: r = C A⁻¹ (e^{At} − I) B, by eigendecomposition
+    lam, W = np.linalg.eig(A2)
+    c = np.linalg.solve(W, np.linalg.solve(A2, B2))[:, 0]
+    r = np.real((W[1, :] * c) @ (np.exp(np.outer(lam, t)) - 1.0))
+    k = int(np.argmax(r >= (1.0 - math.exp(-1.0)) * K))
+    T = float(np.interp((1.0 - math.exp(-1.0)) * K, r[k - 1:k + 1], t[k - 1:k + 1]))
+    return K, T
+
+
+def designed_pi_gains(model: Catamaran, T_u: float, h: float) -> tuple[float, float]:
+    """(K_i [1/s], K_p [s]) of the PI on the Nomoto model T ṙ + r = K δ whose closed
+    loop T s² + (1 + K K_p) s + K K_i has its poles at −1/T_u and −1/h:
+    K_p = (T (1/T_u + 1/h) − 1)/K, K_i = T/(K T_u h)."""
+    K, T = nomoto_model(model)
+    return T / (K * T_u * h), (T * (1.0 / T_u + 1.0 / h) - 1.0) / K
+
+
+class PolePlacementRate:
+    """Equal-bandwidth pole placement: δ̇ = −k_v v̇ − k_r ṙ − k_ξ (r − ω*) (see the module docstring);
+    v̇ and ṙ are the model's at the measured state, as law (20) uses Φ₃."""
+
+    def __init__(self, model: Catamaran, *, T_u: float, h: float, omega_ref, gain=None,
+                 Ts: float | None = None):
+        require(T_u > 0 and h > 0, "controller.T_u/h", (T_u, h), "must be > 0 s")
+        self.model = model
+        self.T_u, self.h = float(T_u), float(h)
+        self.K = place_rate_gain(model, T_u, h) if gain is None else np.asarray(gain, dtype=float)
+        self.omega_ref = as_rate_reference(omega_ref)
+        self.Ts, self.continuous = Ts, Ts is None
+        self.signals = (Signal("omega_ref", "rad/s", "yaw-rate reference"),)
+        self.events: list[dict] = []
+        self._last: dict = {}
+
+    def reset(self, batch_shape) -> None:
+        self.omega_ref.reset(batch_shape)
+        self.events = []
+
+    def law(self, t, x, reference):
+        w = self.omega_ref.value(t, x)
+        xdot = self.model.derivatives(x, np.zeros((*np.shape(x)[:-1], 1)))
+        u = -self.K[0] * xdot[..., V] - self.K[1] * xdot[..., R] - self.K[2] * (x[..., R] - w)
+        self._last = {"omega_ref": w}
+        return u[..., None]
+
+    step = law
+
+    def signal_values(self):
+        return dict(self._last)
+
+    def kernel_reason(self) -> str | None:
+        """Why :meth:`kernel` cannot compile this controller (None when it can)."""
+        if self.model.params.delta_row != "rate":
+            return "pole placement on a lag-row plant (its v̇ needs the rate row)"
+        return kernel_params_reason(self.model.params) or source_reason(self.omega_ref)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`law` for the composed loop (:func:`pole_placement_step`): parameters ``[K (3),
+        model, ω* source]``, per-ship state ``[calls, ω*, source state]``."""
+        reason = self.kernel_reason()
+        if reason:
+            raise NotCompiled(reason)
+        batch_shape = tuple(batch_shape)
+        block, block_state = self.omega_ref.rate_block(batch_shape)
+        state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
+        state[..., 2:] = block_state
+
+        def restore(z: np.ndarray) -> None:
+            z = z.reshape(-1, 2 + N_RATE_STATE)
+            if z.shape[0] and np.any(z[:, 0] > 0):
+                self._last = {"omega_ref": z[:, 1].reshape(batch_shape).copy()}
+            self.omega_ref.restore_block(z[:, 2:], batch_shape)
+
+        return Kernel(pole_placement_step, flat(self.K, kernel_params(self.model.params), block),
+                      state, restore=restore, continuous=self.continuous)
+
+
+#: offsets in :meth:`PolePlacementRate.kernel`'s parameters: the model's, the ω* source's
+PLACE_MODEL = 3
+PLACE_SOURCE = PLACE_MODEL + N_KERNEL_PARAMS
+
+
+@kernel_function
+def pole_placement_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`PolePlacementRate.law` for one ship, operation for operation:
+    δ̇ = −k_v v̇ − k_r ṙ − k_ξ (r − ω*) with v̇, ṙ of :func:`~shipgnc.models.catamaran.catamaran_rhs`
+    (no disturbance)."""
+    z[0] += 1.0
+    w = rate_value(t, x, ref, p, PLACE_SOURCE, z, 2)
+    o = PLACE_MODEL
+    _, Y, N = _hull_forces(x, p, o)
+    sd = math.sin(x[DELTA])
+    v_dot = (Y - p[o + 7] * sd + 0.0) / p[o + 1]
+    r_dot = (N + p[o + 8] * sd + 0.0) / p[o + 2]
+    u = -p[0] * v_dot - p[1] * r_dot - p[2] * (x[R] - w)
+    z[1] = w
+    sig[0] = w
+    cmd[0] = u
+
+
+class DesignedPI:
+    """PI yaw-rate controller designed on the Nomoto model for the FSM's poles, with anti-windup
+    (see the module docstring): δ̇ = K_i (ω* − r) − K_p ṙ, and δ̇ = 0 when |δ| ≥ δ_max and the
+    command pushes |δ| further."""
+
+    def __init__(self, model: Catamaran, *, T_u: float, h: float, omega_ref,
+                 delta_max: float | None = DELTA_LIMIT, gains: tuple[float, float] | None = None,
+                 Ts: float | None = None):
+        require(T_u > 0 and h > 0, "controller.T_u/h", (T_u, h), "must be > 0 s")
+        require(delta_max is None or 0 < delta_max <= math.pi / 2, "controller.delta_max", delta_max,
+                "need 0 < delta_max <= pi/2 rad")
+        self.model = model
+        self.T_u, self.h = float(T_u), float(h)
+        self.K_i, self.K_p = designed_pi_gains(model, T_u, h) if gains is None else gains
+        self.delta_max = delta_max
+        self.omega_ref = as_rate_reference(omega_ref)
+        self.Ts, self.continuous = Ts, Ts is None
+        self.signals = (Signal("omega_ref", "rad/s", "yaw-rate reference"),)
+        self.events: list[dict] = []
+        self._last: dict = {}
+
+    def reset(self, batch_shape) -> None:
+        self.omega_ref.reset(batch_shape)
+        self.events = []
+
+    def law(self, t, x, reference):
+        w = self.omega_ref.value(t, x)
+        u = self.K_i * (w - x[..., R]) - self.K_p * self.model.yaw_acceleration(x)
+        if self.delta_max is not None:
+            delta = x[..., DELTA]
+            u = np.where((np.abs(delta) >= self.delta_max) & (np.sign(u) == np.sign(delta)), 0.0, u)
+        self._last = {"omega_ref": w}
+        return u[..., None]
+
+    step = law
+
+    def signal_values(self):
+        return dict(self._last)
+
+    def kernel_reason(self) -> str | None:
+        """Why :meth:`kernel` cannot compile this controller (None when it can)."""
+        return kernel_params_reason(self.model.params) or source_reason(self.omega_ref)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`law` for the composed loop (:func:`designed_pi_step`): parameters ``[K_i, K_p,
+        clamp?, δ_max, model, ω* source]``, per-ship state ``[calls, ω*, source state]``."""
+        reason = self.kernel_reason()
+        if reason:
+            raise NotCompiled(reason)
+        batch_shape = tuple(batch_shape)
+        block, block_state = self.omega_ref.rate_block(batch_shape)
+        state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
+        state[..., 2:] = block_state
+
+        def restore(z: np.ndarray) -> None:
+            z = z.reshape(-1, 2 + N_RATE_STATE)
+            if z.shape[0] and np.any(z[:, 0] > 0):
+                self._last = {"omega_ref": z[:, 1].reshape(batch_shape).copy()}
+            self.omega_ref.restore_block(z[:, 2:], batch_shape)
+
+        params = flat(self.K_i, self.K_p, float(self.delta_max is not None), self.delta_max or 0.0,
+                      kernel_params(self.model.params), block)
+        return Kernel(designed_pi_step, params, state, restore=restore, continuous=self.continuous)
+
+
+#: offsets in :meth:`DesignedPI.kernel`'s parameters: the model's, the ω* source's
+DPI_MODEL = 4
+DPI_SOURCE = DPI_MODEL + N_KERNEL_PARAMS
+
+
+@kernel_function
+def designed_pi_step(t, x, ref, z, p, cmd, sig):
+    """One :meth:`DesignedPI.law` for one ship, operation for operation: δ̇ = K_i (ω* − r) − K_p Φ₃,
+    set to 0 when |δ| ≥ δ_max and sign(δ̇) = sign(δ) (anti-windup)."""
+    z[0] += 1.0
+    w = rate_value(t, x, ref, p, DPI_SOURCE, z, 2)
+    u = p[0] * (w - x[R]) - p[1] * catamaran_yaw_acceleration(x, p, DPI_MODEL)
+    delta = x[DELTA]
+    if p[2] != 0.0 and abs(delta) >= p[3] and sign(u) == sign(delta):
+        u = 0.0
+    z[1] = w
+    sig[0] = w
+    cmd[0] = u

@@ -27,14 +27,15 @@ def _builders() -> dict:
             "compare": _compare}
 
 
-def _compare(preset_name: str = "si", t_end: float = 600.0, t_end_rate: float = 300.0,
-             vessel: dict | None = None):
-    """FSM laws against the PI / LQR baselines on S3, S4 (``t_end_rate``) and S7 (``t_end``)
-    (spec 004 §4.11.3)."""
+def _compare(preset_name: str = "si-consistent", t_end: float = 600.0, t_end_rate: float = 300.0,
+             baselines: str = "all", vessel: dict | None = None):
+    """FSM laws against the baselines on S3, S4 (``t_end_rate``) and S7 (``t_end``): the
+    equal-bandwidth pole placement and designed PI, and the spec's §4.11.3 PI / LQR kept as
+    reproductions (``baselines``: all | designed | reproduction)."""
     from shipgnc.cases.catamaran import comparison_cases
 
     return comparison_cases(preset_name, t_end_rate=min(t_end_rate, t_end), t_end_heading=t_end,
-                            vessel=vessel)
+                            vessel=vessel, baselines=baselines)
 
 
 def builder_options(name: str) -> dict[str, object]:
@@ -66,9 +67,9 @@ def cases(scenario: Scenario) -> dict:
         kwargs[key] = value
     if "preset_name" in params:
         kwargs["preset_name"] = scenario.vessel.preset
-    elif scenario.vessel.preset != "si":
+    elif scenario.vessel.preset != "si-consistent":
         raise ConfigError(f"vessel.preset = {scenario.vessel.preset!r}: builder {cfg.builder!r} runs "
-                          "preset 'si' only")
+                          "preset 'si-consistent' only")
     overrides = scenario.vessel.overrides()
     if overrides:
         from shipgnc.models.catamaran import preset
@@ -134,14 +135,15 @@ def score(scenario: Scenario, ds, case, controller=None) -> dict:
     """The scenario's catamaran metrics of one run of ``case`` (the keys ``shipgnc run`` prints;
     ``diverged`` is the caller's). ``controller``: the run's controller, whose events join those
     found in the logged δ (None: the events in ``ds.attrs`` or the logged δ alone)."""
-    from shipgnc.analysis.catamaran_metrics import catamaran_metrics, comparison_metrics
+    from shipgnc.analysis.catamaran_metrics import catamaran_metrics, comparison_metrics, model_fields
 
+    note = model_fields(case.model, scenario.vessel.preset)
     if np.ndim(case.x0) > 1:
-        return montecarlo_summary(ds, case)
+        return {**montecarlo_summary(ds, case), **note}
     if scenario.case.builder == "compare":
         return {**catamaran_metrics(ds, controller, case.heading_target),
-                **comparison_metrics(ds, case.heading_target)}
-    return catamaran_metrics(ds, controller, case.heading_target)
+                **comparison_metrics(ds, case.heading_target), **note}
+    return {**catamaran_metrics(ds, controller, case.heading_target), **note}
 
 
 def setup(scenario: Scenario, variant: str | None = None):

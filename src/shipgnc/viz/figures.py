@@ -76,29 +76,8 @@ def _path_figures(job: FigureJob) -> list[Path]:
 
 def _catamaran_figures(job: FigureJob) -> list[Path]:
     """Document 004's figures that belong to the run's case (``result``: Datasets by run key)."""
-    from shipgnc.models.catamaran import Catamaran
     from shipgnc.viz import catamaran as cv
     from shipgnc.viz.dashboard import save_figure
 
     runs, opts = job.result, job.options or {}
-    builder, out = opts.get("builder"), job.out
-    first = next(iter(runs.values()))
-    figures = []
-    if builder == "turn":
-        figures.append((cv.fig_turn(runs.get("law21", first), f"{job.title}: turn"), "turn.png"))
-        figures.append((cv.fig_yaw_rate_laws(runs), "yaw_rate.png"))
-    elif builder == "steps":
-        model = Catamaran.from_preset(opts.get("preset", "si"))
-        key = next((k for k in runs if k.startswith("law20")), next(iter(runs)))
-        figures.append((cv.fig_phi3(runs[key], model), "fig1_phi3.png"))
-        figures.append((cv.fig_yaw_rate_laws(runs), "fig2_3_yaw_rate.png"))
-    elif builder == "fixed-angle":
-        figures.append((cv.fig_transients(runs), "fig4_5_transients.png"))
-    elif builder == "sine":
-        figures.append((cv.fig_sine(first), "fig7_sine.png"))
-    elif builder == "heading":
-        figures.append((cv.fig_heading(first, opts.get("heading_target", 0.0)), "fig8_heading.png"))
-    elif builder in ("actuator", "compare"):
-        rate_runs = {k: v for k, v in runs.items() if not k.startswith("S7")}
-        figures.append((cv.fig_yaw_rate_laws(rate_runs, t_max=None), "yaw_rate.png"))
-    return [save_figure(fig, out / name) for fig, name in figures]
+    return [save_figure(fig, job.out / name) for fig, name in cv.scenario_figures(runs, opts, job.title)]
