@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 from typer.testing import CliRunner
@@ -179,3 +180,88 @@ def test_a_run_without_the_turn_reports_no_figures_instead_of_fake_zeros(tmp_pat
 def test_times_are_clean_numbers(tmp_path):
     result = invoke("run", "boat-los", "--out", tmp_path, "--json", "--no-figures")
     assert json.loads(result.stdout)["completion_time_s"] == 121.05
+
+
+@pytest.mark.parametrize(("args", "section", "reads"), [
+    (["show", "zermelo-paper", "--set", "simulation.t_end=5"], "simulation", "route, sail"),
+    (["run", "zermelo-paper", "--set", "simulation.t_end=5", "--no-figures"], "simulation", "route"),
+    (["show", "boat-los", "--set", "quality.lam=2"], "quality", "actuator"),
+    (["show", "catamaran-steps", "--set", "guidance.lookahead=5"], "guidance", "case"),
+    (["show", "cybership-calm", "--set", "montecarlo.runs=5"], "montecarlo", "quality"),
+])
+def test_a_setting_the_scenario_does_not_use_is_refused(args, section, reads, tmp_path):
+    """``--set`` into a section the scenario never reads would be accepted and ignored: it is
+    refused with the key and the sections the scenario uses (exit 2, bad input)."""
+    result = invoke(*args, *(["--out", tmp_path / "out"] if args[0] == "run" else []))
+    assert result.exit_code == 2, (result.stdout, result.stderr)
+    message = " ".join(result.stderr.split())
+    assert f"--set {args[3].split('=')[0]}" in message and repr(section) in message, message
+    assert reads in message and "ignored" in message, message
+    assert not (tmp_path / "out").exists()
+
+
+def test_controller_sampling_follows_dt_unless_set(tmp_path):
+    """``Ts`` left out is the simulation's dt: ``--set simulation.dt=...`` alone changes the
+    controller's sampling; a ``Ts`` given (the built-in files) stays as given."""
+    import yaml
+
+    from shipgnc.scenarios.registry import load_scenario, raw_scenario
+    from shipgnc.scenarios.runner import build
+
+    for name in ("boat-autopilot", "cybership-calm", "mariner-lqr"):
+        data, _ = raw_scenario(name)
+        for ctrl in [data["controller"]] if "controller" in data else data["controllers"].values():
+            ctrl.pop("Ts", None)
+        path = tmp_path / f"{name}.yaml"
+        path.write_text(yaml.safe_dump(data))
+        dt = load_scenario(name).simulation.dt
+        assert build(load_scenario(str(path))).controller.Ts == pytest.approx(dt)
+        assert build(load_scenario(str(path), [f"simulation.dt={dt / 2}"])).controller.Ts == \
+            pytest.approx(dt / 2)
+        pinned = build(load_scenario(name, [f"simulation.dt={dt / 2}"])).controller.Ts
+        assert pinned == pytest.approx(dt)  # the file sets Ts: a whole multiple of the new dt
+    result = invoke("show", tmp_path / "boat-autopilot.yaml")
+    assert result.exit_code == 0 and "Ts" not in result.stdout  # follows dt: nothing to show
+
+
+def test_help_texts_render_cleanly():
+    """Rich markup must not eat the help text ("Output directory ." was "[default: ...]")."""
+    for args in ([], ["run"], ["sweep"], ["show"], ["list"]):
+        result = runner.invoke(app, [*args, "--help"], env={"COLUMNS": "200"}, color=False)
+        assert result.exit_code == 0, args
+        # a sentence ending in " ." is text that markup swallowed
+        assert not re.search(r"\w \.(\s|$)", result.stdout), (args, result.stdout)
+    run_help = " ".join(runner.invoke(app, ["run", "--help"], env={"COLUMNS": "200"}).stdout.split())
+    assert "Output directory (default: runs/<scenario>)" in run_help
+    sweep_help = " ".join(runner.invoke(app, ["sweep", "--help"], env={"COLUMNS": "200"}).stdout.split())
+    assert "Output directory (default: runs/sweep-<scenario>)" in sweep_help
+    assert "east [m], psi_deg [deg]" in sweep_help
+
+
+def test_wide_tables_wrap_to_a_narrow_terminal():
+    """A comparison wider than the terminal is wrapped into tables that fit (every controller
+    and every value shown, nothing cut with "…"); too narrow for one column beside the names:
+    one table per controller."""
+    from rich.console import Console
+
+    from shipgnc.cli import print_columns
+
+    names = [f"S{i}/law{20 + i % 2}@0.00072" for i in range(8)]
+    rows = ["final_yaw_rate_rad_s", "yaw_rate_overshoot_pct", "thruster_travel_deg"]
+    columns = {n: [f"{1.23456789 * (i + 1) * 10 ** j:.6g}" for j in range(3)]
+               for i, n in enumerate(names)}
+    for width, tables in ((80, None), (200, 1), (30, 8)):
+        console = Console(width=width, record=True, color_system=None)
+        print_columns(console, "catamaran-compare: metrics by controller", "metric", rows, columns)
+        text = console.export_text()
+        assert all(len(line) <= width for line in text.splitlines()), width
+        assert "…" not in text
+        flat = "".join(text.split())
+        for name, values in columns.items():
+            assert name.replace(" ", "") in flat or width == 30, name
+            for value in values:
+                assert value in flat, (width, value)
+        if tables is not None:
+            assert text.count("┏") == tables, (width, text)
+        else:
+            assert 1 < text.count("┏") < 8

@@ -30,6 +30,7 @@ SHORTER = {
     "mariner-fl-paper": ("simulation.t_end=1200",),
     "mariner-fl-lookahead": ("simulation.t_end=1200",),
     "mariner-montecarlo": ("simulation.t_end=600", "montecarlo.runs=20"),
+    "mariner-montecarlo-wide": ("simulation.t_end=600", "montecarlo.runs=20"),
     "catamaran-turn": ("simulation.t_end=300",),
     "catamaran-steps": ("simulation.t_end=300",),
     "catamaran-fixed-angle": ("simulation.t_end=300",),
@@ -40,7 +41,8 @@ SHORTER = {
     "catamaran-montecarlo": ("simulation.t_end=100",),
 }
 #: document 002's routing problems (no vessel simulated); zermelo-sail sails its route (below)
-NOT_SIMULATED = {"zermelo-paper", "zermelo-vortex", "zermelo-shoal", "zermelo-sail"}
+NOT_SIMULATED = {"zermelo-paper", "zermelo-vortex", "zermelo-shoal", "zermelo-sail",
+                 "zermelo-sail-mariner"}
 SIMULATED = sorted(s.name for s in list_scenarios() if s.name not in NOT_SIMULATED)
 
 

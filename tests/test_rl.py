@@ -6,6 +6,8 @@ single envs step for step."""
 
 from __future__ import annotations
 
+import math
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -155,3 +157,23 @@ def test_vector_env_refuses_a_batch_coupling_integrator():
     ShipEnv(scenario)  # one ship: the adaptive integrator is fine
     with pytest.raises(ConfigError, match="vectorised environment needs 'rk4'"):
         ShipVectorEnv(num_envs=2, scenario=scenario)
+
+
+def test_observations_are_read_by_name():
+    """``named``: an observation as {name: value}, for one env and for a vector env's batch; the
+    values are the model's state and the tracking error, whatever their position."""
+    from shipgnc.rl import named
+
+    env = gym.make("shipgnc/BoatHeading-v0").unwrapped
+    obs, info = env.reset(seed=0)
+    o = env.named(obs)
+    assert list(o) == env.observation_names
+    assert o["r"] == info["state"][5] and o["psi"] == pytest.approx(info["state"][2])
+    assert o["psi_error"] == pytest.approx(math.remainder(o["psi"] - o["psi_d"], 2 * math.pi))
+    envs = ShipVectorEnv(num_envs=3, scenario="boat-autopilot")
+    batch, _ = envs.reset(seed=0)
+    by_name = envs.named(batch)
+    assert by_name["psi_error"].shape == (3,)
+    np.testing.assert_array_equal(by_name["u"], batch[:, envs.observation_names.index("u")])
+    with pytest.raises(ValueError, match="names"):
+        named(obs[:-1], env.observation_names)

@@ -108,7 +108,7 @@ def show_command(scenario: Annotated[str, typer.Argument(help="Built-in name or 
 def run_command(
     scenario: Annotated[str, typer.Argument(help="Built-in scenario name or a YAML file.")],
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output directory "
-                                             "[default: runs/<scenario>].")] = None,
+                                             "(default: runs/<scenario>).")] = None,
     set_: SetOption = None,
     json_: Annotated[bool, typer.Option("--json", help="Print only the metrics JSON on stdout.")] = False,
     live: Annotated[bool, typer.Option("--live", help="Animate the dashboard while simulating.")] = False,
@@ -220,23 +220,61 @@ def _cell(value) -> str:
 
 
 def _print_metrics(name: str, metrics: dict) -> None:
-    """A metric/value table, or for a comparison one row per controller."""
+    """A metric/value table, or for a comparison one row per metric and one column per controller
+    (split over several tables when they do not fit the terminal; see :func:`print_columns`)."""
     if metrics and all(isinstance(v, dict) for v in metrics.values()):
         rows = list(dict.fromkeys(k for m in metrics.values() for k in m))
-        table = Table(title=f"{name}: metrics by controller", title_justify="left")
-        table.add_column("metric", style="bold")
-        for controller in metrics:
-            table.add_column(controller, justify="right")
-        for row in rows:
-            table.add_row(row, *(_cell(values.get(row)) for values in metrics.values()))
-        stdout.print(table)
+        columns = {controller: [_cell(values.get(row)) for row in rows]
+                   for controller, values in metrics.items()}
+        print_columns(stdout, f"{name}: metrics by controller", "metric", rows, columns)
         return
-    table = Table(title=f"{name}: metrics", title_justify="left")
-    table.add_column("metric", style="bold")
-    table.add_column("value", justify="right")
-    for key, value in metrics.items():
-        table.add_row(key, _cell(value))
-    stdout.print(table)
+    keys = list(metrics)
+    print_columns(stdout, f"{name}: metrics", "metric", keys,
+                  {"value": [_cell(metrics[k]) for k in keys]})
+
+
+def _table_width(first: list[str], columns: list[list[str]]) -> int:
+    """Width of a rich table with a heavy head: each column its widest cell plus 3 (padding and
+    rule), plus the closing rule."""
+    return 1 + sum(3 + max(len(c) for c in col) for col in [first, *columns])
+
+
+def print_columns(console: Console, title: str, first_header: str, rows: list[str],
+                  columns: dict[str, list[str]]) -> None:
+    """One table: a first column of row names, then one column per entry of ``columns``; when
+    it is wider than the terminal (``console.width``), the columns are wrapped into several
+    tables that fit, each repeating the row names; when not even one column fits beside the
+    row names, a narrow layout: one two-column table (row, value) per column. Cells fold onto
+    more lines rather than being cut."""
+    from rich.markup import escape
+
+    first = [first_header, *rows]
+    cells = {name: [name, *values] for name, values in columns.items()}
+    width = console.width
+    groups: list[list[str]] = []
+    for name in cells:
+        if groups and _table_width(first, [cells[n] for n in [*groups[-1], name]]) <= width:
+            groups[-1].append(name)
+        else:
+            groups.append([name])
+    if len(cells) > 1 and any(_table_width(first, [cells[g[0]]]) > width for g in groups):
+        for name, values in columns.items():  # narrow: one small table per column, folded
+            table = Table(title=escape(f"{title}: {name}"), title_justify="left")
+            table.add_column(first_header, style="bold", overflow="fold")
+            table.add_column("value", justify="right", overflow="fold")
+            for row, value in zip(rows, values, strict=True):
+                table.add_row(escape(row), escape(value))
+            console.print(table)
+        return
+    for i, group in enumerate(groups):
+        part = f" ({i + 1} of {len(groups)})" if len(groups) > 1 else ""
+        table = Table(title=escape(title + part), title_justify="left")
+        table.add_column(first_header, style="bold", overflow="fold")
+        for name in group:
+            table.add_column(escape(name), justify="right", overflow="fold")
+        for j, row in enumerate(rows):
+            table.add_row(escape(row), *(escape(columns[name][j]) for name in group))
+        console.print(table)
 
 
 from shipgnc.cli_route import route as _route  # noqa: E402  (the route command, spec 002)

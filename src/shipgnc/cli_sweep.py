@@ -44,7 +44,7 @@ def sweep(
     chunk_size: Annotated[int, typer.Option("--chunk-size", help="Members per task.")] = 1000,
     series: Annotated[bool, typer.Option("--series", help="Keep every member's time series.")] = False,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output directory "
-                                             "[default: runs/sweep-<scenario>].")] = None,
+                                             "(default: runs/sweep-<scenario>).")] = None,
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write sweep.png.")] = True,
     keep_partial: Annotated[bool, typer.Option(
         "--keep-partial", help="If every member diverges (exit 3), still write the study "
@@ -149,11 +149,9 @@ def write_study(ds, out: Path, *, figures: bool = True, overwrite: bool = False,
 
 
 def _print_summary(run, max_columns: int = 8) -> None:
-    """One row per metric, one column per grid point: the median and [p5, p95] of the members."""
-    from rich.markup import escape
-    from rich.table import Table
-
-    from shipgnc.cli import stdout
+    """One row per metric, one column per grid point: the median and [p5, p95] of the members
+    (wrapped into several tables, or one per point, when wider than the terminal)."""
+    from shipgnc.cli import print_columns, stdout
     from shipgnc.scenarios.runner import metric_text
 
     def metric_text4(value) -> str:
@@ -169,12 +167,9 @@ def _print_summary(run, max_columns: int = 8) -> None:
     title = f"{ds.attrs['scenario']}: median [p5, p95] over {ds.attrs['members']} members"
     if len(rows) > len(shown):
         title += f" (first {len(shown)} of {len(rows)} points; all in summary.csv)"
-    table = Table(title=escape(title), title_justify="left")
-    table.add_column("metric", style="bold")
+    columns = {}
     for row in shown:
         label = ", ".join(f"{k.rsplit('.', 1)[-1]}={metric_text4(row[k])}" for k in cell_keys) or "all"
-        table.add_column(escape(label), justify="right")
-    for m in metrics:
-        table.add_row(m, *(escape(f"{metric_text4(r[f'{m}_median'])} [{metric_text4(r[f'{m}_p5'])}, "
-                                  f"{metric_text4(r[f'{m}_p95'])}]") for r in shown))
-    stdout.print(table)
+        columns[label] = [f"{metric_text4(row[f'{m}_median'])} [{metric_text4(row[f'{m}_p5'])}, "
+                          f"{metric_text4(row[f'{m}_p95'])}]" for m in metrics]
+    print_columns(stdout, title, "metric", metrics, columns)

@@ -180,10 +180,12 @@ def waypoint_arrays(t, leg, along, cross, alpha, leg_lengths, capture_distance: 
     with np.errstate(invalid="ignore", divide="ignore"):
         rms = np.sqrt(time_sum(np.where(captured, cross**2, 0.0)) / n_captured)
     peak = np.max(np.where(captured, np.abs(cross), -np.inf), axis=0)
+    peak_all = np.max(np.where(keep & np.isfinite(cross), np.abs(cross), -np.inf), axis=0)
     return {
         "completion_time_s": np.where(any_done, t[done.argmax(axis=0)], np.nan),
         "crosstrack_rms_m": np.where(n_captured > 0, rms, np.nan),
         "crosstrack_max_m": np.where(n_captured > 0, peak, np.nan),
+        "crosstrack_max_all_m": np.where(np.isfinite(peak_all), peak_all, np.nan),
         "waypoints_reached": np.max(np.where(keep, leg, -1), axis=0) + any_done,
         "max_thruster_angle_deg": to_deg(np.max(np.where(keep, np.abs(alpha), -np.inf), axis=0)),
         "final_crosstrack_m": np.take_along_axis(cross, (end - 1)[None, :], axis=0)[0],
@@ -195,7 +197,10 @@ def waypoint_metrics(ds, leg_lengths, capture_distance: float = 20.0) -> dict:
 
     ``completion_time_s``: first sample at which the along-track distance reaches the end of the
     last leg (``None`` if never). ``crosstrack_max_m`` / ``crosstrack_rms_m``: max |e| and RMS of
-    e over the samples with along-track distance ≥ ``capture_distance`` on their own leg.
+    e over the samples with along-track distance ≥ ``capture_distance`` (20 m) on their own leg —
+    the first 20 m of every leg, where the boat turns onto it and overshoots, are left out (spec
+    001 §1.10's window). ``crosstrack_max_all_m``: max |e| over the whole run, the turns onto
+    each leg included.
     ``waypoints_reached``: waypoints after the start whose leg was completed. Samples after the
     completion are left out (a ship of a batch keeps sailing until every ship is done).
     """
@@ -208,9 +213,117 @@ def waypoint_metrics(ds, leg_lengths, capture_distance: float = 20.0) -> dict:
     return out
 
 
+#: share of the run (or of each reference segment) whose end must show no sustained oscillation
+STABLE_FINAL_FRACTION = 0.2
+#: share of a final window's samples at *each* actuator limit above which the actuator counts as
+#: pinned at saturation in alternating sign (a bang-bang limit cycle)
+STABLE_PINNED_FRACTION = 0.05
+#: the heading error's oscillation amplitude above which a course-keeping run is not stable [deg]
+COURSE_OSCILLATION_DEG = 5.0
+
+
+def stable_arrays(t, error, *, bound, oscillation_tol, reached=True, diverged=False,
+                  actuator=None, actuator_max=None, segments=None,
+                  final_fraction: float = STABLE_FINAL_FRACTION,
+                  pinned_fraction: float = STABLE_PINNED_FRACTION) -> dict:
+    """Whether each run of a batch is **stable**: bounded *and* converged; the one definition of
+    ``stable`` for every metric set of shipgnc.
+
+    Arrays ``(time, ship)`` (NaN after a ship's run stopped); ``error`` is the tracked error (a
+    heading error [rad], a cross-track error [m]) and ``bound`` / ``oscillation_tol`` are in its
+    unit (``bound`` a number or a ``(ship,)`` array). A run is stable when all of:
+
+    1. *reached*: it ran to its end, and the divergence guard did not stop it (``diverged``);
+    2. *bounded*: |e| < ``bound`` on every sample;
+    3. *no limit cycle*: over the final window — the last ``final_fraction`` (20 %) of the run, or
+       of each segment when ``segments`` labels the samples (a new segment wherever the label
+       changes, e.g. each course step) — the error's oscillation amplitude
+       A = ½ (max ρ − min ρ), with ρ the error minus its least-squares straight line over the
+       window (a slow monotone approach is not an oscillation), is at most ``oscillation_tol``;
+    4. *no saturated oscillation*: in no final window does the ``actuator`` sit at +``actuator_max``
+       *and* at −``actuator_max`` on at least ``pinned_fraction`` (5 %) of the samples each.
+
+    Returns ``stable`` (bool), ``bounded`` (bool), ``oscillation`` (the largest A over the final
+    windows, in the error's unit) and ``saturated_oscillation`` (bool), each ``(ship,)``.
+    """
+    t = np.asarray(t, dtype=float)
+    e = np.asarray(error, dtype=float).reshape(t.size, -1)
+    n_ships = e.shape[1]
+    finite = np.isfinite(e)
+    bound = np.broadcast_to(np.asarray(bound, dtype=float), (n_ships,))
+    bounded = np.all(~finite | (np.abs(np.where(finite, e, 0.0)) < bound), axis=0)
+    labels = (np.zeros(t.size) if segments is None
+              else np.asarray(segments, dtype=float).reshape(t.size))
+    starts = np.flatnonzero(np.r_[True, labels[1:] != labels[:-1]])
+    ends = np.r_[starts[1:], t.size]
+    amplitude = np.zeros(n_ships)
+    pinned = np.zeros(n_ships, dtype=bool)
+    act = None if actuator is None else np.asarray(actuator, dtype=float).reshape(t.size, -1)
+    for i0, i1 in zip(starts, ends, strict=True):
+        # each ship's own final window: the last fraction of its samples in this segment
+        seg = np.zeros_like(finite)
+        seg[i0:i1] = finite[i0:i1]
+        t_last = np.max(np.where(seg, t[:, None], -np.inf), axis=0)
+        t_first = np.min(np.where(seg, t[:, None], np.inf), axis=0)
+        window = seg & (t[:, None] >= t_last - final_fraction * (t_last - t_first) - 1e-9)
+        n = time_sum(window)
+        if not np.any(n >= 3):
+            continue
+        tc = np.where(window, t[:, None] - 0.5 * (t_first + t_last), 0.0)
+        ew = np.where(window, e, 0.0)
+        s_t, s_e, s_tt, s_te = time_sum(tc), time_sum(ew), time_sum(tc * tc), time_sum(tc * ew)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            det = n * s_tt - s_t * s_t
+            slope = np.where(det > 0, (n * s_te - s_t * s_e) / det, 0.0)
+            intercept = np.where(n > 0, (s_e - slope * s_t) / n, 0.0)
+        rho = ew - (intercept + slope * tc)
+        half_range = 0.5 * (np.max(np.where(window, rho, -np.inf), axis=0)
+                            - np.min(np.where(window, rho, np.inf), axis=0))
+        amplitude = np.maximum(amplitude, np.where(n >= 3, half_range, 0.0))
+        if act is not None and actuator_max is not None:
+            limit = float(actuator_max) * (1.0 - 1e-6)
+            a = np.where(window, act, 0.0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                high = time_sum(window & (a >= limit)) / n
+                low = time_sum(window & (a <= -limit)) / n
+            pinned |= (n >= 3) & (high >= pinned_fraction) & (low >= pinned_fraction)
+    reached = np.broadcast_to(np.asarray(reached, dtype=bool), (n_ships,))
+    diverged = np.broadcast_to(np.asarray(diverged, dtype=bool), (n_ships,))
+    stable = reached & ~diverged & bounded & (amplitude <= oscillation_tol) & ~pinned
+    return {"stable": stable, "bounded": bounded, "oscillation": amplitude,
+            "saturated_oscillation": pinned}
+
+
+def _segments_of(reference) -> np.ndarray | None:
+    """Segment labels ``(time,)`` of a piecewise-constant reference (its first ship): a new
+    segment at every change of the reference."""
+    if reference is None:
+        return None
+    ref = np.asarray(reference, dtype=float)
+    ref = ref.reshape(ref.shape[0], -1)[:, 0]
+    changed = np.r_[False, np.abs(np.diff(np.where(np.isfinite(ref), ref, 0.0))) > 1e-12]
+    return np.cumsum(changed)
+
+
+def actuator_motion_arrays(t, actuator) -> tuple[np.ndarray, np.ndarray]:
+    """RMS rate [unit/s] and travel Σ|Δa| [unit] of an actuator series ``(time, ship)`` (samples
+    after a ship's run stopped, NaN, are left out)."""
+    t = np.asarray(t, dtype=float)
+    a = np.asarray(actuator, dtype=float).reshape(t.size, -1)
+    step = np.diff(a, axis=0)
+    ok = np.isfinite(step)
+    step0 = np.where(ok, step, 0.0)
+    dt = np.diff(t)[:, None]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rate_rms = np.sqrt(time_sum(np.where(ok, (step0 / dt) ** 2, 0.0)) / time_sum(ok))
+    return np.where(time_sum(ok) > 0, rate_rms, np.nan), time_sum(np.abs(step0))
+
+
 def course_quality_arrays(t, psi_error, delta, u, *, lam: float = 1.0, t_end: float | None = None,
                           diverged=False, psi=None, psi_z=None, bound_deg: float = 90.0,
-                          settle_window_s: float = 30.0, settle_band_deg: float = 2.0) -> dict:
+                          settle_window_s: float = 30.0, settle_band_deg: float = 2.0,
+                          psi_d=None, delta_max: float | None = None,
+                          oscillation_deg: float = COURSE_OSCILLATION_DEG) -> dict:
     """The figures of :func:`course_quality_metrics` for every ship: arrays ``(time, ship)`` →
     ``(ship,)`` arrays; samples after a ship's run stopped (NaN padding) are left out."""
     t = np.asarray(t, dtype=float)[:, None]
@@ -224,6 +337,12 @@ def course_quality_arrays(t, psi_error, delta, u, *, lam: float = 1.0, t_end: fl
     reached = np.ones_like(t_last, dtype=bool) if t_end is None else t_last >= t_end - 1e-9
     late = finite & (t >= t_last - settle_window_s)
     dpsi_deg = np.abs(to_deg(dpsi0))
+    delta_arr = np.asarray(delta, dtype=float)
+    verdict = stable_arrays(t[:, 0], dpsi, bound=math.radians(bound_deg),
+                            oscillation_tol=math.radians(oscillation_deg), reached=reached,
+                            diverged=diverged, actuator=delta_arr, actuator_max=delta_max,
+                            segments=_segments_of(psi_d))
+    rate_rms, travel = actuator_motion_arrays(t[:, 0], delta_arr)
     out = {
         "psi_E": psi_E,
         "delta_E": delta_E,
@@ -231,8 +350,9 @@ def course_quality_arrays(t, psi_error, delta, u, *, lam: float = 1.0, t_end: fl
         "min_surge_mps": np.min(np.where(np.isfinite(u), u, np.inf), axis=0),
         "final_heading_error_deg": to_deg(np.take_along_axis(dpsi0, last[None, :], axis=0)[0]),
         "max_rudder_deg": to_deg(np.max(np.where(finite, np.abs(delta), -np.inf), axis=0)),
-        "stable": reached & ~np.asarray(diverged, dtype=bool) & np.all(
-            ~finite | (dpsi_deg < bound_deg), axis=0),
+        "rudder_rate_rms_deg_s": to_deg(rate_rms),
+        "rudder_travel_deg": to_deg(travel),
+        "stable": verdict["stable"],
         "settled": np.all(~late | (dpsi_deg <= settle_band_deg), axis=0),
     }
     if psi_z is not None:
@@ -246,23 +366,37 @@ def course_quality_arrays(t, psi_error, delta, u, *, lam: float = 1.0, t_end: fl
 
 def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
                            diverged: bool = False, bound_deg: float = 90.0,
-                           settle_window_s: float = 30.0, settle_band_deg: float = 2.0) -> dict:
+                           settle_window_s: float = 30.0, settle_band_deg: float = 2.0,
+                           delta_max: float | None = None,
+                           oscillation_deg: float = COURSE_OSCILLATION_DEG) -> dict:
     """Document 003's quality index and course-keeping figures (spec 003 §3.1, §3.8).
 
     On every sample t_i: Δψ_i = wrap(ψ_d − ψ_i) [rad]; ``psi_E`` = Σ Δψ_i², ``delta_E`` = λ Σ δ_i²
     with the applied rudder δ [rad], ``J`` = ``psi_E`` + ``delta_E`` (eq. 2). ``min_surge_mps``,
-    ``final_heading_error_deg`` (Δψ at the last sample), ``max_rudder_deg`` (applied). ``stable``:
-    the run reached ``t_end`` without the divergence guard and |Δψ| stayed below 90°. Extras:
+    ``final_heading_error_deg`` (Δψ at the last sample), ``max_rudder_deg`` (applied).
+    J does not see how hard the rudder works; beside it: ``rudder_rate_rms_deg_s``, the RMS of
+    the applied rudder rate Δδ_i/Δt_i, and ``rudder_travel_deg`` = Σ|Δδ_i|, the rudder's total
+    travel (wear of the steering machine).
+
+    ``stable`` (:func:`stable_arrays`): the run reached ``t_end`` without the divergence guard,
+    |Δψ| stayed below 90°, and over the last 20 % of each course step (a segment of constant
+    ψ_d) the heading error's oscillation about its trend is at most ``oscillation_deg`` (5°) in
+    amplitude and the rudder is not pinned at both limits ±``delta_max`` (default: the result's
+    ``delta_max`` attribute; none checked if absent) — a limit cycle is not stable. Extras:
     ``settled`` (|Δψ| ≤ 2° over the last 30 s) and ``psi_E_ref`` (Σ wrap(ψ_z − ψ)² against the
     reference model, for controllers that have one; spec 003 B11).
     """
     has_ref = "psi_z" in ds
+    if delta_max is None and "delta_max" in ds.attrs:
+        delta_max = float(ds.attrs["delta_max"])
     a = course_quality_arrays(ds.time.values, series(ds, "psi_error"), series(ds, "delta"),
                               series(ds, "u"), lam=lam, t_end=t_end, diverged=diverged,
                               psi=series(ds, "psi") if has_ref else None,
                               psi_z=series(ds, "psi_z") if has_ref else None,
                               bound_deg=bound_deg, settle_window_s=settle_window_s,
-                              settle_band_deg=settle_band_deg)
+                              settle_band_deg=settle_band_deg,
+                              psi_d=series(ds, "psi_d") if "psi_d" in ds else None,
+                              delta_max=delta_max, oscillation_deg=oscillation_deg)
     out = {key: _scalar(value[0]) for key, value in a.items()}
     out["stable"], out["settled"] = bool(a["stable"][0]), bool(a["settled"][0])
     return out

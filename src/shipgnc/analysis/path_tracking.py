@@ -15,8 +15,11 @@ time before the first leg switch.
   10 min (signed; the heading error's is the circular mean, so a ship near ψ_r = ±180° reads
   ±180°, not 0);
 * ``rudder_rms_deg``; ``saturation_fraction``: share of samples with |δ| at δ_max;
-* ``stable``: the run reached its end without the divergence guard, |y_r| stayed below
-  max(3 nm, 2|y_r(0)|) (spec 000 §0.8, [A]) and the ship is not ``reversed``;
+* ``stable`` (the one definition, :func:`shipgnc.analysis.metrics.stable_arrays`): the run
+  reached its end without the divergence guard, |y_r| stayed below max(3 nm, 2|y_r(0)|) (spec 000
+  §0.8, [A]), over the last 20 % of the run y_r oscillates about its trend by at most 0.05 nm (the
+  settling band) and the rudder is not pinned at both limits ±δ_max (no limit cycle, no
+  saturated oscillation), and the ship is not ``reversed``;
 * ``reversed``: the run ends with |heading error| > 90° (the final heading error above, the
   circular mean over the last 10 min): the reversed equilibrium ψ_r = π of spec 000 §0.5, a ship
   sailing its leg backwards with y_r bounded, which is not tracking (issue 15).
@@ -28,6 +31,7 @@ import math
 
 import numpy as np
 
+from shipgnc.analysis.metrics import stable_arrays
 from shipgnc.batchmath import time_sum
 from shipgnc.units import MINUTE, NAUTICAL_MILE, to_deg
 
@@ -62,7 +66,7 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
     t = np.asarray(time, dtype=float)
     y, psi, lg, d = (np.asarray(a, dtype=float).reshape(t.size, -1) for a in (y_r, psi_r, leg, delta))
     valid = np.isfinite(y) & np.isfinite(lg)
-    n_t, n_ships = y.shape
+    n_t = y.shape[0]
     rows = np.arange(n_t)[:, None]
     switched = valid & (lg > 0)
     has_switch = switched.any(axis=0)
@@ -101,12 +105,13 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
         rudder_rms = np.sqrt(time_sum(np.where(applied, d * d, 0.0)) / applied.sum(axis=0))
         saturated = applied & (np.abs(d) >= delta_max * (1.0 - 1e-9))
         saturation = saturated.sum(axis=0) / applied.sum(axis=0)
-        peak = np.max(np.where(valid, np.abs(y), 0.0), axis=0)
     bound = np.maximum(STABLE_BOUND, 2.0 * np.abs(y0))
     final_heading = to_deg(np.arctan2(final_mean(np.sin(psi)), final_mean(np.cos(psi))))
     reversed_ = np.abs(final_heading) > REVERSED_DEG  # NaN (no valid sample) compares False
-    stable = (np.broadcast_to(np.asarray(reached_end, dtype=bool), (n_ships,)) & (peak < bound)
-              & ~reversed_)
+    verdict = stable_arrays(t, np.where(valid, y, np.nan), bound=bound,
+                            oscillation_tol=SETTLE_BAND, reached=reached_end,
+                            actuator=np.where(valid, d, np.nan), actuator_max=delta_max)
+    stable = verdict["stable"] & ~reversed_
     return {
         "settle_time_min": settle,
         "overshoot_nm": overshoot,
@@ -146,8 +151,9 @@ def montecarlo_summary(ds, *, delta_max: float, diverged: bool = False) -> dict:
     """Distribution of the path-tracking metrics over the ships of a batch result.
 
     ``runs``; ``settled_fraction`` and ``stable_fraction``; ``on_path_at_end_fraction``: runs whose
-    mean |y_r| over the last 10 min is inside the settling band (0.05 nm) — bounded is not
-    converged: a ship circling with its rudder hard over stays ``stable``; median and 95th percentile of
+    mean |y_r| over the last 10 min is inside the settling band (0.05 nm) — a ship that ends
+    off the path without oscillating (still approaching it, or held off by a bias) can be
+    ``stable`` but is not on the path; median and 95th percentile of
     ``settle_time_min`` (a ship that never settles counts as +∞, so a percentile it reaches is
     null) and of ``crosstrack_rms_after_leg1_nm`` (a ship that never finishes leg 1 counts as +∞
     too: leaving them out would flatter a controller whose failures stay on leg 1).

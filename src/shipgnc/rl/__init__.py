@@ -31,7 +31,7 @@ try:
 except ImportError as exc:  # pragma: no cover - the [rl] extra is missing
     raise ImportError("shipgnc.rl needs gymnasium: pip install 'shipgnc[rl]'") from exc
 
-from shipgnc.rl.env import ShipEnv, ShipVectorEnv
+from shipgnc.rl.env import ShipEnv, ShipVectorEnv, named
 
 ENVIRONMENTS = {
     "shipgnc/BoatHeading-v0": {"scenario": "boat-autopilot", "perturb": ("psi_deg=uniform:-30,30",)},
@@ -54,4 +54,4 @@ def register() -> None:
 
 register()
 
-__all__ = ["ENVIRONMENTS", "ShipEnv", "ShipVectorEnv", "register"]
+__all__ = ["ENVIRONMENTS", "ShipEnv", "ShipVectorEnv", "named", "register"]

@@ -2,7 +2,8 @@
 ships stepped in one array operation (:class:`ShipVectorEnv`).
 
 * observation: the model's states (angles wrapped to (−π, π]), the guidance references and the
-  tracking errors, named in ``observation_names``; unbounded ``Box`` (float64, SI units);
+  tracking errors, named in ``observation_names``; unbounded ``Box`` (float64, SI units); read
+  them by name with ``env.named(obs)["psi_error"]`` (:func:`named`) rather than by index;
 * action: the model's inputs (``Box`` between the actuator limits, e.g. thrust [0, 200] N and
   thruster angle ±45° for the boat; the catamaran's thruster rate δ̇ has no limit in document 004,
   so its ``Box`` is unbounded), held over the scenario controller's sample time ``Ts``;
@@ -29,6 +30,20 @@ from gymnasium.vector.utils import batch_space
 from shipgnc.rl.episode import BatchedEpisode
 
 
+def named(obs, names) -> dict[str, np.ndarray | float]:
+    """An observation read by name: ``{name: value}`` for a single env's ``(n,)`` observation
+    (floats), or ``{name: (num_envs,) array}`` for a vector env's ``(num_envs, n)`` batch;
+    ``names`` is the env's ``observation_names``. E.g. ``named(obs, names)["psi_error"]``."""
+    obs = np.asarray(obs, dtype=float)
+    names = list(names)
+    if obs.shape[-1] != len(names):
+        raise ValueError(f"observation of {obs.shape[-1]} values, {len(names)} names: "
+                         f"{', '.join(names)}")
+    if obs.ndim == 1:
+        return {name: float(obs[i]) for i, name in enumerate(names)}
+    return {name: obs[..., i] for i, name in enumerate(names)}
+
+
 def _spaces(episode: BatchedEpisode):
     n_obs = len(episode.observation_names)
     observation = gym.spaces.Box(-np.inf, np.inf, shape=(n_obs,), dtype=np.float64)
@@ -46,6 +61,10 @@ class ShipEnv(gym.Env):
         self.episode = BatchedEpisode(scenario, batch=1, perturb=perturb)
         self.observation_space, self.action_space = _spaces(self.episode)
         self.observation_names = self.episode.observation_names
+
+    def named(self, obs) -> dict[str, float]:
+        """``obs`` as ``{name: value}`` by :attr:`observation_names` (see :func:`named`)."""
+        return named(obs, self.observation_names)
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
@@ -77,6 +96,10 @@ class ShipVectorEnv(VectorEnv):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.observation_names = self.episode.observation_names
         self._streams: list[np.random.Generator] | None = None
+
+    def named(self, obs) -> dict[str, np.ndarray]:
+        """A batch of observations as ``{name: (num_envs,) array}`` (see :func:`named`)."""
+        return named(obs, self.observation_names)
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
         if seed is not None or self._streams is None:

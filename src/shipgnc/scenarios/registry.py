@@ -174,10 +174,39 @@ def load_scenario(name_or_path: str, overrides: list[str] | tuple[str, ...] = ()
     """Load a built-in scenario by name or a YAML file by path, apply ``key=value`` overrides
     (dotted keys, YAML values: ``simulation.dt=0.01``, ``vessel.preset=otter-munk``) and validate."""
     data, source = raw_scenario(name_or_path)
+    keys = []
     for item in overrides:
         key, value = parse_override(item)
         set_path(data, key, value)
-    return validate(data, source)
+        if value is not None:  # KEY=null clears a setting (e.g. controllers=null): never unused
+            keys.append(key)
+    try:
+        scenario = validate(data, source)
+    except ConfigError:
+        if keys:  # an override into a section the scenario does not read: say that first
+            try:
+                base = validate(raw_scenario(name_or_path)[0], source)
+            except ConfigError:
+                base = None
+            if base is not None:
+                refuse_unused(base, keys)
+        raise
+    refuse_unused(scenario, keys)
+    return scenario
+
+
+def refuse_unused(scenario: Scenario, keys) -> None:
+    """A ConfigError naming the first dotted key whose top-level section ``scenario`` does not
+    read (:meth:`Scenario.used_sections`): such an override would be accepted and ignored."""
+    used = scenario.used_sections()
+    for key in keys:
+        section = key.split(".", 1)[0]
+        if section not in used:
+            reads = [s for s in used if s not in ("name", "description", "document", "metrics",
+                                                  "document_figures")]
+            raise ConfigError(f"--set {key}: scenario {scenario.name!r} does not use the section "
+                              f"{section!r}, so the setting would be ignored; its sections: "
+                              f"{', '.join(reads)}")
 
 
 def parse_override(item: str) -> tuple[str, object]:

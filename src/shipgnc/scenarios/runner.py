@@ -111,6 +111,14 @@ def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
     return batch
 
 
+def sampled(cfg, scenario: Scenario):
+    """The controller config with its sampling period resolved: ``Ts`` left out (None) follows
+    ``simulation.dt`` (a controller that samples at every step)."""
+    if getattr(cfg, "Ts", 0.0) is None:
+        return cfg.model_copy(update={"Ts": scenario.simulation.dt})
+    return cfg
+
+
 def _controller(cfg, model, scenario: Scenario):
     if cfg.type == "open-loop":
         entries = cfg.schedule
@@ -131,7 +139,10 @@ def _course_controller(cfg, params, propeller_rps: float):
     common = {"Ts": cfg.Ts, "propeller_rps": propeller_rps}
     if cfg.variant == "pd":
         return course.CoursePD(**gains, **common)
-    design_model = course.design_model_of(params, gains.pop("design_model", "eq18"))
+    if cfg.variant == "smc_identified":
+        return course.smc_identified(params, **common, **gains)
+    design_model = course.design_model_of(params, gains.pop("design_model", "eq18"),
+                                          propeller_rps=propeller_rps)
     if cfg.variant == "smc_tuned":
         return course.smc_tuned(design_model, **common, **gains)
     lam1, lam2 = gains.pop("lam1", course.PAPER_LAMBDAS[0]), gains.pop("lam2", course.PAPER_LAMBDAS[1])
@@ -155,12 +166,28 @@ def _guidance(g):
 
 
 def _disturbance(d, scenario: Scenario):
-    if d is None:
+    """The force disturbance ``d`` and the scenario's ``current`` composed once
+    (:class:`~shipgnc.environment.current_field.CurrentDisturbance`), or the force alone."""
+    force = _force_disturbance(d, scenario)
+    current = getattr(scenario, "current", None)
+    if current is None:
+        return force
+    from shipgnc.environment.current_field import CurrentDisturbance
+
+    return CurrentDisturbance(current.build(), force)
+
+
+def _force_disturbance(d, scenario: Scenario):
+    if d is None or (d.type == "waves" and d.hs == 0):  # hs: 0 is calm water: no wave load at all
         return None
     if d.type == "constant":
         return ConstantDisturbance(d.values)
     if d.type == "gaussian":
-        return GaussianForceNoise(d.std, d.mean)
+        if d.psd is not None:  # white noise of spectral density S: σ = √(S/dt) per step
+            return GaussianForceNoise(psd=d.psd, dt=scenario.simulation.dt, mean=d.mean)
+        if d.stationary_std is not None:
+            return GaussianForceNoise(d.stationary_std, d.mean, time_constant=d.time_constant)
+        return GaussianForceNoise(d.per_step_std, d.mean)
     from shipgnc.environment.waves import FroudeKrylovWaveLoads, WaveSpectrum
 
     if d.spectrum == "modified-pm":
@@ -169,7 +196,8 @@ def _disturbance(d, scenario: Scenario):
         spectrum = WaveSpectrum.jonswap(d.hs, d.t0, gamma=d.gamma)  # t0 is the peak period here
     else:
         spectrum = WaveSpectrum.pierson_moskowitz(hs=d.hs)  # one parameter: the period follows
-    return FroudeKrylovWaveLoads(spectrum, direction=deg(d.heading_deg), n_components=d.components)
+    return FroudeKrylovWaveLoads(spectrum, direction=deg(d.heading_deg), n_components=d.components,
+                                 gains=d.gains)
 
 
 def _mariner(scenario: Scenario):
@@ -222,9 +250,10 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
 
         path = mariner.mariner_path(scenario.guidance)
         d = scenario.disturbance
-        return Setup(model, x0, actuator, mariner.controller(variants[name], model, path, scenario),
+        return Setup(model, x0, actuator,
+                     mariner.controller(sampled(variants[name], scenario), model, path, scenario),
                      None, None if d is None else mariner.disturbance(d, path), path=path)
-    return Setup(model, x0, actuator, _controller(variants[name], model, scenario),
+    return Setup(model, x0, actuator, _controller(sampled(variants[name], scenario), model, scenario),
                  _guidance(scenario.guidance), _disturbance(scenario.disturbance, scenario), u0)
 
 
@@ -248,7 +277,8 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
                                        scenario.guidance.capture_distance)
     elif scenario.metrics == "course-quality":
         out = metrics.course_quality_metrics(result, lam=scenario.quality.lam,
-                                             t_end=scenario.simulation.t_end, diverged=diverged)
+                                             t_end=scenario.simulation.t_end, diverged=diverged,
+                                             delta_max=float(setup.model.params.delta_max))
     elif scenario.metrics == "path-tracking":
         from shipgnc.analysis import path_tracking
 
@@ -300,7 +330,9 @@ def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndar
             t, series(result, "psi_error"), series(result, "delta"), series(result, "u"),
             lam=scenario.quality.lam, t_end=scenario.simulation.t_end,
             psi=series(result, "psi") if has_ref else None,
-            psi_z=series(result, "psi_z") if has_ref else None)
+            psi_z=series(result, "psi_z") if has_ref else None,
+            psi_d=series(result, "psi_d") if "psi_d" in result else None,
+            delta_max=float(setup.model.params.delta_max))
     elif scenario.metrics == "path-tracking" and scenario.montecarlo is None:
         from shipgnc.analysis import path_tracking
 
@@ -548,11 +580,16 @@ def figure_job(run: ScenarioRun, out: Path):
             runs = {n: run.result.sel(controller=n).dropna("time", how="all") for n in names}
         else:
             runs = {run.scenario.name: run.result}
-        if any("ship" in ds.dims for ds in runs.values()):
-            return None  # a batch: its metrics summarise it
+        from shipgnc.analysis.catamaran_metrics import model_fields
+        from shipgnc.viz.catamaran import batch_bands  # a batch: its quantiles, not every ship
+
+        runs = {k: batch_bands(ds) if "ship" in ds.dims else ds for k, ds in runs.items()}
         target = getattr(run.setup.controller, "omega_ref", None)
+        omega = getattr(target, "omega", None)
         options = {"builder": run.scenario.case.builder, "preset": run.scenario.vessel.preset,
-                   "heading_target": float(getattr(target, "psi_target", 0.0) or 0.0)}
+                   "heading_target": float(getattr(target, "psi_target", 0.0) or 0.0),
+                   "omega": float(omega) if omega is not None and np.ndim(omega) == 0 else None,
+                   "model_note": model_fields(run.setup.model, run.scenario.vessel.preset)["model_note"]}
         return FigureJob(result=runs, out=out, title=run.scenario.name, kind="catamaran",
                          options=options)
     if run.setup.path is not None:
@@ -625,13 +662,16 @@ def write_table(rows: list[dict], out: Path, stem: str = "table") -> list[Path]:
 
 def metric_text(value, digits: int = 4) -> str:
     """A metric as table text: numbers to ``digits`` significant digits, None as "—", a list of
-    numbers joined, a list of events (dicts with ``kind``) by kind ("none" if empty)."""
+    numbers joined, a list of events (dicts with ``kind``) by kind ("none" if empty), a mapping
+    as "key value" pairs."""
     if value is None:
         return "—"
     if isinstance(value, bool):
         return str(value)
     if isinstance(value, float):
         return f"{value:.{digits}g}"
+    if isinstance(value, dict):  # a nested record (e.g. a route's global check): key value pairs
+        return ", ".join(f"{k} {metric_text(v, digits)}" for k, v in value.items())
     if isinstance(value, (list, tuple)):
         if not value:
             return "none"

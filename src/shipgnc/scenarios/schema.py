@@ -125,12 +125,17 @@ class MarinerVesselConfig(Strict):
 
 
 class CatamaranVesselConfig(Strict):
-    """``vessel`` for document 004's twin-azimuth catamaran: parameter preset (spec 004 §4.4)."""
+    """``vessel`` for document 004's twin-azimuth catamaran: parameter preset (spec 004 §4.4).
+
+    ``si-consistent`` (default): the physically consistent hull (SI units, sway Coriolis sign
+    corrected, hull lift [A]); ``si`` (printed Coriolis sign) and ``paper`` (the listing's mixed
+    units) are the document's reproductions, flagged in figures and metrics."""
 
     model: Literal["catamaran"]
-    preset: Literal["si", "paper"] = "si"
-    #: sway Coriolis sign of the printed model, or the consistent one (spec 004 §4.3)
-    coriolis: Literal["printed", "consistent"] = "printed"
+    preset: Literal["si-consistent", "si", "paper"] = "si-consistent"
+    #: sway Coriolis sign: the printed model's, or the consistent one (spec 004 §4.3); None: the
+    #: preset's (consistent for ``si-consistent``, printed for ``si`` and ``paper``)
+    coriolis: Literal["printed", "consistent"] | None = None
     #: resistance below V_m: the quadratic continuation, or the literal fit (spec 004 §4.3)
     low_speed: Literal["continued", "literal"] = "continued"
     #: other :class:`CatamaranParams` overrides (SI), e.g. ``{J_zz: 4.0e6, T_v: 18000}``
@@ -139,7 +144,7 @@ class CatamaranVesselConfig(Strict):
     def overrides(self) -> dict:
         """Parameter overrides of the preset (the defaults left out)."""
         out = dict(self.params)
-        if self.coriolis != "printed":
+        if self.coriolis is not None:
             out["coriolis"] = self.coriolis
         if self.low_speed != "continued":
             out["low_speed"] = self.low_speed
@@ -251,14 +256,14 @@ class HeadingSpeedConfig(Strict):
     """The boat's heading + speed autopilot (spec 001 §1.10)."""
 
     type: Literal["heading-speed"]
-    Ts: Positive = 0.05
+    Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
     omega_ref: Positive = 1.0
     omega: Positive = 1.0
     omega_u: Positive = 1.0
     yaw_feedforward: bool = True
 
 
-COURSE_CONTROLLERS = ("pd", "smc_printed", "smc_consistent", "smc_tuned")
+COURSE_CONTROLLERS = ("pd", "smc_printed", "smc_consistent", "smc_tuned", "smc_identified")
 
 
 COURSE_GAINS = {
@@ -266,6 +271,7 @@ COURSE_GAINS = {
     "smc_printed": ("design_model", "lam1", "lam2", "eta", "phi", "omega_n", "zeta"),
     "smc_consistent": ("design_model", "lam1", "lam2", "eta", "phi", "omega_n", "zeta"),
     "smc_tuned": ("design_model", "lam1", "lam2", "eta_rudder", "phi"),
+    "smc_identified": ("lam1", "lam2", "eta_rudder", "phi"),
 }
 
 
@@ -276,15 +282,17 @@ class CourseControllerConfig(Strict):
     PD (eq. 3): ``Kp``, ``Kd``. SMC (eq. 9–15): the design model (``eq18`` as printed, ``eq17``,
     ``eq16``), eigenvalues ``lam1``, ``lam2`` [1/s], switching gain ``eta`` and boundary layer
     ``phi``, reference model ``omega_n`` [rad/s], ``zeta``; ``smc_tuned`` takes its switching gain
-    as a rudder angle ``eta_rudder`` [rad] (η_h = η_δ |hᵀB_h|).
+    as a rudder angle ``eta_rudder`` [rad] (η_h = η_δ |hᵀB_h|). ``smc_identified``: the same law
+    and settings on the first-order Nomoto model identified from the plant's 20°/20° zig-zag
+    (``design_model: identified`` gives that model to the other SMC variants too).
     """
 
     type: Literal["course"]
-    variant: Literal["pd", "smc_printed", "smc_consistent", "smc_tuned"]
-    Ts: Positive = 0.1
+    variant: Literal["pd", "smc_printed", "smc_consistent", "smc_tuned", "smc_identified"]
+    Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
     Kp: Positive | None = None
     Kd: NonNegative | None = None
-    design_model: Literal["eq18", "eq17", "eq16"] | None = None
+    design_model: Literal["eq18", "eq17", "eq16", "identified"] | None = None
     lam1: Annotated[float, Field(lt=0, allow_inf_nan=False)] | None = None
     lam2: Annotated[float, Field(lt=0, allow_inf_nan=False)] | None = None
     eta: Positive | None = None
@@ -316,7 +324,7 @@ class PathLQRConfig(Strict):
     ``anti_windup``: conditional integration while the rudder saturates (the document has none)."""
 
     type: Literal["lqr"]
-    Ts: Positive = 0.3
+    Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
     Q: tuple[NonNegative, NonNegative, NonNegative, NonNegative] | None = None
     R: Positive | None = None
     K_paper: tuple[Finite, Finite, Finite, Finite] | None = None
@@ -336,7 +344,7 @@ class OutputFLConfig(Strict):
     gains of (23) in the document's units. ``knows_disturbance``: b_r and d_y known (A13)."""
 
     type: Literal["fl"]
-    Ts: Positive = 0.3
+    Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
     lookahead_nm: NonNegative = 0.0
     k1_per_min2: Positive = 0.18
     k2_per_min: Positive = 0.7
@@ -344,15 +352,28 @@ class OutputFLConfig(Strict):
 
 
 class LOSFLConfig(Strict):
-    """LOS guidance with crab compensation feeding an exact FL of the yaw loop (spec 000 §0.5,
-    ``los_fl``): look-ahead ``delta_nm`` Δ, yaw-loop gains in the document's units."""
+    """LOS guidance feeding an exact FL of the yaw loop (spec 000 §0.5, ``los_fl``): look-ahead
+    ``delta_nm`` Δ, yaw-loop gains in the document's units. By default the controller does **not**
+    know the disturbances: integral LOS (gain ``integral_gain_nm_min`` κ, default U/4 =
+    0.0625 nm/min, critically damped) removes the offset of the unknown current and yaw bias, and
+    ẏ_r comes from successive positions (issue 17). ``knows_disturbance: true`` is the
+    document's oracle: b_r and d_y handed to the law (crab compensation −asin(d_y/u), A13) and
+    κ = 0 unless set."""
 
     type: Literal["los-fl"]
-    Ts: Positive = 0.3
+    Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
     delta_nm: Positive = 0.5
     kp_per_min2: Positive = 1.0
     kd_per_min: Positive = 2.0
-    knows_disturbance: bool = True
+    knows_disturbance: bool = False
+    integral_gain_nm_min: Annotated[float, Field(ge=0, le=10, allow_inf_nan=False)] | None = None
+
+    @property
+    def integral_gain(self) -> float:
+        """κ in the document's nm/min: as set, else 0.0625 without disturbance knowledge, 0 with."""
+        if self.integral_gain_nm_min is not None:
+            return self.integral_gain_nm_min
+        return 0.0 if self.knows_disturbance else 0.0625
 
 
 MARINER_CONTROLLERS = ("lqr", "fl", "los-fl")
@@ -445,37 +466,113 @@ GuidanceConfig = Annotated[ScheduleGuidanceConfig | LOSConfig | CourseScheduleCo
 # --------------------------------------------------------------------------- disturbance
 
 class ConstantForceConfig(Strict):
-    """Constant body-frame force and moment [X N, Y N, N N·m]."""
+    """Constant body-frame force and moment [X N, Y N, N N·m] (a current: the scenario's
+    ``current`` section, which combines with it)."""
 
     type: Literal["constant"]
     values: tuple[Finite, Finite, Finite]
 
 
+Triple = tuple[NonNegative, NonNegative, NonNegative]
+
+
 class GaussianForceConfig(Strict):
-    """Seeded white Gaussian force/moment, new sample each step (std [N, N, N·m])."""
+    """Seeded Gaussian force/moment noise [N, N, N·m], held over each step, in one of three forms
+    (:class:`~shipgnc.environment.disturbance.GaussianForceNoise`):
+
+    * ``psd`` — white noise of two-sided spectral density S [N²·s, N²·s, N²·m²·s]: the held value
+      has σ = √(S/dt), so the vessel's response does not depend on ``simulation.dt``;
+    * ``sigma_per_step`` (or its old name ``std``) — σ per step whatever the step: the old form,
+      whose effect scales like √dt (``sigma_per_step: σ`` at dt₀ is ``psd: σ²·dt₀``);
+    * ``stationary_std`` with ``time_constant`` [s] — a first-order Gauss–Markov process.
+    """
 
     type: Literal["gaussian"]
-    std: tuple[NonNegative, NonNegative, NonNegative]
+    psd: Triple | None = None
+    sigma_per_step: Triple | None = None
+    std: Triple | None = None
+    stationary_std: Triple | None = None
+    time_constant: Positive | None = None
     mean: tuple[Finite, Finite, Finite] = (0.0, 0.0, 0.0)
+
+    @model_validator(mode="after")
+    def _one_form(self) -> GaussianForceConfig:
+        given = [n for n in ("psd", "sigma_per_step", "std", "stationary_std")
+                 if getattr(self, n) is not None]
+        if len(given) != 1:
+            raise ValueError(f"give exactly one of psd (white noise, N²·s), sigma_per_step (σ per "
+                             f"step; old name std) or stationary_std with time_constant "
+                             f"(Gauss-Markov); got {', '.join(given) or 'none'}")
+        if (self.time_constant is None) != (self.stationary_std is None):
+            raise ValueError("time_constant and stationary_std go together (the Gauss-Markov form)")
+        return self
+
+    @property
+    def per_step_std(self):
+        """σ per step of the per-step form (``sigma_per_step`` or its old name ``std``)."""
+        return self.sigma_per_step if self.sigma_per_step is not None else self.std
+
+
+class CurrentConfig(Strict):
+    """``current``: an earth-fixed current on the vessel, as relative velocity (Fossen 2021 §10.3;
+    :mod:`shipgnc.environment.current_field`). ``field``: the router's FIELD string in SI
+    (``uniform:north=0,east=0.5`` [m/s], ``shear:k=..``, ``rotation:..``, vortices, a NetCDF file)
+    or ``gauss-markov:speed=0.5,direction=90,speed_std=0.05,speed_tau=600,direction_std=10,
+    direction_tau=900`` (m/s, degrees, s), joined with ``+``. A plain string is the ``field``.
+    Combines with the force ``disturbance`` (constant, gaussian, waves)."""
+
+    field: Annotated[str, Field(min_length=1)]
+
+    @model_validator(mode="before")
+    @classmethod
+    def _string(cls, data):
+        return {"field": data} if isinstance(data, str) else data
+
+    @field_validator("field")
+    @classmethod
+    def _parses(cls, text: str) -> str:
+        from shipgnc.environment.current_field import parse_current
+
+        try:
+            parse_current(text)
+        except ConfigError as exc:
+            raise ValueError(str(exc)) from None
+        return text
+
+    def build(self):
+        """The current object (:func:`~shipgnc.environment.current_field.parse_current`)."""
+        from shipgnc.environment.current_field import parse_current
+
+        return parse_current(self.field)
+
+
+#: vessel models a scenario's ``current`` section applies to
+CURRENT_VESSELS = ("vectored-thrust-boat", "cybership2")
 
 
 class WavesConfig(Strict):
     """Irregular waves from a spectrum and the wave loads they put on the hull (spec 003 §3.6).
 
     ``hs`` [m] and ``t0`` [s] at model scale (1:70 Froude-correct: 3 m → 42.9 mm; the document's
-    printed 5 mm is selectable); ``t0`` is the modal period (the peak period for JONSWAP; unused by
-    the one-parameter ``pm``); ``heading_deg``: the direction the waves travel to, clockwise from
-    north (head seas for a ship on course 0°: ψ_f = 180°). Loads: Froude–Krylov pressure of each
-    component integrated over the hull box (:class:`shipgnc.environment.waves.FroudeKrylovWaveLoads`).
+    printed 5 mm is selectable; ``hs: 0`` is calm water, no wave load); ``t0`` is the modal period
+    (the peak period for JONSWAP; unused by the one-parameter ``pm``); ``heading_deg``: the
+    direction the waves travel to, clockwise from north (head seas for a ship on course 0°:
+    ψ_f = 180°). Loads: Froude–Krylov pressure of each component integrated over the hull box
+    (:class:`shipgnc.environment.waves.FroudeKrylovWaveLoads`), times ``gains`` (surge, sway,
+    yaw; default 1 = the Froude–Krylov loads themselves, no diffraction). Calibration
+    (docs/003_cybership_autopilot.md, "Wave-load calibration"): with gains 1 the
+    wave-frequency heading RMS on the ±30° legs of ``cybership-waves`` is the linear-response
+    (RAO) estimate of :meth:`FroudeKrylovWaveLoads.linear_response`, ≈ 0.2°.
     """
 
     type: Literal["waves"]
     spectrum: Literal["modified-pm", "jonswap", "pm"] = "modified-pm"
-    hs: Positive = 0.0429
+    hs: NonNegative = 0.0429
     t0: Positive = 0.8
     gamma: Annotated[float, Field(ge=1, allow_inf_nan=False)] = 3.3
     heading_deg: Finite = 180.0
     components: Annotated[int, Field(ge=4, le=2000)] = 200
+    gains: tuple[NonNegative, NonNegative, NonNegative] = (1.0, 1.0, 1.0)
 
 
 class MarinerDisturbanceConfig(Strict):
@@ -483,15 +580,40 @@ class MarinerDisturbanceConfig(Strict):
     ``b_r_rad_min2`` added to ṙ, cross current ``d_y_nm_min`` across the active leg
     (``current_frame: path``) or along east (``global``), and narrow-band wave noise added to ṙ of
     RMS ``wave_sigma_rad_min2`` (0 = off), period ``wave_period`` [s], damping ``wave_zeta``
-    (seeded by ``simulation.seed``)."""
+    (seeded by ``simulation.seed``).
+
+    ``wave_heading_sigma_deg`` calibrates the noise to a sea state instead (issue 17): σ_w =
+    ω₀²·σ_ψw, ω₀ = 2π/``wave_period``, so that the free ship's wave-frequency heading has RMS
+    σ_ψw (its yaw rate σ_ψw·ω₀; :func:`shipgnc.environment.filtered_noise.calibrated_yaw_sigma`).
+    Set it or ``wave_sigma_rad_min2``, not both."""
 
     type: Literal["mariner"]
     b_r_rad_min2: Finite = 0.1
     d_y_nm_min: Finite = 0.04
     current_frame: Literal["path", "global"] = "path"
     wave_sigma_rad_min2: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
+    wave_heading_sigma_deg: Annotated[float, Field(ge=0, le=30, allow_inf_nan=False)] | None = None
     wave_period: Annotated[float, Field(ge=0.5, le=600, allow_inf_nan=False)] = 8.0
     wave_zeta: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.1
+
+    @model_validator(mode="after")
+    def _one_wave_level(self) -> MarinerDisturbanceConfig:
+        if self.wave_heading_sigma_deg is not None and self.wave_sigma_rad_min2 > 0:
+            raise ValueError(
+                f"wave_heading_sigma_deg = {self.wave_heading_sigma_deg} and wave_sigma_rad_min2 = "
+                f"{self.wave_sigma_rad_min2}: set one wave level, not both (wave_heading_sigma_deg: "
+                "null to use the literal wave_sigma_rad_min2)")
+        return self
+
+    @property
+    def wave_sigma(self) -> float:
+        """RMS of the wave yaw acceleration in SI [rad/s²]: calibrated from
+        ``wave_heading_sigma_deg`` when set, else ``wave_sigma_rad_min2``."""
+        if self.wave_heading_sigma_deg is not None:
+            from shipgnc.environment.filtered_noise import calibrated_yaw_sigma
+
+            return calibrated_yaw_sigma(math.radians(self.wave_heading_sigma_deg), self.wave_period)
+        return self.wave_sigma_rad_min2 / 3600.0
 
     @property
     def b_r(self) -> float:
@@ -529,15 +651,32 @@ class RouteConfig(Strict):
 
 
 class SailConfig(Strict):
-    """The route sailed by a ship (spec 002 §2.9.6): the Mariner of document 000 (route speed = its
-    straight-running speed U = 15 kn) steered by a heading autopilot along the optimal heading
-    programme and along ``legs`` constant-heading legs, through the same current field."""
+    """The route sailed by a ship (spec 002 §2.9.7; :mod:`shipgnc.scenarios.routing`), SI units.
 
-    vessel: Literal["mariner"] = "mariner"
+    ``vessel``: ``vectored-thrust-boat`` (document 001's Otter-class boat, ``preset``, with a current
+    as relative velocity, under its heading and speed autopilot) sails the route three ways: as a path
+    (LOS through ``path_points`` waypoints on the route's track, ``lookahead`` [m], default four boat
+    lengths, integral LOS gain ``integral_gain``), by the optimal heading programme, and by ``legs``
+    constant-heading legs. ``mariner`` (document 000's Mariner under a feedback-linearising heading
+    autopilot, the route's speed must be its U = 15 kn) sails the last two. A ship has arrived when
+    it comes within ``acceptance_radius`` [m] of the target (default ``acceptance_lengths`` vessel
+    lengths, Fossen's circle-of-acceptance rule R = 2 L); otherwise the run reports ``arrived:
+    false``, no arrival time and its miss distance (closest approach)."""
+
+    vessel: Literal["vectored-thrust-boat", "mariner"] = "vectored-thrust-boat"
+    #: the boat's parameter preset (spec 001 §1.6); unused by the Mariner
+    preset: Literal["otter", "doc-eq7", "doc-printed", "otter-munk"] = "otter"
     legs: Annotated[int, Field(ge=1, le=50)] = 4
-    dt: Positive = 0.3
-    #: run this long past the optimal arrival time (fraction of it) to find the closest approach
-    margin: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.2
+    #: simulation step [s]; default 0.1 s for the boat, 0.3 s for the Mariner
+    dt: Positive | None = None
+    #: run this long past the optimal arrival time (fraction of it); a ship not within the
+    #: acceptance radius by then has not arrived
+    margin: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.5
+    acceptance_radius: Positive | None = None
+    acceptance_lengths: Positive = 2.0
+    path_points: Annotated[int, Field(ge=2, le=2000)] = 40
+    lookahead: Positive | None = None
+    integral_gain: NonNegative = 0.0
     #: the simulation loop of the sailed runs, as ``simulation.backend`` (a route scenario has no
     #: simulation section): auto, numpy, or compiled (the composed loop, or an error naming why not)
     backend: Literal["auto", "numpy", "compiled"] = "auto"
@@ -599,11 +738,49 @@ class Scenario(Strict):
     sail: SailConfig | None = None
     #: the document's own figures, by controller (shown beside ours in comparison tables)
     document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
+    #: an earth-fixed current on the vessel (boat, CyberShip II), with any force disturbance
+    current: CurrentConfig | None = None
+
+    @field_validator("current")
+    @classmethod
+    def _current_fits(cls, current, info):
+        if current is None:
+            return current
+        vessel = getattr(info.data.get("vessel"), "model", None)
+        if info.data.get("route") is not None or info.data.get("case") is not None or (
+                vessel not in CURRENT_VESSELS):
+            raise ValueError(f"a current section applies to vessel models "
+                             f"{', '.join(CURRENT_VESSELS)} (the Mariner's current is its "
+                             f"disturbance's d_y; a route takes its field from route.field)")
+        return current
 
     @property
     def variants(self) -> dict[str, object]:
         """Controllers by name (one unnamed controller is called ``controller``)."""
         return dict(self.controllers) if self.controllers else {"controller": self.controller}
+
+    def used_sections(self) -> tuple[str, ...]:
+        """The top-level sections this kind of scenario reads; a ``--set`` into any other would
+        be silently ignored, so :func:`~shipgnc.scenarios.registry.load_scenario` refuses it.
+        Every scenario reads its identity (``name``, ``description``, ``document``, ``metrics``,
+        ``document_figures``); a route reads ``route`` and ``sail``; a catamaran case
+        ``vessel``, ``simulation`` and ``case``; the others their vessel, simulation,
+        controller(s), guidance and disturbance, plus ``actuator`` (the boat), ``montecarlo``
+        (the Mariner) and ``quality`` (document 003's index)."""
+        common = ("name", "description", "document", "metrics", "document_figures")
+        if self.route is not None:
+            return (*common, "route", "sail")
+        vessel = self.vessel.model
+        if vessel == "catamaran":
+            return (*common, "vessel", "simulation", "case")
+        used = [*common, "vessel", "simulation", "controller", "controllers", "guidance",
+                "disturbance"]
+        used += {"vectored-thrust-boat": ["actuator"], "mariner": ["montecarlo"]}.get(vessel, [])
+        if vessel in CURRENT_VESSELS:
+            used.append("current")
+        if self.metrics == "course-quality":
+            used.append("quality")
+        return tuple(used)
 
     @model_validator(mode="wrap")
     @classmethod
@@ -663,7 +840,7 @@ class Scenario(Strict):
             if needs and (self.guidance is None or self.guidance.type not in needs):
                 raise ValueError(f"{where}: type {ctrl.type!r} needs a guidance section of type "
                                  f"{' or '.join(needs)}")
-            Ts = getattr(ctrl, "Ts", self.simulation.dt)
+            Ts = getattr(ctrl, "Ts", None) or self.simulation.dt  # None: follows dt
             ratio = Ts / self.simulation.dt
             if round(ratio) < 1 or abs(round(ratio) - ratio) > 1e-9 * ratio:
                 raise ValueError(f"{where}.Ts = {Ts!r} must be a whole multiple of "
@@ -703,10 +880,6 @@ class Scenario(Strict):
                                  "(and its ship from sail)")
         if self.metrics not in ("route", "none"):
             raise ValueError(f"metrics = {self.metrics!r}: a route scenario reports 'route'")
-        if self.route.units == "nautical" and self.sail is not None and abs(self.route.speed - 15.0) > 1e-9:
-            raise ValueError(f"route.speed = {self.route.speed!r} kn: the sailing Mariner runs at its "
-                             "straight-running speed U = 15 kn; scale the route (speed and current "
-                             "by the same factor) to sail it")
         return self
 
     def _consistent_catamaran(self) -> Scenario:
