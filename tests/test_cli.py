@@ -201,8 +201,8 @@ def test_a_setting_the_scenario_does_not_use_is_refused(args, section, reads, tm
 
 
 def test_controller_sampling_follows_dt_unless_set(tmp_path):
-    """``Ts`` left out is the simulation's dt: ``--set simulation.dt=...`` alone changes the
-    controller's sampling; a ``Ts`` given (the built-in files) stays as given."""
+    """``Ts`` left out (the built-in files) is the simulation's dt: ``--set simulation.dt=...``
+    alone changes the controller's sampling; a ``Ts`` given stays as given."""
     import yaml
 
     from shipgnc.scenarios.registry import load_scenario, raw_scenario
@@ -218,8 +218,11 @@ def test_controller_sampling_follows_dt_unless_set(tmp_path):
         assert build(load_scenario(str(path))).controller.Ts == pytest.approx(dt)
         assert build(load_scenario(str(path), [f"simulation.dt={dt / 2}"])).controller.Ts == \
             pytest.approx(dt / 2)
-        pinned = build(load_scenario(name, [f"simulation.dt={dt / 2}"])).controller.Ts
-        assert pinned == pytest.approx(dt)  # the file sets Ts: a whole multiple of the new dt
+        assert build(load_scenario(name, [f"simulation.dt={dt / 2}"])).controller.Ts == \
+            pytest.approx(dt / 2)  # the built-in file leaves Ts out too
+        ctrl_key = "controller" if "controller" in data else f"controllers.{next(iter(data['controllers']))}"
+        pinned = build(load_scenario(name, [f"simulation.dt={dt / 2}", f"{ctrl_key}.Ts={dt}"]))
+        assert pinned.controller.Ts == pytest.approx(dt)  # a Ts given: a whole multiple of dt
     result = invoke("show", tmp_path / "boat-autopilot.yaml")
     assert result.exit_code == 0 and "Ts" not in result.stdout  # follows dt: nothing to show
 

@@ -61,21 +61,3 @@ def test_compiled_run_equals_numpy_run(name):
     for var in ref.result.data_vars:
         np.testing.assert_allclose(got.result[var].values, ref.result[var].values, rtol=1e-9,
                                    atol=1e-12, err_msg=f"{name}: {var}")
-
-
-def test_sailed_route_compiled_equals_numpy():
-    """zermelo-sail: the Mariner sails the optimal heading programme and the constant-heading legs
-    through the route's current field (``sail.backend``; routing scenarios have no simulation
-    section)."""
-    runs = [run_scenario("zermelo-sail", overrides=(f"sail.backend={backend}",))
-            for backend in ("numpy", "compiled")]
-    assert set(runs[1].sailed) == set(runs[0].sailed)
-    for label, ref in runs[0].sailed.items():
-        got = runs[1].sailed[label]
-        assert got.attrs["backend"] == "compiled" and ref.attrs["backend"] == "numpy"
-        for var in ref.data_vars:
-            np.testing.assert_allclose(got[var].values, ref[var].values, rtol=1e-9, atol=1e-12,
-                                       err_msg=f"{label}: {var}")
-    for key, value in runs[0].metrics.items():
-        if isinstance(value, float):
-            assert runs[1].metrics[key] == pytest.approx(value, rel=1e-9, abs=1e-9), key
