@@ -70,6 +70,24 @@ def pi_gains(params, T_u: float, h: float) -> tuple[float, float]:
     k = params.J / (params.L * params.T_v)
     return k / (T_u * h), k / T_u
 
+def rate_source_kernel(controller, function, batch_shape, *params) -> Kernel:
+    """The :class:`Kernel` of a yaw-rate law fed by a ω* source (``controller.omega_ref``):
+    parameters ``[*params, source block]``, per-ship state ``[calls, ω*, source state]``; its
+    ``restore`` hands the last ω* and the source's state back to the numpy objects."""
+    batch_shape = tuple(batch_shape)
+    block, block_state = controller.omega_ref.rate_block(batch_shape)
+    state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
+    state[..., 2:] = block_state
+
+    def restore(z: np.ndarray) -> None:
+        z = z.reshape(-1, 2 + N_RATE_STATE)
+        if z.shape[0] and np.any(z[:, 0] > 0):
+            controller._last = {"omega_ref": z[:, 1].reshape(batch_shape).copy()}
+        controller.omega_ref.restore_block(z[:, 2:], batch_shape)
+
+    return Kernel(function, flat(*params, block), state, restore=restore,
+                  continuous=controller.continuous)
+
 
 class YawRatePI:
     """Fixed-gain PI yaw-rate controller (law (20) without the 1/cos δ scheduling)."""
@@ -109,20 +127,8 @@ class YawRatePI:
         reason = self.kernel_reason()
         if reason:
             raise NotCompiled(reason)
-        batch_shape = tuple(batch_shape)
-        block, block_state = self.omega_ref.rate_block(batch_shape)
-        state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
-        state[..., 2:] = block_state
-
-        def restore(z: np.ndarray) -> None:
-            z = z.reshape(-1, 2 + N_RATE_STATE)
-            if z.shape[0] and np.any(z[:, 0] > 0):
-                self._last = {"omega_ref": z[:, 1].reshape(batch_shape).copy()}
-            self.omega_ref.restore_block(z[:, 2:], batch_shape)
-
-        return Kernel(yaw_rate_pi_step, flat(self.K_i, self.K_p, kernel_params(self.model.params),
-                                             block), state, restore=restore,
-                      continuous=self.continuous)
+        return rate_source_kernel(self, yaw_rate_pi_step, batch_shape, self.K_i, self.K_p,
+                                  kernel_params(self.model.params))
 
 
 #: offset of the ω* source's parameters in :meth:`YawRatePI.kernel`
@@ -350,19 +356,8 @@ class PolePlacementRate:
         reason = self.kernel_reason()
         if reason:
             raise NotCompiled(reason)
-        batch_shape = tuple(batch_shape)
-        block, block_state = self.omega_ref.rate_block(batch_shape)
-        state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
-        state[..., 2:] = block_state
-
-        def restore(z: np.ndarray) -> None:
-            z = z.reshape(-1, 2 + N_RATE_STATE)
-            if z.shape[0] and np.any(z[:, 0] > 0):
-                self._last = {"omega_ref": z[:, 1].reshape(batch_shape).copy()}
-            self.omega_ref.restore_block(z[:, 2:], batch_shape)
-
-        return Kernel(pole_placement_step, flat(self.K, kernel_params(self.model.params), block),
-                      state, restore=restore, continuous=self.continuous)
+        return rate_source_kernel(self, pole_placement_step, batch_shape, self.K,
+                                  kernel_params(self.model.params))
 
 
 #: offsets in :meth:`PolePlacementRate.kernel`'s parameters: the model's, the ω* source's
@@ -437,20 +432,9 @@ class DesignedPI:
         reason = self.kernel_reason()
         if reason:
             raise NotCompiled(reason)
-        batch_shape = tuple(batch_shape)
-        block, block_state = self.omega_ref.rate_block(batch_shape)
-        state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
-        state[..., 2:] = block_state
-
-        def restore(z: np.ndarray) -> None:
-            z = z.reshape(-1, 2 + N_RATE_STATE)
-            if z.shape[0] and np.any(z[:, 0] > 0):
-                self._last = {"omega_ref": z[:, 1].reshape(batch_shape).copy()}
-            self.omega_ref.restore_block(z[:, 2:], batch_shape)
-
-        params = flat(self.K_i, self.K_p, float(self.delta_max is not None), self.delta_max or 0.0,
-                      kernel_params(self.model.params), block)
-        return Kernel(designed_pi_step, params, state, restore=restore, continuous=self.continuous)
+        return rate_source_kernel(self, designed_pi_step, batch_shape, self.K_i, self.K_p,
+                                  float(self.delta_max is not None), self.delta_max or 0.0,
+                                  kernel_params(self.model.params))
 
 
 #: offsets in :meth:`DesignedPI.kernel`'s parameters: the model's, the ω* source's

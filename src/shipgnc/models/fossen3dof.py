@@ -288,16 +288,7 @@ def boat_rhs(x, u, d, p, xdot):
     """ẋ of eq. (1)–(5), (9)–(11') for one ship in still water: the forces ``d[0:3]`` only (any
     further entries of ``d`` are not read); ``p`` = [M11, M22, M33, X_u, Y_v, N_r, N_rr, k_Munk,
     L_m]."""
-    su, sv, sr = x[3], x[4], x[5]
-    lateral = u[0] * math.sin(u[1])
-    tau_u = u[0] * math.cos(u[1]) + d[0]
-    tau_v = lateral + d[1]
-    tau_r = -p[8] * lateral + d[2]
-    c, s = math.cos(x[2]), math.sin(x[2])
-    xdot[0] = c * su - s * sv
-    xdot[1] = s * su + c * sv
-    xdot[2] = sr
-    xdot[3], xdot[4], xdot[5] = _boat_accelerations(su, sv, sr, tau_u, tau_v, tau_r, p)
+    _boat_rhs(x, u, d, p, xdot, 0.0, 0.0)
 
 
 @kernel_function
@@ -305,6 +296,16 @@ def boat_current_rhs(x, u, d, p, xdot):
     """:meth:`VectoredThrustBoat.derivatives` for one ship, operation for operation: forces
     ``d[0:3]``, earth-fixed current ``d[3:5]`` as relative velocity (module docstring; a zero
     current is still water)."""
+    if d.shape[0] < 5:  # forces only
+        _boat_rhs(x, u, d, p, xdot, 0.0, 0.0)
+    else:
+        _boat_rhs(x, u, d, p, xdot, d[3], d[4])
+
+
+@kernel_function
+def _boat_rhs(x, u, d, p, xdot, current_north, current_east):
+    """The boat's ẋ with forces ``d[0:3]`` and an earth-fixed current (N, E) [m/s]: the hull
+    forces on ν_r = ν − R(ψ)ᵀ v_c, and ν̇ = ν̇_r + (r v_c, −r u_c, 0) (Fossen 2021 §10.3)."""
     su, sv, sr = x[3], x[4], x[5]
     lateral = u[0] * math.sin(u[1])
     tau_u = u[0] * math.cos(u[1]) + d[0]
@@ -314,11 +315,11 @@ def boat_current_rhs(x, u, d, p, xdot):
     xdot[0] = c * su - s * sv
     xdot[1] = s * su + c * sv
     xdot[2] = sr
-    if d.shape[0] < 5 or (d[3] == 0.0 and d[4] == 0.0):  # still water (or forces only)
+    if current_north == 0.0 and current_east == 0.0:  # still water: the plain equations
         xdot[3], xdot[4], xdot[5] = _boat_accelerations(su, sv, sr, tau_u, tau_v, tau_r, p)
         return
-    uc = c * d[3] + s * d[4]
-    vc = -s * d[3] + c * d[4]
+    uc = c * current_north + s * current_east
+    vc = -s * current_north + c * current_east
     du, dv, dr = _boat_accelerations(su - uc, sv - vc, sr, tau_u, tau_v, tau_r, p)
     xdot[3] = du + sr * vc
     xdot[4] = dv - sr * uc
