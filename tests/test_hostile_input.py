@@ -168,3 +168,15 @@ def test_obstacle_ring_with_nan_is_one_line(tmp_path):
     path.write_text('{"type": "Polygon", "coordinates": [[[0, 0], [1, NaN], [1, 1], [0, 0]]]}')
     with pytest.raises(ConfigError, match="finite numbers"):
         load_geojson(path)
+
+
+def test_sweep_max_memory_option(tmp_path):
+    from shipgnc.cli import app
+
+    runner_ = CliRunner()
+    result = runner_.invoke(app, ["sweep", "boat-autopilot", "--mc", "10", "--max-memory", "1M",
+                                  "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2, result.stderr
+    assert "more than --max-memory" in " ".join(result.stderr.split()), result.stderr
+    bad = runner_.invoke(app, ["sweep", "boat-autopilot", "--max-memory", "lots"])
+    assert bad.exit_code == 2 and "expected a size" in bad.stderr

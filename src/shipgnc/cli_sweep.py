@@ -43,6 +43,9 @@ def sweep(
         "--scheduler", help="Address of a running dask scheduler, tcp://HOST:PORT.")] = None,
     chunk_size: Annotated[int, typer.Option("--chunk-size", help="Members per task.")] = 1000,
     series: Annotated[bool, typer.Option("--series", help="Keep every member's time series.")] = False,
+    max_memory: Annotated[str | None, typer.Option(
+        "--max-memory", help="Memory the study may hold, e.g. 4G or 500M (default: the memory "
+                             "available now); a larger estimate is refused before any work.")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output directory "
                                              "(default: runs/sweep-<scenario>).")] = None,
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write sweep.png.")] = True,
@@ -66,6 +69,7 @@ def sweep(
             raise ConfigError(f"--mc {mc}: must be an integer >= 1")
         if chunk_size < 1:
             raise ConfigError(f"--chunk-size {chunk_size}: must be an integer >= 1")
+        limit = None if max_memory is None else parse_size(max_memory, "--max-memory")
         study = Study(scenario, grid=tuple(parse_grid(g) for g in grid or []), members=mc, seed=seed,
                       perturb=tuple(Perturbation.parse(p) for p in perturb or []),
                       overrides=tuple(set_ or []), series=series)
@@ -75,7 +79,7 @@ def sweep(
                             overwrite=overwrite)  # before any work
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ShipGNCWarning)
-            run = _run_with_progress(study, workers, scheduler, chunk_size)
+            run = _run_with_progress(study, workers, scheduler, chunk_size, limit)
         for warning in caught:
             if issubclass(warning.category, ShipGNCWarning):
                 stderr.print(f"[yellow]warning:[/] {escape(str(warning.message))}", soft_wrap=True)
@@ -113,7 +117,23 @@ def diverged_count(ds) -> tuple[int, int]:
     return int(np.sum(flags > 0)), int(flags.size)
 
 
-def _run_with_progress(study, workers, scheduler, chunk_size):
+#: binary multiples of ``--max-memory``
+SIZE_UNITS = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
+
+
+def parse_size(text: str, option: str) -> float:
+    """``"4G"`` → 4·2³⁰ bytes (units K, M, G, T, binary; an optional trailing ``B`` or ``iB``)."""
+    import re
+
+    match = re.fullmatch(r"\s*([0-9]*\.?[0-9]+)\s*([KMGT]?)(I?B)?\s*", text.upper())
+    if not match or float(match.group(1)) <= 0:
+        from shipgnc.errors import ConfigError
+
+        raise ConfigError(f"{option} {text!r}: expected a size such as 4G, 500M or 1.5T")
+    return float(match.group(1)) * SIZE_UNITS[match.group(2)]
+
+
+def _run_with_progress(study, workers, scheduler, chunk_size, max_memory=None):
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from shipgnc.cli import stderr
@@ -127,7 +147,7 @@ def _run_with_progress(study, workers, scheduler, chunk_size):
             bar.update(task, completed=done, total=total)
 
         return run_study(study, workers=workers, scheduler=scheduler, chunk_size=chunk_size,
-                         on_chunk=update)
+                         on_chunk=update, max_memory=max_memory)
 
 
 def write_study(ds, out: Path, *, figures: bool = True, overwrite: bool = False,
