@@ -400,3 +400,31 @@ def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
     out = {key: _scalar(value[0]) for key, value in a.items()}
     out["stable"], out["settled"] = bool(a["stable"][0]), bool(a["settled"][0])
     return out
+
+
+def navigation_arrays(ds) -> dict[str, np.ndarray]:
+    """The navigation figures of a run with sensors / an estimator (issue 18), ``(ship,)`` arrays
+    over every logged sample where the quantity exists (NaN-free samples only):
+
+    ``heading_est_rmse_deg`` √mean(wrap(ψ̂ − ψ)²), ``position_est_rmse_m`` √mean((N̂ − N)² + (Ê − E)²),
+    ``heading_meas_rmse_deg`` √mean(wrap(ψ_meas − ψ)²) over the valid compass samples, and
+    ``nees_mean`` the mean normalised estimation error squared (its expectation is the number of
+    estimated states for a consistent filter). Keys whose signals the run did not log are absent."""
+    out: dict[str, np.ndarray] = {}
+
+    def rms(error: np.ndarray) -> np.ndarray:
+        with np.errstate(invalid="ignore"):
+            return np.sqrt(np.nanmean(error ** 2, axis=0))
+
+    if "psi_hat" in ds:
+        out["heading_est_rmse_deg"] = to_deg(rms(wrap_angle(series(ds, "psi_hat") - series(ds, "psi"))))
+    if "north_hat" in ds and "east_hat" in ds:
+        out["position_est_rmse_m"] = rms(np.hypot(series(ds, "north_hat") - series(ds, "north"),
+                                                  series(ds, "east_hat") - series(ds, "east")))
+    if "psi_meas" in ds:
+        out["heading_meas_rmse_deg"] = to_deg(rms(wrap_angle(series(ds, "psi_meas")
+                                                             - series(ds, "psi"))))
+    if "nees" in ds:
+        with np.errstate(invalid="ignore"):
+            out["nees_mean"] = np.nanmean(series(ds, "nees"), axis=0)
+    return out

@@ -44,6 +44,8 @@ class Setup:
     path: WaypointPath | None = None
     #: document 004's case this setup runs (a :class:`~shipgnc.cases.catamaran.CatamaranCase`)
     case: object | None = None
+    #: sensors and estimator between the true state and the controller (issue 18), or None
+    navigation: object | None = None
 
 
 @dataclass
@@ -252,9 +254,43 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
         d = scenario.disturbance
         return Setup(model, x0, actuator,
                      mariner.controller(sampled(variants[name], scenario), model, path, scenario),
-                     None, None if d is None else mariner.disturbance(d, path), path=path)
+                     None, None if d is None else mariner.disturbance(d, path), path=path,
+                     navigation=navigation(scenario))
     return Setup(model, x0, actuator, _controller(sampled(variants[name], scenario), model, scenario),
-                 _guidance(scenario.guidance), _disturbance(scenario.disturbance, scenario), u0)
+                 _guidance(scenario.guidance), _disturbance(scenario.disturbance, scenario), u0,
+                 navigation=navigation(scenario))
+
+
+def navigation(scenario: Scenario):
+    """The scenario's :class:`~shipgnc.navigation.Navigation` (its ``sensors`` and ``estimator``,
+    degrees converted to radians here), or None when it has no sensors."""
+    if not scenario.sensors:
+        return None
+    import math
+
+    from shipgnc import navigation as nav
+
+    sensors = []
+    for c in scenario.sensors:
+        common = {"rate_hz": c.rate_hz, "latency": c.latency, "name": c.name,
+                  "dropouts": [tuple(interval) for interval in c.dropouts]}
+        if c.type == "gnss":
+            sensors.append(nav.GNSS(c.noise_m, bias_std=c.bias_std_m,
+                                    bias_time_constant=c.bias_time_constant_s, **common))
+        elif c.type == "compass":
+            sensors.append(nav.Compass(math.radians(c.noise_deg), bias=math.radians(c.bias_deg),
+                                       bias_std=math.radians(c.bias_std_deg), **common))
+        elif c.type == "gyro":
+            sensors.append(nav.RateGyro(math.radians(c.noise_deg_s),
+                                        bias=math.radians(c.bias_deg_s),
+                                        bias_walk=math.radians(c.bias_walk_deg_s), **common))
+        else:
+            sensors.append(nav.SpeedLog(c.noise_m_s, state=c.state, **common))
+    e = scenario.estimator
+    estimator = None if e is None else nav.ExtendedKalmanFilter(
+        process_psd=dict(e.process_psd) or None, P0_std=dict(e.P0_std) or None,
+        x0_offset=dict(e.x0_offset) or None, substeps=e.substeps, noise=e.noise)
+    return nav.Navigation(sensors, estimator)
 
 
 def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
@@ -301,6 +337,8 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
                 out["zero_dynamics_pole_per_min"] = None
     else:
         out = {}
+    if setup.navigation is not None:
+        out.update({k: metrics._scalar(v[0]) for k, v in metrics.navigation_arrays(result).items()})
     out["diverged"] = diverged
     return out
 
@@ -349,6 +387,8 @@ def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndar
         out = {}
     else:
         return None
+    if setup.navigation is not None:
+        out.update(metrics.navigation_arrays(result))
     n = series(result, result.psi.name).shape[1]
     arrays = {key: np.broadcast_to(np.asarray(value, dtype=float), (n,)) for key, value in out.items()}
     arrays["diverged"] = np.zeros(n)
@@ -399,6 +439,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
             run.result = simulate(
                 setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
                 actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
+                navigation=setup.navigation,
                 u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
                 atol=sim.atol, seed=seed, observer=observer, progress=progress,
                 log_every=every, backend="numpy" if observer is not None else sim.backend,

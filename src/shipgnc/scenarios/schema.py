@@ -714,6 +714,74 @@ class QualityConfig(Strict):
     lam: NonNegative = 1.0
 
 
+class _SensorBase(Strict):
+    """Common sensor settings (issue 18; :mod:`shipgnc.navigation.sensors`): its own sample rate
+    (a whole multiple of the control period; default every control sample), a latency in control
+    samples, and intervals ``[t0, t1]`` [s] without measurements."""
+
+    name: str | None = None
+    rate_hz: Positive | None = None
+    latency: Annotated[int, Field(ge=0)] = 0
+    dropouts: list[tuple[NonNegative, NonNegative]] = Field(default_factory=list)
+
+
+class GNSSConfig(_SensorBase):
+    """Position fix (north, east): white noise and a first-order Gauss–Markov bias."""
+
+    type: Literal["gnss"]
+    rate_hz: Positive | None = 1.0
+    noise_m: NonNegative = 1.5
+    bias_std_m: NonNegative = 0.0
+    bias_time_constant_s: Positive = 300.0
+
+
+class CompassConfig(_SensorBase):
+    """Heading: white noise and a constant bias (``bias_std_deg``: drawn per ship)."""
+
+    type: Literal["compass"]
+    noise_deg: NonNegative = 0.5
+    bias_deg: Finite = 0.0
+    bias_std_deg: NonNegative = 0.0
+
+
+class GyroConfig(_SensorBase):
+    """Yaw rate: white noise and a bias that walks (``bias_walk_deg_s``: per √s)."""
+
+    type: Literal["gyro"]
+    noise_deg_s: NonNegative = 0.1
+    bias_deg_s: Finite = 0.0
+    bias_walk_deg_s: NonNegative = 0.0
+
+
+class SpeedLogConfig(_SensorBase):
+    """Speed through the water of one state (``u`` by default): white noise."""
+
+    type: Literal["log"]
+    noise_m_s: NonNegative = 0.05
+    state: str = "u"
+
+
+SensorConfig = Annotated[GNSSConfig | CompassConfig | GyroConfig | SpeedLogConfig,
+                         Field(discriminator="type")]
+
+
+class EKFConfig(Strict):
+    """An extended Kalman filter on the vessel's own model (:class:`~shipgnc.navigation.ekf.
+    ExtendedKalmanFilter`): ``process_psd`` by state name [unit²/s], initial ``P0_std`` and
+    ``x0_offset`` (SI; heading in rad), ``noise``: continuous or held over each step."""
+
+    type: Literal["ekf"]
+    process_psd: dict[str, NonNegative] = Field(default_factory=dict)
+    P0_std: dict[str, Positive] = Field(default_factory=dict)
+    x0_offset: dict[str, Finite] = Field(default_factory=dict)
+    substeps: Annotated[int, Field(ge=1, le=100)] = 1
+    noise: Literal["continuous", "held"] = "continuous"
+
+
+#: the vessels whose scenarios take ``sensors`` / ``estimator`` (the numpy loop runs them)
+NAVIGATION_VESSELS = ("vectored-thrust-boat", "cybership2", "mariner")
+
+
 class Scenario(Strict):
     """A complete, runnable scenario: one ``controller``, or ``controllers`` to compare by name."""
 
@@ -740,6 +808,10 @@ class Scenario(Strict):
     document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
     #: an earth-fixed current on the vessel (boat, CyberShip II), with any force disturbance
     current: CurrentConfig | None = None
+    #: navigation (issue 18): the sensors between the true state and the controller, and an
+    #: estimator between the sensors and the controller (the controller acts on its estimate)
+    sensors: list[SensorConfig] = Field(default_factory=list)
+    estimator: EKFConfig | None = None
 
     @field_validator("current")
     @classmethod
@@ -778,6 +850,8 @@ class Scenario(Strict):
         used += {"vectored-thrust-boat": ["actuator"], "mariner": ["montecarlo"]}.get(vessel, [])
         if vessel in CURRENT_VESSELS:
             used.append("current")
+        if vessel in NAVIGATION_VESSELS:
+            used += ["sensors", "estimator"]
         if self.metrics == "course-quality":
             used.append("quality")
         return tuple(used)
@@ -810,6 +884,14 @@ class Scenario(Strict):
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
+        if self.sensors or self.estimator is not None:
+            if self.route is not None or self.vessel.model not in NAVIGATION_VESSELS:
+                what = "a route" if self.route is not None else f"vessel {self.vessel.model!r}"
+                raise ValueError(f"sensors / estimator: not available for {what} (allowed for "
+                                 f"vessel models {', '.join(NAVIGATION_VESSELS)})")
+            if self.estimator is not None and not self.sensors:
+                raise ValueError("estimator: needs sensors to correct it (e.g. sensors: "
+                                 "[{type: gnss}, {type: compass}])")
         if self.route is not None or self.sail is not None:
             return self._consistent_route()
         if self.simulation is None:

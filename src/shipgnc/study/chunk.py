@@ -145,6 +145,7 @@ def _simulate(setup, scenario, x0, streams, backend: str, log_every: int):
     sim = scenario.simulation
     return simulate(setup.model, x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
                     actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
+                    navigation=setup.navigation,
                     u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
                     atol=sim.atol, seed=streams, log_every=log_every, backend=backend,
                     on_divergence="stop", batch_dims=("member",))
