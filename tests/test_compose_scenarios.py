@@ -27,6 +27,8 @@ SHORTER = {
     "mariner-compare": ("simulation.t_end=1200",),
     "mariner-lqr": ("simulation.t_end=1200",),
     "mariner-los-fl": ("simulation.t_end=1200",),
+    "mariner-los-ekf": ("simulation.t_end=600",),
+    "boat-los-gnss": ("simulation.t_end=60",),
     "mariner-fl-paper": ("simulation.t_end=1200",),
     "mariner-fl-lookahead": ("simulation.t_end=1200",),
     "mariner-montecarlo": ("simulation.t_end=600", "montecarlo.runs=20"),
@@ -43,7 +45,19 @@ SHORTER = {
 #: document 002's routing problems (no vessel simulated); zermelo-sail sails its route (below)
 NOT_SIMULATED = {"zermelo-paper", "zermelo-vortex", "zermelo-shoal", "zermelo-sail",
                  "zermelo-sail-mariner"}
-SIMULATED = sorted(s.name for s in list_scenarios() if s.name not in NOT_SIMULATED)
+#: navigation (sensors, estimators) runs in the numpy loop only so far (issue 18)
+NUMPY_ONLY = {s.name for s in list_scenarios() if s.sensors}
+SIMULATED = sorted(s.name for s in list_scenarios()
+                   if s.name not in NOT_SIMULATED and s.name not in NUMPY_ONLY)
+
+
+@pytest.mark.parametrize("name", sorted(NUMPY_ONLY))
+def test_navigation_scenarios_say_why_they_stay_in_numpy(name):
+    from shipgnc.errors import ConfigError
+
+    assert run_with(name, "auto").result.attrs["backend"] == "numpy"
+    with pytest.raises(ConfigError, match="navigation has no kernel yet"):
+        run_with(name, "compiled")
 
 
 def run_with(name: str, backend: str):

@@ -71,3 +71,15 @@ def test_degrees_reach_the_sensors_in_radians():
     nav = build(load_scenario("boat-los-gnss")).navigation
     compass = next(s for s in nav.sensors if s.kind == "compass")
     assert compass.noise_std == pytest.approx(math.radians(0.5))
+
+
+def test_mariner_los_fl_on_an_ekf():
+    """Document 000's path, integral LOS + FL on an EKF: it still settles and stays stable, the
+    heading estimate beats the 0.2° gyrocompass, and the filter is consistent to within a factor
+    of three of its expected NEES (five states; the current and yaw bias are absorbed by tuned
+    process noise, not modelled)."""
+    m = run_scenario("mariner-los-ekf").metrics
+    assert m["stable"] and m["settle_time_min"] is not None
+    assert m["heading_meas_rmse_deg"] == pytest.approx(0.2, rel=0.05)
+    assert m["heading_est_rmse_deg"] < 0.2
+    assert 5.0 / 3 < m["nees_mean"] < 5.0 * 3
