@@ -24,6 +24,7 @@ SHORTER = {
     "boat-los": ("simulation.t_end=120",),
     "cybership-calm": ("simulation.t_end=12",),
     "cybership-waves": ("simulation.t_end=15",),  # the printed SMC amplifies round-off from 18.6 s
+    "cybership-waves-observer": ("simulation.t_end=15",),
     "mariner-compare": ("simulation.t_end=1200",),
     "mariner-lqr": ("simulation.t_end=1200",),
     "mariner-los-fl": ("simulation.t_end=1200",),
@@ -55,7 +56,7 @@ SIMULATED = sorted(s.name for s in list_scenarios()
 def test_navigation_scenarios_say_why_they_stay_in_numpy(name):
     from shipgnc.errors import ConfigError
 
-    assert run_with(name, "auto").result.attrs["backend"] == "numpy"
+    assert run_with(name, "auto").result.attrs["backend"].startswith("numpy")
     with pytest.raises(ConfigError, match="navigation has no kernel yet"):
         run_with(name, "compiled")
 

@@ -83,3 +83,26 @@ def test_mariner_los_fl_on_an_ekf():
     assert m["heading_meas_rmse_deg"] == pytest.approx(0.2, rel=0.05)
     assert m["heading_est_rmse_deg"] < 0.2
     assert 5.0 / 3 < m["nees_mean"] < 5.0 * 3
+
+
+def test_cybership_waves_observer_keys_and_the_true_state_case():
+    """The contract's controller keys; ``pd_true`` (``sees: truth``) is cybership-waves' PD to
+    the bit (same seed, same sea); the measured and observer runs read the sensors (compass σ
+    0.2° seen in the log)."""
+    short = ["simulation.t_end=40"]
+    run = run_scenario("cybership-waves-observer", overrides=short)
+    assert list(run.metrics) == ["pd_true", "pd_measured", "pd_observer", "smc_observer"]
+    ref = run_scenario("cybership-waves", overrides=[*short, "controllers={pd: {type: course, "
+                                                             "variant: pd, Kp: 2.0, Kd: 50.0}}"])
+    assert run.metrics["pd_true"]["J"] == ref.metrics["pd"]["J"]
+    assert "heading_meas_rmse_deg" not in run.metrics["pd_true"]
+    assert run.metrics["pd_measured"]["heading_meas_rmse_deg"] == pytest.approx(0.2, rel=0.1)
+    for key in ("pd_observer", "smc_observer"):
+        assert run.metrics[key]["stable"] is not None and "heading_est_rmse_deg" in run.metrics[key]
+
+
+def test_sees_needs_what_it_reads():
+    with pytest.raises(ConfigError, match="no estimator"):
+        load_scenario("boat-los-gnss", ["estimator=null", "controller.sees=estimate"])
+    with pytest.raises(ConfigError, match="no sensors"):
+        load_scenario("boat-los", ["controller.sees=measurement"])

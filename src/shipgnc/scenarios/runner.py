@@ -255,16 +255,18 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
         return Setup(model, x0, actuator,
                      mariner.controller(sampled(variants[name], scenario), model, path, scenario),
                      None, None if d is None else mariner.disturbance(d, path), path=path,
-                     navigation=navigation(scenario))
+                     navigation=navigation(scenario, variants[name]))
     return Setup(model, x0, actuator, _controller(sampled(variants[name], scenario), model, scenario),
                  _guidance(scenario.guidance), _disturbance(scenario.disturbance, scenario), u0,
-                 navigation=navigation(scenario))
+                 navigation=navigation(scenario, variants[name]))
 
 
-def navigation(scenario: Scenario):
-    """The scenario's :class:`~shipgnc.navigation.Navigation` (its ``sensors`` and ``estimator``,
-    degrees converted to radians here), or None when it has no sensors."""
-    if not scenario.sensors:
+def navigation(scenario: Scenario, controller=None):
+    """The :class:`~shipgnc.navigation.Navigation` a ``controller`` config reads through (the
+    scenario's ``sensors`` and ``estimator``, degrees converted to radians here; the controller's
+    ``sees`` picks truth, measurement or estimate), or None when it reads the true state."""
+    sees = getattr(controller, "sees", None)
+    if not scenario.sensors or sees == "truth":
         return None
     import math
 
@@ -286,10 +288,17 @@ def navigation(scenario: Scenario):
                                         bias_walk=math.radians(c.bias_walk_deg_s), **common))
         else:
             sensors.append(nav.SpeedLog(c.noise_m_s, state=c.state, **common))
-    e = scenario.estimator
-    estimator = None if e is None else nav.ExtendedKalmanFilter(
-        process_psd=dict(e.process_psd) or None, P0_std=dict(e.P0_std) or None,
-        x0_offset=dict(e.x0_offset) or None, substeps=e.substeps, noise=e.noise)
+    e = None if sees == "measurement" else scenario.estimator
+    if e is None:
+        estimator = None
+    elif e.type == "ekf":
+        estimator = nav.ExtendedKalmanFilter(
+            process_psd=dict(e.process_psd) or None, P0_std=dict(e.P0_std) or None,
+            x0_offset=dict(e.x0_offset) or None, substeps=e.substeps, noise=e.noise)
+    else:
+        estimator = nav.PassiveObserver(e.omega0_rad_s, zeta=e.zeta, zeta_notch=e.zeta_notch,
+                                        omega_c=e.omega_c_rad_s, omega_lf=e.omega_lf_rad_s,
+                                        T_b=e.T_b_s, velocity_model=e.velocity_model)
     return nav.Navigation(sensors, estimator)
 
 

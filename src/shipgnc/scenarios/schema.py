@@ -239,6 +239,15 @@ class CommandEntry(Strict):
     label: str = ""
 
 
+class Navigated(Strict):
+    """What a controller reads when the scenario has navigation (issue 18): ``truth`` (the true
+    state, as without navigation), ``measurement`` (the held sensor values) or ``estimate`` (the
+    estimator's); default: the estimate when there is an estimator, else the measurement when
+    there are sensors, else the truth. A comparison can so set the same law on each."""
+
+    sees: Literal["truth", "measurement", "estimate"] | None = None
+
+
 class OpenLoopConfig(Strict):
     """Document 001's hand-written command sequence: piecewise-constant (T, α) from time t."""
 
@@ -252,7 +261,7 @@ class OpenLoopConfig(Strict):
         return schedule
 
 
-class HeadingSpeedConfig(Strict):
+class HeadingSpeedConfig(Navigated):
     """The boat's heading + speed autopilot (spec 001 §1.10)."""
 
     type: Literal["heading-speed"]
@@ -275,7 +284,7 @@ COURSE_GAINS = {
 }
 
 
-class CourseControllerConfig(Strict):
+class CourseControllerConfig(Navigated):
     """Document 003's course autopilots for CyberShip II (spec 003 §3.2): ``variant`` picks the law;
     gains left out take the document's values (``smc_tuned``: the documented retuned ones).
 
@@ -313,11 +322,11 @@ class CourseControllerConfig(Strict):
 
     def gains(self) -> dict:
         """The settings given (the rest keep the controller's defaults)."""
-        return {k: v for k, v in self.model_dump(exclude={"type", "variant", "Ts"}).items()
+        return {k: v for k, v in self.model_dump(exclude={"type", "variant", "Ts", "sees"}).items()
                 if v is not None}
 
 
-class PathLQRConfig(Strict):
+class PathLQRConfig(Navigated):
     """Document 000's LQR with integral action (spec 000 §0.4): designed from ``Q``, ``R`` in the
     document's units (min / nm / rad; R = 1 as stated, R = 0.5 reproduces the print), or the gain
     ``K_paper`` = [k_y, k_ψ, k_r, k_e] used as given (min / nm / rad; the print: [3.4, 3.2, 1, 0.45]).
@@ -338,7 +347,7 @@ class PathLQRConfig(Strict):
         return self
 
 
-class OutputFLConfig(Strict):
+class OutputFLConfig(Navigated):
     """Document 000's feedback linearisation of the output z = y_r + l sin ψ_r (spec 000 §0.5):
     ``lookahead_nm`` l = 0 is the literal design (``fl_paper``, unstable), 0.1 nm the sound variant;
     gains of (23) in the document's units. ``knows_disturbance``: b_r and d_y known (A13)."""
@@ -351,7 +360,7 @@ class OutputFLConfig(Strict):
     knows_disturbance: bool = True
 
 
-class LOSFLConfig(Strict):
+class LOSFLConfig(Navigated):
     """LOS guidance feeding an exact FL of the yaw loop (spec 000 §0.5, ``los_fl``): look-ahead
     ``delta_nm`` Δ, yaw-loop gains in the document's units. By default the controller does **not**
     know the disturbances: integral LOS (gain ``integral_gain_nm_min`` κ, default U/4 =
@@ -778,6 +787,26 @@ class EKFConfig(Strict):
     noise: Literal["continuous", "held"] = "continuous"
 
 
+class PassiveObserverConfig(Strict):
+    """Fossen & Strand's passive observer with wave filtering (:class:`~shipgnc.navigation.
+    passive_observer.PassiveObserver`): the dominant wave (encounter) frequency ``omega0_rad_s``,
+    the wave model's damping ``zeta`` and the notch's ``zeta_notch``, the cut-off
+    ``omega_c_rad_s`` (default 1.2 ω₀), the low-frequency bandwidth ``omega_lf_rad_s`` (default
+    ω₀/10), bias time constant ``T_b_s``, and the velocity model (``linear``, as published, or the
+    vessel's own ``model``). It needs position and heading measurements."""
+
+    type: Literal["passive-observer"]
+    omega0_rad_s: Positive
+    zeta: Positive = 0.1
+    zeta_notch: Positive = 1.0
+    omega_c_rad_s: Positive | None = None
+    omega_lf_rad_s: Positive | None = None
+    T_b_s: Positive = 1000.0
+    velocity_model: Literal["linear", "model"] = "linear"
+
+
+EstimatorConfig = Annotated[EKFConfig | PassiveObserverConfig, Field(discriminator="type")]
+
 #: the vessels whose scenarios take ``sensors`` / ``estimator`` (the numpy loop runs them)
 NAVIGATION_VESSELS = ("vectored-thrust-boat", "cybership2", "mariner")
 
@@ -811,7 +840,7 @@ class Scenario(Strict):
     #: navigation (issue 18): the sensors between the true state and the controller, and an
     #: estimator between the sensors and the controller (the controller acts on its estimate)
     sensors: list[SensorConfig] = Field(default_factory=list)
-    estimator: EKFConfig | None = None
+    estimator: EstimatorConfig | None = None
 
     @field_validator("current")
     @classmethod
@@ -892,6 +921,13 @@ class Scenario(Strict):
             if self.estimator is not None and not self.sensors:
                 raise ValueError("estimator: needs sensors to correct it (e.g. sensors: "
                                  "[{type: gnss}, {type: compass}])")
+        for name, ctrl in (self.variants.items() if self.route is None else ()):
+            sees = getattr(ctrl, "sees", None)
+            where = "controller" if self.controller is not None else f"controllers.{name}"
+            if sees == "estimate" and self.estimator is None:
+                raise ValueError(f"{where}.sees = 'estimate': the scenario has no estimator")
+            if sees == "measurement" and not self.sensors:
+                raise ValueError(f"{where}.sees = 'measurement': the scenario has no sensors")
         if self.route is not None or self.sail is not None:
             return self._consistent_route()
         if self.simulation is None:
