@@ -180,3 +180,11 @@ def test_sweep_max_memory_option(tmp_path):
     assert "more than --max-memory" in " ".join(result.stderr.split()), result.stderr
     bad = runner_.invoke(app, ["sweep", "boat-autopilot", "--max-memory", "lots"])
     assert bad.exit_code == 2 and "expected a size" in bad.stderr
+
+
+def test_yaml_merge_keys_still_work_and_may_be_overridden(tmp_path):
+    """``<<:`` merges are YAML, not duplicate keys; a key after the merge overrides it."""
+    path = tmp_path / "merge.yaml"
+    path.write_text(BOAT.replace("simulation: {dt: 0.05, t_end: 1.0}",
+                                 "simulation: {<<: {dt: 0.05, t_end: 2.0}, t_end: 1.0}"))
+    assert load_scenario(str(path)).simulation.t_end == 1.0

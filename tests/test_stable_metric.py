@@ -108,3 +108,14 @@ def test_rudder_work_is_reported_beside_j(calm_first_step):
         assert m["rudder_travel_deg"] == pytest.approx(np.abs(np.diff(delta)).sum(), rel=1e-12)
         assert 0 < m["rudder_rate_rms_deg_s"] <= 2.32 * math.sqrt(70) * (1 + 1e-9)
     assert calm_first_step.metrics["smc_consistent"]["rudder_travel_deg"] > 2 * 35.0
+
+
+def test_a_ship_that_stops_early_does_not_cut_the_others_segments():
+    """Course steps read from the ship with the most samples, NaNs carried forward."""
+    import numpy as np
+
+    from shipgnc.analysis.metrics import _segments_of
+
+    ref = np.array([[0.0, 0.0], [0.0, 0.0], [0.5, np.nan], [0.5, np.nan], [-0.5, np.nan]])
+    assert _segments_of(ref).tolist() == [0, 0, 1, 1, 2]
+    assert _segments_of(ref[:, ::-1]).tolist() == [0, 0, 1, 1, 2]

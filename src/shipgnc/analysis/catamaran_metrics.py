@@ -214,7 +214,7 @@ def stable(ds, run_events: list[dict] | None = None, heading_target: float | Non
     if heading_target is not None or "psi_error" in ds:
         bound, tol = STABLE_HEADING_BOUND_RAD, STABLE_HEADING_TOL_RAD
     else:
-        command = error + _series(ds, "r")  # ω* (r − ω* = error)
+        command = _series(ds, "r") - error  # ω* (error = r − ω*)
         scale = float(np.nanmax(np.abs(command))) if np.any(np.isfinite(command)) else 0.0
         bound, tol = np.inf, max(STABLE_RATE_TOL_FRACTION * scale, 1e-4)
     verdict = stable_arrays(t, error, bound=bound, oscillation_tol=tol, reached=reached,

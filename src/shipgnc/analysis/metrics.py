@@ -295,13 +295,22 @@ def stable_arrays(t, error, *, bound, oscillation_tol, reached=True, diverged=Fa
 
 
 def _segments_of(reference) -> np.ndarray | None:
-    """Segment labels ``(time,)`` of a piecewise-constant reference (its first ship): a new
-    segment at every change of the reference."""
+    """Segment labels ``(time,)`` of a piecewise-constant reference shared by the batch (a
+    schedule): a new segment at every change. It is read from the ship with the most finite
+    samples (a ship whose run stopped early is NaN afterwards), NaNs carried forward, so a stopped
+    ship does not cut the others' segments."""
     if reference is None:
         return None
     ref = np.asarray(reference, dtype=float)
-    ref = ref.reshape(ref.shape[0], -1)[:, 0]
-    changed = np.r_[False, np.abs(np.diff(np.where(np.isfinite(ref), ref, 0.0))) > 1e-12]
+    ref = ref.reshape(ref.shape[0], -1)
+    ref = ref[:, int(np.argmax(np.isfinite(ref).sum(axis=0)))]
+    finite = np.isfinite(ref)
+    if not finite.any():
+        return np.zeros(ref.shape[0], dtype=int)
+    last = np.maximum.accumulate(np.where(finite, np.arange(ref.size), 0))
+    filled = ref[last]
+    filled[: int(np.argmax(finite))] = ref[int(np.argmax(finite))]
+    changed = np.r_[False, np.abs(np.diff(filled)) > 1e-12]
     return np.cumsum(changed)
 
 

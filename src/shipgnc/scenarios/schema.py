@@ -918,6 +918,10 @@ class Scenario(Strict):
                 what = "a route" if self.route is not None else f"vessel {self.vessel.model!r}"
                 raise ValueError(f"sensors / estimator: not available for {what} (allowed for "
                                  f"vessel models {', '.join(NAVIGATION_VESSELS)})")
+            if self.montecarlo is not None:
+                raise ValueError("sensors / estimator with montecarlo: the Monte Carlo summary is "
+                                 "scored without navigation figures; sweep the scenario instead "
+                                 "(shipgnc sweep NAME --mc N scores every member's navigation)")
             if self.estimator is not None and not self.sensors:
                 raise ValueError("estimator: needs sensors to correct it (e.g. sensors: "
                                  "[{type: gnss}, {type: compass}])")
