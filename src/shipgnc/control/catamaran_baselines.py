@@ -89,13 +89,11 @@ def rate_source_kernel(controller, function, batch_shape, *params) -> Kernel:
                   continuous=controller.continuous)
 
 
-class YawRatePI:
-    """Fixed-gain PI yaw-rate controller (law (20) without the 1/cos δ scheduling)."""
+class _RateSourceLaw:
+    """What the yaw-rate laws fed by a ω* source share: the source, the sampling (``Ts`` None:
+    continuous, evaluated in every RK stage), the logged ω*, no events of their own."""
 
-    def __init__(self, model: Catamaran, *, T_u: float, h: float, omega_ref, Ts: float | None = None):
-        require(T_u > 0 and h > 0, "controller.T_u/h", (T_u, h), "must be > 0 s")
-        self.model = model
-        self.K_i, self.K_p = pi_gains(model.params, T_u, h)
+    def _init_rate_source(self, omega_ref, Ts) -> None:
         self.omega_ref = as_rate_reference(omega_ref)
         self.Ts, self.continuous = Ts, Ts is None
         self.signals = (Signal("omega_ref", "rad/s", "yaw-rate reference"),)
@@ -106,6 +104,19 @@ class YawRatePI:
         self.omega_ref.reset(batch_shape)
         self.events = []
 
+    def signal_values(self):
+        return dict(self._last)
+
+
+class YawRatePI(_RateSourceLaw):
+    """Fixed-gain PI yaw-rate controller (law (20) without the 1/cos δ scheduling)."""
+
+    def __init__(self, model: Catamaran, *, T_u: float, h: float, omega_ref, Ts: float | None = None):
+        require(T_u > 0 and h > 0, "controller.T_u/h", (T_u, h), "must be > 0 s")
+        self.model = model
+        self.K_i, self.K_p = pi_gains(model.params, T_u, h)
+        self._init_rate_source(omega_ref, Ts)
+
     def law(self, t, x, reference):
         w = self.omega_ref.value(t, x)
         u = self.K_i * (w - x[..., R]) - self.K_p * self.model.yaw_acceleration(x)
@@ -113,9 +124,6 @@ class YawRatePI:
         return u[..., None]
 
     step = law
-
-    def signal_values(self):
-        return dict(self._last)
 
     def kernel_reason(self) -> str | None:
         """Why :meth:`kernel` cannot compile this controller (None when it can)."""
@@ -312,7 +320,7 @@ def designed_pi_gains(model: Catamaran, T_u: float, h: float) -> tuple[float, fl
     return T / (K * T_u * h), (T * (1.0 / T_u + 1.0 / h) - 1.0) / K
 
 
-class PolePlacementRate:
+class PolePlacementRate(_RateSourceLaw):
     """Equal-bandwidth pole placement: δ̇ = −k_v v̇ − k_r ṙ − k_ξ (r − ω*) (see the module docstring);
     v̇ and ṙ are the model's at the measured state, as law (20) uses Φ₃."""
 
@@ -322,15 +330,7 @@ class PolePlacementRate:
         self.model = model
         self.T_u, self.h = float(T_u), float(h)
         self.K = place_rate_gain(model, T_u, h) if gain is None else np.asarray(gain, dtype=float)
-        self.omega_ref = as_rate_reference(omega_ref)
-        self.Ts, self.continuous = Ts, Ts is None
-        self.signals = (Signal("omega_ref", "rad/s", "yaw-rate reference"),)
-        self.events: list[dict] = []
-        self._last: dict = {}
-
-    def reset(self, batch_shape) -> None:
-        self.omega_ref.reset(batch_shape)
-        self.events = []
+        self._init_rate_source(omega_ref, Ts)
 
     def law(self, t, x, reference):
         w = self.omega_ref.value(t, x)
@@ -340,9 +340,6 @@ class PolePlacementRate:
         return u[..., None]
 
     step = law
-
-    def signal_values(self):
-        return dict(self._last)
 
     def kernel_reason(self) -> str | None:
         """Why :meth:`kernel` cannot compile this controller (None when it can)."""
@@ -383,7 +380,7 @@ def pole_placement_step(t, x, ref, z, p, cmd, sig):
     cmd[0] = u
 
 
-class DesignedPI:
+class DesignedPI(_RateSourceLaw):
     """PI yaw-rate controller designed on the Nomoto model for the FSM's poles, with anti-windup
     (see the module docstring): δ̇ = K_i (ω* − r) − K_p ṙ, and δ̇ = 0 when |δ| ≥ δ_max and the
     command pushes |δ| further."""
@@ -398,15 +395,7 @@ class DesignedPI:
         self.T_u, self.h = float(T_u), float(h)
         self.K_i, self.K_p = designed_pi_gains(model, T_u, h) if gains is None else gains
         self.delta_max = delta_max
-        self.omega_ref = as_rate_reference(omega_ref)
-        self.Ts, self.continuous = Ts, Ts is None
-        self.signals = (Signal("omega_ref", "rad/s", "yaw-rate reference"),)
-        self.events: list[dict] = []
-        self._last: dict = {}
-
-    def reset(self, batch_shape) -> None:
-        self.omega_ref.reset(batch_shape)
-        self.events = []
+        self._init_rate_source(omega_ref, Ts)
 
     def law(self, t, x, reference):
         w = self.omega_ref.value(t, x)
@@ -418,9 +407,6 @@ class DesignedPI:
         return u[..., None]
 
     step = law
-
-    def signal_values(self):
-        return dict(self._last)
 
     def kernel_reason(self) -> str | None:
         """Why :meth:`kernel` cannot compile this controller (None when it can)."""
