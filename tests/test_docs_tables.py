@@ -25,7 +25,7 @@ def tables():
         sys.modules.pop("doc_tables", None)
 
 
-@pytest.mark.parametrize("page", ["001_vectored_thrust_boat.md"])
+@pytest.mark.parametrize("page", ["001_vectored_thrust_boat.md", "003_cybership_autopilot.md"])
 def test_documented_tables_match_their_runs(tables, page):
     text = (DOCS / page).read_text(encoding="utf-8")
     assert "<!-- table: " in text, f"{page} has no generated table"
