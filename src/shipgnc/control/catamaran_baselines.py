@@ -70,20 +70,23 @@ def pi_gains(params, T_u: float, h: float) -> tuple[float, float]:
     k = params.J / (params.L * params.T_v)
     return k / (T_u * h), k / T_u
 
-def rate_source_kernel(controller, function, batch_shape, *params) -> Kernel:
-    """The :class:`Kernel` of a yaw-rate law fed by a ω* source (``controller.omega_ref``):
-    parameters ``[*params, source block]``, per-ship state ``[calls, ω*, source state]``; its
-    ``restore`` hands the last ω* and the source's state back to the numpy objects."""
+def rate_source_kernel(controller, function, batch_shape, *params, source=None,
+                       signal: str = "omega_ref") -> Kernel:
+    """The :class:`Kernel` of a law fed by a reference source (``source``, default
+    ``controller.omega_ref``): parameters ``[*params, source block]``, per-ship state
+    ``[calls, last reference, source state]``; its ``restore`` hands the last reference (logged
+    as ``signal``) and the source's state back to the numpy objects."""
+    source = controller.omega_ref if source is None else source
     batch_shape = tuple(batch_shape)
-    block, block_state = controller.omega_ref.rate_block(batch_shape)
+    block, block_state = source.rate_block(batch_shape)
     state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
     state[..., 2:] = block_state
 
     def restore(z: np.ndarray) -> None:
         z = z.reshape(-1, 2 + N_RATE_STATE)
         if z.shape[0] and np.any(z[:, 0] > 0):
-            controller._last = {"omega_ref": z[:, 1].reshape(batch_shape).copy()}
-        controller.omega_ref.restore_block(z[:, 2:], batch_shape)
+            controller._last = {signal: z[:, 1].reshape(batch_shape).copy()}
+        source.restore_block(z[:, 2:], batch_shape)
 
     return Kernel(function, flat(*params, block), state, restore=restore,
                   continuous=controller.continuous)
@@ -213,19 +216,8 @@ class HeadingLQR:
         reason = self.kernel_reason()
         if reason:
             raise NotCompiled(reason)
-        batch_shape = tuple(batch_shape)
-        block, block_state = self.capture.rate_block(batch_shape)
-        state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
-        state[..., 2:] = block_state
-
-        def restore(z: np.ndarray) -> None:
-            z = z.reshape(-1, 2 + N_RATE_STATE)
-            if z.shape[0] and np.any(z[:, 0] > 0):
-                self._last = {"psi_ref": z[:, 1].reshape(batch_shape).copy()}
-            self.capture.restore_block(z[:, 2:], batch_shape)
-
-        return Kernel(heading_lqr_step, flat(np.ravel(self.K), block), state, restore=restore,
-                      continuous=self.continuous)
+        return rate_source_kernel(self, heading_lqr_step, batch_shape, np.ravel(self.K),
+                                  source=self.capture, signal="psi_ref")
 
 
 @kernel_function

@@ -45,7 +45,7 @@ import math
 
 import numpy as np
 
-from shipgnc.errors import ConfigError, require
+from shipgnc.errors import require
 from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
 from shipgnc.routing.fields import CurrentField, SumField, field_velocity
 from shipgnc.sim.streams import MemberStreams
@@ -346,18 +346,10 @@ _GM = {"speed": ("speed", 1.0), "direction": ("direction", math.pi / 180),
 
 def _gauss_markov(text: str) -> GaussMarkovCurrent:
     _, _, args = text.partition(":")
-    values: dict[str, float] = {}
-    for part in filter(None, (a.strip() for a in args.split(","))):
-        key, eq, val = part.partition("=")
-        key = key.strip().lower()
-        require(eq == "=" and key in _GM, "current gauss-markov", part,
-                f"expected key=value with key in {', '.join(_GM)}")
-        try:
-            number = float(val)
-        except ValueError:
-            raise ConfigError(f"current gauss-markov.{key} = {val!r}: must be a number") from None
-        require(math.isfinite(number), f"current gauss-markov.{key}", val, "must be finite")
-        values[key] = number * _GM[key][1]
+    from shipgnc.routing.field_spec import key_values
+
+    values = {key: number * _GM[key][1]
+              for key, number in key_values(args, _GM, "current gauss-markov").items()}
     missing = [k for k in ("speed", "direction") if k not in values]
     require(not missing, "current gauss-markov", text, f"missing {', '.join(missing)}")
     kw = {k: values[k] for k in ("speed_std", "speed_tau", "direction_std", "direction_tau", "step")

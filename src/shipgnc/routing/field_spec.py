@@ -50,18 +50,8 @@ def _term(text: str, units: str):
         raise ConfigError(f"--field = {text!r}: unknown field; allowed: {', '.join(_SPECS)}, a sum joined "
                           "with '+', or a NetCDF file")
     spec = _SPECS[name]
-    values: dict[str, float] = {}
-    for part in filter(None, (a.strip() for a in args.split(","))):
-        key, eq, val = part.partition("=")
-        key = key.strip().lower()
-        require(eq == "=" and key in spec, f"--field {name}", part,
-                f"expected key=value with key in {', '.join(spec)}")
-        try:
-            number = float(val)
-        except ValueError:
-            raise ConfigError(f"--field {name}.{key} = {val!r}: must be a number") from None
-        require(math.isfinite(number), f"--field {name}.{key}", val, "must be finite")
-        values[key] = number * (spec[key][1] if units == "nautical" else 1.0)
+    values = {key: number * (spec[key][1] if units == "nautical" else 1.0)
+              for key, number in key_values(args, spec, f"--field {name}").items()}
     missing = [k for k, (req, _) in spec.items() if req and k not in values]
     require(not missing, f"--field {name}", text, f"missing {', '.join(missing)}")
     centre = (values.get("north", 0.0), values.get("east", 0.0))
@@ -85,3 +75,21 @@ def parse_field(text: str, units: str = "si"):
     from shipgnc.routing.fields import SumField
 
     return SumField(terms)
+
+
+def key_values(args: str, keys, where: str) -> dict[str, float]:
+    """``"a=1, b=2.5"`` → ``{"a": 1.0, "b": 2.5}``: keys (case-insensitive) among ``keys``, finite
+    numbers; anything else a one-line ConfigError naming ``where``."""
+    values: dict[str, float] = {}
+    for part in filter(None, (a.strip() for a in args.split(","))):
+        key, eq, val = part.partition("=")
+        key = key.strip().lower()
+        require(eq == "=" and key in keys, where, part,
+                f"expected key=value with key in {', '.join(keys)}")
+        try:
+            number = float(val)
+        except ValueError:
+            raise ConfigError(f"{where}.{key} = {val!r}: must be a number") from None
+        require(math.isfinite(number), f"{where}.{key}", val, "must be finite")
+        values[key] = number
+    return values
