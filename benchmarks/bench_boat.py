@@ -1,4 +1,4 @@
-"""Speed of the vectored-thrust boat's simulation patterns (spec 001 §1.12, §1.16 item 13).
+"""Speed of the vectored-thrust boat's simulation patterns (notes 001-1.12, 001-1.16 item 13).
 
     python benchmarks/bench_boat.py [--quick]
 
@@ -147,7 +147,7 @@ def main(argv=None) -> dict:
     closed_loop("compiled", 64)
     document = document_pattern(boat, t_end=1.0)
 
-    # the same physics in all three open-loop patterns (spec 001 §1.16 item 8: 1e-3 m, 0.01°)
+    # the same physics in all three open-loop patterns (note 001-1.16 item 8: 1e-3 m, 0.01°)
     document = document_pattern(boat)
     final = np.array([compiled_result[name].values[-1] for name in ("north", "east", "psi")])
     position_gap = float(np.max(np.abs(document[-1, :2] - final[:2])))
@@ -195,9 +195,9 @@ def main(argv=None) -> dict:
         "mode": "quick" if quick else "full",
         "machine": {**machine_info(), "load_average_1min_before": load_before},
         "scenarios": {
-            "open_loop": {"document": "001 §1.9 boat-stern-kick", "t_end_s": OPEN_LOOP_T_END,
+            "open_loop": {"document": "note 001-1.9 boat-stern-kick", "t_end_s": OPEN_LOOP_T_END,
                           "dt_s": DT, "boats": 1, "steps": open_steps},
-            "closed_loop": {"document": "001 §1.10 boat-autopilot", "t_end_s": AUTOPILOT_T_END,
+            "closed_loop": {"document": "note 001-1.10 boat-autopilot", "t_end_s": AUTOPILOT_T_END,
                             "dt_s": DT, "boats": n_boats, "steps": closed_steps,
                             "log_every": 20},
         },

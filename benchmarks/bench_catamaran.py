@@ -1,4 +1,4 @@
-"""Speed of document 004's catamaran runs (spec 004 §4.11.9, check 16).
+"""Speed of document 004's catamaran runs (notes 004-4.11.9, 004-4.12 check 16).
 
     python benchmarks/bench_catamaran.py [--quick]
 

@@ -7,10 +7,10 @@ project = "shipgnc"
 author = "shipgnc developers"
 release = _version("shipgnc")
 extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon",
-              "sphinx.ext.mathjax"]
-source_suffix = {".md": "markdown"}
+              "sphinx.ext.mathjax", "sphinx_gallery.gen_gallery"]
+source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
-exclude_patterns = ["_build", "figures/*.py"]
+exclude_patterns = ["_build", "figures/*.py", "**/*.ipynb", "**/*.py", "**/*.zip"]
 myst_enable_extensions = ["colon_fence", "dollarmath"]
 myst_heading_anchors = 3
 autodoc_default_options = {"members": True, "show-inheritance": False}
@@ -21,6 +21,23 @@ napoleon_google_docstring = False
 html_theme = "furo"
 html_title = "shipgnc"
 suppress_warnings = ["myst.header"]
+
+# The example gallery and the tutorial (sphinx-gallery): every script under examples/gallery and
+# examples/tutorial runs at each build (run_stale_examples: no cached output is trusted), a
+# failing script fails the build, and its figures are the ones the site shows.
+sphinx_gallery_conf = {
+    "examples_dirs": ["../examples/gallery", "../examples/tutorial"],
+    "gallery_dirs": ["gallery", "tutorial"],
+    "filename_pattern": r"/plot_",
+    "abort_on_example_error": True,
+    "run_stale_examples": True,
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "within_subsection_order": "FileNameSortKey",
+    "reset_modules": ("matplotlib",),
+    "show_memory": False,
+    "write_computation_times": True,
+}
 autodoc_inherit_docstrings = False
 
 # Docstrings write mathematics in plain text (|x| for an absolute value, N_|r|r for a coefficient,

@@ -39,6 +39,9 @@ SETS = {
                    "catamaran-characteristic.png")),
     "study": ("make_figures:study_figure", ("study-boat-autopilot.png",)),
     "cybership-analysis": ("cybership_analysis:figure", ("cybership-analysis.png",)),
+    "trials": ("shipgnc.trials.figures:document_figures",
+               tuple(f"trials-{v}-{w}.png" for v in ("mariner", "kvlcc2")
+                     for w in ("turning", "zigzag-20", "zigzag-10", "spiral"))),
 }
 
 

@@ -61,7 +61,7 @@ def test_time_sum_ignores_batch_width_and_trailing_zeros():
 
 
 def test_a_schedule_without_turn_reports_what_is_defined_and_why_not_the_rest():
-    """Straight running at 100 N: the steady speed T/(−X_u) exists (spec 001 §1.7), the turn's
+    """Straight running at 100 N: the steady speed T/(−X_u) exists (note 001-1.7), the turn's
     figures do not, and the note names them."""
     from shipgnc.scenarios.runner import run_scenario
 

@@ -1,9 +1,9 @@
-"""Physics checks of the vectored-thrust boat: spec 001 §1.16, acceptance checks 1–9 (and 10).
+"""Physics checks of the vectored-thrust boat: note 001-1.16, acceptance checks 1–9 (and 10).
 
 Expected values come from the parameters and the physics: closed forms written here, the
 equations (9)–(11') written out again here and integrated with ``scipy.integrate.solve_ivp`` at
 tight tolerances, an independent ``fsolve``, or ``scipy.signal``; never from the toolkit's own
-output. Where the spec prints a figure it is asserted as well, with the spec's tolerance.
+output. Where the notes on document 001 (docs/001_vectored_thrust_boat.md) print a figure it is asserted as well, with their tolerance.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ STATES = ("north", "east", "psi", "u", "v", "r")
 DT = 0.05
 
 
-# ---------------------------------------------------------------- independent physics (spec 001)
+# ---------------------------------------------------------------- independent physics (document 001)
 def masses(p: BoatParams) -> tuple[float, float, float]:
     """M₁₁, M₂₂, M₃₃ of eq. (6), from the raw fields."""
     return p.m - p.X_udot, p.m - p.Y_vdot, p.I_z - p.N_rdot
@@ -76,7 +76,7 @@ def turn_equilibrium(p: BoatParams, thrust: float, alpha: float) -> np.ndarray:
 
 
 def stern_kick_schedule(alpha: float = deg(-15.0)) -> OpenLoopSchedule:
-    """Document 001's open-loop commands (spec 001 §1.9)."""
+    """Document 001's open-loop commands (note 001-1.9)."""
     return OpenLoopSchedule([0.0, 5.0, 10.0], [[0.0, 0.0], [150.0, alpha], [150.0, 0.0]])
 
 
@@ -97,7 +97,7 @@ def boat() -> VectoredThrustBoat:
 
 @pytest.fixture(scope="module")
 def scenario(boat) -> xr.Dataset:
-    """``boat-stern-kick``: rest at the origin, RK4, dt = 0.05 s, 30 s (spec 001 §1.9)."""
+    """``boat-stern-kick``: rest at the origin, RK4, dt = 0.05 s, 30 s (note 001-1.9)."""
     return simulate(boat, np.zeros(6), t_end=30.0, dt=DT, controller=stern_kick_schedule(),
                     backend="numpy")
 
@@ -138,7 +138,7 @@ def test_scenario_initial_signs(scenario):
     first = scenario.sel(time=5.0 + DT, method="nearest")
     assert float(first.time) == pytest.approx(5.05)
     assert float(first.v) < 0.0 and float(first.r) > 0.0
-    # spec 001 §1.9 table: v, r at 5.05 s
+    # note 001-1.9 table: v, r at 5.05 s
     assert float(first.v) == pytest.approx(-0.011687, abs=1e-6)
     assert float(first.r) == pytest.approx(0.048184, abs=1e-6)
 
@@ -154,7 +154,7 @@ def test_steady_turn_after_40_s_equals_closed_form(boat):
     np.testing.assert_allclose(final, [1.60517, -0.46596, 0.269526], rtol=0, atol=1e-5)
 
 
-# table of spec 001 §1.7: (overrides, T, α°, u, v, r, U, radius, β°)
+# table of note 001-1.7: (overrides, T, α°, u, v, r, U, radius, β°)
 TURN_TABLE = [
     ({}, 150.0, -15.0, 1.6052, -0.4660, 0.26953, 1.6714, 6.20, -16.19),
     ({"N_rr": 0.0}, 150.0, -15.0, 0.6551, -0.5813, 0.9960, 0.8759, 0.88, -41.58),
@@ -218,7 +218,7 @@ def test_mirror_symmetry(boat, scenario):
 
 # ---------------------------------------------------------------- check 5: stern kick
 def hand_transfer_functions(p: BoatParams, T0: float) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Numerators and denominators of spec 001 §1.8, built coefficient by coefficient."""
+    """Numerators and denominators of note 001-1.8, built coefficient by coefficient."""
     M11, M22, M33 = masses(p)
     k = p.munk_factor * (p.Y_vdot - p.X_udot)
     u0, Lm = T0 / -p.X_u, p.L_m
@@ -246,7 +246,7 @@ def test_stern_kick_transfer_function_coefficients(boat):
     np.testing.assert_allclose(den_y[:3] / 6334.25, [1.0, 2.0, 1.0], rtol=1e-6)  # Δ = 6334.25 (s + 1)²
 
 
-# spec 001 §1.8 table: c_M, T₀, zeros of y/α, zero of r/α, poles of Δ, DC r/α, DC v/α
+# note 001-1.8 table: c_M, T₀, zeros of y/α, zero of r/α, poles of Δ, DC r/α, DC v/α
 ZERO_TABLE = [
     (0.0, 150.0, (4.5889, -1.7572), -1.0, (-1.0, -1.0), -3.8481, 4.8293),
     (0.0, 200.0, (5.9239, -1.8149), -1.0, (-1.0, -1.0), -5.1308, 8.1751),
@@ -298,7 +298,7 @@ def test_stern_kick_one_degree_nonlinear_vs_linear(boat):
     assert abs(y_nl[i_nl] - y_lin[i_lin]) <= 0.05 * abs(y_lin[i_lin])
     cross_nl, cross_lin = first_up_crossing(t, y_nl, i_nl), first_up_crossing(t_fine, y_lin, i_lin)
     assert cross_nl == pytest.approx(cross_lin, abs=0.02)
-    # spec 001 §1.8: nonlinear −0.486 mm at 0.43 s, back at 0 at 0.66 s; linear −0.478 mm, 0.43 s, 0.65 s
+    # note 001-1.8: nonlinear −0.486 mm at 0.43 s, back at 0 at 0.66 s; linear −0.478 mm, 0.43 s, 0.65 s
     assert (y_nl[i_nl], t[i_nl], cross_nl) == (pytest.approx(-0.486e-3, abs=1e-6),
                                                pytest.approx(0.43, abs=0.01), pytest.approx(0.66, abs=0.01))
     assert (y_lin[i_lin], t_fine[i_lin], cross_lin) == (pytest.approx(-0.478e-3, abs=1e-6),
@@ -310,7 +310,7 @@ def test_stern_kick_one_degree_nonlinear_vs_linear(boat):
 
 
 def test_stern_kick_fifteen_degrees_from_cruise(boat):
-    """Spec 001 §1.8: CG to −9.50 mm at 0.54 s, back at 0 at 0.86 s; the stern to −0.241 m at 1.49 s."""
+    """Note 001-1.8: CG to −9.50 mm at 0.54 s, back at 0 at 0.86 s; the stern to −0.241 m at 1.49 s."""
     p = boat.params
     u0 = 150.0 / -p.X_u
     ds = simulate(boat, [0.0, 0.0, 0.0, u0, 0.0, 0.0], t_end=2.5, dt=0.01, u0=[150.0, deg(-15.0)],
@@ -407,7 +407,7 @@ def test_rk4_is_fourth_order_on_harmonic_oscillator():
 
 
 def test_scenario_matches_tight_reference(scenario):
-    """RK4 at dt = 0.05 s vs DOP853 (rtol 1e-11) on the hand-written equations (spec 001 §1.9)."""
+    """RK4 at dt = 0.05 s vs DOP853 (rtol 1e-11) on the hand-written equations (note 001-1.9)."""
     p = VectoredThrustBoat().params
     t = scenario.time.values
     ref = np.empty((t.size, 6))
@@ -420,9 +420,9 @@ def test_scenario_matches_tight_reference(scenario):
         ref[mask] = sol.sol(t[mask]).T
         x = sol.y[:, -1]
     got = states(scenario)
-    assert np.max(np.abs(got[:, :2] - ref[:, :2])) < 1e-4  # spec: 5.9e-5 m
-    assert np.max(np.abs(got[:, 2] - ref[:, 2])) < 5e-6  # spec: 1.8e-6 rad
-    assert np.max(np.abs(got[:, 5] - ref[:, 5])) < 1e-5  # spec: 3.5e-6 rad/s
+    assert np.max(np.abs(got[:, :2] - ref[:, :2])) < 1e-4  # notes: 5.9e-5 m
+    assert np.max(np.abs(got[:, 2] - ref[:, 2])) < 5e-6  # notes: 1.8e-6 rad
+    assert np.max(np.abs(got[:, 5] - ref[:, 5])) < 1e-5  # notes: 3.5e-6 rad/s
 
 
 def test_rk4_and_per_step_rk45_agree(boat, scenario):
@@ -569,7 +569,7 @@ def test_netcdf_round_trip(boat, scenario, tmp_path):
     xr.testing.assert_identical(load(save(batched, tmp_path / "batch.nc")), batched)
 
 
-# ---------------------------------------------------------------- parameters (spec 001 table 1.6)
+# ---------------------------------------------------------------- parameters (note 001-1.6)
 UNROUNDED = {"m": (80.0, 0.0), "X_udot": (-5.2815, 5e-5), "Y_vdot": (-82.5, 0.0), "I_z": (14.4375, 0.0),
              "N_rdot": (-24.544, 5e-4), "X_u": (-77.554, 5e-4), "Y_v": (-162.5, 0.0),
              "N_r": (-38.981, 5e-4), "N_rr": (-389.81, 5e-3)}
@@ -597,7 +597,7 @@ def test_otter_rules_follow_the_table_rules():
 
 
 def test_otter_rules_defaults_give_unrounded_column():
-    """Spec 001 §1.6: "With the Otter's own inputs it returns the unrounded column"."""
+    """Note 001-1.6: "With the Otter's own inputs it returns the unrounded column"."""
     p = otter_rules()
     for name, (printed, tol) in UNROUNDED.items():
         assert getattr(p, name) == pytest.approx(printed, abs=tol), name
@@ -650,7 +650,7 @@ def test_unknown_parameter_is_named():
 
 # ---------------------------------------------------------------- check 10: the reference scenario
 def test_stern_kick_scenario_reference_figures(scenario):
-    """Spec 001 §1.16 item 10 (figures of §1.9, with their tolerances)."""
+    """Note 001-1.16 item 10 (figures of note 001-1.9, with their tolerances)."""
     t = scenario.time.values
     psi = np.degrees(scenario.psi.values)
     assert psi[t == 10.0][0] - psi[t == 5.0][0] == pytest.approx(74.075, abs=0.05)

@@ -1,4 +1,4 @@
-"""Document 004 classical baselines (spec 004 §4.11.3): equal-bandwidth PI and LQR heading autopilot."""
+"""Document 004 classical baselines (note 004-4.11.3): equal-bandwidth PI and LQR heading autopilot."""
 
 from __future__ import annotations
 

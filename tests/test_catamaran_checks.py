@@ -1,4 +1,4 @@
-"""Spec 004 §4.12 acceptance checks 6, 8–14 and 16 through the simulator (checks 1–5, 7, 15: other files).
+"""Note 004-4.12 acceptance checks 6, 8–14 and 16 through the simulator (checks 1–5, 7, 15: other files).
 
 Runs use ``t_end`` shorter than the document's 1500 s where the quantity checked is a steady
 value reached long before (the slowest mode settles in < 60 s; 300–600 s leave > 5 time constants

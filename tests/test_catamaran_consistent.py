@@ -23,7 +23,7 @@ from shipgnc.models.catamaran import Catamaran, model_note, preset, straight_run
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import run_scenario
 
-T_U = H = 2.5  # the FSM's si gains (spec 004 §4.4)
+T_U = H = 2.5  # the FSM's si gains (note 004-4.4)
 
 
 def test_consistent_hull_is_directionally_stable_and_turns_bow_in():
@@ -46,7 +46,7 @@ def test_consistent_hull_is_directionally_stable_and_turns_bow_in():
         Y_ext = Y - p.sigma * p.m_x * s.u * r - 2.0 * p.T_v * math.sin(s.delta)  # hull + thrust
         assert Y_ext == pytest.approx(p.m_x * s.u * r, rel=1e-9)
         assert Y_ext > 0 > -2.0 * p.T_v * math.sin(s.delta)
-    # the printed sign drifts the other way (spec 004 §4.4: bow out of the circle)
+    # the printed sign drifts the other way (note 004-4.4: bow out of the circle)
     assert steady_turn(preset("si"), 0.08).v > 0
 
 

@@ -76,7 +76,7 @@ def test_s1_straight_run_acceleration():
 def test_check15_eigenvalues_and_counter_steer_sign():
     paper = straight_running_eigenvalues(Catamaran.from_preset("paper"))
     si = straight_running_eigenvalues(Catamaran.from_preset("si"))
-    # the spec prints 14.50 (four digits): its last digit bounds the comparison of that part
+    # note 004-4.12 prints 14.50 (four digits): its last digit bounds the comparison of that part
     np.testing.assert_allclose(paper.real, [-0.3355, -0.3355, -0.172], atol=1e-3)
     np.testing.assert_allclose(np.abs(paper.imag), [14.50, 14.50, 0.0], atol=5e-3)
     np.testing.assert_allclose(si, [-0.3355 - 0.3465j, -0.3355 + 0.3465j, -0.172], atol=1e-3)

@@ -1,4 +1,4 @@
-"""Document 004's built-in scenarios end to end (spec 004 §4.7): names, settings, metrics, files."""
+"""Document 004's built-in scenarios end to end (note 004-4.7): names, settings, metrics, files."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ def test_every_scenario_is_built_in_and_shows():
 
 
 def test_turn_reaches_the_commanded_yaw_rate(tmp_path):
-    """S3 with both laws: r → ω* = 0.08 rad/s (spec 004 check: the FSM makes r track ω*)."""
+    """S3 with both laws: r → ω* = 0.08 rad/s (document 004 check: the FSM makes r track ω*)."""
     result = CliRunner().invoke(app, ["run", "catamaran-turn", "--set", "simulation.t_end=200",
                                       "--out", str(tmp_path), "--json"])
     assert result.exit_code == 0, result.stderr
@@ -83,7 +83,7 @@ def test_bad_settings_name_the_field(overrides, words):
 
 
 def test_omega_beyond_the_limit_is_reported_not_silent():
-    """Spec 004 check 13 / §4.11.1: at the paper preset's feasibility limit law (21) fails with an
+    """Notes 004-4.12 check 13 / 004-4.11.1: at the paper preset's feasibility limit law (21) fails with an
     event and ``stable`` false instead of a silent wrong run."""
     run = run_scenario("catamaran-turn", overrides=["vessel.preset=paper", "case.options.omega=0.2",
                                                     "simulation.t_end=200"])
@@ -94,8 +94,8 @@ def test_omega_beyond_the_limit_is_reported_not_silent():
 
 
 def test_vessel_options_change_plant_and_design():
-    """The sway-sign question of spec 004 §4.3 is a scenario setting. With the sign-consistent
-    Coriolis term the drag-only hull is directionally unstable (spec 004 C3): law (20) still holds
+    """The sway-sign question of note 004-4.3 is a scenario setting. With the sign-consistent
+    Coriolis term the drag-only hull is directionally unstable (note 004-C3): law (20) still holds
     ω*, on the opposite thruster angle (counter-steering), unlike the printed sign's positive angle."""
     base = ["simulation.t_end=300", "case.options.omega=0.04", "vessel.preset=si"]
     printed = run_scenario("catamaran-turn", overrides=base).metrics["law20"]

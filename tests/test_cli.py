@@ -43,7 +43,7 @@ def test_json_flag_prints_exactly_the_metrics_object(tmp_path):
     for key in ("initial_sway_sign", "initial_yaw_rate_sign", "steady_yaw_rate_sign",
                 "max_speed_mps", "final_speed_mps", "heading_change_deg"):
         assert key in metrics
-    # spec 001 §1.9: the signs of the stern kick in NED
+    # note 001-1.9: the signs of the stern kick in NED
     assert (metrics["initial_sway_sign"], metrics["initial_yaw_rate_sign"],
             metrics["steady_yaw_rate_sign"]) == (-1, 1, 1)
 

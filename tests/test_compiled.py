@@ -1,4 +1,4 @@
-"""The compiled (numba) loop against the numpy reference loop (spec 001 §1.12, §1.16 item 13).
+"""The compiled (numba) loop against the numpy reference loop (notes 001-1.12, 001-1.16 item 13).
 
 Every comparison runs the same setup through ``simulate(..., backend="numpy")`` and
 ``backend="compiled"`` and requires the same variables, sample times and attributes, and values
@@ -28,7 +28,7 @@ BOAT = VectoredThrustBoat()
 
 
 def stern_kick():
-    """Document 001's open-loop commands (spec 001 §1.9)."""
+    """Document 001's open-loop commands (note 001-1.9)."""
     return OpenLoopSchedule([0, 5, 10], [[0, 0], [150, math.radians(-15)], [150, 0]])
 
 
@@ -37,7 +37,7 @@ def autopilot(model=BOAT, **kw):
 
 
 def heading_steps():
-    """The ``boat-autopilot`` references (spec 001 §1.10)."""
+    """The ``boat-autopilot`` references (note 001-1.10)."""
     return ReferenceSchedule([0, 10, 40], np.radians([0, 45, -30]), [1.5] * 3)
 
 
@@ -80,7 +80,7 @@ def test_stern_kick_open_loop():
     assert (ref.attrs["backend"], got.attrs["backend"]) == ("numpy", "compiled")
     psi = np.degrees(got.psi.values)
     i5, i10 = 100, 200
-    assert psi[i10] - psi[i5] == pytest.approx(74.075, abs=0.05)  # spec 001 §1.16 item 10
+    assert psi[i10] - psi[i5] == pytest.approx(74.075, abs=0.05)  # note 001-1.16 item 10
     assert psi[-1] == pytest.approx(81.564, abs=0.05)
 
 
@@ -138,7 +138,7 @@ def test_munk_preset():
     munk = VectoredThrustBoat.from_preset("otter-munk")
     ref, got = both(munk, np.zeros(6), lambda: {"controller": stern_kick()}, t_end=60, dt=0.05)
     assert_same(ref, got)
-    assert got.r.values[-1] == pytest.approx(0.24298, abs=1e-3)  # keeps turning (spec 001 §1.9)
+    assert got.r.values[-1] == pytest.approx(0.24298, abs=1e-3)  # keeps turning (note 001-1.9)
     ref, got = both(munk, fleet(8), lambda: {"controller": autopilot(munk),
                                              "guidance": heading_steps()}, t_end=70, dt=0.05)
     assert_same(ref, got)

@@ -2,7 +2,7 @@
 numpy reference loop.
 
 Each component's kernel equals its numpy form on single ships (the model's eq. (25), the path
-controllers' laws (13), (19)–(23) and LOS + FL, the disturbance of §0.6); and every comparison of a
+controllers' laws (13), (19)–(23) and LOS + FL, the disturbance of note 000-0.6); and every comparison of a
 whole run goes through ``simulate(..., backend="numpy")`` and ``backend="compiled"`` on fresh
 components and requires the same variables, sample times and attributes, values equal to 1e-9
 relative (round-off of the variable's scale absolute), the same divergence errors and the
@@ -54,7 +54,7 @@ def waves():
 
 
 def doc_disturbance(path, **kw):
-    """b_r and the cross current of spec 000 §0.6 (A9, A10), no wave noise."""
+    """b_r and the cross current of note 000-0.6 (A9, A10), no wave noise."""
     return MarinerDisturbance(b_r=DOC_B_R, current=CrossCurrent(DOC_D_Y, path, **kw))
 
 

@@ -1,5 +1,5 @@
 """Course autopilots of document 003: PD (3), sliding mode (9)–(15), on the design model and on the
-nonlinear CyberShip II (spec 003 §3.2, §3.4, §3.8, §3.9)."""
+nonlinear CyberShip II (notes 003-3.2, 003-3.4, 003-3.8, 003-3.9)."""
 
 from __future__ import annotations
 
@@ -67,7 +67,7 @@ class HeadingSchedule:
         return None
 
 
-# --------------------------------------------------------------------------- design (§3.4)
+# --------------------------------------------------------------------------- design (note 003-3.4)
 
 
 @pytest.mark.parametrize(("a22", "b2", "K", "hB"), [
@@ -96,7 +96,7 @@ def test_design_satisfies_its_defining_equations(lam1, lam2):
     A = np.array([[0, 1], [0, A22]])
     B = np.array([[0], [B2]])
     Ac = A - B @ g.K.reshape(1, 2)
-    # closed-loop eigenvalues (10), and the closed form of §3.2
+    # closed-loop eigenvalues (10), and the closed form of note 003-3.2
     np.testing.assert_allclose(np.sort(np.linalg.eigvals(Ac).real), np.sort([lam1, lam2]),
                                rtol=1e-6, atol=1e-9)
     np.testing.assert_allclose(g.K, [lam1 * lam2 / B2, (A22 - lam1 - lam2) / B2], rtol=1e-9)
@@ -234,7 +234,7 @@ def test_tuned_inner_loop_gain_is_well_below_two():
     assert course_controller("smc_printed", P).yaw_rate_gain * b_r * 0.1 > 10
 
 
-# --------------------------------------------------------------------------- closed loop (§3.8)
+# --------------------------------------------------------------------------- closed loop (note 003-3.8)
 
 
 def _run(name, actuator=None, u0=None):
@@ -266,7 +266,7 @@ def test_pd_and_tuned_smc_hold_the_course_sequence(runs, name):
     ds = runs[name]
     m = _metrics(ds)
     assert ds.attrs["diverged"] == 0 and ds.time.values[-1] == pytest.approx(300.0)
-    assert m["max_error_deg"] < 90.0  # `stable` of §3.8 (the steps themselves are 30° and 60°)
+    assert m["max_error_deg"] < 90.0  # `stable` of note 003-3.8 (the steps themselves are 30° and 60°)
     assert abs(m["final_heading_error_deg"]) < 1.0
     assert m["settled"]
     assert m["max_rudder_deg"] <= 35.0 + 1e-9
@@ -276,7 +276,7 @@ def test_pd_and_tuned_smc_hold_the_course_sequence(runs, name):
 
 
 def test_pd_figures_near_the_spec(runs):
-    """Spec §3.8 (indicative): ψ_E ≈ 175, δ_E ≈ 91, J ≈ 266, min u ≈ 0.272, max δ ≈ 28.7°, −0.2°.
+    """Note 003-3.8 (indicative): ψ_E ≈ 175, δ_E ≈ 91, J ≈ 266, min u ≈ 0.272, max δ ≈ 28.7°, −0.2°.
     The core steering machine ramps the rudder within each step, which turns the ship half a step
     sooner: ψ_E ≈ 171, J ≈ 263.5, max δ ≈ 30.6°."""
     m = _metrics(runs["pd"])
@@ -289,7 +289,7 @@ def test_pd_figures_near_the_spec(runs):
 
 
 def test_pd_figures_reproduce_the_spec_with_a_held_rudder():
-    """A discrete rate limiter (the slewed rudder held over the step): the spec's own setting,
+    """A discrete rate limiter (the slewed rudder held over the step): the notes' own setting (003-3.8),
     with its rounded numbers (u(0) = 0.2958 m/s, 19.4°/s; the defaults are the exact 0.295838 m/s
     and 2.32·√70 = 19.4105°/s), which computed the indicative figures."""
     rounded = P.with_(delta_rate=math.radians(19.4))
@@ -308,7 +308,7 @@ def test_tuned_smc_tracks_the_reference_model(runs):
     lag = np.degrees(np.abs(wrap_angle(ds.psi.values - ds.psi_z.values)))
     assert lag.max() < 10.0
     assert np.sum(np.radians(lag) ** 2) < 12.0  # psi_E_ref [rad²]
-    # a cost similar to the PD's, not clearly lower (spec §3.9)
+    # a cost similar to the PD's, not clearly lower (note 003-3.9)
     assert _metrics(ds)["J"] == pytest.approx(_metrics(runs["pd"])["J"], rel=0.1)
 
 
@@ -335,7 +335,7 @@ def test_paper_gain_smcs_misbehave_as_the_spec_says(runs):
 def test_smc_identified_is_designed_on_the_identified_model_by_the_documents_rules():
     """``smc_identified``: pole placement (10) on the identified Nomoto model puts eig(A_c) at
     (λ₁, λ₂) = (−0.0005, −1), h ∝ [−λ₂, 1], and the sampled inner loop on the plant's real
-    instantaneous gain (M⁻¹b)_r = −0.0918 s⁻² (spec 003 §3.3) stays below 1 (the paper's gains
+    instantaneous gain (M⁻¹b)_r = −0.0918 s⁻² (note 003-3.3) stays below 1 (the paper's gains
     on the same model: far above 2)."""
     from shipgnc.analysis.identification import identify_cybership2
     from shipgnc.control.course import course_controller, smc_paper

@@ -1,7 +1,7 @@
-"""CyberShip II model and the linear analysis of document 003 (spec 003 §3.3–3.5).
+"""CyberShip II model and the linear analysis of document 003 (notes 003-3.3–003-3.5).
 
 Expected values are computed here by other routes than the library's (closed forms, finite
-differences, scipy.signal) or are the figures printed in the spec.
+differences, scipy.signal) or are the figures printed in the notes on document 003.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ def test_defaults_are_table1_and_spec_3_5():
                                                                   -0.4304, 0.2363)
     assert P.rudder_model == "table1"
     assert P.delta_max == pytest.approx(math.radians(35.0))
-    # spec 003 B8: IMO's 2.32°/s Froude-scaled by √70 = 19.4105°/s (the spec rounds it to 19.4)
+    # note 003-B8: IMO's 2.32°/s Froude-scaled by √70 = 19.4105°/s (the notes round it to 19.4)
     assert P.delta_rate == pytest.approx(math.radians(2.32 * math.sqrt(70.0)), rel=1e-12)
     assert math.degrees(P.delta_rate) == pytest.approx(19.4105, abs=5e-5)
     # N_δ/Y_δ = x_R: the table's rudder sits at the model's rudder position
@@ -131,7 +131,7 @@ def test_positive_rudder_turns_the_bow_to_port(params):
 
 
 def test_skjetne_rudder_linearisation():
-    # spec §3.5: at 0.3 m/s and 8.13 rps, ∂τ_Y/∂δ = 2.10 N/rad, ∂τ_N/∂δ = −1.153 N·m/rad
+    # note 003-3.5: at 0.3 m/s and 8.13 rps, ∂τ_Y/∂δ = 2.10 N/rad, ∂τ_N/∂δ = −1.153 N·m/rad
     y, n = rudder_gains(SKJETNE, 0.3, CRUISE_RPS)
     assert y == pytest.approx(2.10, abs=5e-3)
     assert n == pytest.approx(-1.153, abs=1e-3)
@@ -278,7 +278,7 @@ def test_eq18_follows_from_the_printed_eq17():
     assert reduced.T == pytest.approx(T, rel=1e-9)
     assert nomoto.T3 == pytest.approx(T3, rel=1e-9)
     np.testing.assert_allclose(np.sort(nomoto.poles.real), poles, rtol=1e-9)
-    # spec §3.3, first row
+    # note 003-3.3, first row
     assert (nomoto.K, nomoto.T1, nomoto.T2, nomoto.T3) == pytest.approx(
         (0.037443, 0.82413, -3.40237, 6.87808), rel=2e-5)
     assert (reduced.T, reduced.a22, reduced.b2) == pytest.approx((-9.45632, 0.105749, -0.0039596),

@@ -1,4 +1,4 @@
-"""Document 003's scenarios end to end: `cybership-calm`, `cybership-waves` (spec 003 §3.8)."""
+"""Document 003's scenarios end to end: `cybership-calm`, `cybership-waves` (note 003-3.8)."""
 
 from __future__ import annotations
 
@@ -36,11 +36,11 @@ def test_calm_metrics_keyed_by_controller(calm):
             assert key in m, (name, key)
         assert m["J"] == pytest.approx(m["psi_E"] + m["delta_E"], rel=1e-12)  # eq. (2)
         assert m["max_rudder_deg"] <= 35.0 + 1e-9  # the steering machine's limit
-    for name in ("pd", "smc_tuned", "smc_identified"):  # spec 003 §3.9: these hold the course
+    for name in ("pd", "smc_tuned", "smc_identified"):  # note 003-3.9: these hold the course
         assert metrics[name]["stable"] and metrics[name]["settled"]
         assert abs(metrics[name]["final_heading_error_deg"]) < 1.0
     # the paper's gains: the consistent law limit-cycles on the rudder limits, the printed one
-    # barely turns and keeps its speed (spec 003 §3.8)
+    # barely turns and keeps its speed (note 003-3.8)
     assert not metrics["smc_consistent"]["settled"]
     assert metrics["smc_consistent"]["max_rudder_deg"] == pytest.approx(35.0)
     assert metrics["smc_consistent"]["min_surge_mps"] < 0.2
@@ -159,7 +159,7 @@ def test_no_rudder_rate_limit_and_a_single_controller(tmp_path):
 
 
 def test_start_surge_and_rudder_rate_are_the_exact_values():
-    """Spec 003 §3.8/B8 round them to 0.2958 m/s and 19.4°/s; the scenarios use the exact ones: the
+    """Notes 003-3.8/003-B8 round them to 0.2958 m/s and 19.4°/s; the scenarios use the exact ones: the
     surge equilibrium of the propeller model at the scenario's rps (``initial_state.u: null``,
     computed at validation, so ``shipgnc show`` prints it) and 2.32·√70 °/s (issue 15)."""
     from shipgnc.models.cybership2 import DELTA_RATE_DEG_S, CyberShip2Params, surge_equilibrium
@@ -176,7 +176,7 @@ def test_start_surge_and_rudder_rate_are_the_exact_values():
         shown = scenario_yaml(scenario)
         assert f"u: {u!r}" in shown and f"rudder_rate_deg_s: {DELTA_RATE_DEG_S!r}" in shown
         assert load_scenario(name, []).model_dump() == scenario.model_dump()  # stable reload
-    # the equilibrium follows the scenario's rps; a number given is kept (the spec's rounded run)
+    # the equilibrium follows the scenario's rps; a number given is kept (the rounded run of note 003-3.8)
     slower = load_scenario("cybership-calm", ["vessel.propeller_rps=7"])
     assert slower.simulation.initial_state.u == surge_equilibrium(params, 7.0)
     rounded = load_scenario("cybership-calm", ["simulation.initial_state.u=0.2958",

@@ -35,11 +35,11 @@ def test_documented_tables_match_their_runs(tables, page):
 
 
 def test_a_drifted_number_is_reported_and_a_rounding_flip_is_not(tables, tmp_path):
-    """The page's numbers for the stern kick of spec 001 (74.075° heading change, −0.0332 m port
+    """The page's numbers for the stern kick of document 001 (74.075° heading change, −0.0332 m port
     excursion): a changed digit is a drift, one unit in the last digit is not."""
     page = tmp_path / "page.md"
     body = tables.render("boat-stern-kick", ["heading_change_deg", "stern_kick_min_lateral_m"])
-    assert "| `heading_change_deg` | 74.075 |" in body  # spec 001 §1.9
+    assert "| `heading_change_deg` | 74.075 |" in body  # note 001-1.9
     assert "| `stern_kick_min_lateral_m` | -0.033225 |" in body
     drifted = body.replace("74.075", "74.175").replace("-0.033225", "-0.033224")
     page.write_text(f"x\n<!-- table: boat-stern-kick keys=heading_change_deg,"

@@ -1,4 +1,4 @@
-"""Wave noise of spec 000 A11 and the cross current of A10."""
+"""Wave noise of note 000-A11 and the cross current of A10."""
 
 from __future__ import annotations
 

@@ -32,7 +32,7 @@ def test_recovers_a_synthetic_first_order_nomoto_plant(K, T):
 
 
 def test_zigzag_reverses_at_the_switch_heading():
-    """The rudder is reversed when the heading has changed ±ψ (spec/trials.md)."""
+    """The rudder is reversed when the heading has changed ±ψ (docs/trials.md)."""
     model = NomotoModel(K=0.1, T=10.0, U=5.0)
     actuator = Actuator(np.array([-1.0]), np.array([1.0]), rate=[math.inf], names=("delta",))
     ds = idn.zigzag_trial(model, actuator, [0.0, 0.0, 0.0, 0.0], delta_deg=10, psi_deg=10,
@@ -54,7 +54,7 @@ def _record(delta_deg, psi_deg):
 
 
 def test_cybership_identified_model_is_between_the_printed_and_the_instantaneous_gain(cybership_fit):
-    """Physics bounds of spec 003 §3.3: the fitted b₂ is larger than the printed (18)'s −0.0040
+    """Physics bounds of note 003-3.3: the fitted b₂ is larger than the printed (18)'s −0.0040
     (the 23-fold error) and not larger than the plant's instantaneous (M⁻¹b)_r = −0.0918 s⁻²."""
     params = CyberShip2Params()
     instantaneous = nomoto_second_order(*davidson_schiff(params, 0.3)).yaw_acceleration_gain

@@ -1,6 +1,6 @@
-"""De Wit–Oppe Mariner model and the Nomoto/Norrbin steering models (spec 000 §0.1–0.4).
+"""De Wit–Oppe Mariner model and the Nomoto/Norrbin steering models (notes 000-0.1–000-0.4).
 
-Expected values are the spec's printed numbers or are computed here by other routes than the
+Expected values are the numbers printed in the notes on document 000 or are computed here by other routes than the
 library's (closed-form solutions, brentq on the steady-state equations, scipy's CARE).
 """
 
@@ -200,7 +200,7 @@ def test_current_and_yaw_disturbance():
     res = run(SHIP, [0.0, 0.0, 0.0, P.U, 0.0], 0.0, t_end=1800.0, dt=2.0, d=d)
     r_ss = brentq(lambda r: P.a * r + P.b * r**3 - DOC_B_R, 0.0, 1.0, xtol=1e-16)
     assert float(res.r[-1]) == pytest.approx(r_ss, rel=1e-8)
-    # equilibrium rudder cancelling b_r: δ = −b_r/c = −1.6126° (spec 0.4)
+    # equilibrium rudder cancelling b_r: δ = −b_r/c = −1.6126° (note 000-0.4)
     assert math.degrees(-DOC_B_R / P.c) == pytest.approx(-1.6126, abs=5e-5)
     calm = run(SHIP, [0.0, 0.0, 0.0, P.U, 0.0], -DOC_B_R / P.c, t_end=600.0, dt=1.0,
                d=[DOC_B_R, 0.5, -0.3])

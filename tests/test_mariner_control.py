@@ -1,7 +1,7 @@
 """Controllers of document 000 (Mariner trajectory tracking): LQR (8)–(13) and feedback
-linearisation (19)–(23) with its sound variants (spec 000 §0.4–0.6, table 0.7).
+linearisation (19)–(23) with its sound variants (notes 000-0.4–000-0.6, 000-0.7).
 
-Closed-loop runs use a local de Wit–Oppe right-hand side (spec eq. (25), SI) integrated with
+Closed-loop runs use a local de Wit–Oppe right-hand side (document 000 eq. (25), SI) integrated with
 ``rk4_step``, independent of the toolkit's Mariner model.
 """
 
@@ -46,7 +46,7 @@ NM, MIN = NAUTICAL_MILE, MINUTE
 
 @dataclass(frozen=True)
 class WO:
-    """De Wit–Oppe coefficients of the Mariner in SI (spec table 0.1)."""
+    """De Wit–Oppe coefficients of the Mariner in SI (note 000-0.1)."""
 
     a: float = 1.084 / MIN
     b: float = 0.62 * MIN
@@ -168,7 +168,7 @@ def test_gain_units():
     x_paper = x_si * [1 / NM, 1.0, MIN, 1 / (NM * MIN)]
     np.testing.assert_allclose(x_si @ gain_to_si(PAPER_LQR_GAIN), x_paper @ np.array(PAPER_LQR_GAIN),
                                rtol=1e-12)
-    # designing in SI with the same Q numbers gives another gain (spec §0.4 table, "s and m")
+    # designing in SI with the same Q numbers gives another gain (note 000-0.4 table, "s and m")
     K_si_design, _ = lqr_tracking_gain(P.a, P.c, U, PAPER_Q, 1.0)
     np.testing.assert_allclose(K_si_design, [3.7545, 170.77, 570.24, 0.3162], rtol=1e-3)
 
@@ -406,7 +406,7 @@ def test_literal_fl_diverges():
 
 
 def test_literal_fl_works_with_the_sign_flipped_sway_coupling():
-    """Spec §0.5: with r₁ = +0.0375 nm/rad in plant and controller the zero dynamics are stable."""
+    """Note 000-0.5: with r₁ = +0.0375 nm/rad in plant and controller the zero dynamics are stable."""
     flipped = WO(r1=+0.0375 * NM)
     assert zero_dynamics_pole(flipped)[0] == pytest.approx(-6.6667, rel=1e-4)
     t, y, psi, _ = closed_loop(fl_paper(flipped, STRAIGHT, Ts=2.0), [[0.0, -1.5 * NM, 0.0, U, 0.0]],
@@ -416,7 +416,7 @@ def test_literal_fl_works_with_the_sign_flipped_sway_coupling():
 
 
 def test_lqr_steady_state_under_disturbances():
-    """On a straight leg with b_r and d_y: ψ_r → −asin(d_y/U), δ → −b_r/c, y_r → 0 (spec §0.4)."""
+    """On a straight leg with b_r and d_y: ψ_r → −asin(d_y/U), δ → −b_r/c, y_r → 0 (note 000-0.4)."""
     t, y, psi, delta = closed_loop(PathLQR(design_lqr(P).K_si, STRAIGHT, Ts=2.0),
                                    [[0.0, 0.0, 0.0, U, 0.0]], t_end=120 * MIN, dt=2.0, b_r=B_R, d_y=D_Y)
     last = t >= 110 * MIN

@@ -1,6 +1,6 @@
 """``los_fl`` without disturbance knowledge (issue 17): integral LOS removes the standing offset
 an unknown cross current and yaw bias leave under plain LOS, and the document's oracle law
-(``knows_disturbance: true``) still reproduces spec 000 §0.8."""
+(``knows_disturbance: true``) still reproduces note 000-0.8."""
 
 from __future__ import annotations
 
@@ -56,7 +56,7 @@ def test_integral_los_on_the_document_path_settles_on_every_leg():
 
 
 def test_oracle_reproduces_the_document():
-    """Spec 000 §0.8's indicative ``los_fl`` row, to its printed digits."""
+    """Note 000-0.8's indicative ``los_fl`` row, to its printed digits."""
     m = run(*ORACLE)
     assert m["settle_time_min"] == pytest.approx(11.1, abs=0.05)
     assert m["overshoot_nm"] == 0.0

@@ -1,4 +1,4 @@
-"""Document 000's scenarios end to end (spec 000 §0.6–0.9): steady states from the model's
+"""Document 000's scenarios end to end (notes 000-0.6–000-0.9): steady states from the model's
 equilibrium, the literal FL's divergence, the look-ahead offset l·d_y/U, the comparison's files,
 every parameter settable with --set, and the Monte Carlo batch."""
 
@@ -21,7 +21,7 @@ from shipgnc.units import MINUTE, NAUTICAL_MILE
 
 NM, MIN = NAUTICAL_MILE, MINUTE
 COMPARED = ("lqr_paper", "lqr", "fl_paper", "fl_lookahead", "los_fl", "los_fl_oracle")
-# the model's straight-leg equilibrium under the document's disturbances (spec 000 §0.4), from
+# the model's straight-leg equilibrium under the document's disturbances (note 000-0.4), from
 # (25) with r = 0 and the paper's numbers: sin ψ_ss = −d_y/U, c δ_ss = −b_r
 U_PAPER, D_Y, B_R, C_PAPER = 0.215 / 0.86, 0.04, 0.1, 3.553
 PSI_SS_DEG = -math.degrees(math.asin(D_Y / U_PAPER))  # −9.2069°
@@ -54,7 +54,7 @@ def test_lookahead_fl_settles_with_the_predicted_offset():
 
 
 def test_literal_fl_diverges():
-    """Spec 000 §0.5 [NR]: the zero dynamics (+6.67 /min) take the heading past 90°; the
+    """Note 000-0.5 [NR]: the zero dynamics (+6.67 /min) take the heading past 90°; the
     cross-track error grows beyond several nm within the run, from 1.5 nm and from 1 m off."""
     m = run("mariner-fl-paper", "simulation.t_end=1800.0").metrics
     assert not m["stable"]
@@ -80,7 +80,7 @@ def test_compare_writes_figures_and_table(tmp_path):
     for name in ("result.nc", "metrics.json", "table.csv", "table.md", "fig3_tracks.png",
                  "fig4_heading.png", "fig5_rudder.png"):
         assert (tmp_path / name).stat().st_size > 500, name
-    # the printed gain, and the gain of the stated R = 1 (spec 000 §0.4 table)
+    # the printed gain, and the gain of the stated R = 1 (note 000-0.4 table)
     assert metrics["lqr_paper"]["lqr_gain"] == pytest.approx([3.4, 3.2, 1.0, 0.45])
     assert metrics["lqr"]["lqr_gain"] == pytest.approx([2.4455, 2.3244, 0.8788, 0.3162], abs=1e-4)
     assert "lqr_gain" not in metrics["los_fl"]
@@ -93,7 +93,7 @@ def test_compare_writes_figures_and_table(tmp_path):
     assert metrics["fl_paper"]["zero_dynamics_pole_per_min"] == pytest.approx(0.25 / 0.0375)
     assert metrics["fl_lookahead"]["zero_dynamics_pole_per_min"] == pytest.approx(-4.0)
     # the document's claim, reproduced by the sound variant: the FL settles much faster than the
-    # LQR, with a far smaller overshoot (spec 000 §0.9)
+    # LQR, with a far smaller overshoot (note 000-0.9)
     assert metrics["fl_lookahead"]["settle_time_min"] < metrics["lqr"]["settle_time_min"] / 2
     assert metrics["fl_lookahead"]["overshoot_nm"] < metrics["lqr"]["overshoot_nm"] / 10
     table = (tmp_path / "table.md").read_text()
@@ -214,7 +214,7 @@ def test_metric_definitions_on_a_synthetic_run():
 
 
 def test_a_ship_sailing_its_leg_backwards_is_reversed_not_stable():
-    """The look-ahead FL has a second stable equilibrium, ψ_r = π (spec 000 §0.5): started heading
+    """The look-ahead FL has a second stable equilibrium, ψ_r = π (note 000-0.5): started heading
     opposite to the leg it settles there, |y_r| bounded (l·d_y/U) but sailing the leg backwards.
     That is ``reversed`` and not ``stable`` (issue 15); the same start heading along the leg is
     neither."""

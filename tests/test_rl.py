@@ -36,7 +36,7 @@ def test_spaces_come_from_the_model_and_the_actuator():
     env = gym.make("shipgnc/BoatHeading-v0").unwrapped
     assert env.observation_names == ["north", "east", "psi", "u", "v", "r", "psi_d", "u_d",
                                      "psi_error", "u_error"]
-    assert env.action_space.low.tolist() == pytest.approx([0.0, -np.pi / 4])  # spec 001: 0-200 N, ±45°
+    assert env.action_space.low.tolist() == pytest.approx([0.0, -np.pi / 4])  # document 001: 0-200 N, ±45°
     assert env.action_space.high.tolist() == pytest.approx([200.0, np.pi / 4])
 
 
@@ -136,11 +136,10 @@ def test_scenarios_without_a_reward_are_refused():
 
 
 def test_hold_mode_rudder_earns_the_spec_J():
-    """With the rudder slewed per step (``rudder_rate_mode: hold``) the PD's J is 265.89 (spec 003
-    hold-mode value). The last sample's rudder is the policy's last action held, where the loop
+    """With the rudder slewed per step (``rudder_rate_mode: hold``) the PD's J is 265.89 (document 003    hold-mode value). The last sample's rudder is the policy's last action held, where the loop
     asks the controller once more, so the return is −J up to one sample's change of the command:
     δ² there is ≈ 7e-5 rad² of J ≈ 266, and one sample changes δ by ≈ 0.1 % (δ ≈ −0.0084 rad,
-    slewing ~6e-6 rad per sample), so the gap is ≲ 1e-9 relative; 1e-6 leaves room. The spec's
+    slewing ~6e-6 rad per sample), so the gap is ≲ 1e-9 relative; 1e-6 leaves room. The notes'
     figure was computed with its rounded start surge 0.2958 m/s and rudder rate 19.4°/s (the
     defaults are the exact 0.295838 m/s and 2.32·√70 = 19.4105°/s), so this run sets them."""
     scenario = load_scenario("cybership-calm", ["vessel.rudder_rate_mode=hold",

@@ -1,4 +1,4 @@
-"""``shipgnc route`` (spec 002 §2.9.6): JSON keys, units, exit codes, files."""
+"""``shipgnc route`` (note 002-2.9.6): JSON keys, units, exit codes, files."""
 
 from __future__ import annotations
 
@@ -125,7 +125,7 @@ def test_obstacles_geojson(tmp_path):
 
 
 def test_arrival_time_is_departure_plus_time_to_target():
-    """Uniform 0.3 kn east, V = 0.5 kn: t_f = 19.209115 h (spec 002 §2.10) whatever the departure
+    """Uniform 0.3 kn east, V = 0.5 kn: t_f = 19.209115 h (note 002-2.10) whatever the departure
     (a steady field); the arrival clock time is departure + t_f, printed only for a departure."""
     args = ("--start=-1.86,3.66", "--target", "0,0", "--speed", "0.5", "--field", "uniform:east=0.3",
             "--units", "nautical", "--method", "pmp")

@@ -1,4 +1,4 @@
-"""Current fields of spec 002 §2.9.1: Jacobians, divergence, far field, gridded data, the protocol."""
+"""Current fields of note 002-2.9.1: Jacobians, divergence, far field, gridded data, the protocol."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Route figures (spec 002 §2.9.6, issue 17): every extremal drawn with the global one highlighted,
+"""Route figures (note 002-2.9.6, issue 17): every extremal drawn with the global one highlighted,
 isochrones labelled with their times, the current arrows with a scale key, titles from the data."""
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ def drawn(monkeypatch):
 
 
 def test_vortex_figure_draws_every_extremal(tmp_path, drawn):
-    """Spec 002 F2: three extremals reach B within 30 h; all three are drawn, the global one
+    """Note 002-F2: three extremals reach B within 30 h; all three are drawn, the global one
     (6.519975 h) thicker, the conjugate point of the third starred."""
     field = LambOseenVortex(2 * NM**2 / H, 0.5 * NM, (-0.93 * NM, 1.83 * NM))
     res = solve_route(field, 0.5 * KNOT, A, B, method="pmp", horizon=30 * H)

@@ -1,4 +1,4 @@
-"""Spec 002 global methods and data: level set (Z-16), graph (Z-17), gridded fields (Z-18), obstacles (Z-19),
+"""Document 002 global methods and data: level set (Z-16), graph (Z-17), gridded fields (Z-18), obstacles (Z-19),
 bad input (Z-22)."""
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ A = np.array([-1.86, 3.66]) * NM
 B = np.zeros(2)
 K = -0.5 / H
 DOC_H = 10.915730527
-DOMAIN = ((-2.5 * NM, 2.0 * NM), (-1.0 * NM, 6.0 * NM))  # the spec's level-set domain
+DOMAIN = ((-2.5 * NM, 2.0 * NM), (-1.0 * NM, 6.0 * NM))  # the level-set domain of note 002-2.9.2
 ISLAND = np.array([(-1.23, 1.53), (-1.23, 2.13), (-0.63, 2.13), (-0.63, 1.53)]) * NM
 SHOAL = np.array([(0.3, 3.6), (0.3, 4.2), (0.9, 4.2), (0.9, 3.6)]) * NM
 

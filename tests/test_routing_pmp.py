@@ -1,4 +1,4 @@
-"""Spec 002 acceptance checks about the maximum principle: Z-1…Z-15, Z-20, Z-21 (section 2.12)."""
+"""Document 002 acceptance checks about the maximum principle: Z-1…Z-15, Z-20, Z-21 (section 2.12)."""
 
 from __future__ import annotations
 
@@ -295,7 +295,7 @@ def test_heading_schedule_and_constant_heading_legs(document):
 
 
 def test_f3_determinant_with_xdot_misfires_in_a_time_varying_current():
-    """Spec F3's det[∂x/∂θ₀, ẋ] changes sign in the tidal uniform current (2.9.5) where V + e·c(t) = 0, though
+    """Note 002-F3's det[∂x/∂θ₀, ẋ] changes sign in the tidal uniform current (2.9.5) where V + e·c(t) = 0, though
     neighbouring extremals never focus (a uniform current: ∂x/∂θ₀ = V t e⊥ ≠ 0). The router uses
     det[∂x/∂θ₀, p/|p|], equal up to the positive factor ẋ·p for steady fields."""
     tide = Modulated(UniformCurrent(0.0, KNOT), 0.0, 1.0, 12.42 * H, 0.0)

@@ -1,4 +1,4 @@
-"""Document 002's built-in scenarios (spec 002 §2.9.6): the document's route, its scale invariance,
+"""Document 002's built-in scenarios (note 002-2.9.6): the document's route, its scale invariance,
 the route sailed by a ship, the several extremals of a vortex, an unreachable target."""
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def test_paper_route_matches_the_document(tmp_path):
 def test_sailed_route_at_the_boats_scale():
     """zermelo-sail: the document's route at 1/10 of its size and 6 times its speeds (3 kn, k = −30 /h)
     keeps the current/speed ratio (0.93/0.5 at A) and takes 1/60 of its time (Zermelo's problem
-    depends only on V/|v|, kt and geometry, spec 002 Z14). The Otter-class boat sailing the route as
+    depends only on V/|v|, kt and geometry, note 002-Z14). The Otter-class boat sailing the route as
     a path (LOS through its waypoints) arrives within the acceptance radius of 2 boat lengths, a few
     per cent after the optimum (its track is the optimum's, its speed through the water the route's)."""
     run = run_scenario("zermelo-sail", overrides=["sail.margin=0.1", "sail.dt=0.2"])  # arrival by 1.1 t_f

@@ -1,6 +1,6 @@
-"""Built-in scenarios against spec 001's reference figures (§1.14, §1.16 items 10–12).
+"""Built-in scenarios against document 001's reference figures (note 001-1.14, note 001-1.16 items 10–12).
 
-Tolerances are the spec's. Analytic expectations (top speed, settling of the reference model) are
+Tolerances are those of the notes on the documents. Analytic expectations (top speed, settling of the reference model) are
 computed here from the parameters.
 """
 
@@ -109,7 +109,7 @@ def test_los_without_switch_radius_uses_crossing_the_normal():
 
 
 def test_otter_munk_never_straightens():
-    """Spec 001 §1.9: with c_M = +1 the boat keeps turning after α → 0, at an equilibrium where
+    """Note 001-1.9: with c_M = +1 the boat keeps turning after α → 0, at an equilibrium where
     1 + (N_|r|r/N_r)|r| = (u/u_crit)²."""
     run = run_scenario("boat-otter-munk")
     ds = run.result

@@ -14,7 +14,7 @@ from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import run_scenario
 
 DEG = math.pi / 180.0
-DELTA_MAX = 35.0 * DEG  # CyberShip II's rudder stops (spec 003)
+DELTA_MAX = 35.0 * DEG  # CyberShip II's rudder stops (document 003)
 t = np.arange(0.0, 300.0, 0.1)
 
 
@@ -90,8 +90,8 @@ def calm_first_step():
 
 
 def test_cybership_smc_consistent_limit_cycle_is_not_stable(calm_first_step):
-    """Spec 003 §3.8: with the paper's gains the consistent SMC limit-cycles on the rudder stops;
-    the PD holds the course (§3.9)."""
+    """Note 003-3.8: with the paper's gains the consistent SMC limit-cycles on the rudder stops;
+    the PD holds the course (note 003-3.9)."""
     m = calm_first_step.metrics
     assert not m["smc_consistent"]["stable"]
     assert m["smc_consistent"]["max_rudder_deg"] == pytest.approx(35.0)
@@ -101,7 +101,7 @@ def test_cybership_smc_consistent_limit_cycle_is_not_stable(calm_first_step):
 def test_rudder_work_is_reported_beside_j(calm_first_step):
     """``rudder_rate_rms_deg_s`` and ``rudder_travel_deg`` from the logged rudder: the travel is
     Σ|Δδ| (at least the 2·35° of one swing between the stops for the limit cycle) and the rate
-    RMS cannot exceed the steering machine's rate limit 2.32·√70 = 19.41°/s (spec 003 B8)."""
+    RMS cannot exceed the steering machine's rate limit 2.32·√70 = 19.41°/s (note 003-B8)."""
     result = calm_first_step.result
     for name, m in calm_first_step.metrics.items():
         delta = np.degrees(result.sel(controller=name).delta.dropna("time").values)

@@ -193,7 +193,7 @@ def test_grid_numbers_in_exponent_notation_are_numbers():
 
 
 def test_products_on_the_path_do_not_depend_on_the_batch():
-    """The wave filter's Φx + Ln (spec 000 A11) and the LQR's K·x (document 000 eq. 13) for one
+    """The wave filter's Φx + Ln (note 000-A11) and the LQR's K·x (document 000 eq. 13) for one
     member are the same bits alone and in a batch of 300 (a BLAS product is not: its summation
     order follows the array sizes)."""
     from shipgnc.control.lqr import PathLQR

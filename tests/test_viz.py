@@ -1,4 +1,4 @@
-"""Figures and live telemetry (spec 001 §1.11, §1.14), headless on Agg."""
+"""Figures and live telemetry (notes 001-1.11, 001-1.14), headless on Agg."""
 
 import matplotlib
 

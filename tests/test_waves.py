@@ -1,4 +1,4 @@
-"""Waves (spec 003 §3.6, B10): spectra and their moments, Froude scaling, seeded realisations, wave loads."""
+"""Waves (notes 003-3.6, 003-B10): spectra and their moments, Froude scaling, seeded realisations, wave loads."""
 
 import math
 from itertools import pairwise
@@ -24,7 +24,7 @@ from shipgnc.environment.waves import (
 from shipgnc.errors import ConfigError
 from shipgnc.units import G
 
-HS, T0 = 0.0429, 0.8  # spec 003 §3.8: the Froude-correct 1:70 model-scale sea
+HS, T0 = 0.0429, 0.8  # note 003-3.8: the Froude-correct 1:70 model-scale sea
 CS2 = {"length": 1.255, "beam": 0.29, "draft": 0.05}
 
 

@@ -277,13 +277,25 @@ def print_columns(console: Console, title: str, first_header: str, rows: list[st
         console.print(table)
 
 
-from shipgnc.cli_route import route as _route  # noqa: E402  (the route command, spec 002)
+from shipgnc.cli_route import route as _route  # noqa: E402  (the route command, document 002)
 
 app.command("route")(_route)
 
 from shipgnc.cli_sweep import sweep as _sweep  # noqa: E402  (studies, here or on dask)
 
 app.command("sweep")(_sweep)
+
+from shipgnc.cli_identify import identify as _identify  # noqa: E402  (models from logged runs)
+
+app.command("identify")(_identify)
+
+from shipgnc.cli_trials import trial as _trial  # noqa: E402  (standard manoeuvring trials)
+
+app.command("trial")(_trial)
+
+from shipgnc.cli_vessels import vessels as _vessels  # noqa: E402  (the vessel catalogue)
+
+app.command("vessels")(_vessels)
 
 
 def main() -> None:

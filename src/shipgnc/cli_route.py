@@ -1,7 +1,15 @@
-"""``shipgnc route``: time-optimal route in a current (spec 002 §2.9.6).
+"""``shipgnc route``: time-optimal route in a current (note 002-2.9.6).
 
     shipgnc route --start N,E --target N,E --speed V --field FIELD [--method auto|pmp|levelset|graph]
                   [--obstacles FILE.geojson] [--units si|nautical] [--json] [--out DIR]
+    shipgnc route --geo --start LAT,LON --target LAT,LON --speed V --field FILE.nc|uniform:..|still
+                  [--depart 2026-06-01T06:00Z] [--land default|none|FILE] [--depth FILE.nc --draft M --ukc M]
+                  [--xte-m 100] [--json] [--out DIR]
+
+``--geo`` (docs/routing_geo.md): positions in decimal degrees on WGS84, currents from CF-NetCDF, land from
+the GSHHG coastline (or ``--land``), shallow water from ``--depth``; ``--out`` writes route.gpx,
+route.geojson, route.rtz, route.json and route.png; the JSON adds ``distance_nm``, ``eta`` and
+``waypoints`` ([lat, lon, eta]) to today's keys.
 
 SI by default; ``--units nautical`` reads positions in nm, speeds in kn, k and ω in 1/h, Γ in nm²/h and prints
 times in h beside s. JSON keys stay SI. Exit codes: 0 a route, 2 bad input, 3 unreachable (one-line reason on
@@ -50,9 +58,20 @@ def route(
     horizon: Annotated[float | None, typer.Option("--horizon", help="Search horizon \\[s | h] "
                                                   "(default 4·|AB|/V).")] = None,
     radius: Annotated[float, typer.Option("--radius", help="Target disc radius \\[m | nm].")] = 0.0,
-    depart: Annotated[float, typer.Option("--depart", help="Departure time t0 \\[s | h].")] = 0.0,
+    depart: Annotated[str, typer.Option("--depart", help="Departure time t0 \\[s | h], or with --geo an ISO 8601 "
+                                        "UTC time (default: the current file's first time).")] = "0",
     grid: Annotated[float | None, typer.Option("--grid",
                                                help="Level-set / graph grid spacing \\[m | nm].")] = None,
+    geo: Annotated[bool, typer.Option("--geo", help="Start/target as LAT,LON on WGS84; --field a CF-NetCDF "
+                                      "file; land avoided (docs/routing_geo.md).")] = False,
+    land: Annotated[str, typer.Option("--land", help="With --geo: default (GSHHG coastline), none, or a "
+                                      "GeoJSON/shapefile of land polygons [lon, lat].")] = "default",
+    depth: Annotated[Path | None, typer.Option("--depth", help="With --geo: bathymetry CF-NetCDF; water "
+                                               "shallower than draft + UKC is avoided.")] = None,
+    draft: Annotated[float, typer.Option("--draft", help="Ship's draught \\[m] (with --depth).")] = 0.0,
+    ukc: Annotated[float, typer.Option("--ukc", help="Under-keel clearance \\[m] (with --depth).")] = 0.0,
+    xte_m: Annotated[float, typer.Option("--xte-m", help="With --geo: cross-track tolerance of the "
+                                         "waypoints \\[m].")] = 100.0,
 ) -> None:
     """Time-optimal route through a current field (Zermelo's problem)."""
     from shipgnc.cli import friendly_errors, stderr, stdout
@@ -72,6 +91,15 @@ def route(
         length = NAUTICAL_MILE if nautical else 1.0
         vel = KNOT if nautical else 1.0
         tscale = 3600.0 if nautical else 1.0
+        if geo:
+            _geo_route(start, target, speed * vel, field, method, obstacles, units, json_, out, horizon, radius,
+                       depart, grid, land, depth, draft, ukc, xte_m, length, tscale)
+            return
+        depart_value = _number(depart, "--depart", "s | h; an ISO 8601 time needs --geo")
+        geo_only = [name for name, given in (("--depth", depth is not None), ("--land", land != "default"),
+                                             ("--draft", draft != 0.0), ("--ukc", ukc != 0.0),
+                                             ("--xte-m", xte_m != 100.0)) if given]
+        require(not geo_only, geo_only[0] if geo_only else "", "given", "needs --geo")
         a = _pair(start, "--start", length)
         b = _pair(target, "--target", length)
         require(math.isfinite(speed) and speed > 0, "--speed", speed,
@@ -83,7 +111,7 @@ def route(
 
             polys = load_geojson(obstacles, units)
         res = solve_route(fld, speed * vel, a, b, method=method, obstacles=polys, radius=radius * length,
-                          t0=depart * tscale, horizon=None if horizon is None else horizon * tscale,
+                          t0=depart_value * tscale, horizon=None if horizon is None else horizon * tscale,
                           grid_spacing=None if grid is None else grid * length)
         payload = res.to_json()
         text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
@@ -102,6 +130,117 @@ def route(
         if not res.reachable:
             stderr.print(f"[bold red]unreachable:[/] {' '.join(str(res.reason).split())}", soft_wrap=True)
             raise typer.Exit(3)
+
+
+def _number(text: str, name: str, rule: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise ConfigError(f"{name} = {text!r}: expected a number ({rule})") from None
+    if not math.isfinite(value):
+        raise ConfigError(f"{name} = {text!r}: must be finite")
+    return value
+
+
+def _geo_route(start, target, speed, field, method, obstacles, units, json_, out, horizon, radius, depart,
+               grid, land, depth, draft, ukc, xte_m, length, tscale) -> None:
+    """``route --geo`` (docs/routing_geo.md)."""
+    from shipgnc.cli import stderr, stdout
+    from shipgnc.errors import require
+    from shipgnc.routing.geo.router import GeoProblem
+
+    require(obstacles is None, "--obstacles", str(obstacles), "is for the local plane; with --geo give --land")
+    require(radius == 0.0, "--radius", radius, "is not used with --geo (the target is a point)")
+    a = _pair(start, "--start", 1.0)
+    b = _pair(target, "--target", 1.0)
+    current = _geo_field(field, units)
+    try:
+        offset, iso_depart = _number(depart, "--depart", "") * tscale, None
+    except ConfigError:
+        from shipgnc.routing.geo.timefmt import parse_iso
+
+        offset, iso_depart = 0.0, parse_iso(depart)
+    problem = GeoProblem(a, b, speed, current=current, land=land, depth=depth, draft=draft, ukc=ukc,
+                         grid=None if grid is None else grid * length, xte_m=xte_m)
+    if iso_depart is None and problem.current.times is None and offset:
+        raise ConfigError(f"--depart = {depart!r}: the current has no time axis; give an ISO 8601 UTC time")
+    t_dep = problem.departure(iso_depart, offset)
+    res = problem.solve(t_dep, method=method, horizon=None if horizon is None else horizon * tscale)
+    payload = res.to_json()
+    text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
+    if out is not None and res.reachable:
+        from shipgnc.outputs import atomic_dir
+        from shipgnc.routing.geo.figures import geo_route_figure
+        from shipgnc.routing.geo.writers import write_geojson, write_gpx, write_rtz
+
+        with atomic_dir(out, command="route") as tmp:
+            (tmp / "route.json").write_text(text + "\n", encoding="utf-8")
+            write_gpx(tmp / "route.gpx", res.waypoints)
+            write_geojson(tmp / "route.geojson", res.waypoints,
+                          {"time_s": payload["time_s"], "distance_nm": payload["distance_nm"],
+                           "eta": payload["eta"], "xte_m": xte_m})
+            write_rtz(tmp / "route.rtz", res.waypoints, xte_m=xte_m)
+            geo_route_figure(res, tmp / "route.png")
+        stderr.print(f"wrote route.json, route.gpx, route.geojson, route.rtz, route.png to {out}", soft_wrap=True)
+    if json_:
+        sys.stdout.write(text + "\n")
+    else:
+        _print_geo(stdout, payload)
+    if not res.reachable:
+        reason = next((n for n in payload["notes"] if n.startswith("unreachable")), "unreachable")
+        stderr.print(f"[bold red]unreachable:[/] {' '.join(reason.removeprefix('unreachable: ').split())}",
+                     soft_wrap=True)
+        raise typer.Exit(3)
+
+
+def _geo_field(field: str, units: str):
+    """A CF-NetCDF path, ``still``/``none``, or ``uniform:north=..,east=..`` (true north/east)."""
+    from shipgnc.routing.fields import UniformCurrent
+
+    text = field.strip()
+    if text.lower() in ("still", "none", "0"):
+        return None
+    if text.lower().startswith("uniform"):
+        from shipgnc.routing.field_spec import parse_field
+
+        fld = parse_field(text, units)
+        if isinstance(fld, UniformCurrent):
+            return (fld.north, fld.east)
+    if Path(text).suffix.lower() in (".nc", ".nc4", ".netcdf", ".cdf") or Path(text).exists():
+        return text
+    raise ConfigError(f"--field = {field!r}: with --geo, a CF-NetCDF file, 'still', or "
+                      "uniform:north=..,east=.. (true north/east)")
+
+
+def _print_geo(console, js) -> None:
+    from rich.markup import escape
+    from rich.table import Table
+
+    table = Table(title="route (WGS84)", title_justify="left")
+    table.add_column("quantity", style="bold")
+    table.add_column("value", justify="right")
+
+    def row(name, value):
+        table.add_row(escape(name), escape(value))
+
+    row("reachable", "yes" if js["reachable"] else "no")
+    if js["reachable"]:
+        t = js["time_s"]
+        row("time to target", f"{t:.0f} s = {t / 3600:.4f} h")
+        row("distance [nm]", f"{js['distance_nm']:.2f} (geodesic {js['geodesic_nm']:.2f})")
+        if js["depart"]:
+            row("departure (UTC)", js["depart"])
+            row("arrival (UTC)", js["eta"])
+        row("waypoints", f"{len(js['waypoints'])} (cross-track tolerance {js['xte_m']:g} m)")
+        row("initial heading [deg]", f"{js['heading_start_deg']:.2f}")
+        row("clear of land and shallow water", {True: "yes", False: "NO", None: "—"}[js["land_clear"]])
+    row("method", js["method"])
+    gc = js["global_check"]
+    if gc and gc.get("time_s") is not None and js["method"] != "levelset":
+        row("global check by level set (plane)", f"{gc['time_s']:.0f} s ({gc['rel_diff']:+.2e})")
+    console.print(table)
+    for note in js["notes"]:
+        console.print(f"note: {note}", soft_wrap=True)
 
 
 def _jsonable(x):

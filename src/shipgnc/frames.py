@@ -28,7 +28,7 @@ def path_frame(north, east, origin_north, origin_east, path_angle):
     """Along-track ``s`` and cross-track ``e`` (positive to starboard) of a straight line.
 
     s = (x − x_k)cos π_p + (y − y_k)sin π_p,  e = −(x − x_k)sin π_p + (y − y_k)cos π_p
-    (spec 001 §1.10; spec 000 eq. (1)–(2)).
+    (note 001-1.10; document 000 eq. (1)–(2)).
     """
     dn, de = north - origin_north, east - origin_east
     c, s = np.cos(path_angle), np.sin(path_angle)

@@ -14,7 +14,7 @@ class PiecewiseConstant:
     """Value ``values[i]`` holds for ``times[i] <= t < times[i+1]`` (the last one forever).
 
     A small tolerance (1e-9 relative) makes a switch at 5 s fire at the sample t = 100·0.05 s
-    even when floating point lands a hair below it (spec 001 A8).
+    even when floating point lands a hair below it (note 001-A8).
     """
 
     times: np.ndarray

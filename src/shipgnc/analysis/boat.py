@@ -1,11 +1,11 @@
-"""Analysis of the vectored-thrust boat of spec 001 (document 001's Fossen 3-DOF model).
+"""Analysis of the vectored-thrust boat of document 001 (document 001's Fossen 3-DOF model).
 
-* :func:`steady_turn` — the equilibrium of eq. (9)–(11') at constant (T, α) (spec 001 §1.7);
+* :func:`steady_turn` — the equilibrium of eq. (9)–(11') at constant (T, α) (note 001-1.7);
 * :func:`directional_stability`, :func:`critical_speed` — the sway–yaw linearisation about a
-  straight run and the speed above which it is unstable (spec 001 §1.7, "Directional stability");
-* :func:`stern_kick_transfer_functions`, :func:`stern_kick_zeros` — v/α, r/α, y/α of spec 001 §1.8
+  straight run and the speed above which it is unstable (note 001-1.7, "Directional stability");
+* :func:`stern_kick_transfer_functions`, :func:`stern_kick_zeros` — v/α, r/α, y/α of note 001-1.8
   as python-control transfer functions (the non-minimum-phase stern kick);
-* :func:`kinetic_energy` — ½ νᵀMν, conserved for c_M = +1 when D = 0 and τ = 0 (spec 001 §1.4).
+* :func:`kinetic_energy` — ½ νᵀMν, conserved for c_M = +1 when D = 0 and τ = 0 (note 001-1.4).
 
 Notation as in :class:`~shipgnc.models.fossen3dof.BoatParams`: M₁₁ = m − X_u̇, M₂₂ = m − Y_v̇,
 M₃₃ = I_z − N_ṙ and k = c_M (Y_v̇ − X_u̇) (``params.munk_coefficient``).
@@ -43,7 +43,7 @@ class SteadyTurn:
 
 
 def _turn_without_munk(p: BoatParams, tau_u: float, tau_v: float, tau_r: float):
-    """Closed form of spec 001 §1.7 for c_M = 0 (the yaw equation decouples)."""
+    """Closed form of note 001-1.7 for c_M = 0 (the yaw equation decouples)."""
     if tau_r == 0.0:
         r = 0.0
     elif p.N_rr < 0.0:
@@ -64,9 +64,9 @@ def _turn_without_munk(p: BoatParams, tau_u: float, tau_v: float, tau_r: float):
 
 
 def steady_turn(params: BoatParams, thrust: float, alpha: float) -> SteadyTurn:
-    """Steady turn at constant thrust ``thrust`` [N] and angle ``alpha`` [rad] (spec 001 §1.7).
+    """Steady turn at constant thrust ``thrust`` [N] and angle ``alpha`` [rad] (note 001-1.7).
 
-    For ``munk_factor`` c_M = 0 the closed form of §1.7: |r| is the positive root of
+    For ``munk_factor`` c_M = 0 the closed form of note 001-1.7: |r| is the positive root of
     −N_|r|r r² − N_r r = |τ_r| (r = −τ_r/N_r when N_|r|r = 0), r takes the sign of τ_r,
     u = (τ_u − M₂₂ r τ_v/Y_v)/(−X_u − M₁₁M₂₂r²/Y_v) and v = (M₁₁ u r − τ_v)/Y_v, with τ from eq. (5).
     Otherwise eq. (9)–(11') with zero derivatives are solved by ``scipy.optimize.fsolve``, started
@@ -106,7 +106,7 @@ def steady_turn(params: BoatParams, thrust: float, alpha: float) -> SteadyTurn:
 
 
 def directional_stability(params: BoatParams, u0: float) -> tuple[np.ndarray, np.ndarray]:
-    """Sway–yaw matrix A at straight running (u₀, 0, 0) and its eigenvalues (spec 001 §1.7).
+    """Sway–yaw matrix A at straight running (u₀, 0, 0) and its eigenvalues (note 001-1.7).
 
     A = [[Y_v/M₂₂, −M₁₁u₀/M₂₂], [k u₀/M₃₃, N_r/M₃₃]] with k = c_M (Y_v̇ − X_u̇); N_|r|r has zero
     slope at r = 0 and drops out. The straight run is stable iff both eigenvalues lie in the open
@@ -119,7 +119,7 @@ def directional_stability(params: BoatParams, u0: float) -> tuple[np.ndarray, np
 
 
 def critical_speed(params: BoatParams) -> float:
-    """Speed above which the straight run is unstable (spec 001 §1.7); ``inf`` if never.
+    """Speed above which the straight run is unstable (note 001-1.7); ``inf`` if never.
 
     With a negative trace of A the run is stable iff Y_v N_r + k M₁₁ u₀² > 0, so for k < 0
     (c_M > 0) u_crit = √(Y_v N_r / (−k M₁₁)); for c_M = +1 this is √(Y_v N_r/(M₁₁(X_u̇ − Y_v̇))).
@@ -132,7 +132,7 @@ def critical_speed(params: BoatParams) -> float:
 
 
 def stern_kick_transfer_functions(params: BoatParams, thrust: float) -> dict[str, control.TransferFunction]:
-    """Linearised responses to the thruster angle about straight running (spec 001 §1.8).
+    """Linearised responses to the thruster angle about straight running (note 001-1.8).
 
     u₀ = T₀/(−X_u), Δ(s) = (M₂₂s − Y_v)(M₃₃s − N_r) + k M₁₁u₀² and::
 
@@ -156,7 +156,7 @@ def stern_kick_transfer_functions(params: BoatParams, thrust: float) -> dict[str
 
 
 def stern_kick_zeros(params: BoatParams, thrust: float) -> np.ndarray:
-    """Zeros of y/α (spec 001 §1.8), sorted by real part, largest first.
+    """Zeros of y/α (note 001-1.8), sorted by real part, largest first.
 
     For c_M ≥ 0 one of them lies in the right half-plane: y/α is non-minimum-phase.
     """
@@ -166,7 +166,7 @@ def stern_kick_zeros(params: BoatParams, thrust: float) -> np.ndarray:
 
 
 def kinetic_energy(params: BoatParams, nu) -> np.ndarray:
-    """½ νᵀMν = ½(M₁₁u² + M₂₂v² + M₃₃r²) for ``nu`` of shape (..., 3) (spec 001 §1.4, eq. (6))."""
+    """½ νᵀMν = ½(M₁₁u² + M₂₂v² + M₃₃r²) for ``nu`` of shape (..., 3) (note 001-1.4, eq. (6))."""
     nu = np.asarray(nu, dtype=float)
     diag = np.array([params.M11, params.M22, params.M33])
     return 0.5 * np.sum(diag * nu**2, axis=-1)

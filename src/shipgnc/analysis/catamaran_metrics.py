@@ -1,13 +1,13 @@
-"""Metrics of document 004's catamaran runs (spec 004 §4.7), computed from a result Dataset.
+"""Metrics of document 004's catamaran runs (note 004-4.7), computed from a result Dataset.
 
-Names are the spec's: ``final_yaw_rate_rad_s``, ``final_delta_deg``, ``final_speed_mps``,
+Names are those of note 004-4.7: ``final_yaw_rate_rad_s``, ``final_delta_deg``, ``final_speed_mps``,
 ``turning_diameter_m``, ``yaw_rate_settling_s``, ``yaw_rate_overshoot_pct``,
 ``max_delta_rate_deg_s``, ``final_heading_error_rad`` (heading runs), ``events``, ``stable``; and for
 the comparison with the classical baselines ``iae`` (of r − ω* for yaw-rate runs, of the wrapped
 heading error for heading runs), ``thruster_travel_deg`` and ``peak_delta_rate_deg_s``.
 
 **Alias.** ``peak_delta_rate_deg_s`` is the same quantity as ``max_delta_rate_deg_s`` (max |δ̇| of
-the applied thruster rate, °/s): both keys are kept (the spec's name and the comparison's), the
+the applied thruster rate, °/s): both keys are kept (the name of note 004-4.7 and the comparison's), the
 second defined from the first in :func:`add_aliases` (:data:`ALIASES`). Beside every quality
 figure the thruster's effort: ``thruster_travel_deg`` (∫|δ̇| dt) and ``delta_rate_rms_deg_s``
 (RMS of δ̇ over the run, issue 17).
@@ -223,7 +223,7 @@ def stable(ds, run_events: list[dict] | None = None, heading_target: float | Non
 
 
 def catamaran_metrics(ds, controller=None, heading_target: float | None = None) -> dict:
-    """Every metric of spec 004 §4.7 for one (unbatched) run, as plain Python values (a heading
+    """Every metric of note 004-4.7 for one (unbatched) run, as plain Python values (a heading
     run — ``heading_target`` given — has no yaw-rate step, so its yaw-rate settling and overshoot
     are null)."""
     run_events = events(ds, controller)

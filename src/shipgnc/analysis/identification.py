@@ -1,10 +1,10 @@
-"""Steering-model identification from a simulated manoeuvre (spec 003 §3.3–3.4, issue 17 item 4).
+"""Steering-model identification from a simulated manoeuvre (notes 003-3.3–003-3.4, issue 17 item 4).
 
 Document 003 designs its sliding-mode autopilot on the first-order Nomoto model (18),
 ṙ = a₂₂ r + b₂ δ, reduced from the linear model (17): a₂₂ = 0.1057 s⁻¹, b₂ = −0.0040 s⁻². That
 model is course-unstable and its rudder gain b₂ is 23 × smaller than the plant's instantaneous
-rudder-to-yaw-acceleration gain (M⁻¹b)_r = −0.0918 s⁻² (spec §3.3). Here the model is instead
-**identified from the plant**, as one identifies a ship from its trials (``spec/trials.md``):
+rudder-to-yaw-acceleration gain (M⁻¹b)_r = −0.0918 s⁻² (note 003-3.3). Here the model is instead
+**identified from the plant**, as one identifies a ship from its trials (``docs/trials.md``):
 
 1. :func:`zigzag_trial` runs the zig-zag δ/ψ manoeuvre (rudder to +δ, reversed each time the
    heading has changed ±ψ from the original course; :class:`ZigZag`) on any model through the
@@ -41,59 +41,8 @@ __all__ = ["NomotoFit", "NomotoFit2", "ZigZag", "fit_nomoto", "fit_nomoto2",
            "identify_cybership2", "zigzag_trial"]
 
 
-class ZigZag:
-    """The zig-zag δ/ψ manoeuvre as a controller (``spec/trials.md``; IMO MSC.137(76)).
-
-    The rudder is put to ``delta`` [rad] at ``t_execute``; each time the heading has changed
-    ``psi_switch`` [rad] from the original course in the direction the rudder turns the ship, the
-    rudder is reversed. ``rudder_sign`` is the sign of the heading change a positive rudder
-    produces (CyberShip II: −1, δ > 0 turns the bow to port; a Nomoto model with K > 0: +1).
-    The command is ``held`` (the other inputs, e.g. the propeller speed) with the rudder written
-    at ``rudder_index``. Works on a batch (each ship switches on its own heading).
-    """
-
-    continuous = False
-    signals = ()
-
-    def __init__(self, delta: float, psi_switch: float, *, rudder_sign: float = -1.0,
-                 held=(), rudder_index: int = -1, t_execute: float = 0.0, Ts: float | None = None):
-        require(math.isfinite(delta) and delta != 0, "zigzag.delta", delta, "must be a finite angle != 0 rad")
-        require(math.isfinite(psi_switch) and psi_switch > 0, "zigzag.psi_switch", psi_switch,
-                "must be a finite angle > 0 rad")
-        require(rudder_sign in (-1, 1, -1.0, 1.0), "zigzag.rudder_sign", rudder_sign, "must be +1 or -1")
-        self.delta, self.psi_switch = float(delta), float(psi_switch)
-        self.rudder_sign = float(rudder_sign)
-        self.held = np.atleast_1d(np.asarray(held, dtype=float))
-        self.rudder_index = int(rudder_index)
-        self.t_execute = float(t_execute)
-        self.Ts = Ts
-        self._rudder = None
-        self._psi0 = None
-
-    def reset(self, batch_shape) -> None:
-        self._batch = tuple(batch_shape)
-        self._rudder = None
-        self._psi0 = None
-
-    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        psi = np.asarray(measurement[..., 2], dtype=float)
-        cmd = np.zeros((*self._batch, self.held.size + 1))
-        cmd[..., [i for i in range(cmd.shape[-1]) if i != self.rudder_index % cmd.shape[-1]]] = self.held
-        if t < self.t_execute - 1e-12:
-            cmd[..., self.rudder_index] = 0.0
-            return cmd
-        if self._rudder is None:
-            self._rudder = np.full(psi.shape, self.delta)
-            self._psi0 = psi.copy()
-        change = psi - self._psi0
-        turning = self.rudder_sign * np.sign(self._rudder)
-        flip = turning * change >= self.psi_switch
-        self._rudder = np.where(flip, -self._rudder, self._rudder)
-        cmd[..., self.rudder_index] = self._rudder
-        return cmd
-
-    def signal_values(self) -> dict[str, np.ndarray]:
-        return {}
+# the zig-zag manoeuvre as a controller lives with the trials (one rule for both); re-exported here
+from shipgnc.trials.zigzag import ZigZag
 
 
 def zigzag_trial(model, actuator, x0, *, delta_deg: float = 20.0, psi_deg: float = 20.0,
@@ -328,7 +277,7 @@ def fit_nomoto2(t, delta, r, *, guess: tuple[float, float, float, float] | None 
 def cybership2_zigzag(params=None, *, delta_deg: float = 20.0, psi_deg: float = 20.0,
                       propeller_rps: float | None = None, t_end: float = 120.0, dt: float = 0.1):
     """The zig-zag ``delta_deg``/``psi_deg`` of CyberShip II from its surge equilibrium at
-    ``propeller_rps`` (default 8.13 rps), with its steering machine (spec B8); a Dataset."""
+    ``propeller_rps`` (default 8.13 rps), with its steering machine (note 003-B8); a Dataset."""
     from shipgnc.models.cybership2 import (
         CRUISE_RPS,
         CyberShip2,

@@ -1,4 +1,4 @@
-"""Scenario metrics computed from a result Dataset, as spec 001 §1.9–1.10 and spec 003 §3.8 define
+"""Scenario metrics computed from a result Dataset, as notes 001-1.9–001-1.10 and note 003-3.8 define
 them.
 
 Each metric set is computed once, for every ship of a batch at once: ``*_arrays`` functions take
@@ -53,7 +53,7 @@ STERN_KICK_KEYS = ("initial_sway_sign", "initial_yaw_rate_sign", "steady_yaw_rat
 
 
 def stern_kick_metrics(ds) -> dict:
-    """Metrics of the open-loop turn (spec 001 §1.9).
+    """Metrics of the open-loop turn (note 001-1.9).
 
     With the turn commanded over [t_on, t_off]: ``initial_sway_sign`` and
     ``initial_yaw_rate_sign`` are the signs of v and r at t_on + dt; ``steady_yaw_rate_sign`` and
@@ -148,7 +148,7 @@ def heading_step_arrays(t, psi_error, psi_d, alpha, thrust, thrust_cmd, u, step_
 
 
 def heading_step_metrics(ds, step_times, tolerance_deg: float = 2.0) -> dict:
-    """Metrics of heading-step tracking (spec 001 §1.10), with e_ψ = wrap(ψ − ψ_d).
+    """Metrics of heading-step tracking (note 001-1.10), with e_ψ = wrap(ψ − ψ_d).
 
     ``heading_rmse_deg``: RMS of e_ψ over the run. For each step at t_k, its settling time is the
     first sample time after which |e_ψ| ≤ 2° holds until the next step (or the end), minus t_k;
@@ -193,13 +193,13 @@ def waypoint_arrays(t, leg, along, cross, alpha, leg_lengths, capture_distance: 
 
 
 def waypoint_metrics(ds, leg_lengths, capture_distance: float = 20.0) -> dict:
-    """Metrics of waypoint following (spec 001 §1.10).
+    """Metrics of waypoint following (note 001-1.10).
 
     ``completion_time_s``: first sample at which the along-track distance reaches the end of the
     last leg (``None`` if never). ``crosstrack_max_m`` / ``crosstrack_rms_m``: max |e| and RMS of
     e over the samples with along-track distance ≥ ``capture_distance`` (20 m) on their own leg —
-    the first 20 m of every leg, where the boat turns onto it and overshoots, are left out (spec
-    001 §1.10's window). ``crosstrack_max_all_m``: max |e| over the whole run, the turns onto
+    the first 20 m of every leg, where the boat turns onto it and overshoots, are left out (the
+    window of note 001-1.10). ``crosstrack_max_all_m``: max |e| over the whole run, the turns onto
     each leg included.
     ``waypoints_reached``: waypoints after the start whose leg was completed. Samples after the
     completion are left out (a ship of a batch keeps sailing until every ship is done).
@@ -378,7 +378,7 @@ def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
                            settle_window_s: float = 30.0, settle_band_deg: float = 2.0,
                            delta_max: float | None = None,
                            oscillation_deg: float = COURSE_OSCILLATION_DEG) -> dict:
-    """Document 003's quality index and course-keeping figures (spec 003 §3.1, §3.8).
+    """Document 003's quality index and course-keeping figures (notes 003-3.1, 003-3.8).
 
     On every sample t_i: Δψ_i = wrap(ψ_d − ψ_i) [rad]; ``psi_E`` = Σ Δψ_i², ``delta_E`` = λ Σ δ_i²
     with the applied rudder δ [rad], ``J`` = ``psi_E`` + ``delta_E`` (eq. 2). ``min_surge_mps``,
@@ -393,7 +393,7 @@ def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
     amplitude and the rudder is not pinned at both limits ±``delta_max`` (default: the result's
     ``delta_max`` attribute; none checked if absent) — a limit cycle is not stable. Extras:
     ``settled`` (|Δψ| ≤ 2° over the last 30 s) and ``psi_E_ref`` (Σ wrap(ψ_z − ψ)² against the
-    reference model, for controllers that have one; spec 003 B11).
+    reference model, for controllers that have one; note 003-B11).
     """
     has_ref = "psi_z" in ds
     if delta_max is None and "delta_max" in ds.attrs:

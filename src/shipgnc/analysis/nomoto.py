@@ -1,4 +1,4 @@
-"""Linear sway–yaw models and Nomoto's steering transfer functions (spec 003 §3.3; generic).
+"""Linear sway–yaw models and Nomoto's steering transfer functions (note 003-3.3; generic).
 
 * :func:`davidson_schiff` — the linear Davidson–Schiff model (16) of CyberShip II at speed u₀,
   M ν̇ + N(u₀) ν = b δ with ν = [v, r], derived from the model's parameters;

@@ -1,4 +1,4 @@
-"""Path-tracking metrics of document 000 (spec 000 §0.8), batched over ships.
+"""Path-tracking metrics of document 000 (note 000-0.8), batched over ships.
 
 Computed on the logged samples from the path-frame errors the controllers log
 (``cross_track_error`` y_r [m], ``heading_error`` ψ_r [rad], ``leg``) and the applied rudder
@@ -16,12 +16,11 @@ time before the first leg switch.
   ±180°, not 0);
 * ``rudder_rms_deg``; ``saturation_fraction``: share of samples with |δ| at δ_max;
 * ``stable`` (the one definition, :func:`shipgnc.analysis.metrics.stable_arrays`): the run
-  reached its end without the divergence guard, |y_r| stayed below max(3 nm, 2|y_r(0)|) (spec 000
-  §0.8, [A]), over the last 20 % of the run y_r oscillates about its trend by at most 0.05 nm (the
+  reached its end without the divergence guard, |y_r| stayed below max(3 nm, 2|y_r(0)|) (note 000-0.8, [A]), over the last 20 % of the run y_r oscillates about its trend by at most 0.05 nm (the
   settling band) and the rudder is not pinned at both limits ±δ_max (no limit cycle, no
   saturated oscillation), and the ship is not ``reversed``;
 * ``reversed``: the run ends with |heading error| > 90° (the final heading error above, the
-  circular mean over the last 10 min): the reversed equilibrium ψ_r = π of spec 000 §0.5, a ship
+  circular mean over the last 10 min): the reversed equilibrium ψ_r = π of note 000-0.5, a ship
   sailing its leg backwards with y_r bounded, which is not tracking (issue 15).
 """
 
@@ -134,7 +133,7 @@ def _series(ds, name: str) -> np.ndarray:
 
 
 def path_tracking_metrics(ds, *, delta_max: float, diverged: bool = False) -> dict:
-    """Spec 000 §0.8 metrics of a single-ship result (plain numbers, ``None`` where undefined)."""
+    """Note 000-0.8 metrics of a single-ship result (plain numbers, ``None`` where undefined)."""
     arrays = path_tracking_arrays(ds["time"].values, _series(ds, "cross_track_error"),
                                   _series(ds, "heading_error"), _series(ds, "leg"),
                                   _series(ds, "delta"), delta_max=delta_max,

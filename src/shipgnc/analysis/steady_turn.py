@@ -1,6 +1,6 @@
 """Steady turning of document 004's catamaran: the algebraic turn (S2), ω_max, the characteristic.
 
-A steady turn is u̇ = v̇ = ṙ = 0 (spec 004 §4.7 S2). It does not depend on the controller, J, T_u
+A steady turn is u̇ = v̇ = ṙ = 0 (notes 004-4.7 004-S2). It does not depend on the controller, J, T_u
 or h. Two parameterisations:
 
 * :func:`steady_turn` — for a given yaw rate r, solve (u, v, δ);
@@ -107,7 +107,7 @@ def _continue(fun, y_start: np.ndarray, target: float, steps: int) -> np.ndarray
 
 
 def steady_turn(vessel, r: float, *, steps: int = 40) -> SteadyTurn:
-    """The steady turn at yaw rate ``r`` [rad/s]: (u, v, δ) with u̇ = v̇ = ṙ = 0 (spec 004 S2).
+    """The steady turn at yaw rate ``r`` [rad/s]: (u, v, δ) with u̇ = v̇ = ṙ = 0 (note 004-S2).
 
     ``vessel`` is a :class:`Catamaran` or its parameters. Raises :class:`ConfigError` when no turn
     with |δ| < 90° exists on the branch from straight running (|r| beyond ω_max, printed sign).
@@ -145,7 +145,7 @@ _OMEGA_MAX_CACHE: dict[tuple, float] = {}
 
 
 def omega_max(vessel) -> float:
-    """Largest steady yaw rate with |δ| ≤ 90°: the turn at δ = 90° (spec 004 check 5) [rad/s].
+    """Largest steady yaw rate with |δ| ≤ 90°: the turn at δ = 90° (note 004-4.12 check 5) [rad/s].
 
     ω_max depends on the hull and the thrust only (not on J); for per-ship arrays of the
     uncertainty factors it is evaluated with the nominal masses (the factors scale m_x, m_y too,

@@ -1,13 +1,13 @@
-"""Document 004's cases S1–S10 as plain builders, ready for ``simulate`` (spec 004 §4.7).
+"""Document 004's cases S1–S10 as plain builders, ready for ``simulate`` (note 004-4.7).
 
-Each builder returns a :class:`CatamaranCase` (or a dict of them keyed like the spec's metrics,
+Each builder returns a :class:`CatamaranCase` (or a dict of them keyed like the metrics of note 004-4.7,
 e.g. ``{"law20": ..., "law21": ...}``) holding ``model, x0, actuator, controller, guidance,
 t_end, dt`` and, for heading runs, ``heading_target``. A runner calls::
 
     case = turn()["law20"]
     ds = simulate(case.model, case.x0, t_end=case.t_end, dt=case.dt, controller=case.controller,
                   actuator=case.actuator, guidance=case.guidance, on_divergence="stop")
-    metrics = case.metrics(ds)          # spec 004 metrics, events included
+    metrics = case.metrics(ds)          # document 004 metrics, events included
 
 or simply ``ds = case.run()`` (``backend="auto"``: the composed compiled loop when the run is long
 or batched and every component has a kernel, see ``simulate``). Common settings: u(0) = 4 m/s,
@@ -229,11 +229,11 @@ def robustness(preset_name: str = DEFAULT_PRESET, n: int = 40, seed: int = 10, o
 
 def montecarlo(n: int = 1000, seed: int = 16, t_end: float = 300.0,
                preset_name: str = "si") -> CatamaranCase:
-    """Check 16: 1000 draws, ``si`` (the spec's check; any preset by name), law (21), ω* = 0.06, 300 s."""
+    """Check 16: 1000 draws, ``si`` (check 16 of note 004-4.12; any preset by name), law (21), ω* = 0.06, 300 s."""
     return robustness(preset_name, n=n, seed=seed, t_end=t_end)
 
 
-#: scenario name → builder (spec 004 §4.7 names); each returns a case or a dict of cases
+#: scenario name → builder (note 004-4.7 names); each returns a case or a dict of cases
 SCENARIOS = {
     "catamaran-turn": turn,
     "catamaran-steps": steps,
@@ -251,14 +251,14 @@ def compare(preset_name: str = DEFAULT_PRESET, vessel: dict | None = None) -> di
     return comparison_cases(preset_name, vessel=vessel)
 
 
-#: ``catamaran-compare``'s baseline sets: the equal-bandwidth designs (issue 17), the spec's
-#: §4.11.3 baselines kept as reproductions (run keys ``pi``, ``lqr``), or both
+#: ``catamaran-compare``'s baseline sets: the equal-bandwidth designs (issue 17), the
+#: note 004-4.11.3 baselines kept as reproductions (run keys ``pi``, ``lqr``), or both
 BASELINES = ("all", "designed", "reproduction")
 #: what each comparison run is (figure legends, docs)
 RUN_LABELS = {
     "law20": "FSM law (20)", "law21": "FSM law (21)",
     "place": "pole placement at the FSM poles", "pi_design": "PI designed for the FSM poles",
-    "pi": "law (20) with cos δ frozen (reproduction)", "lqr": "LQR of spec §4.11.3 (reproduction)",
+    "pi": "law (20) with cos δ frozen (reproduction)", "lqr": "LQR of note 004-4.11.3 (reproduction)",
 }
 
 
@@ -269,7 +269,7 @@ def comparison_cases(preset_name: str = DEFAULT_PRESET, t_end_rate: float = 300.
     (K* = 0.8 rad, ω_c = 0.0022 rad/s). Returns ``{"S3/law20": case, ...}``.
 
     ``baselines``: ``designed`` — pole placement (``place``) and the designed PI (``pi_design``) at
-    the FSM's poles −1/T_u, −1/h; ``reproduction`` — the spec's PI (law (20) with cos δ frozen,
+    the FSM's poles −1/T_u, −1/h; ``reproduction`` — the PI of note 004-4.11.3 (law (20) with cos δ frozen,
     ``pi``) and LQR (``lqr``); ``all`` (default) — both, the designed ones first."""
     require(baselines in BASELINES, "case.options.baselines", baselines, f"allowed: {', '.join(BASELINES)}")
     designed, reproduction = baselines in ("all", "designed"), baselines in ("all", "reproduction")

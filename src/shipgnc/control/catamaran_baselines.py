@@ -1,4 +1,4 @@
-"""Classical baselines for document 004's catamaran on the same plant (spec 004 §4.11.3).
+"""Classical baselines for document 004's catamaran on the same plant (note 004-4.11.3).
 
 * :class:`YawRatePI` — a fixed-gain PI yaw-rate controller with the bandwidth of law (20):
   law (20) with cos δ frozen at 1, i.e. δ̇ = K_i (ω* − ω) − K_p ṙ with K_i = J/(T_u h L T_v),
@@ -9,7 +9,7 @@
   the law δ̇ = −K x is a PID on the heading error (I on e_ψ, P through r, D through ṙ ~ δ) with
   sway feedback. The heading reference is the ramp of the capture profile (17).
 
-Both are kept as named reproductions (the spec's §4.11.3 baselines): the "PI" is law (20) with
+Both are kept as named reproductions (the note 004-4.11.3 baselines): the "PI" is law (20) with
 cos δ frozen, and the LQR's dominant poles (−0.043 ± 0.006j s⁻¹) are ten times slower than the
 FSM. The comparison's baselines of record are designed for the FSM's bandwidth (issue 17):
 
@@ -149,7 +149,7 @@ PI_SOURCE = 2 + N_KERNEL_PARAMS
 @kernel_function
 def yaw_rate_pi_step(t, x, ref, z, p, cmd, sig):
     """One :meth:`YawRatePI.law` for one ship: δ̇ = K_i (ω* − ω) − K_p Φ₃ (law (20) with
-    cos δ = 1, spec 004 §4.11.3), operation for operation."""
+    cos δ = 1, note 004-4.11.3), operation for operation."""
     z[0] += 1.0
     w = rate_value(t, x, ref, p, PI_SOURCE, z, 2)
     u = p[0] * (w - x[R]) - p[1] * catamaran_yaw_acceleration(x, p, 2)
@@ -242,7 +242,7 @@ def heading_lqr_step(t, x, ref, z, p, cmd, sig):
 
 
 # --- equal-bandwidth baselines (issue 17) ----------------------------------------------------------
-#: default thruster-angle limit of :class:`DesignedPI`'s anti-windup [rad] (85°, spec 004 §4.11.1 [A])
+#: default thruster-angle limit of :class:`DesignedPI`'s anti-windup [rad] (85°, note 004-4.11.1 [A])
 DELTA_LIMIT = math.radians(85.0)
 
 
@@ -257,7 +257,7 @@ def sway_yaw_linearisation(model: Catamaran) -> tuple[np.ndarray, np.ndarray]:
 def fsm_poles(T_u: float, h: float) -> tuple[float, float]:
     """The FSM's closed-loop poles: the criterion's −1/T_u and the prediction's −1/h [1/s]
     (law (20): the predicted rate ω̄ = ω + h ω̇ approaches ω* with time constant T_u, so
-    ω/ω* ≈ 1/((1 + T_u s)(1 + h s)); spec 004 §4.5–4.6)."""
+    ω/ω* ≈ 1/((1 + T_u s)(1 + h s)); notes 004-4.5–004-4.6)."""
     return -1.0 / T_u, -1.0 / h
 
 

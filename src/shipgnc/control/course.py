@@ -1,11 +1,11 @@
 """Course autopilots of document 003 for CyberShip II: PD (3) and sliding mode (9)–(15).
 
-Controllers (names of spec 003 §3.8, built by :func:`course_controller`):
+Controllers (names of note 003-3.8, built by :func:`course_controller`):
 
 * ``pd`` — :class:`CoursePD`, eq. (3): δ_z = K_P wrap(ψ − ψ_d) + K_D r, K_P = 2, K_D = 50, on ψ_d
   directly (no reference model). The sign is right because b₂ < 0 (δ > 0 turns the bow to port).
 * ``smc_consistent`` (alias ``fossen``) — :class:`SlidingModeCourse`, the Healey–Lienard / Fossen
-  (1994) form of law (14) (spec §3.2, B4)::
+  (1994) form of law (14) (notes 003-3.2, 003-B4)::
 
       δ_z = N ψ_z − Kᵀx + (hᵀB_h)⁻¹ [hᵀẋ_hz − η_h tanh(σ_h/φ_h)],   σ_h = hᵀ(x − x_z)
 
@@ -83,7 +83,7 @@ class _CourseController:
 class CoursePD(_CourseController):
     """PD course autopilot, eq. (3): δ_z = K_P wrap(ψ − ψ_d) + K_D r (K_P = 2, K_D = 50).
 
-    On the design model (18) the closed-loop poles are −0.04715 ± 0.07601j (spec §3.4).
+    On the design model (18) the closed-loop poles are −0.04715 ± 0.07601j (note 003-3.4).
     """
 
     def __init__(self, Kp: float = 2.0, Kd: float = 50.0, *, Ts: float = 0.1,
@@ -145,7 +145,7 @@ class SMCDesign:
 
 
 def design_smc(a22: float, b2: float, lam1: float, lam2: float) -> SMCDesign:
-    """Gains of the sliding-mode autopilot for ṙ = a₂₂ r + b₂ δ (spec §3.2, §3.4).
+    """Gains of the sliding-mode autopilot for ṙ = a₂₂ r + b₂ δ (notes 003-3.2, 003-3.4).
 
     K by python-control (``place``; ``acker`` for a repeated eigenvalue), h from numpy's
     eigenvectors of A_cᵀ (eigenvalue nearest λ₁), N_x, N_u by solving (13). λ₁ and λ₂ must be real
@@ -314,7 +314,7 @@ TUNED = {"lam1": -0.0005, "lam2": -0.2, "eta_rudder": 0.3, "phi": 0.03}
 
 def smc_tuned(design_model: tuple[float, float] | None = None, *, Ts: float = 0.1,
               propeller_rps: float = CRUISE_RPS, **changes: float) -> SlidingModeCourse:
-    """The consistent law (14) retuned for the nonlinear CyberShip II (``smc_tuned``, spec §3.9).
+    """The consistent law (14) retuned for the nonlinear CyberShip II (``smc_tuned``, note 003-3.9).
 
     Same design model (18) as printed (a₂₂ = 0.1057, b₂ = −0.0040), same reference model
     (ω_n = 0.1, ζ = 0.85), same λ₁ = −0.0005; three changes (``TUNED``, overridable by keyword):
@@ -424,7 +424,7 @@ DESIGN_MODELS = ("eq18", "eq17", "eq16", "identified")
 
 def design_model_of(params=None, which: str = "eq18", *, u0: float | None = None,
                     propeller_rps: float | None = None) -> tuple[float, float]:
-    """(a₂₂, b₂) of a row of spec §3.4: ``eq18`` the printed (18) (default, the document's),
+    """(a₂₂, b₂) of a row of note 003-3.4: ``eq18`` the printed (18) (default, the document's),
     ``eq17`` the reduction of the printed (17), ``eq16`` the reduction of (16) from ``params``
     (CyberShip2Params, default the published ones) at ``u0`` (default 0.3 m/s), or
     ``identified``: the first-order Nomoto model fitted to the plant's 20°/20° zig-zag at
@@ -455,13 +455,13 @@ def design_model_of(params=None, which: str = "eq18", *, u0: float | None = None
 
 def course_controller(name: str, params_or_design_model=None, Ts: float = 0.1, *,
                       design_model: str = "eq18", propeller_rps: float = CRUISE_RPS):
-    """The controller called ``name`` in spec 003 §3.8: ``pd``, ``smc_printed`` (alias ``printed``),
+    """The controller called ``name`` in note 003-3.8: ``pd``, ``smc_printed`` (alias ``printed``),
     ``smc_consistent`` (alias ``fossen``), ``smc_tuned`` or ``smc_identified`` (designed on the
     model identified from the plant ``params``; a design model given directly is used as is).
 
     ``params_or_design_model`` is either the plant's
     :class:`~shipgnc.models.cybership2.CyberShip2Params` (or None), in which case the SMCs are
-    designed on the row ``design_model`` of spec §3.4 (default ``eq18``, the document's choice;
+    designed on the row ``design_model`` of note 003-3.4 (default ``eq18``, the document's choice;
     ``eq16`` uses these parameters), or a design model given directly as (a₂₂, b₂) (e.g. a
     :class:`~shipgnc.analysis.nomoto.NomotoI`). The PD needs no design model.
     """

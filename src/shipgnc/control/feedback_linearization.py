@@ -1,4 +1,4 @@
-"""Feedback-linearising path tracking of document 000 (Mariner), spec 000 §0.5, A13, A14.
+"""Feedback-linearising path tracking of document 000 (Mariner), notes 000-0.5, 000-A13, 000-A14.
 
 Design model (14): a Norrbin yaw equation with the path-frame kinematics, x = [y_r, ψ_r, r]::
 
@@ -29,8 +29,8 @@ switching A6, ``reference_names = ()``):
   offset of an *unknown* current and yaw bias; ``rate_from_positions`` takes ẏ_r from successive
   GPS positions instead of the known current (issue 17).
 
-With r₂ ≠ 0 the laws use ∂v/∂r = r₁ + 3r₂r² where the spec (r₂ = 0) has r₁; for the Mariner
-(r₂ = 0) they are the spec's formulas term by term.
+With r₂ ≠ 0 the laws use ∂v/∂r = r₁ + 3r₂r² where note 000-0.5 (r₂ = 0) has r₁; for the Mariner
+(r₂ = 0) they are the formulas of note 000-0.5 term by term.
 
 **Known disturbances.** b_r (added to ṙ) and the cross current d_y are known to the controller
 (A13; ``b_r`` [rad/s²], ``d_y`` [m/s] constructor arguments, default 0). The "measured" ẏ_r is the
@@ -263,13 +263,13 @@ def fl_lookahead(params, path: WaypointPath, *, Ts: float, lookahead: float = LO
 
 
 class LOSFL(_PathFL):
-    """``los_fl``: (integral) LOS guidance feeding an exact FL of the yaw loop (spec 000 §0.5)::
+    """``los_fl``: (integral) LOS guidance feeding an exact FL of the yaw loop (note 000-0.5)::
 
         ρ = y_r + κ y_int,   ẏ_int = Δ y_r/(ρ² + Δ²)                 (integral LOS, κ ≥ 0)
         ψ_d,r = −atan(ρ/Δ) − asin(d_y/u);  ψ̇_d,r = −Δ (ẏ_r + κ ẏ_int)/(Δ² + ρ²)  (u̇ neglected)
         e = wrap(ψ_r − ψ_d,r);  ν = −k_p e − k_d (r − ψ̇_d,r);  δ = (ν + H_N(r) − b_r)/c.
 
-    κ = 0 with b_r, d_y known is the spec's law (the document's oracle: ``knows_disturbance``).
+    κ = 0 with b_r, d_y known is the law of note 000-0.5 (the document's oracle: ``knows_disturbance``).
     Without that knowledge (b_r = d_y = 0 here) plain LOS keeps a standing offset: the heading
     must settle at the crab angle −asin(d_y/U) plus the yaw loop's error b_r/k_p, which
     −atan(y_r/Δ) supplies only with y_r ≠ 0 (0.21 nm for the document's disturbances). The
@@ -437,7 +437,7 @@ def los_fl_step(t, x, ref, z, p, cmd, sig):
     ẏ_int = Δ y_r/(Δ² + ρ²), ψ_d,r = −atan(ρ/Δ) − asin(clip(d_cross/max(u, 1e-6))),
     ψ̇_d,r = −Δ (ẏ_r + κ ẏ_int)/(Δ² + ρ²) (ẏ_r from the last two positions when asked),
     e = wrap(ψ_r − ψ_d,r), ν = −k_p e − k_d (r − ψ̇_d,r), δ = clip((ν + H_N(r) − b_r)/c)
-    (spec 000 §0.5). ``p`` = [common 9, Δ, k_p, k_d, Δ², 0, κ, rate from positions, leg table];
+    (note 000-0.5). ``p`` = [common 9, Δ, k_p, k_d, Δ², 0, κ, rate from positions, leg table];
     ``z`` = [path_state 6, y_int, ẏ_int, t, north, east, has previous]."""
     delta_max, a, b, c_rudder, b_r = p[0], p[1], p[2], p[3], p[6]
     D, kp, kd, D2, kappa, from_positions = p[9], p[10], p[11], p[12], p[14], p[15]
@@ -466,12 +466,12 @@ def los_fl_step(t, x, ref, z, p, cmd, sig):
 
 class HeadingFL:
     """Heading autopilot for the Mariner: the exact feedback linearisation of the yaw loop of
-    ``los_fl`` (spec 000 §0.5) on a heading reference [ψ_d, r_d] from guidance::
+    ``los_fl`` (note 000-0.5) on a heading reference [ψ_d, r_d] from guidance::
 
         e = wrap(ψ − ψ_d),  ν = −k_p e − k_d (r − r_d),  δ = (ν + H_N(r) − b_r)/c
 
     SI gains ``kp`` [1/s²] = 1/60², ``kd`` [1/s] = 2/60 by default (the ``los_fl`` loop); ``b_r``
-    known [rad/s²]. Used to sail an optimal route's heading programme (spec 002 §2.9.6).
+    known [rad/s²]. Used to sail an optimal route's heading programme (note 002-2.9.6).
     """
 
     continuous = False

@@ -1,6 +1,6 @@
 """The finite-state method (FSM) of document 004, general and for the catamaran's yaw rate.
 
-**General form** (spec 004 §4.5, eq. (12)–(15)). For an affine system ż = Φ(t, z) + B u and a
+**General form** (note 004-4.5, eq. (12)–(15)). For an affine system ż = Φ(t, z) + B u and a
 smooth criterion J(z) with target J*, predict the free motion over a horizon h,
 
     z̄ ≈ z + h Φ(t, z),   W ≈ I + h ∂Φ/∂z(t, z)                              (15)
@@ -19,7 +19,7 @@ Jacobian; :class:`FiniteStateController` wraps it as a controller for any model.
     law (20):  u = (ω* − ω̄)/(T_u W₃₇),  ω̄ = ω + h Φ₃(z)
     law (21):  u = (ω* − ω)/(T_u W₃₇)   (no velocity measurement needed)
 
-:class:`YawRateFSM` implements both with the guards of spec 004 §4.11.1: the feasibility check
+:class:`YawRateFSM` implements both with the guards of note 004-4.11.1: the feasibility check
 |ω*| ≤ ω_max, an optional clamp |δ| ≤ δ_max, an optional frozen 1/cos δ gain near 90°, and events
 (``omega_ref_above_max``, ``delta_clamped``, ``delta_reached_90``) recorded on the controller
 (``controller.events``) rather than a silent failure.
@@ -648,7 +648,7 @@ def yaw_rate_fsm_step(t, x, ref, z, p, cmd, sig):
 
 
 def default_gains(preset_name: str) -> tuple[float, float]:
-    """(T_u, h) of the document (``paper``) or the consistent-unit tuning (``si``), spec 004 §4.4."""
+    """(T_u, h) of the document (``paper``) or the consistent-unit tuning (``si``), note 004-4.4."""
     from shipgnc.models.catamaran import FSM_GAINS
 
     if preset_name not in FSM_GAINS:

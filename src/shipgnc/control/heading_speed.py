@@ -1,6 +1,6 @@
 """Heading + speed autopilot for the vectored-thrust boat (controller ``boat-heading-speed``).
 
-Spec 001 §1.10. Design model: M₃₃ṙ = N_r r + τ_r and M₁₁u̇ = X_u u + τ_u.
+Note 001-1.10. Design model: M₃₃ṙ = N_r r + τ_r and M₁₁u̇ = X_u u + τ_u.
 
 * reference model (critically damped, ω_ref): ψ_r, r_r = ψ̇_r, ψ̈_r;
 * heading PID with model feed-forward, e = wrap(ψ − ψ_r), z = ∫e dt:

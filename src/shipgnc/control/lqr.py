@@ -1,4 +1,4 @@
-"""LQR trajectory tracking of document 000 (Mariner, de Wit–Oppe plant), spec 000 §0.4, A6–A8, A12.
+"""LQR trajectory tracking of document 000 (Mariner, de Wit–Oppe plant), notes 000-0.4, 000-A6–000-A8, 000-A12.
 
 Design model, eq. (7)–(9): the path-frame kinematics ẏ_r = Uψ_r (sway neglected) with the
 linear yaw equation ṙ = −a r + c δ and the integral e_I = ∫ y_r dt::
@@ -12,7 +12,7 @@ criterion (10) J = ∫(ρ_y y_r² + ρ_ψ ψ_r² + ρ_e e_I² + R δ²) dt with 
 control law (13) δ = −K x, K = [k_y, k_ψ, k_r, k_e] > 0 (negative feedback, A8).
 
 **Units.** The document designs in minutes, nautical miles and radians, and the same Q, R give
-different gains in other units (spec §0.4 table), so :func:`design_lqr` designs in paper units
+different gains in other units (note 000-0.4 table), so :func:`design_lqr` designs in paper units
 and :func:`gain_to_si` converts K at the controller's boundary (:data:`PAPER_STATE_UNITS`).
 The printed gain :data:`PAPER_LQR_GAIN` = [3.4, 3.2, 1, 0.45] is reproduced with **R = 0.5**
 (A12), not with the stated R = 1, which gives [2.4455, 2.3244, 0.8788, 0.3162]
@@ -63,7 +63,7 @@ PAPER_STATE_UNITS = np.array([NAUTICAL_MILE, 1.0, 1.0 / MINUTE, NAUTICAL_MILE * 
 #: rudder limit of the Mariner (35°) [rad]
 DELTA_MAX = deg(35.0)
 
-#: indices of the Mariner state [north, east, psi, u, r] (spec 000 eq. (25))
+#: indices of the Mariner state [north, east, psi, u, r] (document 000 eq. (25))
 I_NORTH, I_EAST, I_PSI, I_U, I_R = range(5)
 
 
@@ -165,7 +165,7 @@ def design_lqr(params, *, Q=PAPER_Q, R: float = PAPER_R, U: float | None = None)
 
     ``params`` holds the plant's SI coefficients ``a`` [1/s] and ``c`` [1/s²] (and, unless ``U``
     [m/s] is given, ``U`` or ``S`` [m/s²] and ``f`` [1/s] with U = S/f); they are converted to
-    /min, /min², nm/min for the design (spec §0.4: the gain is in min / nm / rad).
+    /min, /min², nm/min for the design (note 000-0.4: the gain is in min / nm / rad).
     """
     a_si, c_si = plant_coefficient(params, "a"), plant_coefficient(params, "c")
     U_si = nominal_speed(params) if U is None else float(U)
@@ -219,9 +219,9 @@ class PathLQR:
     (A7). The document's law has no anti-windup, and neither has this controller by default;
     ``anti_windup=True`` adds conditional integration: e_I holds while the
     unclipped law is beyond ±δ_max *and* integrating would push it further out (sign(k_e y_r) =
-    sign(K x)), so it only winds back. The spec is silent on anti-windup, and its indicative
-    §0.8 figures for ``lqr``/``lqr_paper`` (settling 25.9 min, overshoot 0.63 nm) are those of
-    ``anti_windup=False``; with it the 1.5 nm capture of §0.6 settles in 25.46 min with a
+    sign(K x)), so it only winds back. Document 000 is silent on anti-windup, and the indicative
+    note 000-0.8 figures for ``lqr``/``lqr_paper`` (settling 25.9 min, overshoot 0.63 nm) are those of
+    ``anti_windup=False``; with it the 1.5 nm capture of note 000-0.6 settles in 25.46 min with a
     0.486 nm overshoot (25.93 min, 0.635 nm without), and the steady state (e_I absorbs b_r,
     d_y) is the same. Logged:
     ``cross_track_error``, ``heading_error``, ``leg``, ``integral_error`` (e_I, before the update).

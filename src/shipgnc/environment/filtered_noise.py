@@ -1,6 +1,6 @@
-"""Narrow-band noise from white noise through a second-order filter (spec 000 A11).
+"""Narrow-band noise from white noise through a second-order filter (note 000-A11).
 
-The wave disturbance of document 000 is "suitably filtered white noise"; spec 000 A11 fixes it as
+The wave disturbance of document 000 is "suitably filtered white noise"; note 000-A11 fixes it as
 the output w = ẋ₁ of the linear wave-response filter (Fossen's linear wave model)::
 
     ẋ₁ = x₂,   ẋ₂ = −ω₀² x₁ − 2ζω₀ x₂ + q ξ(t),   w = x₂,                        (A11)

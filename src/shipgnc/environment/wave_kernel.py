@@ -192,7 +192,7 @@ def _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v):
 @kernel_function
 def froude_krylov_sample(t, x, z, p, w, d):
     """[X_env, Y_env, N_env] of one ship at time ``t`` and stage state ``x``: document 003's
-    seeded Froude–Krylov loads (spec 003 §3.6; :class:`~shipgnc.environment.waves.FroudeKrylovWaveLoads`),
+    seeded Froude–Krylov loads (note 003-3.6; :class:`~shipgnc.environment.waves.FroudeKrylovWaveLoads`),
 
         θᵢ = ωᵢ t − (k_n,ᵢ n + k_e,ᵢ e) + φᵢ,   βᵢ = χᵢ − ψ,   uᵢ = ½kᵢL cos βᵢ,  vᵢ = ½kᵢB sin βᵢ,
         X = Σ w_X,ᵢ B sin uᵢ sinc vᵢ sin θᵢ,   Y = Σ w_Y,ᵢ L sin vᵢ sinc uᵢ sin θᵢ,

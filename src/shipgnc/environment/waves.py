@@ -1,11 +1,11 @@
 """Irregular waves: spectra, seeded realisations and the first-order wave loads on a hull.
 
-Spec 003 §3.6, B10 and §3.8 (scenario ``cybership-waves``); shared with specs 000 and 001.
+Notes 003-3.6, 003-B10 and 003-3.8 (scenario ``cybership-waves``); shared with documents 000 and 001.
 
 **Spectra** (one-sided, of the elevation ζ, S(ω) in m²·s, ω in rad/s; Fossen 2021 ch. 10, ITTC 1978/1984):
 
 * :func:`pierson_moskowitz` — the original one-parameter PM (fully developed sea), from U₁₉.₅ or H_s;
-* :func:`modified_pierson_moskowitz` — the two-parameter ITTC form of spec 3.6, (H_s, modal period T₀);
+* :func:`modified_pierson_moskowitz` — the two-parameter ITTC form of note 003-3.6, (H_s, modal period T₀);
 * :func:`jonswap` — the peak-enhanced fetch-limited sea, normalised exactly to m₀ = H_s²/16.
 
 All three have the ω⁻⁵ high-frequency tail, so the moments m_k = ∫₀^∞ ω^k S(ω) dω exist for k < 4 only.
@@ -13,7 +13,7 @@ All three have the ω⁻⁵ high-frequency tail, so the moments m_k = ∫₀^∞
 
 **Froude scaling** (:func:`froude_scale`): lengths scale with λ, times with λ^½, forces with λ³. The
 document's 5 mm for H_s = 3 m at 1:70 is 3/70^1.5 — the wrong exponent; the correct value is 3/70 = 42.9 mm,
-and its T₀ = 0.8 s model scale is 0.8·√70 = 6.69 s at full scale (spec B10).
+and its T₀ = 0.8 s model scale is 0.8·√70 = 6.69 s at full scale (note 003-B10).
 
 **Realisations** (:class:`WaveRealisation`): ζ(t, n, e) = Σᵢ aᵢ cos(ωᵢt − kᵢ(n cos χᵢ + e sin χᵢ) + φᵢ),
 deep water kᵢ = ωᵢ²/g, χᵢ the direction each component travels to (NED, clockwise from north).
@@ -149,7 +149,7 @@ def _pm_coefficients(*, wind_speed=None, hs=None, g: float = G) -> tuple[float, 
 
 
 def modified_pierson_moskowitz(omega, hs, t0):
-    """Modified (two-parameter, ITTC) Pierson–Moskowitz spectrum [m²·s], as written in spec 003 §3.6.
+    """Modified (two-parameter, ITTC) Pierson–Moskowitz spectrum [m²·s], as written in note 003-3.6.
 
     S(ω) = A ω⁻⁵ exp(−B ω⁻⁴),  B = 1.25 ω₀⁴,  ω₀ = 2π/T₀,  A = B H_s²/4   (ITTC; Fossen 2021 ch. 10).
 
@@ -336,7 +336,7 @@ class WaveSpectrum:
 
     @classmethod
     def modified_pierson_moskowitz(cls, hs, t0) -> WaveSpectrum:
-        """Modified PM sea (spec 003 §3.6) from H_s [m] and the modal period T₀ [s]."""
+        """Modified PM sea (note 003-3.6) from H_s [m] and the modal period T₀ [s]."""
         return cls("modified-pm", hs, t0)
 
     @classmethod
@@ -708,7 +708,7 @@ class FroudeKrylovWaveLoads:
     Give ``spreading`` (e.g. 1, the ITTC cos² sea) for yaw in head seas too. ``gains`` scale the three
     channels for calibration or to switch one off.
 
-    **Defaults — CyberShip II** (spec 003 §3.5–3.6, model scale 1:70): L = 1.255 m, B = 0.29 m, T = 0.05 m,
+    **Defaults — CyberShip II** (notes 003-3.5–003-3.6, model scale 1:70): L = 1.255 m, B = 0.29 m, T = 0.05 m,
     ρ = 1014 kg/m³ as in the plant's rudder model. (The box's 18.5 kg displacement is below the ship's
     23.8 kg: the document's draft is taken as given.) At H_s = 42.9 mm, T₀ = 0.8 s, u = 0.3 m/s and a 150°
     encounter angle (the ±30° legs) the loads are ≈ 1.5 N, 0.86 N and 0.65 N·m RMS, at ω_e ≈ 10 rad/s: far
@@ -951,5 +951,5 @@ class FroudeKrylovWaveLoads:
 
 
 #: another name of :class:`FroudeKrylovWaveLoads`, the wave-load disturbance of document 003's
-#: ``cybership-waves`` (spec 003 §3.6): its yaw moment is what moves the heading in waves
+#: ``cybership-waves`` (note 003-3.6): its yaw moment is what moves the heading in waves
 WaveYawDisturbance = FroudeKrylovWaveLoads

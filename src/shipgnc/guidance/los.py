@@ -1,4 +1,4 @@
-"""Line-of-sight (LOS) waypoint guidance, lookahead-based (spec 001 §1.10).
+"""Line-of-sight (LOS) waypoint guidance, lookahead-based (note 001-1.10).
 
 For leg k from P_k to P_{k+1} with path angle π_p, the along-track distance s and cross-track
 error e (positive to starboard) come from :meth:`WaypointPath.project`; the desired heading is
@@ -16,7 +16,7 @@ e_int is integrated (forward Euler) between the guidance samples and restarts at
 leg; far from the path the denominator slows the integration, which limits wind-up.
 
 The ship switches to leg k + 1 when s ≥ L_k − R_sw (R_sw = 0: crossing the normal at the
-waypoint, the rule of spec 000). The task ends when s reaches the end of the last
+waypoint, the rule of document 000). The task ends when s reaches the end of the last
 leg. Batched: each ship has its own leg index.
 """
 

@@ -1,5 +1,5 @@
 """Waypoint paths: straight legs between waypoints in NED, with the path-fixed frame; the leg
-tracker of spec 000 (A6) and its scalar form for component kernels (:func:`track_leg`)."""
+tracker of document 000 (A6) and its scalar form for component kernels (:func:`track_leg`)."""
 
 from __future__ import annotations
 
@@ -51,7 +51,7 @@ class WaypointPath:
 class LegTracker:
     """Active leg of each ship on a :class:`WaypointPath` and its path-frame position.
 
-    Switching rule of spec 000 (A6): leg i + 1 becomes active once x_r ≥ |P_i P_{i+1}| on leg i
+    Switching rule of document 000 (A6): leg i + 1 becomes active once x_r ≥ |P_i P_{i+1}| on leg i
     (the ship crosses the normal through P_{i+1}); several switches in one sample are allowed;
     the last leg is a half-line. Batched: one leg index per ship.
     """
@@ -102,7 +102,7 @@ LEG_NORTH, LEG_EAST, LEG_COS, LEG_SIN, LEG_LENGTH, LEG_ANGLE = range(6)
 
 @kernel_function
 def track_leg(north, east, leg, p, o):
-    """:meth:`LegTracker.update` for one ship (switching rule A6 of spec 000, several switches in
+    """:meth:`LegTracker.update` for one ship (switching rule A6 of document 000, several switches in
     one sample allowed): ``(leg, x_r, y_r)`` after any due switches, with the path frame of
     :func:`shipgnc.frames.path_frame` (s = Δn cos π_p + Δe sin π_p, e = −Δn sin π_p + Δe cos π_p).
 

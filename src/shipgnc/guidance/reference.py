@@ -11,7 +11,7 @@ from shipgnc.frames import wrap_angle
 class HeadingReferenceModel:
     """Second-order heading filter ψ̈_r + 2ζω ψ̇_r + ω² ψ_r = ω² ψ_d.
 
-    ζ = 1 (critically damped) is spec 001 §1.10's autopilot; document 003 eq. (15) uses ω_n = 0.1,
+    ζ = 1 (critically damped) is note 001-1.10's autopilot; document 003 eq. (15) uses ω_n = 0.1,
     ζ = 0.85. Driven by wrap(ψ_d − ψ_r), so it turns the shortest way round; initialised at the
     measured heading with ψ̇_r = 0; advanced by explicit Euler at the controller's sample time.
     Batched: the state arrays take the batch shape.

@@ -96,7 +96,7 @@ class CourseSchedule:
 
 class HeadingProfile:
     """A continuous heading programme ψ_d(t) from a callable (e.g. an optimal route's heading,
-    spec 002 §2.9.6): references ``[psi_d, r_d]`` with r_d = dψ_d/dt by a central difference over
+    note 002-2.9.6): references ``[psi_d, r_d]`` with r_d = dψ_d/dt by a central difference over
     ``rate_step`` seconds (a piecewise-constant programme gives r_d = 0 away from its jumps).
 
     **Compiled.** A kernel cannot call Python, and the guidance reads its references only at the

@@ -1,6 +1,6 @@
 """Twin-azimuth-thruster research catamaran of document 004 (22.3 m, 155 t), in NED form.
 
-Equations (spec 004 §4.3; document 004 eq. (1)–(11), reconstructed from its MathCAD listing)::
+Equations (note 004-4.3; document 004 eq. (1)–(11), reconstructed from its MathCAD listing)::
 
     m_x u̇ = 2T_v cos δ − R(V) cos β + m_y v r
     m_y v̇ = −2T_v sin δ − R(V) sin β + σ m_x u r          σ = +1 printed, −1 sign-consistent
@@ -14,18 +14,18 @@ with V = √(u² + v²), β = atan2(v, u) (= −β of the document), R(V) = 2000
 c_D = C_d (ρ/2) A_Ls L². The two thrusters are always at the same angle δ with equal thrust T_v;
 δ > 0 turns the bow to starboard (an azimuth angle from +x toward starboard α = −δ).
 
-State ``[u, v, r, north, east, psi, delta]`` (spec 004 §4.2), input ``[delta_rate]`` [rad/s] or
+State ``[u, v, r, north, east, psi, delta]`` (note 004-4.2), input ``[delta_rate]`` [rad/s] or
 ``[v_a]`` [rad], disturbance ``[X_env, Y_env, N_env]`` (body-axis force [N] and moment [N m]).
 
 **δ is a state**, not the output of the foundation's actuator lag: the finite-state laws need δ in
 the state they are evaluated on, and the document's eq. (22) carries a gain k that the foundation's
-lag lacks. So the lag of (22) is the model's ``delta_row="lag"`` option (spec 004 §4.8) with the
+lag lacks. So the lag of (22) is the model's ``delta_row="lag"`` option (note 004-4.8) with the
 true plant's T_t, k_t; a slew limit is the foundation's saturation on u_δ (``slew_actuator``).
 
-**Presets** (spec 004 §4.4): ``si`` (default, consistent units) and ``paper`` (the listing's mixed
+**Presets** (note 004-4.4): ``si`` (default, consistent units) and ``paper`` (the listing's mixed
 units: ρ = 1.025 in M_D and J in t·m² used as kg·m², which reproduces the document's figures).
 Both keep the printed sway Coriolis sign; ``coriolis="consistent"`` flips it (the hull is then
-directionally unstable, spec 004 C3). The document-frame form (x forward, y to port, ω and K
+directionally unstable, note 004-C3). The document-frame form (x forward, y to port, ω and K
 clockwise) is :func:`document_derivatives`, with :func:`to_document`/:func:`from_document`.
 
 **Compiled** (:mod:`shipgnc.kernels`): :meth:`Catamaran.kernel` is :meth:`Catamaran.derivatives`
@@ -52,7 +52,7 @@ from shipgnc.params import Params
 
 #: resistance fit R_K(V) = a0 + a1 V + a2 V² [kN, one hull] of eq. (8)
 RK_COEFFS = (8.1, -8.436, 2.536)
-#: speed of the fit's minimum [m/s]: below it the continued resistance is used (spec 004 §4.3 [A])
+#: speed of the fit's minimum [m/s]: below it the continued resistance is used (note 004-4.3 [A])
 V_MIN_FIT = -RK_COEFFS[1] / (2.0 * RK_COEFFS[2])
 
 CORIOLIS = {"printed": 1.0, "consistent": -1.0}
@@ -216,13 +216,13 @@ CROSS_FLOW_CD = 0.8
 
 def clarke_lateral(L: float = 22.3, T_m: float = 1.55, C_B: float = 0.697, B: float = DEMIHULL_BEAM,
                    hulls: int = 2, rho: float = RHO_SEA, C_Dy: float = CROSS_FLOW_CD) -> dict[str, float]:
-    """Lateral hull lift and cross-flow drag of the physically consistent preset (spec 004 §4.11.7) [A].
+    """Lateral hull lift and cross-flow drag of the physically consistent preset (note 004-4.11.7) [A].
 
     Linear sway derivatives per demihull from Clarke, Gedling & Hine (1983),
     Y'_v = −π(T/L)²(1 + 0.40 C_B B/T), Y'_r = −π(T/L)²(−1/2 + 2.2 B/L − 0.080 B/T), made dimensional
     (Y_v = ½ρL²U Y'_v, Y_r = ½ρL³U Y'_r) and summed over the ``hulls``; cross-flow drag
     Y = −½ρ C_Dy (hulls·L T_m)|v|v. The yaw derivatives are left to the document's own M_K, Munk
-    moment and M_D, which already have Clarke's size (N'_v, N'_r; spec 004 §4.4). Returns the
+    moment and M_D, which already have Clarke's size (N'_v, N'_r; note 004-4.4). Returns the
     :class:`CatamaranParams` fields ``Y_vV`` [kg/m], ``Y_rV`` [kg], ``Y_vv`` [kg/m].
     """
     t2 = math.pi * (T_m / L) ** 2
@@ -232,7 +232,7 @@ def clarke_lateral(L: float = 22.3, T_m: float = 1.55, C_B: float = 0.697, B: fl
             "Y_vv": -0.5 * rho * C_Dy * hulls * L * T_m}
 
 
-#: named parameter sets (spec 004 §4.4). ``si-consistent`` (the scenarios' default) is the
+#: named parameter sets (note 004-4.4). ``si-consistent`` (the scenarios' default) is the
 #: physically consistent hull: SI units, the sway Coriolis sign of the rigid-body equations
 #: (σ = −1) and a lateral hull force (:func:`clarke_lateral`, [A]) so that it is directionally
 #: stable with the drift of a real turn (bow into the circle). ``si`` (units fixed, printed sign)
@@ -250,7 +250,7 @@ PRESET_NOTES: dict[str, str] = {
     "si": "printed Coriolis sign (reproduction)",
     "paper": "paper units (unit-inconsistent), printed Coriolis sign (reproduction)",
 }
-#: the document's finite-state gains per preset: (T_u [s], h [s]) (spec 004 §4.4)
+#: the document's finite-state gains per preset: (T_u [s], h [s]) (note 004-4.4)
 FSM_GAINS: dict[str, tuple[float, float]] = {"paper": (0.1, 0.0625), "si": (2.5, 2.5),
                                              "si-consistent": (2.5, 2.5)}
 
@@ -516,7 +516,7 @@ def catamaran_yaw_acceleration(x, p, o):
 
 
 def slew_actuator(model: Catamaran, rate_deg_s: float) -> Actuator:
-    """Thruster slew limit |δ̇| ≤ ``rate_deg_s`` as the foundation's saturation on u_δ (§4.11.2)."""
+    """Thruster slew limit |δ̇| ≤ ``rate_deg_s`` as the foundation's saturation on u_δ (note 004-4.11.2)."""
     require(model.params.delta_row == "rate", "vessel.params.delta_row", model.params.delta_row,
             "a slew limit on the input needs the rate row (input delta_rate)")
     require(math.isfinite(rate_deg_s) and rate_deg_s > 0, "actuator.slew_deg_s", rate_deg_s, "must be > 0")
@@ -524,7 +524,7 @@ def slew_actuator(model: Catamaran, rate_deg_s: float) -> Actuator:
     return Actuator(np.array([-rate]), np.array([rate]), names=("delta_rate",))
 
 
-# --- document frame (x forward, y to port, ω and K clockwise), spec 004 §4.2 ------------------
+# --- document frame (x forward, y to port, ω and K clockwise), note 004-4.2 ------------------
 def to_document(x):
     """NED state [u, v, r, N, E, ψ, δ] → the document's z = [V_x, V_y, ω, x₁, x₂, K, δ]."""
     z = np.array(x, dtype=float, copy=True)
@@ -580,7 +580,7 @@ def linearize(model: Catamaran, x0, *, step: float = 1e-6) -> tuple[np.ndarray, 
 
 
 def straight_running_eigenvalues(model: Catamaran, speed: float | None = None) -> np.ndarray:
-    """Eigenvalues of the (u, v, r) subsystem at straight running (spec 004 check 15), sorted."""
+    """Eigenvalues of the (u, v, r) subsystem at straight running (note 004-4.12 check 15), sorted."""
     A, _ = linearize(model, straight_running_state(model.params, speed))
     eig = np.linalg.eigvals(A[:3, :3])
     return eig[np.lexsort((eig.imag, eig.real))]

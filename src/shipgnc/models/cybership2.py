@@ -1,6 +1,6 @@
 """CyberShip II: the 1:70 supply-vessel model of document 003 (Skjetne, Smogeli & Fossen, 2004).
 
-Equations (spec 003 §3.5)::
+Equations (note 003-3.5)::
 
     η̇ = J(ψ) ν,   ν = [u, v, r]
     M ν̇ + C(ν) ν + D(ν) ν = τ + τ_env,          M = M_RB + M_A
@@ -22,10 +22,10 @@ x_R = −0.549 m:
 * ``rudder_model="skjetne"``: each rudder in the propeller slipstream gives
   L = (L_δ δ − L_|δ|δ |δ|δ)|u_rud|u_rud with u_rud = u + k_u(√(8T/(πρd²) + u²) − u) (u ≥ 0),
   τ_Y = 2L, τ_N = x_R τ_Y. Linearised at 0.3 m/s and 8.13 rps it is 4.88 × stronger than
-  Table 1 (∂τ_Y/∂δ = 2.10 N/rad, spec §3.5).
+  Table 1 (∂τ_Y/∂δ = 2.10 N/rad, note 003-3.5).
 
 **Rudder sign:** δ > 0 pushes the stern to starboard, so the bow turns to **port** (r < 0):
-b₂ < 0, the opposite of spec 000's Mariner. The document's laws (3) and (14) are written for this
+b₂ < 0, the opposite of document 000's Mariner. The document's laws (3) and (14) are written for this
 sign. Linearised at (u₀, 0, 0) the sway–yaw equations are eq. (16) term by term
 (:func:`shipgnc.analysis.nomoto.davidson_schiff`).
 
@@ -62,8 +62,8 @@ from shipgnc.params import Params
 RUDDER_MODELS = ("table1", "skjetne")
 #: propeller speed of document 003 (both main propellers) [rps]; cruise ≈ 0.3 m/s in calm water
 CRUISE_RPS = 8.13
-#: rudder rate limit of spec 003 B8 [°/s]: IMO's 2.32°/s at full scale, Froude-scaled to 1:70 by
-#: √70 = 19.4105…°/s (the spec rounds it to 19.4)
+#: rudder rate limit of note 003-B8 [°/s]: IMO's 2.32°/s at full scale, Froude-scaled to 1:70 by
+#: √70 = 19.4105…°/s (note 003-B8 rounds it to 19.4)
 DELTA_RATE_DEG_S = 2.32 * math.sqrt(70.0)
 
 
@@ -77,7 +77,7 @@ class CyberShip2Params(Params):
     m                   23.8 kg      Table 1; Skjetne et al. (2004)
     I_z                 1.76 kg·m²   Table 1; Skjetne et al. (2004)
     x_G                 0.046 m      Table 1; Skjetne et al. (2004)
-    X_udot              −2.0 kg      Table 1 "X_u" (dots lost, spec B3)
+    X_udot              −2.0 kg      Table 1 "X_u" (dots lost, note 003-B3)
     Y_vdot              −10.0 kg     Table 1 "Y_v" third column (B3)
     Y_rdot, N_vdot      0.0          Table 1 "Y_ṙ = N_v̇ = 0"
     N_rdot              −1.0 kg·m²   Table 1 "N_r" third column (B3)
@@ -87,7 +87,7 @@ class CyberShip2Params(Params):
     N_r                 −1.900       Table 1  [N·m·s]
     Y_delta             −0.4304      Table 1  [N/rad]  (rudder model ``table1``)
     N_delta             0.2363       Table 1  [N·m/rad]  (N_δ/Y_δ = −0.549 = x_R)
-    X_u                 −0.72253     spec §3.5 (Skjetne et al. 2004 via TUD_RL ``FossenCS2.py``)
+    X_u                 −0.72253     note 003-3.5 (Skjetne et al. 2004 via TUD_RL ``FossenCS2.py``)
     X_absu_u            −1.32742     X_|u|u, same source  [kg/m]
     X_uuu               −5.86643     same source  [kg·s/m²]
     Y_absv_v            −36.47287    Y_|v|v, same source
@@ -105,10 +105,10 @@ class CyberShip2Params(Params):
     k_u                 0.5          induced-velocity factor of u_rud
     d_prop              0.06 m       propeller diameter (Lindegaard's thesis, via TUD_RL)
     rho                 1014 kg/m³   water density of the source
-    x_rudder            −0.549 m     rudder position (N = x_R · Y; spec §3.5)
+    x_rudder            −0.549 m     rudder position (N = x_R · Y; note 003-3.5)
     y_prop              0.078 m      propellers at y = ±0.078 m (equal n: no yaw moment)
     rudder_model        "table1"     ``table1`` (document, default) or ``skjetne``
-    delta_max           35°          steering machine (spec B8, assumption)  [rad]
+    delta_max           35°          steering machine (note 003-B8, assumption)  [rad]
     delta_rate          19.4105°/s   IMO 2.32°/s Froude-scaled by √70 (B8)  [rad/s]
     n_min, n_max        0, 30 rps    propeller-speed limits (toolkit choice)
     ==================  ===========  ==============================================================
@@ -265,7 +265,7 @@ def surge_damping(params: CyberShip2Params, u):
 def surge_equilibrium(params: CyberShip2Params, n: float) -> float:
     """Straight-run speed u [m/s] at propeller speed ``n`` [rps] with δ = 0: 2T(n, u) = d₁₁(u)u.
 
-    At 8.13 rps this is 0.295838 m/s (spec §3.5 rounds it to 0.2958; the document's 0.3 m/s).
+    At 8.13 rps this is 0.295838 m/s (note 003-3.5 rounds it to 0.2958; the document's 0.3 m/s).
     """
     from scipy.optimize import brentq
 
@@ -368,7 +368,7 @@ def _thrust(T_nn, T_nu, n, su):
 
 @kernel_function
 def cybership2_rhs(x, u, d, p, xdot):
-    """ẋ of spec 003 §3.5 for one ship: M ν̇_r + C(ν_r)ν_r + D(ν_r)ν_r = τ + τ_env, η̇ = J(ψ)ν,
+    """ẋ of note 003-3.5 for one ship: M ν̇_r + C(ν_r)ν_r + D(ν_r)ν_r = τ + τ_env, η̇ = J(ψ)ν,
     with the propeller thrust and both rudder models of :meth:`CyberShip2.derivatives`, operation
     for operation (forces ``d[0:3]``, earth-fixed current ``d[3:5]``; zero ``d`` is still water
     without disturbance). ``p`` from :meth:`CyberShip2.kernel`."""
@@ -434,7 +434,7 @@ def steering_machine(params: CyberShip2Params, *, rate_limit: bool = True,
                      rate_mode: str = "ramp") -> Actuator:
     """The actuator of CyberShip II: propeller speed within [n_min, n_max] (no rate limit) and the
     steering machine, δ within ±delta_max slewing at most delta_rate (35°, 2.32·√70 =
-    19.4105°/s; spec B8).
+    19.4105°/s; note 003-B8).
     ``rate_limit=False`` drops the rudder rate limit (B8's comparison); ``rate_mode="hold"`` applies
     the slewed rudder over the whole step instead of ramping within it (see :class:`Actuator`)."""
     p = params

@@ -1,6 +1,6 @@
 """Small boat with one vectored thruster (stern kick): Fossen 3-DOF model of document 001.
 
-Equations (spec 001 §1.3–1.5; document 001 eq. (1)–(11))::
+Equations (notes 001-1.3–001-1.5; document 001 eq. (1)–(11))::
 
     η̇ = J(ψ) ν                                                     (1–3)
     M ν̇ + C(ν) ν + D(ν) ν = τ + τ_env                              (4)
@@ -31,7 +31,7 @@ acceleration R(ψ)ᵀ v̇_c is neglected, as in Fossen's MSS models. The thrust 
 speed, so it is unchanged.
 
 ``munk_factor`` c_M: +1 follows eq. (7) (energy-conserving), −1 the printed eq. (11), 0 (default)
-drops the Munk yaw moment as Fossen's Otter model did (spec 001 A2, A3).
+drops the Munk yaw moment as Fossen's Otter model did (notes 001-A2, 001-A3).
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ from shipgnc.units import G
 
 @dataclass(frozen=True)
 class BoatParams(Params):
-    """Parameters of the vectored-thrust boat (defaults: preset ``otter``, spec 001 table 1.6).
+    """Parameters of the vectored-thrust boat (defaults: preset ``otter``, note 001-1.6).
 
     All SI: kg, kg·m², N·s/m, N·m·s/rad, N·m·s²/rad², m, N, rad.
     """
@@ -113,7 +113,7 @@ class BoatParams(Params):
         return self.munk_factor * (self.Y_vdot - self.X_udot)
 
     def top_speed(self, thrust: float) -> float:
-        """Straight-line steady speed T/(−X_u) [m/s] (spec 001 §1.7)."""
+        """Straight-line steady speed T/(−X_u) [m/s] (note 001-1.7)."""
         return thrust / -self.X_u
 
     @property
@@ -123,7 +123,7 @@ class BoatParams(Params):
 
 
 
-#: Named parameter sets of spec 001 §1.6 (overrides on top of the ``otter`` defaults).
+#: Named parameter sets of note 001-1.6 (overrides on top of the ``otter`` defaults).
 PRESETS: dict[str, dict[str, float]] = {
     "otter": {},
     "doc-eq7": {"munk_factor": 1.0, "N_rr": 0.0},
@@ -145,7 +145,7 @@ def otter_rules(L: float = 2.0, m_hull: float = 55.0, m_payload: float = 25.0,
                 T_sway: float = 1.0, T_yaw: float = 1.0, R66_over_L: float = 0.25,
                 hull_cg_ahead: float = 0.2, payload_x: float = 0.0, rho: float = 1025.0,
                 yaw_quadratic_ratio: float = 10.0, **other: float) -> BoatParams:
-    """Derive a consistent parameter set by the rules of Fossen's Otter model (spec 001 table 1.6).
+    """Derive a consistent parameter set by the rules of Fossen's Otter model (note 001-1.6).
 
     X_u̇ = −2.7 ρ ∇^{5/3}/L² (Söding 1982, ∇ = m_hull/ρ), Y_v̇ = −1.5 m_hull, N_ṙ = −1.7 I_z,
     X_u = −bollard thrust / U_max (U_max = 6 kn converted as otter.m does, 6 × 0.5144 m/s),

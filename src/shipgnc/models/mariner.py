@@ -1,6 +1,6 @@
 """Mariner-class cargo ship: the de Wit–Oppe simulation model (25) of document 000.
 
-Equations (spec 000 §0.3, eq. (25); signs restored, A3)::
+Equations (note 000-0.3, eq. (25); signs restored, A3)::
 
     ẋ = u cos ψ − v sin ψ + c_N          ẏ = u sin ψ + v cos ψ + c_E
     ψ̇ = r                                ṙ = −a r − b r³ + c δ + b_r
@@ -18,7 +18,7 @@ the pivot point, where the hull's lateral velocity v + x r vanishes, lies −r�
 the CG (for r₂ = 0).
 
 **Rudder sign:** c > 0, so δ > 0 gives ṙ > 0: the bow turns to **starboard** (the opposite of
-CyberShip II, spec 003). The steering machine (±35°, 3.8°/s) is an actuator, :func:`rudder`.
+CyberShip II, document 003). The steering machine (±35°, 3.8°/s) is an actuator, :func:`rudder`.
 
 The document works in minutes, nautical miles and radians (A1); :class:`MarinerParams` holds SI
 values and converts at this boundary (:meth:`MarinerParams.from_paper_units`,
@@ -58,7 +58,7 @@ PAPER_UNITS: Mapping[str, tuple[str, float]] = MappingProxyType({
     "delta_rate": ("rad/min", 1.0 / MINUTE),
 })
 
-#: the document's values in its own units (spec 000 table 0.1); δ̇_max = 3.8°/s = 228°/min
+#: the document's values in its own units (note 000-0.1); δ̇_max = 3.8°/s = 228°/min
 PAPER_VALUES: Mapping[str, float] = MappingProxyType({
     "a": 1.084, "b": 0.62, "c": 3.553, "r1": -0.0375, "r2": 0.0, "f": 0.86, "W": 0.067, "S": 0.215,
     "delta_max": math.radians(35.0), "delta_rate": math.radians(228.0),
@@ -132,7 +132,7 @@ class MarinerParams(Params):
         """Parameters from the document's minute / nautical-mile / rad values (see the table).
 
         Omitted names take the document's values; e.g. ``from_paper_units(r1=+0.0375)`` is the
-        sign-flipped sway coupling of spec 000 §0.5.
+        sign-flipped sway coupling of note 000-0.5.
         """
         for key in values:
             if key not in PAPER_UNITS:
@@ -253,7 +253,7 @@ def linear_tracking_model(params: MarinerParams, *,
 
     with U = S/f, sway neglected (eq. (7)). SI by default (m, rad, rad/s, m·s; s); with
     ``paper_units=True`` in the document's nm, rad, rad/min, nm·min (min), the units the printed
-    LQR gain refers to (spec 000 §0.4). B has shape (4, 1).
+    LQR gain refers to (note 000-0.4). B has shape (4, 1).
     """
     from shipgnc.control.lqr import tracking_model
 
@@ -262,7 +262,7 @@ def linear_tracking_model(params: MarinerParams, *,
 
 
 class MarinerDisturbance:
-    """The disturbance vector ``[b_r, current_north, current_east]`` of spec 000 §0.6 (A9–A11).
+    """The disturbance vector ``[b_r, current_north, current_east]`` of note 000-0.6 (A9–A11).
 
     ``b_r`` [rad/s²] constant yaw acceleration; ``current`` a
     :class:`~shipgnc.environment.current.CrossCurrent` (d_y across the active leg, or along east)
@@ -281,7 +281,7 @@ class MarinerDisturbance:
     @property
     def per_stage(self) -> bool:
         """Evaluated at every RK stage when the current is a field of position and time (a route's
-        current, spec 002); else sampled at each step's start and held."""
+        current, document 002); else sampled at each step's start and held."""
         return bool(getattr(self.current, "per_stage", False)) and self.waves is None
 
     def reset(self, batch_shape, rng: np.random.Generator) -> None:
@@ -318,7 +318,7 @@ class MarinerDisturbance:
         """:meth:`__call__` for the composed loop (:func:`mariner_disturbance`), after ``reset``.
 
         Per-ship state ``[leg]``: the path current's own leg tracker (A6), from the ship's position
-        at each step's start. A current field (spec 002) is its ``current_kernel()`` parameters,
+        at each step's start. A current field (document 002) is its ``current_kernel()`` parameters,
         evaluated by :func:`~shipgnc.routing.fields.field_velocity` at the position and time it is
         called with (every RK stage when the disturbance is ``per_stage``). The wave noise does not
         depend on the state: ``table(k0, k1)`` runs the
@@ -382,8 +382,8 @@ _LEGS = 6
 @kernel_function
 def mariner_disturbance(t, x, z, p, w, d):
     """:meth:`MarinerDisturbance.__call__` for one ship: d = [b_r (+ w, the step's wave value),
-    current_north, current_east] (spec 000 §0.6, A9–A11); the path current d_y·[−sin ψ_r0,
-    cos ψ_r0] of the leg its tracker ``z[0]`` finds (A10, A6), or a current field (spec 002) at
+    current_north, current_east] (notes 000-0.6, 000-A9–000-A11); the path current d_y·[−sin ψ_r0,
+    cos ψ_r0] of the leg its tracker ``z[0]`` finds (A10, A6), or a current field (document 002) at
     (t, x[0], x[1]). ``p`` = [b_r, mode (0 none, 1 global, 2 path, 3 field), d_y, north index,
     east index, has waves, then the leg table, c_N, c_E per leg (mode 2) or the field's terms
     (mode 3)]."""

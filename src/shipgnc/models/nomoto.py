@@ -1,4 +1,4 @@
-"""Simple steering models at a constant speed: Nomoto (first order) and Norrbin (spec 000 §0.3).
+"""Simple steering models at a constant speed: Nomoto (first order) and Norrbin (note 000-0.3).
 
 Equations (document 000 eq. (3)–(6)), SI units (s, m, rad)::
 
@@ -15,7 +15,7 @@ CG moves along the heading. With K > 0, δ > 0 turns the bow to starboard.
 Norrbin with a₁ = 1 (a₀ = a₂ = a₃ = 0) is Nomoto; a₁ = −1 is a course-unstable ship, a₀ ≠ 0 a
 single screw, a₂ = 0 a symmetric hull (eq. (6)). In SI a₁ is dimensionless, a₀ in rad/s, a₂ in
 s/rad and a₃ in s²/rad². The Mariner's yaw equation is Norrbin with T = 60 s, K = 60 c,
-a₁ = 60 a, a₃ = 60 b (spec §0.3: T = 1 min, K = c, H_N = a r + b r³, in minutes).
+a₁ = 60 a, a₃ = 60 b (note 000-0.3: T = 1 min, K = c, H_N = a r + b r³, in minutes).
 """
 
 from __future__ import annotations

@@ -5,9 +5,12 @@ See :mod:`shipgnc.navigation` for the interface the simulation loop calls.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from shipgnc.errors import ConfigError, require
+from shipgnc.kernels import Kernel
 from shipgnc.models.base import Signal, names
 from shipgnc.navigation.estimator import Estimator
 from shipgnc.navigation.sensors import Sensor
@@ -126,3 +129,94 @@ class Navigation:
     def signal_values(self) -> dict[str, np.ndarray]:
         """The values of :attr:`signals` at the last :meth:`observe`."""
         return dict(self._values)
+
+    # ---- the compiled loop --------------------------------------------------------------------
+    def kernel_reason(self) -> str | None:
+        """None when the composed loop can run this navigation system, else why not."""
+        est = self.estimator
+        if est is not None and not callable(getattr(est, "kernel_block", None)):
+            return f"estimator {type(est).__name__} has no kernel"
+        return None
+
+    def kernel(self, batch_shape, dt: float, *, x0: np.ndarray) -> NavigationKernel:
+        """The navigation system for the composed loop (after :meth:`reset`; ``x0`` the run's
+        initial true state, where the estimator starts as in :meth:`observe`'s first call):
+        parameters, per-ship state and the sensors' draws per control sample, in the layout of
+        :mod:`shipgnc.navigation.kernels`. ``table(k0, k1)`` returns the draws of the control
+        samples at steps ``k0 <= k < k1`` (one row per control sample, not per step), drawn from
+        the sensors' own streams in the numpy loop's order."""
+        from shipgnc.navigation import kernels as nk
+
+        batch = tuple(batch_shape)
+        n = int(np.prod(batch, dtype=np.int64))
+        hold = max(1, round(self.Ts / dt))
+        ns = len(self.sensors)
+        header = [float(ns), 0.0, 0.0, 0.0, 0.0, 0.0, -1.0] + [0.0] * ns
+        params: list[float] = list(header)
+        z_rows = [np.ones((n, 1))]              # z[0]: the first sample is still to come
+        z_at, w_at, sig_at = 1, 0, 0
+        channels = {}                           # state name -> (held, valid, fresh) z offsets
+        for s_i, sensor in enumerate(self.sensors):
+            k = len(sensor.measures)
+            params[nk.HEADER + s_i] = float(len(params))
+            params += [*sensor.kernel_params(), float(z_at), float(w_at), float(sig_at)]
+            params += sensor.kernel_tail()
+            zs = sensor.kernel_state(n)
+            for c, name in enumerate(sensor.measures):
+                channels[name] = (z_at + c, z_at + k, z_at + k + 1)
+            z_rows.append(zs)
+            z_at += zs.shape[1]
+            w_at += 2 * k
+            sig_at += k + 1
+        params[1] = float(len(channels))
+        params[2] = float(len(params))
+        for name, (held, valid, fresh) in channels.items():
+            params += [float(self.state_names.index(name)), float(held), float(valid),
+                       float(fresh), float(self.measured[name])]
+        kind = nk.NO_ESTIMATOR
+        if self.estimator is not None:
+            x_start = np.broadcast_to(np.asarray(x0, dtype=float),
+                                      (*batch, len(self.state_names))).copy()
+            # the estimator starts at the first control sample from the true initial state
+            self.estimator.start(x_start, self._est_rng)
+            kind, block, z_est, gmap = self.estimator.kernel_block(channels, n)
+            params[3] = float(len(params))
+            params += [float(v) for v in block]
+            params[4] = float(sig_at)
+            params[5] = float(z_at)
+            z_rows.append(np.asarray(z_est, dtype=float).reshape(n, -1))
+            if gmap is not None:
+                params[6] = float(len(params))
+                params += [float(v) for v in gmap]
+        state = np.ascontiguousarray(np.concatenate(z_rows, axis=1))
+        sensors, n_w = self.sensors, w_at
+
+        def table(k0: int, k1: int) -> np.ndarray:
+            j0, j1 = -(-k0 // hold), -(-k1 // hold)
+            out = np.zeros((max(0, j1 - j0), n, n_w))
+            for j in range(j0, j1):
+                at = 0
+                for sensor in sensors:
+                    k = len(sensor.measures)
+                    if j % sensor.every == 0:
+                        out[j - j0, :, at:at + 2 * k] = sensor.kernel_draws(n)
+                    at += 2 * k
+            return out
+
+        return NavigationKernel(nk.sensors_observe, nk_flat(params), state, table, n_w,
+                                estimator=kind, n_signals=len(self.signals), hold=hold)
+
+
+def nk_flat(values) -> np.ndarray:
+    return np.ascontiguousarray(np.asarray(values, dtype=np.float64))
+
+
+@dataclass(frozen=True, eq=False)
+class NavigationKernel(Kernel):
+    """A navigation system's :class:`~shipgnc.kernels.Kernel` with what the composed loop needs
+    beyond it: the estimator's kind (a constant of the generated loop), the number of logged
+    signals and the control samples per step (``table`` rows are control samples)."""
+
+    estimator: int = 0
+    n_signals: int = 0
+    hold: int = 1

@@ -90,6 +90,19 @@ class ExtendedKalmanFilter(GaussianFilter):
         self.rows = [(self.model_names.index(s), s, self.measurement_variance(s, var))
                      for s, var in measured.items()]
 
+    def kernel_block(self, channels, n_ships: int):
+        """(kind, parameters, per-ship state, map) for the composed loop after :meth:`start`:
+        ``[substeps, Ts, held, n_rows, (state, held offset, fresh offset, R, angle) × n_rows,
+        Q_c diagonal]``; the model's derivatives are its kernel in the loop."""
+        from shipgnc.navigation import kernels as nk
+
+        block = [float(self.substeps), self.Ts, float(self.noise == "held"), float(len(self.rows))]
+        for j, s, var in self.rows:
+            block += [float(j), float(channels[s][0]), float(channels[s][2]), float(var),
+                      float(s == "psi")]
+        block += [float(v) for v in np.diagonal(self.Qc)]
+        return nk.EKF, block, self.kernel_state(n_ships), self.kernel_map()
+
     def _f(self, x, u):
         return self.model.derivatives(x, u, None)
 

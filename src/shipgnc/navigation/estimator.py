@@ -150,6 +150,20 @@ class GaussianFilter(Estimator):
             return float(self._meas_std_arg[name]) ** 2
         return float(default)
 
+    # ---- the compiled loop --------------------------------------------------------------------
+    def kernel_state(self, n_ships: int) -> np.ndarray:
+        """Rows ``[ẑ, P (row-major)]`` after :meth:`start`."""
+        n = len(self.state_names)
+        return np.concatenate([self.z.reshape(n_ships, n), self.P.reshape(n_ships, n * n)], axis=1)
+
+    def kernel_map(self) -> list[float]:
+        """``[n, n_mapped, (filter index, model index, angle) × n_mapped]`` (the estimates the
+        controller sees, and the NEES block)."""
+        out = [float(len(self.state_names)), float(len(self.map))]
+        for i, j in self.map.items():
+            out += [float(i), float(j), float(bool(self.angles[i]))]
+        return out
+
     # ---- outputs ------------------------------------------------------------------------------
     def model_estimate(self) -> dict[str, np.ndarray]:
         return {self.state_names[i]: self.z[..., i] for i in self.map}

@@ -175,6 +175,24 @@ class KalmanFilter(GaussianFilter):
         K = P @ self.C.T @ np.linalg.inv(self.C @ P @ self.C.T + np.diag(self._R))
         return P, K
 
+    def kernel_block(self, channels, n_ships: int):
+        """(kind, parameters, per-ship state, map) for the composed loop after :meth:`start`:
+        ``[n, n_inputs, n_rows, A, B, input indices, Q, (held offset, fresh offset, R, angle) ×
+        n_rows, C]`` (:func:`shipgnc.navigation.kernels.kf_step`)."""
+        from shipgnc.navigation import kernels as nk
+
+        n = len(self.state_names)
+        block = [float(n), float(len(self.input_index)), float(len(self.measured))]
+        for m in (self.A, self.B):
+            block += [float(v) for v in np.asarray(m, dtype=float).ravel()]
+        block += [float(i) for i in self.input_index]
+        block += [float(v) for v in np.asarray(self.Q, dtype=float).ravel()]
+        for i, s in enumerate(self.measured):
+            block += [float(channels[s][0]), float(channels[s][2]), float(self._R[i]),
+                      float(s == "psi")]
+        block += [float(v) for v in np.asarray(self.C, dtype=float).ravel()]
+        return nk.KF, block, self.kernel_state(n_ships), self.kernel_map()
+
     def update(self, t, u, meas, first) -> None:
         if not first:
             uu = u[..., self.input_index]

@@ -241,6 +241,27 @@ class PassiveObserver(Estimator):
                           for si, a, b_, c, d in zip(s, k1, k2, k3, k4, strict=True))
         self.xi1, self.xi2, self.eta, self.b, self.nu = s
 
+    # ---- the compiled loop --------------------------------------------------------------------
+    def kernel_block(self, channels, n_ships: int):
+        """(kind, parameters, per-ship state, None) for the composed loop after :meth:`start`
+        (layout: :mod:`shipgnc.navigation.kernels`, ``OBS_VEC``, ``OBS_STATE``)."""
+        from shipgnc.navigation import kernels as nk
+
+        block = [1.0 if self.velocity_model == "model" else 0.0, float(self.substeps), self.Ts,
+                 *map(float, self.ieta), *map(float, self.inu),
+                 *(float(channels[s][0]) for s in ETA), *(float(channels[s][1]) for s in ETA)]
+        block += [*(-self.omega0**2), *(2 * self.zeta * self.omega0), *self.K1a, *self.K1b,
+                  *self.K2, *self.T_b]
+        for m in (self.K3, self.K4, self.D, self.Minv, self.M):
+            block += [float(v) for v in np.asarray(m, dtype=float).ravel()]
+        nx = self._x_template.shape[-1]
+        z = np.concatenate([np.broadcast_to(a, (*a.shape[:-1], a.shape[-1])).reshape(n_ships, -1)
+                            for a in (self.xi1, self.xi2, self.eta, self.b, self.nu,
+                                      np.zeros((n_ships, 3)),
+                                      self._x_template.reshape(n_ships, nx))], axis=1)
+        assert z.shape[1] == nk.OBS_STATE + nx
+        return nk.OBSERVER, block, z, None
+
     # ---- outputs ------------------------------------------------------------------------------
     def model_estimate(self):
         out = {s: self.eta[..., k] for k, s in enumerate(ETA)}

@@ -161,6 +161,56 @@ class Sensor:
                 self.valid = np.ones(self.batch_shape, dtype=bool)
                 self.fresh = np.ones(self.batch_shape, dtype=bool)
 
+    # ---- the compiled loop (navigation.kernels.sensors_observe) --------------------------------
+    #: kind code of the kernel; the bias process's scale (GNSS: σ_b √(1 − a²), gyro: σ_rw √h)
+    kernel_kind = -1
+
+    def _kernel_bias(self) -> tuple[float, float, float]:
+        """(bias_std, a, b_scale) of the kernel's bias process (0 where the sensor has none)."""
+        return 0.0, 0.0, 0.0
+
+    def kernel_params(self) -> list[float]:
+        """The sensor's parameter block without its offsets (:mod:`shipgnc.navigation.kernels`):
+        ``[kind, k, every, latency, n_dropouts, noise_std, bias_std, a, b_scale]``, then (after the
+        three offsets the navigation system adds) the state indices and the dropout intervals."""
+        bstd, a, bscale = self._kernel_bias()
+        return [float(self.kernel_kind), float(len(self.measures)), float(self.every),
+                float(self.latency), float(len(self.dropouts)), float(self.noise_std), bstd, a,
+                bscale]
+
+    def kernel_tail(self) -> list[float]:
+        return [float(i) for i in self.index] + [float(v) for pair in self.dropouts for v in pair]
+
+    def kernel_state(self, n_ships: int) -> np.ndarray:
+        """Rows ``[held × k, valid, fresh, j, first, bias × k, pipe]`` after :meth:`reset`."""
+        k = len(self.measures)
+        z = np.zeros((n_ships, 2 * k + 4 + (self.latency + 1) * (2 + k)))
+        z[:, :k] = np.asarray(self.held, dtype=float).reshape(n_ships, k)
+        z[:, k] = np.asarray(self.valid, dtype=float).reshape(n_ships)
+        z[:, k + 1] = np.asarray(self.fresh, dtype=float).reshape(n_ships)
+        z[:, k + 2] = self._j
+        z[:, k + 3] = float(getattr(self, "_first", True))
+        z[:, k + 4:2 * k + 4] = np.broadcast_to(self._kernel_bias_state(), (*self.batch_shape, k)
+                                                ).reshape(n_ships, k)
+        return z
+
+    def _kernel_bias_state(self):
+        return 0.0
+
+    def kernel_draws(self, n_ships: int) -> np.ndarray:
+        """The draws of one due sample, ``(n_ships, 2k)``: ``[bias step, noise]``, taken from the
+        sensor's stream in the order :meth:`_measure` takes them (zeros where it takes none)."""
+        k = len(self.measures)
+        out = np.zeros((n_ships, 2 * k))
+        bstd, _a, bscale = self._kernel_bias()
+        if (self.kernel_kind == 0 and bstd > 0) or (self.kernel_kind == 2 and bscale > 0):
+            if not self._first:
+                out[:, :k] = self._draw().reshape(n_ships, k)
+            self._first = False
+        if self.noise_std > 0:
+            out[:, k:] = self._draw().reshape(n_ships, k)
+        return out
+
     # ---- what the estimators read -------------------------------------------------------------
     def variances(self) -> np.ndarray:
         """The stationary variance of each channel's error (white noise + random bias), the
@@ -198,6 +248,17 @@ class GNSS(Sensor):
             (*self.batch_shape, 2))
         self._first = True
 
+    kernel_kind = 0
+
+    def _kernel_bias(self):
+        if self.bias_std <= 0:
+            return 0.0, 0.0, 0.0
+        a = math.exp(-self.period / self.bias_time_constant)
+        return self.bias_std, a, self.bias_std * math.sqrt(1 - a * a)
+
+    def _kernel_bias_state(self):
+        return self.bias
+
     def _measure(self, p):
         if self.bias_std > 0:
             if not self._first:
@@ -230,6 +291,11 @@ class Compass(Sensor):
     def _reset_errors(self) -> None:
         self._b = self.bias + (self.bias_std * self._draw() if self.bias_std > 0 else 0.0)
 
+    kernel_kind = 1
+
+    def _kernel_bias_state(self):
+        return self._b
+
     def _measure(self, psi):
         noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
         return psi + self._b + noise
@@ -258,6 +324,15 @@ class RateGyro(Sensor):
         self._b = np.full((*self.batch_shape, 1), self.bias)
         self._first = True
 
+    kernel_kind = 2
+
+    def _kernel_bias(self):
+        scale = self.bias_walk * math.sqrt(self.period) if self.bias_walk > 0 else 0.0
+        return 0.0, 0.0, scale
+
+    def _kernel_bias_state(self):
+        return self._b
+
     def _measure(self, r):
         if self.bias_walk > 0:
             if not self._first:
@@ -283,6 +358,8 @@ class SpeedLog(Sensor):
         require(isinstance(state, str), f"{self.name}.state", state, "must be a state name")
         self.measures = (state,)
         self.units = ("m/s",)
+
+    kernel_kind = 3
 
     def _measure(self, u):
         noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0

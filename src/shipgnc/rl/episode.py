@@ -10,10 +10,10 @@ as the policy earns the negative of the scenario's own metric.
 **Reward** — the per-sample term of the scenario's metric, summed over the samples of the control
 period (the final sample t_end included in the last step):
 
-* ``heading-steps`` (spec 001 §1.10): r = −Σ e_ψ² [rad²]; an episode's return is −N·mse, so
+* ``heading-steps`` (note 001-1.10): r = −Σ e_ψ² [rad²]; an episode's return is −N·mse, so
   ``heading_rmse_deg`` = deg(√(−return / N)) with N the number of samples;
 * ``course-quality`` (document 003, eq. 2): r = −Σ (Δψ² + λ δ²); the return is −J;
-* ``waypoints`` (spec 001 §1.10): r = −Σ e² with e the LOS cross-track error [m], over the samples
+* ``waypoints`` (note 001-1.10): r = −Σ e² with e the LOS cross-track error [m], over the samples
   the metric counts (along-track distance past the capture distance on their own leg);
 * document 004's catamaran (metric set ``catamaran``, whose figures are end-of-run values, so the
   reward is the tracking error its runs are about): a yaw-rate case (builders ``turn``, ``sine``)

@@ -1,10 +1,10 @@
-"""Time-optimal routing in a current (Zermelo's problem, spec 002).
+"""Time-optimal routing in a current (Zermelo's problem, document 002).
 
-* :mod:`~shipgnc.routing.fields`: current fields v(x, t) (spec 002 §2.9.1), usable by the router and
+* :mod:`~shipgnc.routing.fields`: current fields v(x, t) (note 002-2.9.1), usable by the router and
   as a ship's current in the simulation loop;
-* :mod:`~shipgnc.routing.pmp`: Pontryagin extremals, shooting, the batched global sweep (§2.4–2.6, 2.9.4);
-* :mod:`~shipgnc.routing.levelset` and :mod:`~shipgnc.routing.graph`: global checks (§2.9.2);
-* :mod:`~shipgnc.routing.obstacles`: polygons, vertex decomposition (§2.9.3);
+* :mod:`~shipgnc.routing.pmp`: Pontryagin extremals, shooting, the batched global sweep (notes 002-2.4–002-2.6, 002-2.9.4);
+* :mod:`~shipgnc.routing.levelset` and :mod:`~shipgnc.routing.graph`: global checks (note 002-2.9.2);
+* :mod:`~shipgnc.routing.obstacles`: polygons, vertex decomposition (note 002-2.9.3);
 * :mod:`~shipgnc.routing.router`: :func:`solve_route`, the front door returning a
   :class:`~shipgnc.routing.result.RouteResult`.
 

@@ -1,4 +1,4 @@
-"""Closed forms and exact checks of spec 002: the linear shear (§2.5), uniform and tidal currents (2.10, F1,
+"""Closed forms and exact checks of document 002: the linear shear (note 002-2.5), uniform and tidal currents (2.10, F1,
 F1b, 2.9.5) and the straight course (F6). SI throughout: m, s, m/s, rad, k in 1/s.
 """
 
@@ -162,7 +162,7 @@ def uniform_solution(speed, current, start, target) -> UniformSolution:
 
 
 def tidal_uniform_solution(speed, drift, start, target, horizon, n_scan=20000):
-    """First t with ‖B − A − ∫₀ᵗ c‖ = V t for a time-varying uniform current (spec 002 §2.9.5).
+    """First t with ‖B − A − ∫₀ᵗ c‖ = V t for a time-varying uniform current (note 002-2.9.5).
 
     ``drift(t)`` returns ∫₀ᵗ c dt (shape (..., 2)) [m]; returns (t_f, constant heading) or None.
     """

@@ -1,4 +1,4 @@
-"""Parse the CLI's FIELD strings (spec 002 §2.9.1) into SI current fields.
+"""Parse the CLI's FIELD strings (note 002-2.9.1) into SI current fields.
 
     uniform:north=..,east=..                 c₀ [m/s | kn]
     shear:k=..                               v_E = k·x_N [1/s | 1/h]

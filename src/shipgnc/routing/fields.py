@@ -1,4 +1,4 @@
-"""Current fields v(x, t) in NED, SI (spec 002 §2.9.1).
+"""Current fields v(x, t) in NED, SI (note 002-2.9.1).
 
 One protocol serves the router and the simulation loop:
 
@@ -47,7 +47,7 @@ __all__ = [
 
 
 class FieldDomainError(ConfigError):
-    """A gridded field was queried outside its grid (spec 002 F9); the message names point and extent."""
+    """A gridded field was queried outside its grid (note 002-F9); the message names point and extent."""
 
 
 def _finite(value, field: str) -> float:
@@ -118,7 +118,7 @@ class CurrentField:
 
 @dataclass(frozen=True)
 class UniformCurrent(CurrentField):
-    """A uniform current c₀ = (north, east) [m/s] (spec 002 §2.9.1, section 2.10)."""
+    """A uniform current c₀ = (north, east) [m/s] (notes 002-2.9.1, 002-2.10)."""
 
     north: float = 0.0
     east: float = 0.0
@@ -145,7 +145,7 @@ class UniformCurrent(CurrentField):
 
 @dataclass(frozen=True)
 class AffineCurrent(CurrentField):
-    """v = v₀ + G (x − x_ref) (spec 002 §2.9.1); the document's shear is G = [[0, 0], [k, 0]] (§2.5)."""
+    """v = v₀ + G (x − x_ref) (note 002-2.9.1); the document's shear is G = [[0, 0], [k, 0]] (note 002-2.5)."""
 
     v0: tuple[float, float] = (0.0, 0.0)
     gradient: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
@@ -180,7 +180,7 @@ class AffineCurrent(CurrentField):
 
 
 def shear(k: float, s: float = 0.0) -> AffineCurrent:
-    """The document's linear shear v = (0, k (x_N − s)) [k in 1/s, s in m] (spec 002 §2.5)."""
+    """The document's linear shear v = (0, k (x_N − s)) [k in 1/s, s in m] (note 002-2.5)."""
     _finite(k, "shear.k")
     return AffineCurrent((0.0, 0.0), ((0.0, 0.0), (float(k), 0.0)), (float(s), 0.0))
 
@@ -253,7 +253,7 @@ class _Vortex(CurrentField):
 
 @dataclass(frozen=True)
 class LambOseenVortex(_Vortex):
-    """Lamb–Oseen vortex v_t = Γ/(2πr)·(1 − exp(−r²/r_c²)) [Γ in m²/s, r_c in m] (spec 002 §2.9.1)."""
+    """Lamb–Oseen vortex v_t = Γ/(2πr)·(1 − exp(−r²/r_c²)) [Γ in m²/s, r_c in m] (note 002-2.9.1)."""
 
     gamma: float
     rc: float
@@ -307,7 +307,7 @@ class RankineVortex(_Vortex):
 
 
 class SumField(CurrentField):
-    """The sum of several fields (spec 002 §2.9.1)."""
+    """The sum of several fields (note 002-2.9.1)."""
 
     def __init__(self, fields):
         flat = []
@@ -344,7 +344,7 @@ class SumField(CurrentField):
 class Modulated(CurrentField):
     """A field scaled in time: v(x, t) = m(t)·w(x), m(t) = mean + amplitude·cos(2πt/period + phase).
 
-    The tidal uniform current of spec 002 §2.9.5 is ``Modulated(UniformCurrent(0, c), 0, 1, T, φ)``; its
+    The tidal uniform current of note 002-2.9.5 is ``Modulated(UniformCurrent(0, c), 0, 1, T, φ)``; its
     tidally modulated shear k(t) = k(1 + 0.5 sin(2πt/T)) is ``Modulated(shear(k), 1, 0.5, T, −π/2)``.
     """
 
@@ -398,7 +398,7 @@ class Modulated(CurrentField):
 
 
 class GriddedCurrent(CurrentField):
-    """Gridded data (spec 002 §2.9.1): an ``xarray.Dataset`` with ``current_north`` and ``current_east``
+    """Gridded data (note 002-2.9.1): an ``xarray.Dataset`` with ``current_north`` and ``current_east``
     [m/s] on coordinates ``north`` and ``east`` [m], optionally ``time`` [s].
 
     ``method="linear"`` interpolates bilinearly (exact for affine fields), ``"cubic"`` with a bicubic spline

@@ -1,4 +1,4 @@
-"""Route figures (spec 002 §2.9.6): the route on a north-up chart (east horizontal, north vertical, equal
+"""Route figures (note 002-2.9.6): the route on a north-up chart (east horizontal, north vertical, equal
 scales, Z10) over current arrows, hourly isochrones when the level set ran, obstacles and the vertex
 touched."""
 
@@ -23,7 +23,7 @@ def _time_label(seconds: float, nautical: bool) -> str:
 
 
 def _isochrone_step(horizon_s: float, nautical: bool) -> float:
-    """Hourly isochrones for nautical routes (spec 002 §2.9.6); else a round step giving ≤ 12 lines."""
+    """Hourly isochrones for nautical routes (note 002-2.9.6); else a round step giving ≤ 12 lines."""
     if nautical and horizon_s >= 2 * 3600:
         return 3600.0
     for step in (1, 2, 5, 10, 30, 60, 120, 300, 600, 900, 1800, 3600, 7200):
@@ -196,7 +196,7 @@ def document_figures(out_dir) -> list:
     res = solve_route(shear(-0.5 / h), V, A, B, method="auto", obstacles=[shoal], horizon=30 * h,
                       n_angles=720, grid_spacing=0.04 * nm, domain=dom)
     gc = res.global_check or {}
-    text = (f"via (0.9, 4.2) nm: {res.time_s / h:.6f} h (spec 11.031160 h)\n"
+    text = (f"via (0.9, 4.2) nm: {res.time_s / h:.6f} h (note 002-2.9.3: 11.031160 h)\n"
             f"level set 0.04 nm, shoal frozen: {gc.get('time_s', math.nan) / h:.6f} h")
     written.append(route_figure(res, out / "zermelo-shoal.png", nautical=True, extra_text=text,
                                 title="shear and a square shoal"))

@@ -1,4 +1,4 @@
-"""Graph search on a grid: a cheap global seed (spec 002 §2.9.2, F7).
+"""Graph search on a grid: a cheap global seed (notes 002-2.9.2, 002-F7).
 
 Dijkstra (scipy.sparse.csgraph) over grid nodes; each edge is sailed at constant course, with the crab
 triangle evaluated on the current at the edge midpoint: the ship holds the edge if the cross-current is below

@@ -1,8 +1,8 @@
-"""Reachability fronts by the level-set method (spec 002 §2.9.2; Lolla et al., ICRA 2012).
+"""Reachability fronts by the level-set method (note 002-2.9.2; Lolla et al., ICRA 2012).
 
     φ_t + V‖∇φ‖ + v(x, t)·∇φ = 0,   R(t) = {φ ≤ 0},   T(B) = min{t : φ(B, t) ≤ 0}
 
-The scheme is the one the spec's reference numbers come from:
+The scheme is the one the reference numbers of note 002-2.9.2 come from:
 
 * WENO5 one-sided derivatives (Jiang & Peng);
 * Osher–Sethian (Godunov) upwinding for V‖∇φ‖ and upwind advection for v·∇φ;
@@ -209,7 +209,7 @@ def _signed_distance(poly, nn, ee, h):
 
 def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizon=None, obstacles=None,
                  cfl=0.5, store_every=None, recover=True, compiled=True) -> LevelSetResult:
-    """Propagate the reachability front from ``start`` until it covers ``target`` (spec 002 §2.9.2).
+    """Propagate the reachability front from ``start`` until it covers ``target`` (note 002-2.9.2).
 
     ``domain`` = ((north_min, north_max), (east_min, east_max)) [m]; ``spacing`` h [m]; ``obstacles`` a
     list of shapely polygons (frozen cells). Returns a :class:`LevelSetResult`. ``compiled=False`` uses
@@ -345,7 +345,7 @@ def _grad_at(res: LevelSetResult, k, x):
 
 
 def _recover(field, speed, start, target, res: LevelSetResult, t0, t_init, ends) -> LevelSetRoute:
-    """Integrate ẋ = V∇φ/‖∇φ‖ + v backwards from (B, T(B)) over the stored fronts (spec 002 §2.9.2)."""
+    """Integrate ẋ = V∇φ/‖∇φ‖ + v backwards from (B, T(B)) over the stored fronts (note 002-2.9.2)."""
     times = res.snapshot_times
     t_arr = res.arrival
     n_sub = 4

@@ -1,4 +1,4 @@
-"""Obstacles as polygons: shoals, storm areas, ship domains (spec 002 §2.9.3).
+"""Obstacles as polygons: shoals, storm areas, ship domains (note 002-2.9.3).
 
 Polygons are held as shapely polygons in (north, east) metres (shapely's x = north, y = east). They enter:
 
@@ -193,7 +193,7 @@ def _extremal_xy(ext, max_step=10.0, speed_hint=1.0):
 
 
 def route_around(res, polys, *, horizon, n_angles=1440, leg_angles=360, leg_steps=800):
-    """Vertex decomposition with PMP legs (spec 002 §2.9.3); fills ``res`` (a RouteResult)."""
+    """Vertex decomposition with PMP legs (note 002-2.9.3); fills ``res`` (a RouteResult)."""
     from shipgnc.routing import pmp
     from shipgnc.routing.router import _ChainPath, _ext_dict
 

@@ -1,6 +1,6 @@
-"""Pontryagin extremals of Zermelo's problem (spec 002 §2.4, 2.9.4, 2.9.5; failure modes F2–F5).
+"""Pontryagin extremals of Zermelo's problem (notes 002-2.4, 002-2.9.4, 002-2.9.5; failure modes F2–F5).
 
-State and costate, in the maximum form with p₀ = −1 (spec 002 §2.2):
+State and costate, in the maximum form with p₀ = −1 (note 002-2.2):
 
     ẋ = V e(u) + v(x, t),  u = atan2(p₂, p₁)                         (2.1), (2.2)
     ṗ = −(∂v/∂x)ᵀ p                                                     (2.3)
@@ -119,7 +119,7 @@ def integrate_family(field, speed, start, theta0, t0, duration, n_steps, record=
 
 @dataclass
 class Extremal:
-    """One polished extremal through A and B (forward parameterisation, spec 002 §2.4)."""
+    """One polished extremal through A and B (forward parameterisation, note 002-2.4)."""
 
     theta0: float  #: initial heading u(t₀) [rad]
     duration: float  #: t_f − t₀ [s]
@@ -142,7 +142,7 @@ class Extremal:
         return t, y
 
     def heading(self, t):
-        """ψ(t) [rad] in [0, 2π), clamped to [t₀, t_f] (the heading schedule of spec 002 §2.9.6)."""
+        """ψ(t) [rad] in [0, 2π), clamped to [t₀, t_f] (the heading schedule of note 002-2.9.6)."""
         t = np.clip(np.asarray(t, float), self.t0, self.t_end)
         y = self.solution.sol(t)
         return np.mod(np.arctan2(y[3], y[2]), TWO_PI)
@@ -215,7 +215,7 @@ class _Shooter:
 
 
 def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol_m=1.0, rtol=1e-11):
-    """Polish one extremal from a guess (θ₀, t_f − t₀) with Levenberg–Marquardt (spec 002 §2.9.4).
+    """Polish one extremal from a guess (θ₀, t_f − t₀) with Levenberg–Marquardt (note 002-2.9.4).
 
     Returns an :class:`Extremal` or ``None`` when the solver fails, returns t_f ≤ 0 (F4), misses by more
     than ``tol_m`` metres, or ends with an inadmissible costate V + e(u_f)ᵀv(B) ≤ 0 (F5, (2.4)).
@@ -288,7 +288,7 @@ def conjugate_time(field, speed, start, ext: Extremal, h: float = 1e-6, n: int =
 
     The front x(t; θ₀) has its tangent ∂x/∂θ₀ normal to p, so det[∂x/∂θ₀, p/|p|] is ±|∂x/∂θ₀| and changes
     sign only where ∂x/∂θ₀ vanishes, a conjugate point. For a steady field with H = 0 this is
-    det[∂x/∂θ₀, ẋ]·|p| (ẋ·p = 1), the test of spec 002 F3; unlike det[∂x/∂θ₀, ẋ] it stays valid for
+    det[∂x/∂θ₀, ẋ]·|p| (ẋ·p = 1), the test of note 002-F3; unlike det[∂x/∂θ₀, ẋ] it stays valid for
     time-varying fields, where ẋ·p may change sign (2.9.5).
     """
     from scipy.optimize import brentq
@@ -314,7 +314,7 @@ def conjugate_time(field, speed, start, ext: Extremal, h: float = 1e-6, n: int =
 
 @dataclass
 class SweepResult:
-    """The global sweep (spec 002 §2.9.4): polished extremals ascending in time, and the sweep's data."""
+    """The global sweep (note 002-2.9.4): polished extremals ascending in time, and the sweep's data."""
 
     extremals: list[Extremal]
     closest_approach: float  #: min over the sweep of |x − B| [m]
@@ -327,7 +327,7 @@ class SweepResult:
 
 def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n_steps=None,
           radius=0.0, max_candidates=24, conjugate=True) -> SweepResult:
-    """Every extremal from ``start`` through ``target`` below ``horizon`` (spec 002 §2.9.4, F2).
+    """Every extremal from ``start`` through ``target`` below ``horizon`` (notes 002-2.9.4, 002-F2).
 
     N costate angles are integrated together with RK4; the 2-D local minima (over angle and time) of
     the distance to B are polished with :func:`shoot`; duplicates are merged; each survivor is checked for

@@ -1,4 +1,4 @@
-"""The router's result (spec 002 §2.9.6): one object for a route or an explicit, worded failure (§2.8)."""
+"""The router's result (note 002-2.9.6): one object for a route or an explicit, worded failure (note 002-2.8)."""
 
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ class Unreachable(ShipGNCError):
 
 @dataclass
 class LegPlan:
-    """Constant-heading legs approximating the optimal heading programme (spec 002 §2.9.6)."""
+    """Constant-heading legs approximating the optimal heading programme (note 002-2.9.6)."""
 
     times: np.ndarray  #: leg start times [s], plus the arrival time as the last entry
     headings: np.ndarray  #: one heading per leg [rad]
@@ -43,7 +43,7 @@ class LegPlan:
 
 @dataclass
 class RouteResult:
-    """A solved (or unreachable) route; SI throughout. ``to_json()`` gives the keys of spec 002 §2.9.6."""
+    """A solved (or unreachable) route; SI throughout. ``to_json()`` gives the keys of note 002-2.9.6."""
 
     reachable: bool
     start: np.ndarray
@@ -60,7 +60,7 @@ class RouteResult:
     extremal_paths: list = dc_field(default_factory=list, repr=False)
     global_check: dict | None = None  #: {"method", "time_s", "rel_diff"} or None
     reason: str | None = None
-    notes: list[str] = dc_field(default_factory=list)  #: failure modes and remarks, in words (§2.8)
+    notes: list[str] = dc_field(default_factory=list)  #: failure modes and remarks, in words (note 002-2.8)
     grid_spacing: float | None = None  #: of the global method [m]
     closest_approach_m: float | None = None
     closest_time_s: float | None = None
@@ -88,7 +88,7 @@ class RouteResult:
         return self.path.position(t)
 
     def heading_schedule(self, n: int = 1001):
-        """(t [s], ψ [rad]) on n instants from t₀ to t_f, for a heading autopilot (spec 002 §2.9.6)."""
+        """(t [s], ψ [rad]) on n instants from t₀ to t_f, for a heading autopilot (note 002-2.9.6)."""
         t = np.linspace(self.t0, self.t_end, n)
         return t, self.heading(t)
 
@@ -99,7 +99,7 @@ class RouteResult:
         return t, x[:, 0], x[:, 1], self.heading(t)
 
     def constant_heading_legs(self, n_legs: int = 4) -> LegPlan:
-        """Replace ψ(t) by ``n_legs`` constant-heading legs of equal duration (spec 002 §2.9.6).
+        """Replace ψ(t) by ``n_legs`` constant-heading legs of equal duration (note 002-2.9.6).
 
         The leg headings and the arrival time are re-optimised (SLSQP: minimum time subject to reaching
         B), starting from the circular mean of ψ(t) over each leg; returns the plan and its time penalty.
@@ -140,7 +140,7 @@ class RouteResult:
 
     # ------------------------------------------------------------------ output
     def to_json(self) -> dict:
-        """The keys of spec 002 §2.9.6 (SI): reachable, time_s, time_h, heading_start_deg, ..."""
+        """The keys of note 002-2.9.6 (SI): reachable, time_s, time_h, heading_start_deg, ..."""
         def deg(x):
             return None if x is None else float(np.mod(math.degrees(x), 360.0))
 
@@ -170,7 +170,7 @@ class RouteResult:
         return out
 
     def to_dataset(self, n: int = 1001):
-        """The route as an ``xarray.Dataset`` on time (spec 002 §2.9.6), units in attrs."""
+        """The route as an ``xarray.Dataset`` on time (note 002-2.9.6), units in attrs."""
         import xarray as xr
 
         t, north, east, psi = self.sample(n)

@@ -1,4 +1,4 @@
-"""The router's front door: :func:`solve_route` (spec 002 §2.4–2.9; failure modes §2.8).
+"""The router's front door: :func:`solve_route` (notes 002-2.4–002-2.9; failure modes note 002-2.8).
 
 ``method``:
 

@@ -1,10 +1,10 @@
-"""Sailing a solved route in the simulation loop (spec 002 §2.9.7 ``zermelo-sail``).
+"""Sailing a solved route in the simulation loop (note 002-2.9.7 ``zermelo-sail``).
 
 A route gives a heading programme ψ(t) and a ground track; a ship sails it through the *same* current
 field object the router used:
 
 * ``path`` — LOS guidance (:class:`~shipgnc.guidance.los.LOSGuidance`, integral LOS against the crab
-  angle, spec 001 §1.17) through waypoints sampled on the route's track, with the vessel's heading
+  angle, note 001-1.17) through waypoints sampled on the route's track, with the vessel's heading
   autopilot (closed loop on position);
 * ``programme`` — the optimal heading programme ψ(t) as the autopilot's set-point (open loop on
   position, closed on heading);
@@ -12,7 +12,7 @@ field object the router used:
   open loop on position too.
 
 **The boat in a current** (:class:`BoatInCurrent`). Document 001's boat with the current as relative
-velocity (Fossen 2021 §10.3; spec 001 §1.17): the state's u, v are the velocities through the water,
+velocity (Fossen 2021 §10.3; note 001-1.17): the state's u, v are the velocities through the water,
 ν_r = ν − ν_c, and
 
     η̇ = J(ψ) ν_r + [v_N, v_E, 0]ᵀ(η, t),     M ν̇_r + C(ν_r) ν_r + D(ν_r) ν_r = τ

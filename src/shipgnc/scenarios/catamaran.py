@@ -1,5 +1,5 @@
 """Document 004's scenarios: the case builders of :mod:`shipgnc.cases.catamaran` driven by a
-validated :class:`~shipgnc.scenarios.schema.Scenario` (spec 004 §4.7).
+validated :class:`~shipgnc.scenarios.schema.Scenario` (note 004-4.7).
 
 A catamaran scenario names a ``case.builder`` and its ``case.options`` (the builder's keyword
 arguments, checked against its signature); ``vessel.preset``, ``simulation.t_end`` and
@@ -30,7 +30,7 @@ def _builders() -> dict:
 def _compare(preset_name: str = "si-consistent", t_end: float = 600.0, t_end_rate: float = 300.0,
              baselines: str = "all", vessel: dict | None = None):
     """FSM laws against the baselines on S3, S4 (``t_end_rate``) and S7 (``t_end``): the
-    equal-bandwidth pole placement and designed PI, and the spec's §4.11.3 PI / LQR kept as
+    equal-bandwidth pole placement and designed PI, and the note 004-4.11.3 PI / LQR kept as
     reproductions (``baselines``: all | designed | reproduction)."""
     from shipgnc.cases.catamaran import comparison_cases
 
@@ -82,7 +82,7 @@ def cases(scenario: Scenario) -> dict:
         kwargs.setdefault("dt", sim.dt)
     elif abs(sim.dt - DT) > 1e-12:
         raise ConfigError(f"simulation.dt = {sim.dt!r}: builder {cfg.builder!r} integrates at "
-                          f"dt = {DT} s (spec 004 §4.7)")
+                          f"dt = {DT} s (note 004-4.7)")
     built = build(**kwargs)
     if isinstance(built, CatamaranCase):
         law = getattr(built, "notes", {}).get("law")

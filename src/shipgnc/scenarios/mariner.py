@@ -1,4 +1,4 @@
-"""Document 000's scenario pieces: the Mariner, its path (spec 000 A4), controllers and
+"""Document 000's scenario pieces: the Mariner, its path (note 000-A4), controllers and
 disturbances built from a validated :class:`~shipgnc.scenarios.schema.Scenario`.
 
 The scenario file keeps the document's units where it names them (``*_nm``, ``*_rad_min2``,
@@ -29,7 +29,7 @@ def vessel(scenario: Scenario):
 
 
 def mariner_path(g) -> WaypointPath:
-    """The path of spec 000 A4 from the printed points [nm] and their ``reading``, in NED [m]."""
+    """The path of note 000-A4 from the printed points [nm] and their ``reading``, in NED [m]."""
     points = np.asarray(g.points_nm, dtype=float)
     if g.reading == "literal":
         north_east = points
@@ -41,7 +41,7 @@ def mariner_path(g) -> WaypointPath:
 
 
 def controller(cfg, model, path: WaypointPath, scenario: Scenario):
-    """Document 000's path controllers (spec 000 §0.4–0.5) with the scenario's settings."""
+    """Document 000's path controllers (notes 000-0.4–000-0.5) with the scenario's settings."""
     from shipgnc.control import feedback_linearization as fl
     from shipgnc.control.lqr import PAPER_Q, PAPER_R, PathLQR, design_lqr, gain_to_si
 
@@ -69,7 +69,7 @@ def controller(cfg, model, path: WaypointPath, scenario: Scenario):
 
 
 def disturbance(d, path: WaypointPath):
-    """b_r, the cross current and the optional wave noise of spec 000 §0.6 (A9–A11), in SI."""
+    """b_r, the cross current and the optional wave noise of note 000-0.6 (A9–A11), in SI."""
     from shipgnc.environment.current import CrossCurrent
     from shipgnc.environment.filtered_noise import SecondOrderNoise
     from shipgnc.models.mariner import MarinerDisturbance

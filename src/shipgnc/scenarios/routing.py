@@ -1,5 +1,5 @@
 """Document 002's scenarios: a routing problem solved as ``shipgnc route`` solves it, and the route
-sailed by a ship through the same current field (spec 002 §2.9.7).
+sailed by a ship through the same current field (note 002-2.9.7).
 
 The sailing ship (``sail.vessel``) is, by default, document 001's Otter-class boat
 (:class:`~shipgnc.routing.sailing.BoatInCurrent`: the current as relative velocity) under its heading and

@@ -25,7 +25,7 @@ from shipgnc.guidance.path import WaypointPath
 from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.fossen3dof import VectoredThrustBoat
 from shipgnc.scenarios.registry import load_scenario
-from shipgnc.scenarios.schema import Scenario
+from shipgnc.scenarios.schema import CATALOGUE_VESSELS, Scenario
 from shipgnc.units import NAUTICAL_MILE, deg
 
 
@@ -99,6 +99,10 @@ def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
         from shipgnc.scenarios import catamaran
 
         return np.array(next(iter(catamaran.cases(scenario).values())).x0, dtype=float)
+    if scenario.vessel.model in CATALOGUE_VESSELS:
+        from shipgnc.vessels import scenario as catalogue
+
+        return catalogue.initial_state(scenario)
     init = scenario.simulation.initial_state
     if scenario.vessel.model != "mariner":
         return np.array([init.north, init.east, deg(init.psi_deg), init.u, init.v, deg(init.r_deg_s)])
@@ -130,11 +134,15 @@ def _controller(cfg, model, scenario: Scenario):
         return HeadingSpeedAutopilot(model.params, Ts=cfg.Ts, omega_ref=cfg.omega_ref,
                                      omega=cfg.omega, omega_u=cfg.omega_u,
                                      yaw_feedforward=cfg.yaw_feedforward)
+    if scenario.vessel.model in CATALOGUE_VESSELS:
+        from shipgnc.vessels import scenario as catalogue
+
+        return catalogue.controller(cfg, model)
     return _course_controller(cfg, model.params, scenario.vessel.propeller_rps)
 
 
 def _course_controller(cfg, params, propeller_rps: float):
-    """Document 003's PD or sliding-mode autopilot with the scenario's gains (spec 003 §3.2)."""
+    """Document 003's PD or sliding-mode autopilot with the scenario's gains (note 003-3.2)."""
     from shipgnc.control import course
 
     gains = cfg.gains()
@@ -215,8 +223,14 @@ def _catamaran(scenario: Scenario):
     return first.model, first.actuator, first.u0
 
 
+def _catalogue(scenario: Scenario):
+    from shipgnc.vessels import scenario as catalogue
+
+    return catalogue.vessel(scenario)
+
+
 VESSELS = {"vectored-thrust-boat": _boat, "cybership2": _cybership, "mariner": _mariner,
-           "catamaran": _catamaran}
+           "catamaran": _catamaran, **dict.fromkeys(CATALOGUE_VESSELS, _catalogue)}
 
 
 def variant_names(scenario: Scenario) -> list[str] | None:
@@ -336,7 +350,7 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
         if K_paper is not None:
             out["lqr_gain"] = [float(k) for k in K_paper]
         lookahead = getattr(setup.controller, "lookahead", None)
-        if lookahead is not None:  # output feedback linearisation: its zero dynamics (spec 000 §0.5)
+        if lookahead is not None:  # output feedback linearisation: its zero dynamics (note 000-0.5)
             from shipgnc.control.feedback_linearization import zero_dynamics_pole
 
             try:

@@ -62,7 +62,7 @@ class VesselConfig(Strict):
         return params
 
 
-#: spec 003 B8's rudder rate [°/s], 2.32·√70 (the same number as models.cybership2.DELTA_RATE_DEG_S)
+#: note 003-B8's rudder rate [°/s], 2.32·√70 (the same number as models.cybership2.DELTA_RATE_DEG_S)
 CYBERSHIP_RUDDER_RATE_DEG_S = 2.32 * math.sqrt(70.0)
 
 
@@ -73,12 +73,12 @@ class CyberShipVesselConfig(Strict):
     rudder_model: Literal["table1", "skjetne"] = "table1"
     propeller_rps: Positive = 8.13
     rudder_max_deg: Annotated[float, Field(gt=0, le=90, allow_inf_nan=False)] = 35.0
-    #: steering-machine rate limit; null for none (spec 003 B8 compares both). Default IMO's
+    #: steering-machine rate limit; null for none (note 003-B8 compares both). Default IMO's
     #: 2.32°/s Froude-scaled by √70: 19.4105…°/s (``models.cybership2.DELTA_RATE_DEG_S``; the
-    #: spec's indicative figures used it rounded to 19.4)
+    #: indicative figures of note 003-3.8 used it rounded to 19.4)
     rudder_rate_deg_s: Positive | None = CYBERSHIP_RUDDER_RATE_DEG_S
     #: ``ramp``: the rudder slews linearly within a step; ``hold``: the slewed value is held over
-    #: the step (a discrete rate limiter, the setting of spec 003's indicative figures)
+    #: the step (a discrete rate limiter, the setting of document 003's indicative figures)
     rudder_rate_mode: Literal["ramp", "hold"] = "ramp"
 
 
@@ -88,7 +88,7 @@ MARINER_PARAM_NAMES = ("a", "b", "c", "r1", "r2", "f", "W", "S")
 class MarinerVesselConfig(Strict):
     """``vessel`` for document 000's Mariner (de Wit–Oppe model (25)).
 
-    ``params_paper``: coefficients in the **document's units** (min, nm, rad; spec 000 table 0.1),
+    ``params_paper``: coefficients in the **document's units** (min, nm, rad; note 000-0.1),
     e.g. ``{r1: 0.0375}`` for the sign-flipped sway coupling; converted to SI at the model boundary.
     The steering machine: ``rudder_max_deg``, ``rudder_rate_deg_s`` (null: no rate limit).
     """
@@ -125,7 +125,7 @@ class MarinerVesselConfig(Strict):
 
 
 class CatamaranVesselConfig(Strict):
-    """``vessel`` for document 004's twin-azimuth catamaran: parameter preset (spec 004 §4.4).
+    """``vessel`` for document 004's twin-azimuth catamaran: parameter preset (note 004-4.4).
 
     ``si-consistent`` (default): the physically consistent hull (SI units, sway Coriolis sign
     corrected, hull lift [A]); ``si`` (printed Coriolis sign) and ``paper`` (the listing's mixed
@@ -133,10 +133,10 @@ class CatamaranVesselConfig(Strict):
 
     model: Literal["catamaran"]
     preset: Literal["si-consistent", "si", "paper"] = "si-consistent"
-    #: sway Coriolis sign: the printed model's, or the consistent one (spec 004 §4.3); None: the
+    #: sway Coriolis sign: the printed model's, or the consistent one (note 004-4.3); None: the
     #: preset's (consistent for ``si-consistent``, printed for ``si`` and ``paper``)
     coriolis: Literal["printed", "consistent"] | None = None
-    #: resistance below V_m: the quadratic continuation, or the literal fit (spec 004 §4.3)
+    #: resistance below V_m: the quadratic continuation, or the literal fit (note 004-4.3)
     low_speed: Literal["continued", "literal"] = "continued"
     #: other :class:`CatamaranParams` overrides (SI), e.g. ``{J_zz: 4.0e6, T_v: 18000}``
     params: dict[str, Finite] = Field(default_factory=dict)
@@ -156,7 +156,7 @@ CATAMARAN_BUILDERS = ("turn", "steps", "fixed-angle", "sine", "heading", "actuat
 
 
 class CatamaranCaseConfig(Strict):
-    """Document 004's case (spec 004 §4.7): a ``builder`` of :mod:`shipgnc.cases.catamaran` and its
+    """Document 004's case (note 004-4.7): a ``builder`` of :mod:`shipgnc.cases.catamaran` and its
     keyword ``options`` (checked against the builder's signature when the scenario is built)."""
 
     builder: Literal["turn", "steps", "fixed-angle", "sine", "heading", "actuator", "montecarlo",
@@ -164,20 +164,86 @@ class CatamaranCaseConfig(Strict):
     options: dict[str, Finite | int | bool | str | None] = Field(default_factory=dict)
 
 
+#: the vessel catalogue's models (``shipgnc vessels``; :mod:`shipgnc.vessels`)
+CATALOGUE_VESSELS = ("mariner-cst", "frigate", "kvlcc2", "kvlcc2-l7", "linear-3dof", "nomoto",
+                     "nomoto2")
+Matrix3 = Annotated[list[Annotated[list[Finite], Field(min_length=3, max_length=3)]],
+                    Field(min_length=3, max_length=3)]
+
+
+class CatalogueVesselConfig(Strict):
+    """``vessel`` from the catalogue (``shipgnc vessels``; :mod:`shipgnc.vessels`), SI: the model
+    at ``speed_mps`` (default: its design speed) with the entry's parameters, e.g. ``K``, ``T``
+    for ``nomoto``, ``M``, ``N``, ``B`` (or ``L``, ``B``, ``T``, ``Cb``, ...) for ``linear-3dof``;
+    the steering machine ``rudder_max_deg``, ``rudder_rate_deg_s``, ``rudder_time_constant_s``.
+    The vessel starts in its steady straight run at that speed (``initial_state`` sets position,
+    heading and yaw rate)."""
+
+    model: Literal["mariner-cst", "frigate", "kvlcc2", "kvlcc2-l7", "linear-3dof", "nomoto",
+                   "nomoto2"]
+    speed_mps: Positive | None = None
+    K: Finite | None = None
+    T: Finite | None = None
+    T1: Finite | None = None
+    T2: Finite | None = None
+    T3: Finite | None = None
+    a0: Finite | None = None
+    a1: Finite | None = None
+    a2: Finite | None = None
+    a3: Finite | None = None
+    M: Matrix3 | None = None
+    N: Matrix3 | None = None
+    B: Finite | Annotated[list[Finite], Field(min_length=3, max_length=3)] | Annotated[
+        list[Annotated[list[Finite], Field(min_length=1, max_length=1)]],
+        Field(min_length=3, max_length=3)] | None = None
+    L: Finite | None = None
+    Cb: Finite | None = None
+    R66: Finite | None = None
+    xg: Finite | None = None
+    T_surge: Finite | None = None
+    T_n: Positive | None = None
+    rudder_max_deg: Annotated[float, Field(gt=0, le=90, allow_inf_nan=False)] | None = None
+    rudder_rate_deg_s: Positive | None = None
+    rudder_time_constant_s: Positive | None = None
+
+    def params(self) -> dict:
+        """The entry's parameters given (None left out)."""
+        return {k: v for k, v in self.model_dump(exclude={"model", "speed_mps"}).items()
+                if v is not None}
+
+    def build(self):
+        """The model (:meth:`shipgnc.vessels.VesselEntry.build`)."""
+        from shipgnc.vessels import get_vessel
+
+        return get_vessel(self.model).build(self.speed_mps, **self.params())
+
+    @model_validator(mode="after")
+    def _builds(self) -> CatalogueVesselConfig:
+        try:
+            self.build()
+        except ConfigError as exc:
+            raise ValueError(str(exc)) from None
+        return self
+
+
 def _vessel_tag(value) -> str:
     if isinstance(value, dict):
-        return value.get("model", "vectored-thrust-boat")
-    return getattr(value, "model", "vectored-thrust-boat")
+        model = value.get("model", "vectored-thrust-boat")
+    else:
+        model = getattr(value, "model", "vectored-thrust-boat")
+    return "catalogue" if model in CATALOGUE_VESSELS else model
 
 
 Vessel = Annotated[
     Annotated[VesselConfig, Tag("vectored-thrust-boat")]
     | Annotated[CyberShipVesselConfig, Tag("cybership2")]
     | Annotated[MarinerVesselConfig, Tag("mariner")]
-    | Annotated[CatamaranVesselConfig, Tag("catamaran")],
+    | Annotated[CatamaranVesselConfig, Tag("catamaran")]
+    | Annotated[CatalogueVesselConfig, Tag("catalogue")],
     Discriminator(_vessel_tag, custom_error_type="vessel_model",
                   custom_error_message="unknown vessel model; allowed: vectored-thrust-boat, "
-                                       "cybership2, mariner, catamaran"),
+                                       "cybership2, mariner, catamaran, "
+                                       + ", ".join(CATALOGUE_VESSELS)),
 ]
 
 
@@ -193,8 +259,7 @@ class ActuatorConfig(Strict):
 class InitialState(Strict):
     """``simulation.initial_state``. ``u: null``: the vessel's straight-run surge equilibrium,
     computed when the scenario is validated (``shipgnc show`` prints the number): CyberShip II's
-    at ``vessel.propeller_rps`` (2T(n, u) = d₁₁(u)u, δ = 0; 0.29583… m/s at 8.13 rps, spec 003
-    §3.5), the Mariner's U = S/f."""
+    at ``vessel.propeller_rps`` (2T(n, u) = d₁₁(u)u, δ = 0; 0.29583… m/s at 8.13 rps, note 003-3.5), the Mariner's U = S/f."""
 
     north: Finite = 0.0
     east: Finite = 0.0
@@ -262,7 +327,7 @@ class OpenLoopConfig(Strict):
 
 
 class HeadingSpeedConfig(Navigated):
-    """The boat's heading + speed autopilot (spec 001 §1.10)."""
+    """The boat's heading + speed autopilot (note 001-1.10)."""
 
     type: Literal["heading-speed"]
     Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
@@ -285,7 +350,7 @@ COURSE_GAINS = {
 
 
 class CourseControllerConfig(Navigated):
-    """Document 003's course autopilots for CyberShip II (spec 003 §3.2): ``variant`` picks the law;
+    """Document 003's course autopilots for CyberShip II (note 003-3.2): ``variant`` picks the law;
     gains left out take the document's values (``smc_tuned``: the documented retuned ones).
 
     PD (eq. 3): ``Kp``, ``Kd``. SMC (eq. 9–15): the design model (``eq18`` as printed, ``eq17``,
@@ -327,7 +392,7 @@ class CourseControllerConfig(Navigated):
 
 
 class PathLQRConfig(Navigated):
-    """Document 000's LQR with integral action (spec 000 §0.4): designed from ``Q``, ``R`` in the
+    """Document 000's LQR with integral action (note 000-0.4): designed from ``Q``, ``R`` in the
     document's units (min / nm / rad; R = 1 as stated, R = 0.5 reproduces the print), or the gain
     ``K_paper`` = [k_y, k_ψ, k_r, k_e] used as given (min / nm / rad; the print: [3.4, 3.2, 1, 0.45]).
     ``anti_windup``: conditional integration while the rudder saturates (the document has none)."""
@@ -348,7 +413,7 @@ class PathLQRConfig(Navigated):
 
 
 class OutputFLConfig(Navigated):
-    """Document 000's feedback linearisation of the output z = y_r + l sin ψ_r (spec 000 §0.5):
+    """Document 000's feedback linearisation of the output z = y_r + l sin ψ_r (note 000-0.5):
     ``lookahead_nm`` l = 0 is the literal design (``fl_paper``, unstable), 0.1 nm the sound variant;
     gains of (23) in the document's units. ``knows_disturbance``: b_r and d_y known (A13)."""
 
@@ -361,7 +426,7 @@ class OutputFLConfig(Navigated):
 
 
 class LOSFLConfig(Navigated):
-    """LOS guidance feeding an exact FL of the yaw loop (spec 000 §0.5, ``los_fl``): look-ahead
+    """LOS guidance feeding an exact FL of the yaw loop (note 000-0.5, ``los_fl``): look-ahead
     ``delta_nm`` Δ, yaw-loop gains in the document's units. By default the controller does **not**
     know the disturbances: integral LOS (gain ``integral_gain_nm_min`` κ, default U/4 =
     0.0625 nm/min, critically damped) removes the offset of the unknown current and yaw bias, and
@@ -445,7 +510,7 @@ class CourseScheduleConfig(Strict):
 
 
 class PathConfig(Strict):
-    """Document 000's waypoint path (spec 000 A4): ``points_nm`` as printed in the document, read as
+    """Document 000's waypoint path (note 000-A4): ``points_nm`` as printed in the document, read as
     ``caption`` (pairs are (y, x): plot-horizontal then plot-vertical; default), ``text`` (the same
     first three points, then a half-line parallel to OX) or ``literal`` (pairs are (x, y)).
     x is north, y east (NED); the last leg is a half-line; switching as in A6."""
@@ -560,7 +625,7 @@ CURRENT_VESSELS = ("vectored-thrust-boat", "cybership2")
 
 
 class WavesConfig(Strict):
-    """Irregular waves from a spectrum and the wave loads they put on the hull (spec 003 §3.6).
+    """Irregular waves from a spectrum and the wave loads they put on the hull (note 003-3.6).
 
     ``hs`` [m] and ``t0`` [s] at model scale (1:70 Froude-correct: 3 m → 42.9 mm; the document's
     printed 5 mm is selectable; ``hs: 0`` is calm water, no wave load); ``t0`` is the modal period
@@ -585,7 +650,7 @@ class WavesConfig(Strict):
 
 
 class MarinerDisturbanceConfig(Strict):
-    """Document 000's disturbances in its units (spec 000 §0.6, A9–A11): yaw acceleration
+    """Document 000's disturbances in its units (notes 000-0.6, 000-A9–000-A11): yaw acceleration
     ``b_r_rad_min2`` added to ṙ, cross current ``d_y_nm_min`` across the active leg
     (``current_frame: path``) or along east (``global``), and narrow-band wave noise added to ṙ of
     RMS ``wave_sigma_rad_min2`` (0 = off), period ``wave_period`` [s], damping ``wave_zeta``
@@ -641,7 +706,7 @@ DisturbanceConfig = Annotated[ConstantForceConfig | GaussianForceConfig | WavesC
 # --------------------------------------------------------------------------- scenario
 
 class RouteConfig(Strict):
-    """Document 002's routing problem (spec 002): as ``shipgnc route`` takes it. With ``units:
+    """Document 002's routing problem (document 002): as ``shipgnc route`` takes it. With ``units:
     nautical`` positions and ``radius``/``grid`` are in nm, ``speed`` in kn, ``horizon``/``depart``
     in h and the FIELD parameters as the route command reads them (k, ω in 1/h, Γ in nm²/h);
     ``obstacles``: polygons of [north, east] vertices in the same length unit."""
@@ -660,7 +725,7 @@ class RouteConfig(Strict):
 
 
 class SailConfig(Strict):
-    """The route sailed by a ship (spec 002 §2.9.7; :mod:`shipgnc.scenarios.routing`), SI units.
+    """The route sailed by a ship (note 002-2.9.7; :mod:`shipgnc.scenarios.routing`), SI units.
 
     ``vessel``: ``vectored-thrust-boat`` (document 001's Otter-class boat, ``preset``, with a current
     as relative velocity, under its heading and speed autopilot) sails the route three ways: as a path
@@ -673,7 +738,7 @@ class SailConfig(Strict):
     false``, no arrival time and its miss distance (closest approach)."""
 
     vessel: Literal["vectored-thrust-boat", "mariner"] = "vectored-thrust-boat"
-    #: the boat's parameter preset (spec 001 §1.6); unused by the Mariner
+    #: the boat's parameter preset (note 001-1.6); unused by the Mariner
     preset: Literal["otter", "doc-eq7", "doc-printed", "otter-munk"] = "otter"
     legs: Annotated[int, Field(ge=1, le=50)] = 4
     #: simulation step [s]; default 0.1 s for the boat, 0.3 s for the Mariner
@@ -903,6 +968,8 @@ class Scenario(Strict):
             from shipgnc.models.mariner import MarinerParams
 
             u = MarinerParams.from_paper_units(**vessel.params_paper).U
+        elif vessel.model in CATALOGUE_VESSELS:
+            u = vessel.build().straight_state()[3]  # the steady straight run's surge speed
         else:
             raise ValueError(f"simulation.initial_state.u = null (the surge equilibrium) is "
                              f"defined for vessel models 'cybership2' and 'mariner', not "
@@ -951,7 +1018,8 @@ class Scenario(Strict):
             raise ValueError(f"actuator: applies to the vectored-thrust boat; the {vessel} steering "
                              "machine is set in vessel (rudder_max_deg, rudder_rate_deg_s)")
         fits = {"vectored-thrust-boat": ("open-loop", "heading-speed"), "cybership2": ("course",),
-                "mariner": MARINER_CONTROLLERS}[vessel]
+                "mariner": MARINER_CONTROLLERS,
+                **dict.fromkeys(CATALOGUE_VESSELS, ("course",))}[vessel]
         for name, ctrl in self.variants.items():
             where = "controller" if self.controller is not None else f"controllers.{name}"
             if ctrl.type not in fits:
@@ -980,7 +1048,7 @@ class Scenario(Strict):
         dist = self.disturbance.type if self.disturbance is not None else None
         allowed_dist = {"vectored-thrust-boat": ("constant", "gaussian"),
                         "cybership2": ("constant", "gaussian", "waves"),
-                        "mariner": ("mariner",)}[vessel]
+                        "mariner": ("mariner",), **dict.fromkeys(CATALOGUE_VESSELS, ())}[vessel]
         if dist is not None and dist not in allowed_dist:
             raise ValueError(f"disturbance type {dist!r} does not fit vessel model {vessel!r} "
                              f"(allowed: {', '.join(allowed_dist)})")

@@ -1,6 +1,7 @@
 """The composed loop's body, as source: :mod:`shipgnc.sim.compose` writes it under a header that
 binds the free names below (the components' kernels ``model_fn``, ``ctrl_fn``, ``guid_fn``,
-``dist_fn`` and a disturbance's current part ``cur_fn``; the sizes ``nx``, ``nu``, ...; the row
+``dist_fn`` and a disturbance's current part ``cur_fn``; the navigation step ``nav_observe`` of
+:mod:`shipgnc.sim.nav_template`, written before this body; the sizes ``nx``, ``nu``, ...; the row
 offsets ``o_*`` and log columns ``c_*`` of
 :func:`~shipgnc.sim.compose.row_layout`; the flags ``has_*``) as constants of one combination,
 and compiles it (so this module is never imported as itself). It is
@@ -19,7 +20,7 @@ from shipgnc.kernels import JIT_OPTIONS, clip, wrap  # noqa: F401  (JIT_OPTIONS:
 
 
 def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, pd_rows, limits,
-         err, out, event, done_at, Wu, pu_rows):
+         err, out, event, done_at, Wu, pu_rows, Wn, pn_rows):
     n_ships = S.shape[0]
     for i in numba.prange(n_ships):
         row = S[i]
@@ -30,6 +31,7 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
         pg = pg_rows[min(ship, pg_rows.shape[0] - 1)].copy()
         pd = pd_rows[min(ship, pd_rows.shape[0] - 1)].copy()
         pu = pu_rows[min(ship, pu_rows.shape[0] - 1)].copy()
+        pn = pn_rows[min(ship, pn_rows.shape[0] - 1)].copy()
         zui = np.empty(0)  # the current part keeps no state
         # the ship's carried state as fresh local arrays (written back after its last step):
         # arrays that cannot alias each other let LLVM keep values in registers across the
@@ -45,6 +47,10 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
         zci = row[o_zc:o_zc + nzc].copy()
         zgi = row[o_zg:o_zg + nzg].copy()
         zdi = row[o_zd:o_zd + nzd].copy()
+        zni = row[o_zn:o_zn + nzn].copy()   # navigation: its state and held logged signals
+        nsg = row[o_nsg:o_nsg + nnsig].copy()
+        seen = np.empty(nx if has_nav else 0)  # the state guidance and controller see
+        j0 = (k0 + hold - 1) // hold  # the chunk's first control sample (row 0 of Wn)
         done = row[o_done]
         start = np.empty(nu)
         end = np.empty(nu)
@@ -63,11 +69,14 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
         for k in range(k0, k1):
             t = k * dt
             if ic == 0:
+                if has_nav:  # Navigation.observe: the estimate (or measurements) from the truth
+                    nav_observe(t, x, applied, zni, pn, Wn[k // hold - j0, i], seen, nsg, pm)
                 if has_guid:
-                    if guid_fn(t, x, zgi, pg, ref, gout):
+                    if guid_fn(t, seen if has_nav else x, zgi, pg, ref, gout):
                         done = 1.0
-                if has_ctrl:
-                    ctrl_fn(t, x, ref, zci, pc, cmd, sig)
+                if has_ctrl:  # a continuous controller's law reads the truth (as run_numpy)
+                    ctrl_fn(t, seen if (has_nav and not continuous) else x, ref, zci, pc, cmd,
+                            sig)
                     bad = False
                     for j in range(nu):
                         if not math.isfinite(cmd[j]):
@@ -107,6 +116,8 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
                     out[c_out + j, s, i] = gout[j]
                 for j in range(nsig):
                     out[c_sig + j, s, i] = sig[j]
+                for j in range(nnsig):
+                    out[c_nav + j, s, i] = nsg[j]
                 s += 1
             if k == k_last:
                 break
@@ -195,4 +206,6 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
         row[o_zc:o_zc + nzc] = zci
         row[o_zg:o_zg + nzg] = zgi
         row[o_zd:o_zd + nzd] = zdi
+        row[o_zn:o_zn + nzn] = zni
+        row[o_nsg:o_nsg + nnsig] = nsg
         row[o_done] = done

@@ -3,7 +3,7 @@
     guidance ──ref──▶ controller ──command──▶ actuator ──u──▶ model ẋ = f(x, u, d) ◀── disturbance
 
 At each sample t_k = k·dt the state x(t_k) is logged together with the command and the applied
-input acting from t_k (document 001's loop records the state before the step, spec 001 A13).
+input acting from t_k (document 001's loop records the state before the step, note 001-A13).
 Every ``Ts/dt`` samples the guidance and the controller are evaluated; the command is held in
 between. The plant (and any actuator lag) is integrated with fixed-step RK4 or with
 ``scipy.integrate.solve_ivp`` over each ``dt``. The last sample is t_end itself.

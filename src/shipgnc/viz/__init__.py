@@ -1,4 +1,4 @@
-"""Figures drawn from result datasets, and the live telemetry dashboard (spec 001 §1.11, §1.14).
+"""Figures drawn from result datasets, and the live telemetry dashboard (notes 001-1.11, 001-1.14).
 
 The public names are imported lazily: ``import shipgnc.viz`` does not import matplotlib until a
 figure function is used (the ``dashboard`` function lives in :mod:`shipgnc.viz.dashboard`, the module

@@ -1,4 +1,4 @@
-"""The telemetry dashboard (spec 001 §1.11) and the stern-kick close-up (§1.14 item 4).
+"""The telemetry dashboard (note 001-1.11) and the stern-kick close-up (note 001-1.14 item 4).
 
 Figures are drawn from a result ``xarray.Dataset`` only (no simulation, no I/O except
 :func:`save_figure`). :class:`DashboardLayout` owns the axes and artists of the dashboard; the
@@ -69,7 +69,7 @@ def thrust_arrow(north: float, east: float, psi: float, thrust: float, alpha: fl
 
 
 def lateral_offset(north, east, origin_north: float, origin_east: float, heading: float):
-    """Position to starboard of the line through the origin along ``heading`` [m] (spec 001 §1.8)."""
+    """Position to starboard of the line through the origin along ``heading`` [m] (note 001-1.8)."""
     return (-(np.asarray(north) - origin_north) * math.sin(heading)
             + (np.asarray(east) - origin_east) * math.cos(heading))
 
@@ -350,7 +350,7 @@ def _check_waypoints(waypoints) -> np.ndarray:
 def dashboard(result, *, title: str = "", waypoints=None, limits: Mapping | None = None,
               outline: tuple[float, float] = (2.0, 1.08), lever_arm: float = 1.0, ship=0,
               boat_every: float | None = None):
-    """The telemetry dashboard of one ship of ``result`` (spec 001 §1.11) as a Figure.
+    """The telemetry dashboard of one ship of ``result`` (note 001-1.11) as a Figure.
 
     Parameters
     ----------
@@ -404,7 +404,7 @@ def _ghost_indices(t: np.ndarray, every: float) -> list[int]:
 
 def stern_kick_closeup(result, *, lever_arm: float = 1.0, t0: float | None = None,
                        duration: float = 3.0, length: float = 2.0, ship=0, title: str | None = None):
-    """Lateral position of the CG, the bow and the stern after a thruster step (spec 001 §1.14, 4).
+    """Lateral position of the CG, the bow and the stern after a thruster step (note 001-1.14, 4).
 
     y is measured to starboard of the line through the CG position at ``t0`` along the heading at
     ``t0`` (the frame of the initial heading). The bow is ``length/2`` ahead of the CG, the stern

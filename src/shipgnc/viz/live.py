@@ -1,4 +1,4 @@
-"""Live telemetry: the dashboard as a simulator observer (spec 001 §1.11, ``shipgnc run … --live``).
+"""Live telemetry: the dashboard as a simulator observer (note 001-1.11, ``shipgnc run … --live``).
 
 The simulation loop stays free of plotting: :func:`~shipgnc.sim.simulator.simulate` calls
 ``observer(t, x, command, applied)`` at every sample. :class:`LiveDashboard` buffers the samples

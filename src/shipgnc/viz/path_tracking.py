@@ -6,7 +6,7 @@ for display (time in min, positions in nm, angles in deg), so a worker process n
 North is up and east to the right (NED, the document's x up, y right under the caption reading).
 
 **Unbounded runs** (issue 17): a run whose |y_r| passes the ``stable`` bound max(3 nm, 2|y_r(0)|)
-of spec 000 §0.8 (the literal FL, 18 nm off after 100 min) would swamp the axes. Every run is
+of note 000-0.8 (the literal FL, 18 nm off after 100 min) would swamp the axes. Every run is
 still drawn, but the axes limits come from the bounded runs: Fig. 3 adds a panel with every track
 whole, Fig. 4 marks the unbounded runs as leaving the frame, Fig. 5 draws them in a panel of
 their own. Titles say what is drawn (how many runs, which are unbounded).
@@ -28,7 +28,7 @@ PATH_KEYS = ("time", "north", "east", "psi", "heading_error", "cross_track_error
 CONTROLLER_COLORS = {"lqr_paper": "#9467bd", "lqr": "#1f77b4", "fl_paper": "#d62728",
                      "fl_lookahead": "#2ca02c", "los_fl": "#ff7f0e", "los_fl_oracle": "#8c564b",
                      "controller": "#1f77b4"}
-#: the ``stable`` bound of spec 000 §0.8: |y_r| < max(3 nm, 2 |y_r(0)|)
+#: the ``stable`` bound of note 000-0.8: |y_r| < max(3 nm, 2 |y_r(0)|)
 BOUND_NM = 3.0
 #: margin around the bounded runs' data (fraction of the span)
 MARGIN = 0.06
@@ -59,7 +59,7 @@ def _waypoint_plot(ax, waypoints) -> None:
 
 
 def is_bounded(data: Mapping[str, np.ndarray]) -> bool:
-    """Whether a run keeps |y_r| below the ``stable`` bound max(3 nm, 2|y_r(0)|) (spec 000 §0.8)."""
+    """Whether a run keeps |y_r| below the ``stable`` bound max(3 nm, 2|y_r(0)|) (note 000-0.8)."""
     y = np.asarray(data.get("cross_track_error", ()), dtype=float)
     y = y[np.isfinite(y)]
     if y.size == 0:

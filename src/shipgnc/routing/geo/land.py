@@ -1,0 +1,117 @@
+"""Land and shallow water as polygons in longitude/latitude.
+
+* :func:`coastline` — the default land: GSHHG (Wessel & Smith 1996, *J. Geophys. Res.* 101(B4),
+  8741–8743), full resolution, as shipped inside the ``roaring-landmask`` wheel (no download at run time);
+  clipped to the route's box and cached per process.
+* :func:`load_land` — the user's own polygons: GeoJSON (RFC 7946, [lon, lat]) or an ESRI shapefile
+  (read with ``pyshp`` when installed).
+* :func:`region_polygons` — the region of a grid where a value is below a level (NaN counts as below):
+  shallow water from a depth grid, land from the NaN cells of a current grid; the boundary is the
+  bilinear interpolant's level line (``contourpy``), finer than the cells.
+"""
+
+from __future__ import annotations
+
+import json
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from shipgnc.errors import ConfigError
+
+
+@lru_cache(maxsize=1)
+def _gshhg():
+    import shapely
+
+    try:
+        import roaring_landmask as rl
+    except ImportError:  # pragma: no cover - a core dependency
+        raise ConfigError("the default coastline needs roaring-landmask: pip install roaring-landmask") from None
+    geoms = shapely.get_parts(shapely.from_wkb(rl.Shapes.wkb(rl.LandmaskProvider.Gshhg)))
+    return geoms, shapely.STRtree(geoms)
+
+
+def coastline(lon0, lat0, lon1, lat1) -> list:
+    """GSHHG land polygons clipped to the box (lon/lat degrees); an empty list over open sea."""
+    import shapely
+
+    geoms, tree = _gshhg()
+    box = shapely.box(lon0, lat0, lon1, lat1)
+    out = []
+    for k in tree.query(box, predicate="intersects"):
+        g = shapely.intersection(geoms[k], box)
+        out.extend(p for p in shapely.get_parts(g) if p.geom_type == "Polygon" and p.area > 0)
+    return out
+
+
+def load_land(path) -> list:
+    """Polygons (lon/lat) of a GeoJSON file or a shapefile; one-line errors name the file."""
+    import shapely
+    import shapely.geometry
+
+    name = str(path)
+    p = Path(name)
+    if not p.is_file():
+        raise ConfigError(f"--land = {name!r}: no such file")
+    if p.suffix.lower() == ".shp":
+        try:
+            import shapefile  # pyshp
+        except ImportError:
+            raise ConfigError(f"--land = {name!r}: reading a shapefile needs pyshp (pip install pyshp); or "
+                              "give GeoJSON") from None
+        try:
+            geoms = [shapely.geometry.shape(s.__geo_interface__) for s in shapefile.Reader(name).shapes()]
+        except Exception as exc:
+            raise ConfigError(f"--land = {name!r}: cannot read the shapefile ({exc})") from None
+    else:
+        try:
+            data = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, ValueError) as exc:
+            raise ConfigError(f"--land = {name!r}: not GeoJSON ({str(exc).splitlines()[0][:120]})") from None
+        feats = data.get("features", [data]) if isinstance(data, dict) else []
+        geoms = []
+        for k, f in enumerate(feats if isinstance(feats, list) else []):
+            geom = f.get("geometry", f) if isinstance(f, dict) else None
+            if not isinstance(geom, dict) or geom.get("type") not in ("Polygon", "MultiPolygon"):
+                continue
+            try:
+                geoms.append(shapely.geometry.shape(geom))
+            except Exception as exc:
+                raise ConfigError(f"--land = {name!r}: feature {k}: not a polygon ({exc})") from None
+    polys = [g for geom in geoms for g in shapely.get_parts(shapely.make_valid(geom))
+             if g.geom_type == "Polygon" and g.area > 0]
+    if not polys:
+        raise ConfigError(f"--land = {name!r}: holds no Polygon or MultiPolygon")
+    for g in polys:
+        x0, y0, x1, y1 = g.bounds
+        if not (-180 <= x0 <= x1 <= 360 and -90 <= y0 <= y1 <= 90):
+            raise ConfigError(f"--land = {name!r}: coordinates must be [lon, lat] in degrees; found bounds "
+                              f"{g.bounds}")
+    return polys
+
+
+def region_polygons(x, y, value, level: float) -> list:
+    """Polygons (in the grid's x, y) of {value < level} with NaN counted as below: the filled level set
+    of the bilinear interpolant. ``value`` is (len(y), len(x))."""
+    import contourpy
+    import shapely
+
+    v = np.where(np.isfinite(value), value, level - 1e6)
+    if not np.any(v < level):
+        return []
+    # pad with an 'outside' border so the region closes along the grid's edges
+    xp = np.concatenate([[x[0] - 1e-9 * max(1.0, abs(x[0]))], x, [x[-1] + 1e-9 * max(1.0, abs(x[-1]))]])
+    yp = np.concatenate([[y[0] - 1e-9 * max(1.0, abs(y[0]))], y, [y[-1] + 1e-9 * max(1.0, abs(y[-1]))]])
+    vp = np.pad(v, 1, mode="edge")
+    gen = contourpy.contour_generator(xp, yp, vp, fill_type=contourpy.FillType.OuterOffset)
+    pts, offs = gen.filled(float(np.min(vp)) - 1.0, level)
+    polys = []
+    for p, o in zip(pts, offs, strict=True):
+        rings = [p[o[k]:o[k + 1]] for k in range(len(o) - 1)]
+        rings = [r for r in rings if len(r) >= 4]
+        if rings:
+            poly = shapely.make_valid(shapely.Polygon(rings[0], rings[1:]))
+            polys.extend(g for g in shapely.get_parts(poly) if g.geom_type == "Polygon" and g.area > 0)
+    return polys

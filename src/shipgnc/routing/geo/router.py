@@ -1,0 +1,536 @@
+"""Time-optimal routes on the WGS84 ellipsoid through CF-NetCDF currents, round land and shallow water.
+
+The problem in latitude/longitude is solved in the plane of :class:`~.projection.RouteProjection` (an
+oblique Mercator centred on the route, conformal, scale within 10⁻⁴ of one near the route) by the router of
+document 002 (:func:`~shipgnc.routing.router.solve_route`):
+
+1. the current is resampled onto a regular plane grid (bilinear in latitude/longitude, its vectors turned
+   from true north to grid north), a :class:`~shipgnc.routing.fields.GriddedCurrent` that keeps the file's
+   time axis (linear in time); NaN cells and cells outside the file are land;
+2. land (the GSHHG coastline, or ``land=`` polygons), shallow water (depth < draft + UKC) and the current's
+   NaN cells are polygons in the plane; the router keeps one level-set cell ``clearance`` off them;
+3. in open water the extremals (PMP) with the level-set global check; with land in the box, the level set
+   (frozen land cells) — the method that goes round any coastline;
+4. the optimal track is thinned to waypoints within ``xte_m`` of it (Douglas–Peucker, no leg across land)
+   and the waypoint route is re-timed on the ellipsoid: along each geodesic leg (Karney 2013) the ship
+   holds the leg's course with the crab angle of the true current, ground speed
+   c∥ + √(V² − c⊥²); ``time_s`` and every ETA are that sailed time.
+
+All public quantities are SI; positions (lat, lon) in degrees; times in seconds since 1970-01-01T00:00Z
+where the problem has a clock.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from dataclasses import field as dc_field
+
+import numpy as np
+
+from shipgnc.errors import ConfigError, require
+from shipgnc.routing.geo.projection import RouteProjection, geod
+from shipgnc.routing.geo.timefmt import iso
+from shipgnc.units import NAUTICAL_MILE
+
+#: the default cross-track tolerance of the waypoints [m]
+XTE_M = 100.0
+#: plane grid of the current: at most this many nodes a side
+MAX_FIELD_NODES = 260
+
+
+@dataclass
+class GeoCurrent:
+    """The true current over the ellipsoid: ``velocity(t, lat, lon) -> (..., 2)`` = (v_N, v_E) [m/s]."""
+
+    grid: object = None  #: a :class:`~.cf.GeoGrid` (NaN → 0 for sailing), or None
+    uniform: tuple[float, float] | None = None
+
+    def __post_init__(self):
+        if self.grid is not None:
+            self._filled = np.nan_to_num(self.grid.values, nan=0.0)
+
+    @property
+    def times(self):
+        return None if self.grid is None else self.grid.times
+
+    def velocity(self, t, lat, lon):
+        lat, lon = np.asarray(lat, float), np.asarray(lon, float)
+        shape = np.broadcast_shapes(lat.shape, lon.shape)
+        if self.grid is None:
+            c = self.uniform or (0.0, 0.0)
+            out = np.empty((*shape, 2))
+            out[..., 0], out[..., 1] = c
+            return out
+        g = self.grid
+        idx, w = g.weights(np.broadcast_to(lat, shape), np.broadcast_to(lon, shape))
+        if g.times is None or g.times.size == 1:
+            return g.bilinear(self._filled[0], idx, w).reshape(*shape, 2)
+        k, a = g.time_weights(float(t))
+        v0 = g.bilinear(self._filled[int(k)], idx, w)
+        v1 = g.bilinear(self._filled[int(k) + 1], idx, w)
+        return ((1 - a) * v0 + a * v1).reshape(*shape, 2)
+
+
+def crab_speed(c, azimuth_deg, speed):
+    """Ground speed [m/s] holding a course of ``azimuth_deg`` at ``speed`` through water in current c
+    (v_N, v_E): c∥ + √(V² − c⊥²); NaN where the course cannot be held."""
+    a = np.radians(azimuth_deg)
+    along = c[..., 0] * np.cos(a) + c[..., 1] * np.sin(a)
+    cross = -c[..., 0] * np.sin(a) + c[..., 1] * np.cos(a)
+    disc = speed**2 - cross**2
+    with np.errstate(invalid="ignore"):
+        sog = along + np.sqrt(disc)
+    return np.where((disc > 0) & (sog > 0), sog, np.nan)
+
+
+def sail_legs(current: GeoCurrent, speed, lats, lons, t_start, step_m=250.0):
+    """Sail the geodesic legs through the waypoints from ``t_start`` [s]: (elapsed [s] at each waypoint,
+    leg courses [deg], leg mean ground speeds [m/s], leg lengths [m]). Each leg is cut into pieces of at
+    most ``step_m``; on each the ground speed is the crab triangle's with the current at the piece's
+    middle at the time the ship is there."""
+    g = geod()
+    elapsed = [0.0]
+    courses, sogs, lengths = [], [], []
+    t = float(t_start)
+    for k in range(len(lats) - 1):
+        az, _, dist = g.inv(lons[k], lats[k], lons[k + 1], lats[k + 1])
+        n = max(1, math.ceil(dist / step_m))
+        pts = g.npts(lons[k], lats[k], lons[k + 1], lats[k + 1], n - 1) if n > 1 else []
+        lo = np.array([lons[k], *[p[0] for p in pts], lons[k + 1]])
+        la = np.array([lats[k], *[p[1] for p in pts], lats[k + 1]])
+        a12, _, d = g.inv(lo[:-1], la[:-1], lo[1:], la[1:])
+        mlo, mla, _ = g.fwd(lo[:-1], la[:-1], a12, np.asarray(d) / 2)
+        leg_t = 0.0
+        for j in range(len(d)):
+            c = current.velocity(t + leg_t, mla[j], mlo[j])
+            sog = float(crab_speed(np.asarray(c), a12[j], speed))
+            if not math.isfinite(sog):
+                return None
+            leg_t += d[j] / sog
+        t += leg_t
+        elapsed.append(elapsed[-1] + leg_t)
+        courses.append(float(az % 360.0))
+        sogs.append(float(dist / leg_t) if leg_t > 0 else float(speed))
+        lengths.append(float(dist))
+    return np.array(elapsed), courses, sogs, lengths
+
+
+@dataclass
+class GeoRoute:
+    """A route on the ellipsoid (or an explicit failure): the plane result plus waypoints and ETAs."""
+
+    plane: object  #: the :class:`~shipgnc.routing.result.RouteResult` in the projection
+    problem: GeoProblem
+    reachable: bool
+    time_s: float | None = None
+    depart_s: float | None = None  #: absolute departure [s since epoch] or None (no clock)
+    waypoints: list = dc_field(default_factory=list)  #: dicts of :mod:`~.writers`
+    track: np.ndarray | None = None  #: dense optimal track (n, 2) (lat, lon)
+    distance_m: float | None = None
+    land_clear: bool | None = None
+    notes: list = dc_field(default_factory=list)
+
+    @property
+    def eta_s(self):
+        if not self.reachable or self.depart_s is None:
+            return None
+        return self.depart_s + self.time_s
+
+    def to_json(self) -> dict:
+        js = self.plane.to_json()
+        pr = self.problem
+        plane_time = js.get("time_s")
+        for key in ("heading_start_deg", "heading_end_deg"):  # grid headings → true headings
+            if js.get(key) is not None:
+                js[key] = float((js[key] - pr.grid_north_deg(key == "heading_start_deg")) % 360.0)
+        js.update({
+            "reachable": bool(self.reachable),
+            "time_s": None if self.time_s is None else float(self.time_s),
+            "time_h": None if self.time_s is None else float(self.time_s / 3600.0),
+            "distance_nm": None if self.distance_m is None else self.distance_m / NAUTICAL_MILE,
+            "eta": None if self.eta_s is None else iso(self.eta_s),
+            "depart": None if self.depart_s is None else iso(self.depart_s),
+            "waypoints": [[w["lat"], w["lon"], None if w["eta_s"] is None else iso(w["eta_s"])]
+                          for w in self.waypoints],
+            "start": list(pr.start), "target": list(pr.target),
+            "geodesic_nm": pr.projection.geodesic_m / NAUTICAL_MILE,
+            "speed_mps": pr.speed, "xte_m": pr.xte_m, "clearance_m": pr.clearance,
+            "plane_time_s": plane_time,
+            "land_clear": self.land_clear,
+            "projection": pr.projection.proj4,
+            "notes": [*pr.notes, *js["notes"], *self.notes],
+        })
+        if self.depart_s is not None:
+            js["t0_s"] = float(self.depart_s)
+        return js
+
+
+class GeoProblem:
+    """A routing problem in latitude/longitude, projected once (see the module docstring); :meth:`solve`
+    for one departure, as often as wanted (a departure scan)."""
+
+    def __init__(self, start, target, speed, *, current=None, land="default", depth=None, draft=0.0,
+                 ukc=0.0, grid=None, margin=None, xte_m=XTE_M, clearance=None):
+        from shipgnc.routing.geo import cf
+
+        for name, p in (("--start", start), ("--target", target)):
+            ok = len(p) == 2 and all(math.isfinite(v) for v in p) and -90 < p[0] < 90 and -180 <= p[1] <= 360
+            require(ok, name, list(p), "must be LAT,LON in decimal degrees (WGS84), |lat| < 90")
+        require(math.isfinite(speed) and speed > 0, "--speed", speed, "must be a finite speed > 0")
+        require(math.isfinite(xte_m) and xte_m > 0, "--xte-m", xte_m, "must be a cross-track tolerance > 0 m")
+        require(math.isfinite(draft) and draft >= 0, "--draft", draft, "must be >= 0 m")
+        require(math.isfinite(ukc) and ukc >= 0, "--ukc", ukc, "must be >= 0 m")
+        self.start, self.target = (float(start[0]), float(start[1])), (float(target[0]), float(target[1]))
+        self.speed, self.xte_m, self.notes = float(speed), float(xte_m), []
+        proj = self.projection = RouteProjection(self.start, self.target)
+        self.notes.append(f"projection: {proj.describe()}")
+        A = np.array(proj.to_plane(*self.start), float)
+        B = np.array(proj.to_plane(*self.target), float)
+        self.A, self.B = A, B
+        dist = float(np.hypot(*(B - A)))
+        require(proj.geodesic_m <= 2_500 * NAUTICAL_MILE, "--target", list(target),
+                f"is {proj.geodesic_m / NAUTICAL_MILE:.0f} nm from the start; routes up to 2500 nm")
+        m = max(0.5 * dist, 10_000.0) if margin is None else float(margin)
+        self.box = ((min(A[0], B[0]) - m, max(A[0], B[0]) + m), (min(A[1], B[1]) - m, max(A[1], B[1]) + m))
+        size = max(self.box[0][1] - self.box[0][0], self.box[1][1] - self.box[1][0])
+        self.h = float(grid) if grid is not None else size / 200.0
+        require(math.isfinite(self.h) and self.h > 0, "--grid", grid, "must be a spacing > 0")
+        self.clearance = self.h if clearance is None else float(clearance)
+        # ---- the current
+        if current is None:
+            current = GeoCurrent(uniform=(0.0, 0.0))
+        elif isinstance(current, tuple):
+            current = GeoCurrent(uniform=(float(current[0]), float(current[1])))
+        elif not isinstance(current, GeoCurrent):
+            current = GeoCurrent(grid=cf.read_current(current))
+        self.current = current
+        if current.grid is not None:
+            self.notes.extend(current.grid.notes)
+            for name, p in (("start", self.start), ("target", self.target)):
+                if not bool(current.grid.covers(*p)):
+                    raise ConfigError(f"{current.grid.path}: the route's {name} ({p[0]:.4f}, {p[1]:.4f}) lies "
+                                      f"outside the file's coverage {current.grid.extent}")
+        self._plane_field(current)
+        # ---- obstacles
+        self._obstacles(land, depth, draft, ukc)
+
+    # ------------------------------------------------------------------ set-up
+    def _plane_nodes(self, spacing):
+        (n0, n1), (e0, e1) = self.box
+        nn = np.linspace(n0, n1, max(3, min(MAX_FIELD_NODES, math.ceil((n1 - n0) / spacing) + 1)))
+        ee = np.linspace(e0, e1, max(3, min(MAX_FIELD_NODES, math.ceil((e1 - e0) / spacing) + 1)))
+        return nn, ee
+
+    def _plane_field(self, current: GeoCurrent):
+        import xarray as xr
+
+        from shipgnc.routing.fields import GriddedCurrent
+
+        grid = current.grid
+        spacing = self.h if grid is None else min(grid.spacing_m() / 1.5, self.h)
+        nn, ee = self._plane_nodes(max(spacing, 100.0))
+        self._nodes = (nn, ee)
+        N, E = np.meshgrid(nn, ee, indexing="ij")
+        lat, lon = self.projection.to_geo(N.ravel(), E.ravel())
+        one = np.ones(lat.size)
+        cn, ce = self.projection.rotate(lat, lon, one, 0 * one)  # true north in the plane
+        self._grid_north = (nn, ee, np.degrees(np.arctan2(ce, cn)).reshape(N.shape))
+        if grid is None:
+            from shipgnc.routing.fields import AffineCurrent, UniformCurrent
+
+            vn, ve = current.uniform
+            v = np.column_stack(self.projection.rotate(lat, lon, vn * one, ve * one))
+            # the uniform current turned by the meridian convergence is affine in the plane to
+            # first order: fitted by least squares, its residual reported
+            ref = (0.5 * (nn[0] + nn[-1]), 0.5 * (ee[0] + ee[-1]))
+            X = np.column_stack([one, N.ravel() - ref[0], E.ravel() - ref[1]])
+            coef, *_ = np.linalg.lstsq(X, v, rcond=None)
+            resid = float(np.max(np.hypot(*(X @ coef - v).T)))
+            self.field = UniformCurrent(0.0, 0.0) if not (vn or ve) else AffineCurrent((float(coef[0, 0]), float(coef[0, 1])),
+                                       ((float(coef[1, 0]), float(coef[2, 0])), (float(coef[1, 1]), float(coef[2, 1]))),
+                                       ref)
+            self.field_spacing = float(nn[1] - nn[0])
+            self.wet = np.ones(N.shape)
+            if vn or ve:
+                self.notes.append(f"uniform current ({vn:g}, {ve:g}) m/s true north/east; in the plane turned by "
+                                  f"the meridian convergence, an affine field (fit residual {resid:.1e} m/s)")
+            return
+        idx, w = grid.weights(lat, lon)
+        v = grid.bilinear(np.nan_to_num(grid.values, nan=0.0), idx, w)  # (time, n, 2) true
+        wet = grid.bilinear(np.all(np.isfinite(grid.values), axis=(0, -1)).astype(float)[..., None],
+                            idx, w)[:, 0]
+        wet = np.where(grid.covers(lat, lon), wet, 0.0)
+        self.wet = wet.reshape(N.shape)
+        rn = cn * v[..., 0] - ce * v[..., 1]  # rotate (n, e) by the grid angle (cn, ce)
+        re = ce * v[..., 0] + cn * v[..., 1]
+        v = np.stack([rn, re], axis=-1)
+        times = grid.times
+        data = v.reshape(v.shape[0], *N.shape, 2)
+        dims = ("north", "east")
+        coords = {"north": nn, "east": ee}
+        if times is not None and times.size > 1:
+            dims = ("time", *dims)
+            coords["time"] = times
+            arrays = {"current_north": (dims, data[..., 0]), "current_east": (dims, data[..., 1])}
+        else:
+            arrays = {"current_north": (dims, data[0, ..., 0]), "current_east": (dims, data[0, ..., 1])}
+        self.field = GriddedCurrent(xr.Dataset(arrays, coords=coords))
+        self.field_spacing = float(nn[1] - nn[0])
+
+    def grid_north_deg(self, at_start: bool) -> float:
+        nn, ee, ang = self._grid_north
+        p = self.A if at_start else self.B
+        i = int(np.argmin(np.abs(nn - p[0])))
+        j = int(np.argmin(np.abs(ee - p[1])))
+        return float(ang[i, j])
+
+    def _obstacles(self, land, depth, draft, ukc):
+        import shapely
+
+        from shipgnc.routing.geo import cf
+        from shipgnc.routing.geo.land import coastline, load_land, region_polygons
+
+        proj = self.projection
+        (n0, n1), (e0, e1) = self.box
+        bn = np.concatenate([np.linspace(n0, n1, 50), np.full(50, n1), np.linspace(n1, n0, 50), np.full(50, n0)])
+        be = np.concatenate([np.full(50, e0), np.linspace(e0, e1, 50), np.full(50, e1), np.linspace(e1, e0, 50)])
+        blat, blon = proj.to_geo(bn, be)
+        pad = 0.05
+        self.geo_box = (float(blon.min() - pad), float(blat.min() - pad), float(blon.max() + pad),
+                        float(blat.max() + pad))
+        geo_polys, kinds = [], []
+        if isinstance(land, (list, tuple)):
+            geo_polys += list(land)
+            kinds.append("land polygons given")
+        elif land in (None, "none"):
+            pass
+        elif land == "default":
+            polys = coastline(*self.geo_box)
+            geo_polys += polys
+            kinds.append("GSHHG full-resolution coastline (roaring-landmask)")
+        else:
+            geo_polys += load_land(land)
+            kinds.append(f"land from {land}")
+        if depth is not None:
+            dg = cf.read_depth(depth)
+            self.notes.extend(dg.notes)
+            for name, p in (("start", self.start), ("target", self.target)):
+                if not bool(dg.covers(*p)):
+                    raise ConfigError(f"{dg.path}: the route's {name} ({p[0]:.4f}, {p[1]:.4f}) lies outside the "
+                                      f"depth grid's coverage {dg.extent}")
+            limit = draft + ukc
+            shallow = region_polygons(dg.lon, dg.lat, dg.values[0], limit)
+            geo_polys += shallow
+            kinds.append(f"water shallower than draft + UKC = {limit:g} m from {dg.path}")
+            self.notes.append(f"depth grid {dg.path}: outside its coverage {dg.extent} the depth is unknown "
+                              "and not checked")
+        self.land_geo = [p for p in geo_polys if p.intersects(shapely.box(*self.geo_box))]
+        to_plane = self._to_plane_geom
+        plane = [to_plane(p) for p in self.land_geo]
+        nn, ee = self._nodes
+        if self.current.grid is not None and np.any(self.wet < 0.5):
+            nan_polys = [shapely.Polygon(np.asarray(p.exterior.coords)[:, ::-1],
+                                         [np.asarray(r.coords)[:, ::-1] for r in p.interiors])
+                         for p in region_polygons(ee, nn, self.wet, 0.5)]
+            # region_polygons works in (x, y) = (east, north); flip to (north, east)
+            plane += nan_polys
+            kinds.append(f"NaN cells and the outside of {self.current.grid.path}")
+        self.land_kinds = kinds
+        box = shapely.box(n0, e0, n1, e1)
+        union = shapely.union_all([shapely.make_valid(p) for p in plane]) if plane else shapely.Polygon()
+        union = shapely.intersection(union, box.buffer(4 * self.clearance))
+        self.hard = union  # the obstacles themselves, (north, east) m
+        shapely.prepare(self.hard)
+        for name, p, q in (("start", self.A, self.start), ("target", self.B, self.target)):
+            if not self.hard.is_empty and self.hard.contains(shapely.Point(p)):
+                what = ", ".join(kinds) if kinds else "an obstacle"
+                raise ConfigError(f"--{name} = {q[0]:.5f},{q[1]:.5f}: on land or in water too shallow "
+                                  f"({what})")
+        if self.hard.is_empty:
+            self.router_obstacles = []
+            return
+        soft = self.hard.simplify(self.clearance / 10).buffer(self.clearance, quad_segs=2)
+        soft = soft.difference(shapely.Point(self.A).buffer(1.5 * self.clearance))
+        soft = soft.difference(shapely.Point(self.B).buffer(1.5 * self.clearance))
+        soft = shapely.intersection(soft, box).simplify(self.clearance / 8)
+        self.router_obstacles = [g for g in shapely.get_parts(soft)
+                                 if g.geom_type == "Polygon" and g.area > 0 and g.is_valid]
+        self.notes.append(f"land/shallow water: {'; '.join(kinds)}; the router keeps {self.clearance:.0f} m "
+                          "(one level-set cell) off it")
+
+    def _to_plane_geom(self, geom):
+        import shapely
+
+        def f(xy):
+            n, e = self.projection.to_plane(xy[:, 1], xy[:, 0])
+            return np.column_stack([n, e])
+
+        return shapely.make_valid(shapely.transform(geom, f))
+
+    # ------------------------------------------------------------------ solving
+    def departure(self, depart_s=None, offset_s=0.0):
+        """The absolute departure [s since epoch] or None; a time axis bounds it (errors name the file)."""
+        times = self.current.times
+        if depart_s is None:
+            if times is None:
+                return None
+            depart_s = float(times[0]) + float(offset_s)
+        if times is not None and times.size > 1 and not times[0] <= depart_s <= times[-1]:
+            raise ConfigError(f"{self.current.grid.path}: the departure {iso(depart_s)} lies outside the file's "
+                              f"time coverage {self.current.grid.time_extent()}")
+        return float(depart_s)
+
+    def field_from(self, depart_s):
+        """The plane current on the clock of a departure: t = 0 at ``depart_s`` (the plane problem always
+        starts at t₀ = 0; its time axis is the file's shifted by the departure)."""
+        import copy
+
+        times = getattr(self.field, "times", None)
+        if depart_s is None or times is None or times.size == 1:
+            return self.field
+        fld = copy.copy(self.field)
+        fld.times = self.field.times - float(depart_s)
+        return fld
+
+    def solve(self, depart_s=None, *, method="auto", horizon=None, global_check=None, **kw) -> GeoRoute:
+        """The route for a departure [s since epoch, or None without a clock]. With land in the box, or a
+        gridded current (``method`` auto/levelset), the level set of :mod:`.frontier` (the global method);
+        otherwise :func:`~shipgnc.routing.router.solve_route` (``method``; ``kw`` passed on)."""
+        from shipgnc.routing.router import solve_route
+
+        fld = self.field_from(depart_s)
+        notes = []
+        if horizon is None:
+            horizon = 4.0 * float(np.hypot(*(self.B - self.A))) / self.speed
+        gridded = self.current.grid is not None
+        if self.router_obstacles or (gridded and method in ("auto", "levelset")):
+            if method not in ("auto", "levelset"):
+                notes.append(f"--method {method}: land in the route's box; the level set is used")
+            res = self._round_land(fld, horizon, notes)
+        else:
+            res = solve_route(fld, self.speed, self.A, self.B, t0=0.0, method=method, horizon=horizon,
+                              grid_spacing=self.h, domain=self.box, global_check=global_check, **kw)
+        out = GeoRoute(res, self, False, depart_s=depart_s, notes=notes)
+        if not res.reachable:
+            out.notes.append(f"unreachable: {res.reason}")
+            return out
+        self._finish(out)
+        return out
+
+    def _round_land(self, fld, horizon, notes):
+        from shipgnc.routing.geo.frontier import reach_round_land
+        from shipgnc.routing.result import RouteResult
+
+        ls, frozen = reach_round_land(fld, self.speed, self.A, self.B, self.box, self.h,
+                                      self.router_obstacles, horizon=horizon)
+        res = RouteResult(False, self.A, self.B, self.speed, t0=0.0, method="levelset", field=fld)
+        res.isochrones, res.grid_spacing = ls, ls.spacing
+        if frozen.any():
+            notes.append(f"land or shallow water in the route's box ({100 * frozen.mean():.0f} % of the "
+                         f"level-set cells): the level set with land cells frozen, φ clipped to a band "
+                         f"(docs/routing_geo.md), grid {self.h:.0f} m")
+        else:
+            notes.append(f"gridded current: the level set (global method), grid {self.h:.0f} m")
+        if ls.arrival is None:
+            res.reason = (f"target not reachable round the land within {horizon:.0f} s ({horizon / 3600:.1f} h) "
+                          f"at {self.speed:.3f} m/s: the front's closest approach is {ls.closest_approach:.0f} m")
+            res.closest_approach_m = ls.closest_approach
+            return res
+        r = ls.route
+        res.reachable, res.time_s = True, float(ls.arrival)
+        res.heading_start, res.heading_end, res.miss_m, res.path = r.heading_start, r.heading_end, r.miss, r
+        res.global_check = {"method": "levelset", "time_s": float(ls.arrival), "rel_diff": 0.0}
+        return res
+
+    def _finish(self, out: GeoRoute):
+        import shapely
+
+        res = out.plane
+        length = res.speed * res.time_s * 2
+        n = int(min(max(400, length / 200.0), 20000))
+        _t, north, east, _ = res.sample(n)
+        xy = np.column_stack([north, east])
+        lat, lon = self.projection.to_geo(north, east)
+        out.track = np.column_stack([lat, lon])
+        hard = self.hard
+
+        def leg_ok(i, j):
+            if hard.is_empty:
+                return True
+            return not hard.intersects(shapely.LineString([xy[i], xy[j]]))
+
+        idx = [int(k) for k in np_thin(xy, self.xte_m, leg_ok)]
+        lat_w = [float(lat[k]) for k in idx]
+        lon_w = [float(lon[k]) for k in idx]
+        lat_w[0], lon_w[0] = self.start
+        lat_w[-1], lon_w[-1] = self.target
+        t_start = out.depart_s if out.depart_s is not None else 0.0
+        sailed = sail_legs(self.current, self.speed, lat_w, lon_w, t_start)
+        if sailed is None:
+            out.notes.append("a thinned leg cannot be held against the cross current; waypoints are the "
+                             "dense track")
+            idx = list(range(len(xy)))
+            lat_w, lon_w = list(map(float, lat)), list(map(float, lon))
+            sailed = sail_legs(self.current, self.speed, lat_w, lon_w, t_start)
+            if sailed is None:
+                out.reachable = False
+                out.notes.append("the track cannot be sailed on the ellipsoid (cross current above the "
+                                 "ship's speed)")
+                return
+        elapsed, courses, sogs, lengths = sailed
+        wps = []
+        for k in range(len(lat_w)):
+            wps.append({"name": f"WP{k + 1:03d}", "lat": lat_w[k], "lon": lon_w[k],
+                        "elapsed_s": float(elapsed[k]),
+                        "eta_s": None if out.depart_s is None else out.depart_s + float(elapsed[k]),
+                        "course_deg": courses[k] if k < len(courses) else None,
+                        "sog_mps": sogs[k] if k < len(sogs) else None})
+        out.waypoints = wps
+        out.reachable, out.time_s, out.distance_m = True, float(elapsed[-1]), float(sum(lengths))
+        out.land_clear = self.legs_clear(lat_w, lon_w)
+        rel = (out.time_s - res.time_s) / res.time_s if res.time_s else 0.0
+        dist_k = self.projection.distortion(lat, lon)
+        out.notes.append(f"projection scale over the route within {dist_k:.1e} of one (|k − 1| max)")
+        out.notes.append(f"{len(wps)} waypoints within {self.xte_m:g} m of the optimal track; sailed on the "
+                         f"ellipsoid along geodesic legs: {out.time_s:.0f} s, the plane solution "
+                         f"{res.time_s:.0f} s ({100 * rel:+.3f} %)")
+        times = self.current.times
+        if out.depart_s is not None and times is not None and times.size > 1 and out.eta_s > times[-1]:
+            out.notes.append(f"arrival {iso(out.eta_s)} after the current file's last time "
+                             f"{iso(times[-1])}: its last field is held")
+        if out.land_clear is False:
+            out.notes.append("WARNING: a waypoint leg meets land or shallow water; refine --grid")
+
+    def legs_clear(self, lats, lons, step_m=100.0) -> bool | None:
+        """Do the geodesic legs, sampled every ``step_m``, stay off every obstacle polygon?"""
+        import shapely
+
+        if self.hard.is_empty:
+            return True
+        g = geod()
+        for k in range(len(lats) - 1):
+            _, _, d = g.inv(lons[k], lats[k], lons[k + 1], lats[k + 1])
+            m = max(0, math.ceil(d / step_m) - 1)
+            pts = g.npts(lons[k], lats[k], lons[k + 1], lats[k + 1], m) if m else []
+            lo = np.array([lons[k], *[p[0] for p in pts], lons[k + 1]])
+            la = np.array([lats[k], *[p[1] for p in pts], lats[k + 1]])
+            n, e = self.projection.to_plane(la, lo)
+            if self.hard.intersects(shapely.LineString(np.column_stack([n, e]))):
+                return False
+        return True
+
+
+def np_thin(xy, tol, leg_ok):
+    from shipgnc.routing.geo.thin import thin
+
+    return thin(xy, tol, leg_ok)
+
+
+def scan_departures(problem: GeoProblem, departures, **kw) -> list[GeoRoute]:
+    """Solve the problem for every departure [s since epoch]: the time-optimal departure is the one with
+    the shortest ``time_s`` (or the earliest ``eta_s``, as wanted)."""
+    return [problem.solve(float(t), **kw) for t in departures]
+
+
+__all__ = ["XTE_M", "GeoCurrent", "GeoProblem", "GeoRoute", "crab_speed", "sail_legs", "scan_departures"]

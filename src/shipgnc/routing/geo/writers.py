@@ -1,0 +1,103 @@
+"""Routes out for chart plotters and ECDIS.
+
+* GPX 1.1 (Topografix, https://www.topografix.com/GPX/1/1/) — one ``<rte>`` whose ``<rtept>`` carry each
+  waypoint's ETA in ``<time>``; written with ``gpxpy``.
+* GeoJSON (RFC 7946) — a LineString through the waypoints and one Point feature per waypoint with its
+  ETA, course and speed over ground of the leg that leaves it.
+* RTZ 1.1 (IEC 61174:2015 Annex S, namespace ``http://www.cirm.org/RTZ/1/1``) — ``routeInfo``,
+  ``waypoints/waypoint`` with ``position`` and ``leg``, and a ``schedules/schedule/calculated`` with one
+  ``scheduleElement`` per waypoint (``etd`` at the first, ``eta`` at the others).
+
+A waypoint is a dict with ``lat``, ``lon`` [deg], ``eta_s`` [s since the epoch, or None], ``course_deg``,
+``sog_mps`` (of the leg leaving it; None at the last) and ``name``.
+"""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+
+from shipgnc.routing.geo.timefmt import iso, to_datetime
+from shipgnc.units import KNOT, NAUTICAL_MILE
+
+RTZ_NS = "http://www.cirm.org/RTZ/1/1"
+
+
+def write_gpx(path, waypoints, name="shipgnc time-optimal route", description="") -> None:
+    import gpxpy.gpx
+
+    gpx = gpxpy.gpx.GPX()
+    gpx.creator = "shipgnc"
+    rte = gpxpy.gpx.GPXRoute(name=name, description=description or None)
+    for w in waypoints:
+        pt = gpxpy.gpx.GPXRoutePoint(w["lat"], w["lon"], name=w["name"],
+                                     time=None if w["eta_s"] is None else to_datetime(w["eta_s"]))
+        if w.get("sog_mps") is not None:
+            pt.comment = f"COG {w['course_deg']:.1f} deg, SOG {w['sog_mps'] / KNOT:.2f} kn"
+        rte.points.append(pt)
+    gpx.routes.append(rte)
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(gpx.to_xml(version="1.1"))
+
+
+def geojson(waypoints, properties=None) -> dict:
+    line = {"type": "Feature", "geometry": {"type": "LineString",
+                                            "coordinates": [[w["lon"], w["lat"]] for w in waypoints]},
+            "properties": {"kind": "route", **(properties or {})}}
+    feats = [line]
+    for w in waypoints:
+        feats.append({"type": "Feature", "geometry": {"type": "Point", "coordinates": [w["lon"], w["lat"]]},
+                      "properties": {"kind": "waypoint", "name": w["name"],
+                                     "eta": None if w["eta_s"] is None else iso(w["eta_s"]),
+                                     "elapsed_s": w["elapsed_s"], "course_deg": w["course_deg"],
+                                     "speed_over_ground_mps": w["sog_mps"],
+                                     "speed_over_ground_kn": None if w["sog_mps"] is None
+                                     else w["sog_mps"] / KNOT}})
+    return {"type": "FeatureCollection", "features": feats}
+
+
+def write_geojson(path, waypoints, properties=None) -> None:
+    with open(path, "w", encoding="utf-8") as fh:
+        json.dump(geojson(waypoints, properties), fh, indent=1)
+        fh.write("\n")
+
+
+def write_rtz(path, waypoints, name="shipgnc time-optimal route", xte_m=100.0, speed_mps=None) -> None:
+    ET.register_namespace("", RTZ_NS)
+
+    def q(tag):
+        return f"{{{RTZ_NS}}}{tag}"
+
+    root = ET.Element(q("route"), {"version": "1.1"})
+    info = {"routeName": name, "routeAuthor": "shipgnc",
+            "routeStatus": "Planned by a time-optimal router; check against official charts before use"}
+    if waypoints and waypoints[0]["eta_s"] is not None:
+        info["validityPeriodStart"] = iso(waypoints[0]["eta_s"])
+        info["validityPeriodStop"] = iso(waypoints[-1]["eta_s"])
+    ET.SubElement(root, q("routeInfo"), info)
+    wps = ET.SubElement(root, q("waypoints"))
+    xtd = f"{xte_m / NAUTICAL_MILE:.4f}"
+    default = ET.SubElement(wps, q("defaultWaypoint"), {"radius": "0.1"})
+    ET.SubElement(default, q("leg"), {"starboardXTD": xtd, "portXTD": xtd, "geometryType": "Orthodrome"})
+    for k, w in enumerate(waypoints, start=1):
+        el = ET.SubElement(wps, q("waypoint"), {"id": str(k), "name": w["name"], "revision": "0"})
+        ET.SubElement(el, q("position"), {"lat": f"{w['lat']:.8f}", "lon": f"{w['lon']:.8f}"})
+        if k > 1:  # the leg arriving at this waypoint
+            prev = waypoints[k - 2]
+            leg = {"starboardXTD": xtd, "portXTD": xtd, "geometryType": "Orthodrome"}
+            if prev.get("sog_mps") is not None:
+                leg["speedPlanned"] = f"{prev['sog_mps'] / KNOT:.2f}"
+            ET.SubElement(el, q("leg"), leg)
+    if waypoints and waypoints[0]["eta_s"] is not None:
+        sch = ET.SubElement(ET.SubElement(root, q("schedules")), q("schedule"),
+                            {"id": "1", "name": "time-optimal"})
+        calc = ET.SubElement(sch, q("calculated"))
+        for k, w in enumerate(waypoints, start=1):
+            attrs = {"waypointId": str(k)}
+            attrs["etd" if k == 1 else "eta"] = iso(w["eta_s"])
+            if w.get("sog_mps") is not None:
+                attrs["speed"] = f"{w['sog_mps'] / KNOT:.2f}"
+            ET.SubElement(calc, q("scheduleElement"), attrs)
+    tree = ET.ElementTree(root)
+    ET.indent(tree)
+    tree.write(path, encoding="UTF-8", xml_declaration=True)

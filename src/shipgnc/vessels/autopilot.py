@@ -1,0 +1,90 @@
+"""A heading autopilot for catalogue vessels: PID on the heading error with the trim rudder.
+
+    δ_c = δ₀ − K_P wrap(ψ − ψ_d) − K_D r − K_I ∫ wrap(ψ − ψ_d) dt,     |δ_c| ≤ δ_max
+
+(Fossen 2021, §15.3: PID heading autopilot; the signs are those of a vessel whose positive rudder
+turns the bow to starboard, as every catalogue vessel's). δ₀ is the trim rudder of steady
+straight running (the ``delta`` of ``model.straight_state()``), a feed-forward of the constant
+side-force terms some models have (the Mariner's Y₀, N₀). The integral runs only while the command
+is within the rudder limit (conditional integration, no wind-up). Further inputs of the vessel
+(e.g. the KVLCC2's propeller command ``n_c``) are held at ``hold``.
+
+Reads the catalogue state layout (``psi`` at index 2, ``r`` at 5; :mod:`shipgnc.vessels.base`)
+and the reference ``psi_d`` (e.g. :class:`~shipgnc.guidance.schedule.CourseSchedule`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from shipgnc.errors import require
+from shipgnc.frames import wrap_angle
+from shipgnc.kernels import Kernel, flat, kernel_function, wrap
+from shipgnc.models.base import Signal
+
+
+class HeadingAutopilot:
+    """PID heading autopilot (module docstring), sampled every ``Ts`` seconds."""
+
+    continuous = False
+    reference_names = ("psi_d",)
+    signals: tuple[Signal, ...] = ()
+
+    def __init__(self, Kp: float, Kd: float, Ki: float = 0.0, *, Ts: float, delta_max: float,
+                 trim: float = 0.0, hold=()):
+        for name, value in (("Kp", Kp), ("Kd", Kd), ("Ki", Ki)):
+            require(isinstance(value, (int, float)) and math.isfinite(value) and value >= 0,
+                    f"controller.{name}", value, "must be a finite number >= 0")
+        require(isinstance(Ts, (int, float)) and math.isfinite(Ts) and Ts > 0, "controller.Ts",
+                Ts, "must be > 0 s")
+        require(0 < delta_max <= math.pi / 2, "controller.delta_max", delta_max,
+                "need 0 < delta_max <= pi/2 rad")
+        self.Kp, self.Kd, self.Ki = float(Kp), float(Kd), float(Ki)
+        self.Ts, self.delta_max, self.trim = float(Ts), float(delta_max), float(trim)
+        self.hold = tuple(float(h) for h in hold)
+        self._z = np.zeros(())
+
+    def reset(self, batch_shape) -> None:
+        self._z = np.zeros(tuple(batch_shape))
+
+    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        e = wrap_angle(measurement[..., 2] - reference[..., 0])
+        raw = self.trim - self.Kp * e - self.Kd * measurement[..., 5] - self.Ki * self._z
+        delta_c = np.clip(raw, -self.delta_max, self.delta_max)
+        if self.Ki:
+            self._z = np.where(raw == delta_c, self._z + self.Ts * e, self._z)
+        parts = [delta_c] + [np.full_like(delta_c, h) for h in self.hold]
+        return np.stack(parts, axis=-1)
+
+    def signal_values(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`step` for the composed loop (:func:`heading_autopilot_step`); the integral is
+        the per-ship state."""
+        state = np.broadcast_to(self._z, tuple(batch_shape)).reshape(-1, 1)
+
+        def restore(z):
+            self._z = np.asarray(z[:, 0]).reshape(tuple(batch_shape)).copy()
+
+        return Kernel(heading_autopilot_step,
+                      flat(self.Kp, self.Kd, self.Ki, self.trim, self.delta_max, self.Ts,
+                           len(self.hold), *self.hold),
+                      state, restore=restore)
+
+
+@kernel_function
+def heading_autopilot_step(t, x, ref, z, p, cmd, sig):
+    """:meth:`HeadingAutopilot.step` for one ship; p = [K_P, K_D, K_I, δ₀, δ_max, Ts, n_hold,
+    hold...], z = [∫e dt]."""
+    e = wrap(x[2] - ref[0])
+    raw = p[3] - p[0] * e - p[1] * x[5] - p[2] * z[0]
+    dmax = p[4]
+    delta_c = min(max(raw, -dmax), dmax)
+    if p[2] != 0.0 and raw == delta_c:
+        z[0] = z[0] + p[5] * e
+    cmd[0] = delta_c
+    for j in range(int(p[6])):
+        cmd[1 + j] = p[7 + j]
