@@ -50,11 +50,21 @@ _LITERAL = re.compile(r"(``.*?``|:[a-z:]+:`[^`]*`)")
 _SHAPE_STAR = re.compile(r"(\(|, )\*(?=[A-Za-z_])")  # (*batch, *t.shape)
 
 
+_LITERAL_GLUED = re.compile(r"(``[^`]+``)(?=[^\s.,;:!?)\]}'\"/\\–—-])")  # ``bias_std``² needs an escaped space
+_LONE_STRONG = re.compile(r"\*\*(?=[A-Za-z_])")                               # **params in a signature
+
+
 def _escape_plain_maths(app, what, name, obj, options, lines):
     for i, line in enumerate(lines):
         parts = _LITERAL.split(line)
-        lines[i] = "".join(part if j % 2 else _SHAPE_STAR.sub(r"\1\\*", part.replace("|", "\\|"))
-                           .replace("_\\|", "\\_\\|") for j, part in enumerate(parts))
+        out = []
+        for j, part in enumerate(parts):
+            if j % 2 == 0:
+                part = _SHAPE_STAR.sub(r"\1\\*", part.replace("|", "\\|")).replace("_\\|", "\\_\\|")
+                if part.count("**") % 2:                                   # not bold: **kwargs
+                    part = _LONE_STRONG.sub(r"\\*\\*", part)
+            out.append(part)
+        lines[i] = _LITERAL_GLUED.sub(r"\1\\ ", "".join(out))
 
 
 def setup(app):

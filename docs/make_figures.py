@@ -38,6 +38,7 @@ SETS = {
                    "catamaran-fig4-5-fixed.png", "catamaran-fig7-sine.png", "catamaran-fig8-heading.png",
                    "catamaran-characteristic.png")),
     "study": ("make_figures:study_figure", ("study-boat-autopilot.png",)),
+    "routing-geo": ("shipgnc.routing.geo.figures:document_figure", ("routing-geo-channel.png",)),
     "cybership-analysis": ("cybership_analysis:figure", ("cybership-analysis.png",)),
     "trials": ("shipgnc.trials.figures:document_figures",
                tuple(f"trials-{v}-{w}.png" for v in ("mariner", "kvlcc2")

@@ -188,3 +188,17 @@ def test_yaml_merge_keys_still_work_and_may_be_overridden(tmp_path):
     path.write_text(BOAT.replace("simulation: {dt: 0.05, t_end: 1.0}",
                                  "simulation: {<<: {dt: 0.05, t_end: 2.0}, t_end: 1.0}"))
     assert load_scenario(str(path)).simulation.t_end == 1.0
+
+
+def test_a_reader_that_leaves_early_is_not_an_internal_error():
+    """`shipgnc vessels --json | true`: the pipe closes under the writer; the command stops
+    quietly with the shell's SIGPIPE status (128 + 13), not an "internal error" line."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "shipgnc", "vessels", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # the reader leaves before the command (still importing) writes a byte
+    stderr = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 141
+    assert "internal error" not in stderr

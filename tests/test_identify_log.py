@@ -48,8 +48,9 @@ def _frigate():
     return model, act, np.zeros(4)
 
 
-def test_frigate_source_is_reported():
-    """Switch: this file uses the catalogue's 'frigate' once shipgnc.vessels has it."""
+def test_frigate_switches_to_the_catalogue_entry_when_it_exists():
+    """Switch: the frigate checks use shipgnc.vessels' 'frigate' once the catalogue has it, else
+    the same published Norrbin model built here (delete the fallback when the entry lands)."""
     from shipgnc.vessels import VESSELS
 
     model, _, _ = _frigate()
@@ -178,12 +179,16 @@ def test_confidence_intervals_cover_the_truth_in_a_seeded_monte_carlo():
 
 
 def test_written_vessel_yaml_loads_and_resimulates_the_fit(frigate_fit, linear_fit, tmp_path):
-    """vessel.yaml → yaml → the catalogue's model → the logged rudder: the fitted response."""
+    """vessel.yaml → yaml → the scenario schema and the catalogue's model → the logged rudder:
+    the fitted response."""
+    from shipgnc.scenarios.schema import CatalogueVesselConfig
+
     for ident in (frigate_fit, linear_fit[0]):
         path = tmp_path / f"{ident.model}.yaml"
         path.write_text(vessel_yaml(ident, source="test"), encoding="utf-8")
         spec = yaml.safe_load(path.read_text(encoding="utf-8"))["vessel"]
         assert spec == ident.vessel
+        CatalogueVesselConfig.model_validate(spec)  # a scenario's vessel: section accepts it
         model = build_vessel(spec)
         x0 = model.straight_state(spec["speed_mps"])
         for key in ("u", "v", "r"):
@@ -270,6 +275,12 @@ def test_degrees_read_as_radians_are_caught(tmp_path):
     cols["delta"] = np.degrees(cols["delta"])
     msg = _cli_error(_write_csv(tmp_path / "log.csv", cols))
     assert "looks like degrees" in msg and "--units deg" in msg
+
+
+def test_a_cell_that_is_not_a_number_is_named(tmp_path):
+    path = tmp_path / "log.csv"
+    path.write_text("time,delta,r\n0,0,0\n0.5,0.1,abc\n", encoding="utf-8")
+    assert "line 3, column 'r': 'abc' is not a number" in _cli_error(path)
 
 
 def test_read_log_errors_are_config_errors(tmp_path):

@@ -232,17 +232,26 @@ def test_perfect_sensors_give_the_true_state_run():
         np.testing.assert_array_equal(meas[name], truth[name])
 
 
-def test_navigation_none_is_unchanged_and_compiled_refuses():
+def test_navigation_none_is_unchanged_and_compiled_runs_navigation():
+    from shipgnc.navigation import Estimator
+
     a = _los_run(None, t_end=5.0)
     b = _los_run(None, t_end=5.0)
     np.testing.assert_array_equal(a.north, b.north)
     assert not any(k.endswith("_meas") for k in a.data_vars)
-    with pytest.raises(ConfigError, match="navigation has no kernel yet"):
-        simulate(BOAT, np.zeros(6), t_end=1.0, dt=0.1, navigation=Navigation([GNSS()]),
-                 backend="compiled")
+
+    class NoKernel(Estimator):
+        requires = ("north",)
+
+        def prepare(self, model, Ts, measured):
+            pass
+
+    with pytest.raises(ConfigError, match="estimator NoKernel has no kernel"):
+        simulate(BOAT, np.zeros(6), t_end=1.0, dt=0.1,
+                 navigation=Navigation([GNSS()], NoKernel()), backend="compiled")
     res = simulate(BOAT, np.zeros((64, 6)), t_end=1.0, dt=0.1, navigation=Navigation([GNSS()]),
                    backend="auto")
-    assert res.attrs["backend"] == "numpy"
+    assert res.attrs["backend"] == "compiled"
 
 
 def test_same_seed_same_result_and_sensor_only_view():

@@ -319,3 +319,12 @@ def test_cli_bad_input_one_line(args, text):
     assert r.exit_code == 2
     err = r.stderr.strip()
     assert err.count("\n") == 0 and text in err and "Traceback" not in r.output
+
+
+def test_zigzag_reversal_at_the_crossing_not_the_sample():
+    # the rudder reverses when the heading crosses ±ψ inside a step: the overshoots converge with
+    # the step (RK4: ~h⁴) instead of carrying an error ~ r·h from reversing at the next sample
+    res = [zigzag.zigzag("mariner-cst", 10.0, 10.0, sides=("starboard",), dt=h) for h in (1.0, 0.25)]
+    assert res[0]["first_overshoot_deg"] == pytest.approx(res[1]["first_overshoot_deg"], abs=5e-3)
+    assert res[0]["second_overshoot_deg"] == pytest.approx(res[1]["second_overshoot_deg"], abs=5e-3)
+    assert res[0]["initial_turning_time_s"] == pytest.approx(res[1]["initial_turning_time_s"], abs=5e-3)

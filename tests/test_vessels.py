@@ -269,3 +269,34 @@ def test_catalogue_vessels_in_scenarios():
     with pytest.raises(ConfigError, match=r"vessel = .*frigate: speed_mps = 13.0 is outside") as info:
         validate(scenario({"model": "frigate", "speed_mps": 13.0}), "test")
     assert "\n" not in str(info.value)
+
+
+def test_mariner_cst_linearised_nomoto_constants_match_fossens_published_values():
+    """Linearised about straight running at 15 kn, the mariner-cst sway–yaw model's rudder-to-yaw-
+    rate transfer function r/δ = K(1 + T₃s)/((1 + T₁s)(1 + T₂s)) has the constants Fossen gives
+    for this Chislett & Strøm-Tejsen Mariner: T₁ = 118 s, T₂ = 7.8 s, T₃ = 18.5 s, K = 0.185 s⁻¹
+    (Fossen, Guidance and Control of Ocean Vehicles, 1994, and MSS ``exNomoto.m``). The
+    published values carry two or three digits: 1.5 % is half a unit of the last digit of 7.8."""
+    import control
+
+    entry = get_vessel("mariner-cst")
+    model = entry.build()
+    x0 = model.straight_state(entry.design_speed_mps)
+    iv, ir, idl = (state_index(model, name) for name in ("v", "r", "delta"))
+    u0 = np.array([x0[idl]])
+    h = 1e-6
+    jac = np.empty((len(x0), len(x0)))
+    for j in range(len(x0)):  # central differences of the model's own derivatives
+        dx = np.zeros(len(x0))
+        dx[j] = h
+        jac[:, j] = (model.derivatives(x0 + dx, u0) - model.derivatives(x0 - dx, u0)) / (2 * h)
+    a = jac[np.ix_([iv, ir], [iv, ir])]
+    b = jac[[iv, ir], idl].reshape(2, 1)
+    tf = control.ss2tf(control.ss(a, b, np.array([[0.0, 1.0]]), 0.0))
+    num, den = tf.num[0][0], tf.den[0][0]
+    t_slow, t_fast = sorted(-1.0 / np.roots(den).real, reverse=True)
+    gain, t3 = num[-1] / den[-1], num[0] / num[-1]
+    assert t_slow == pytest.approx(118.0, rel=0.015)
+    assert t_fast == pytest.approx(7.8, rel=0.015)
+    assert t3 == pytest.approx(18.5, rel=0.015)
+    assert gain == pytest.approx(0.185, rel=0.015)

@@ -6,8 +6,9 @@ Document 000 compares an LQR designed on the linearised path-tracking model with
 controller. Here the built-in comparison ``mariner-compare`` is loaded from the registry, cut to
 two of its controllers — the LQR designed from the printed weights (``lqr``) and integral LOS with
 a feedback-linearised heading loop (``los_fl``, told neither the current nor the yaw bias) — and
-shortened to the first 30 minutes (at twice the document's step). Both capture the path from 1.5 nm off; in the cross current the
-ship holds the path crabbed about 9° into it (note 000-0.4 on :doc:`/000_mariner_tracking`).
+shortened to the first 30 minutes (at twice the document's step). Both capture the path from
+1.5 nm off; in the cross current the ship holds the path crabbed about 9° into it (note 000-0.4
+on :doc:`/000_mariner_tracking`).
 """
 
 import matplotlib.pyplot as plt
@@ -19,7 +20,8 @@ from shipgnc.scenarios.runner import run_scenario
 NM = 1852.0
 scenario = load_scenario("mariner-compare", ["simulation.t_end=1800", "simulation.dt=0.6",
                                              "simulation.backend=numpy"])
-scenario = scenario.model_copy(update={"controllers": {k: scenario.controllers[k] for k in ("lqr", "los_fl")}})
+keep = ("lqr", "los_fl")
+scenario = scenario.model_copy(update={"controllers": {k: scenario.controllers[k] for k in keep}})
 run = run_scenario(scenario)
 res = run.result                                   # dims (controller, time)
 for name, m in run.metrics.items():

@@ -47,6 +47,10 @@ def friendly_errors():
     except KeyboardInterrupt as exc:  # Ctrl-C: one line, no traceback (Interrupted names the time)
         stderr.print(_one_line(exc) if str(exc) else "interrupted", soft_wrap=True)
         raise typer.Exit(130) from None
+    except BrokenPipeError:  # `shipgnc … | head`: the reader left; say nothing, exit as SIGPIPE would
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # no second error when Python flushes stdout at exit
+        raise typer.Exit(141) from None
     except Exception as exc:
         if os.environ.get("SHIPGNC_DEBUG"):
             raise

@@ -72,6 +72,8 @@ def route(
     ukc: Annotated[float, typer.Option("--ukc", help="Under-keel clearance \\[m] (with --depth).")] = 0.0,
     xte_m: Annotated[float, typer.Option("--xte-m", help="With --geo: cross-track tolerance of the "
                                          "waypoints \\[m].")] = 100.0,
+    sail: Annotated[bool, typer.Option("--sail", help="With --geo: the sailed check, the Otter-class boat "
+                                       "with LOS through the waypoints (sail_* keys).")] = False,
 ) -> None:
     """Time-optimal route through a current field (Zermelo's problem)."""
     from shipgnc.cli import friendly_errors, stderr, stdout
@@ -93,12 +95,12 @@ def route(
         tscale = 3600.0 if nautical else 1.0
         if geo:
             _geo_route(start, target, speed * vel, field, method, obstacles, units, json_, out, horizon, radius,
-                       depart, grid, land, depth, draft, ukc, xte_m, length, tscale)
+                       depart, grid, land, depth, draft, ukc, xte_m, length, tscale, sail)
             return
         depart_value = _number(depart, "--depart", "s | h; an ISO 8601 time needs --geo")
         geo_only = [name for name, given in (("--depth", depth is not None), ("--land", land != "default"),
                                              ("--draft", draft != 0.0), ("--ukc", ukc != 0.0),
-                                             ("--xte-m", xte_m != 100.0)) if given]
+                                             ("--xte-m", xte_m != 100.0), ("--sail", sail)) if given]
         require(not geo_only, geo_only[0] if geo_only else "", "given", "needs --geo")
         a = _pair(start, "--start", length)
         b = _pair(target, "--target", length)
@@ -143,7 +145,7 @@ def _number(text: str, name: str, rule: str) -> float:
 
 
 def _geo_route(start, target, speed, field, method, obstacles, units, json_, out, horizon, radius, depart,
-               grid, land, depth, draft, ukc, xte_m, length, tscale) -> None:
+               grid, land, depth, draft, ukc, xte_m, length, tscale, sail=False) -> None:
     """``route --geo`` (docs/routing_geo.md)."""
     from shipgnc.cli import stderr, stdout
     from shipgnc.errors import require
@@ -167,6 +169,10 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     t_dep = problem.departure(iso_depart, offset)
     res = problem.solve(t_dep, method=method, horizon=None if horizon is None else horizon * tscale)
     payload = res.to_json()
+    if sail and res.reachable:
+        from shipgnc.routing.geo.sail import sail_check
+
+        payload.update(sail_check(res))
     text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
     if out is not None and res.reachable:
         from shipgnc.outputs import atomic_dir
@@ -234,6 +240,10 @@ def _print_geo(console, js) -> None:
         row("waypoints", f"{len(js['waypoints'])} (cross-track tolerance {js['xte_m']:g} m)")
         row("initial heading [deg]", f"{js['heading_start_deg']:.2f}")
         row("clear of land and shallow water", {True: "yes", False: "NO", None: "—"}[js["land_clear"]])
+    if "sail_arrived" in js:
+        row("sailed check: arrived", "yes" if js["sail_arrived"] else f"no (miss {js['sail_miss_m']:.1f} m)")
+        if js["sail_time_s"] is not None:
+            row("sailed check: time / optimum", f"{js['sail_time_s']:.0f} s / {js['sail_ratio']:.4f}")
     row("method", js["method"])
     gc = js["global_check"]
     if gc and gc.get("time_s") is not None and js["method"] != "levelset":

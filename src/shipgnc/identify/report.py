@@ -38,8 +38,9 @@ def identification_figure(ident, path, *, title: str = "") -> Path:
                 linewidth=1.2, label=f"{key} measured")
         score = ident.nrmse_holdout.get(key)
         extra = f" (held-out NRMSE {score:.3f})" if score is not None else ""
-        ax.plot(t, ident.simulated[key] * scale, label=f"{key} re-simulated{extra}",
-                **style.REFERENCE)
+        name = (f"{key} re-simulated{extra}" if key in ident.nrmse_holdout
+                else f"{key} held at u(0) (surge not identified)")
+        ax.plot(t, ident.simulated[key] * scale, label=name, **style.REFERENCE)
         ax.set_ylabel(label, fontsize=style.LABEL_SIZE)
     # heading: logged vs the re-simulated yaw rate integrated from the logged ψ(0)
     ax = axes[len(outputs)]

@@ -28,7 +28,12 @@ The interface the simulation loop calls (:func:`shipgnc.sim.simulator.simulate`,
 * ``signal_values() -> dict[str, np.ndarray]`` — the last values of ``signals`` for the log.
 
 No navigation (``navigation=None``) is today's loop unchanged: the controller reads the truth.
-Only the numpy loop runs navigation ("navigation has no kernel yet").
+
+Both loops run navigation: :meth:`Navigation.kernel` hands the sensors and the estimator (passive
+observer, EKF, KF) to the composed compiled loop (:mod:`shipgnc.navigation.kernels`,
+:mod:`shipgnc.sim.nav_template`) with the sensors' draws taken from the same child streams, so a
+seed gives the same run in both; an estimator without ``kernel_block`` runs in the numpy loop
+(``unsupported_reason`` names it).
 """
 
 from shipgnc.navigation.core import Navigation, spawn_streams

@@ -42,8 +42,8 @@ class ExtendedKalmanFilter(GaussianFilter):
     process_psd : dict state → spectral density [unit²/s] of the white noise on that state's
         derivative (default 0 for positions and heading, 1e-4 for every other state).
     P0_std : dict state → initial standard deviation (default 1 in SI units).
-    x0_offset : dict state → initial estimation error x̂(0) − x(0) (e.g. ``{"north": 50,
-        "psi": math.radians(30)}``).
+    x0_offset : dict state → initial estimation error x̂(0) − x(0)
+        (e.g. ``{"north": 50, "psi": math.radians(30)}``).
     sample_initial : add an N(0, P0) draw to the initial estimate (a Monte Carlo whose initial
         errors match P0, e.g. for a NEES test).
     requires : the states the sensors must measure (default north, east, psi: position and

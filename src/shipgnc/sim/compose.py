@@ -24,6 +24,13 @@ several (progress, bounded log chunks) that carry each ship's state in its row o
 bit-identical results (:func:`shipgnc.sim.compiled.drive`). :func:`unsupported_reason` names the
 first component without a kernel; ``simulate`` then runs the numpy loop.
 
+Navigation (:class:`~shipgnc.navigation.Navigation`: sensors and an estimator) enters at step 1:
+at each control sample its step (:mod:`shipgnc.sim.nav_template`, written into the combination's
+module so the estimators call the model's kernel by name) turns the true state into the state the
+guidance and the controller see and the logged ``<state>_meas``, ``<state>_hat``, ... columns
+(after the controller's signals, the order of :func:`~shipgnc.sim.simulator.log_signals`); its
+table holds the sensors' draws per control sample, from the same child streams as the numpy loop.
+
 A disturbance with ``kernel_current(batch_shape, dt)`` (a force disturbance and an earth-fixed
 current, :class:`~shipgnc.environment.current_field.CurrentDisturbance`) gives the loop a second
 kernel, called right after the disturbance's own wherever that one is (step start or every RK

@@ -82,7 +82,7 @@ class SimSetup:
     progress: Callable | None
     log_every: int
     u0: np.ndarray
-    navigation: object | None = None  # sensors and estimator (shipgnc.navigation), numpy loop only
+    navigation: object | None = None  # sensors and estimator (shipgnc.navigation)
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
@@ -120,7 +120,8 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         each control sample ``navigation.observe(t, x, applied)`` turns the true state into the
         state the guidance and the controller see (the estimate, else the measurements); its
         signals (``<state>_meas``, ``<state>_hat``, ...) are logged. None: they read the truth.
-        Only this numpy loop runs it (``backend="compiled"`` refuses; ``"auto"`` runs numpy).
+        Both loops run it (the compiled one through ``navigation.kernel``; an estimator without
+        a kernel keeps the run in this loop).
     backend : ``"numpy"`` (this loop), ``"compiled"`` (a numba twin; ConfigError naming each twin's
         reason when none covers the setup), ``"auto"``: a twin that covers the setup when the
         batch has ≥ :data:`COMPILED_MIN_BATCH` ships or the run ≥ :data:`COMPILED_MIN_WORK`

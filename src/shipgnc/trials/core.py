@@ -111,7 +111,7 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
                                           dtype=float))
         lo, hi = entry.speed_range_mps
         for s in speeds:
-            require(math.isfinite(s) and lo - 1e-9 <= s <= hi + 1e-9, "--speed-kn", round(s / KNOT, 4),
+            require(math.isfinite(s) and lo - 1e-9 <= s <= hi + 1e-9, "--speed-kn", round(float(s) / KNOT, 4),
                     f"{entry.name} is valid for {lo / KNOT:.4g}-{hi / KNOT:.4g} kn "
                     f"({lo:.4g}-{hi:.4g} m/s)")
         models = [entry.build(speed_mps=float(s), **params) for s in speeds]
@@ -338,6 +338,33 @@ def programme(ship: TrialShip, kind: str, n: int, *, speed_index=0, delta_a=None
                            x0=ship.x0[idx].copy(), inputs0=ship.inputs0[idx].copy())
 
 
+def _reverse_within_step(model_of, x0, x1, t, h, inputs, sign, psi0, prog, index, max_rudder):
+    """Zig-zag ships whose heading crossed ±ψ inside the step [t, t + h] are integrated again:
+    RK4 up to the crossing θh (linear interpolation of the heading) with the old command, then
+    with the reversed one, so the reversal happens at the crossing, not at the next sample
+    (steering machine in the model only: the command is a held input)."""
+    from shipgnc.trials.zigzag import reverse_rudder
+
+    p = index["psi"]
+    c0, c1 = x0[:, p] - psi0, x1[:, p] - psi0
+    zz = prog.zz_amp != 0
+    new = reverse_rudder(sign, c1, prog.zz_psi)
+    hit = np.nonzero(zz & (new != sign) & (sign * c0 < prog.zz_psi))[0]
+    if hit.size == 0:
+        return x1
+    a, b = sign[hit] * c0[hit], sign[hit] * c1[hit]
+    theta = np.clip((prog.zz_psi[hit] - a) / np.where(b > a, b - a, 1.0), 0.0, 1.0)[:, None]
+    m = model_of(hit)
+    u_old = inputs[hit].copy()
+    u_new = u_old.copy()
+    u_new[:, 0] = np.clip(prog.delta_a[hit] + new[hit] * np.abs(prog.zz_amp[hit]), -max_rudder, max_rudder)
+    mid = rk4_step(lambda tt, z: m.derivatives(z, u_old), t, x0[hit], theta * h)
+    end = rk4_step(lambda tt, z: m.derivatives(z, u_new), t, mid, (1.0 - theta) * h)
+    out = x1.copy()
+    out[hit] = end
+    return out
+
+
 class Stacked:
     """One batch over ships whose models differ (one model per test speed): ``derivatives``
     evaluates each distinct model on its ships (``which``: the model index of each ship along
@@ -418,6 +445,10 @@ def run(ship: TrialShip, prog: RudderProgramme, finished, *, dt: float | None = 
 
     index = ship.index
     model = Stacked.of(ship.models, prog.speed_index)
+
+    def model_of(which):
+        return Stacked.of(ship.models, prog.speed_index[which])
+
     h = ship.dt if dt is None else float(dt)
     B = prog.size
     t_end = float(np.max(prog.t_max))
@@ -485,7 +516,11 @@ def run(ship: TrialShip, prog: RudderProgramme, finished, *, dt: float | None = 
                 inputs[:, 0] = (_a + theta * (_b - _a))[:, 0]
                 return model.derivatives(z, inputs)
             applied = u_end
+        x_old = x
         x = rk4_step(f, t, x, h)
+        if act is None and np.any(zigzag):
+            x = _reverse_within_step(model_of, x_old, x, t, h, inputs, s, psi0, prog, index,
+                                     ship.max_rudder)
         X[k + 1] = x
         if np.any(auto):
             integral = np.clip(integral + h * (r_ref - x[:, index["r"]]), -i_max, i_max)

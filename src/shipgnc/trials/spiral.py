@@ -55,6 +55,9 @@ def angles(ship, max_deg: float | None = None, grid=None) -> np.ndarray:
     """Rudder angles of the sweep [deg], descending, centred on the trim rudder δ₀."""
     g = np.asarray(GRID if grid is None else grid, dtype=float)
     if max_deg is not None:
+        from shipgnc.trials.turning import rudder_angle
+
+        max_deg = rudder_angle(ship, max_deg)
         g = g * (max_deg / g.max())
     half = np.unique(np.abs(g))
     offsets = np.concatenate([-half[::-1], half[1:]] if half[0] == 0 else [-half[::-1], half])

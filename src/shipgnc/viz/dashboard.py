@@ -359,7 +359,7 @@ def dashboard(result, *, title: str = "", waypoints=None, limits: Mapping | None
     title : the figure title (scenario, preset, key metrics).
     waypoints : ``(n, 2)`` (north, east) [m] of the path, drawn when given.
     limits : actuator limits in SI, e.g. ``{"T": (0, 200), "alpha": (-0.785, 0.785)}``; drawn as lines.
-    outline : (length, beam) of the boat outline [m].
+    outline : ``(length, beam)`` of the boat outline [m].
     lever_arm : distance from the CG back to the thruster [m], where the thrust arrow ends.
     ship : index along the batch dimension of a batched result.
     boat_every : time between the outlines drawn on the track [s]; default about ten per run

@@ -26,7 +26,8 @@ def geo_route_figure(route, path, *, gpx_path=None, title=None, ax=None):
     box = (lon0 - pad_lon, lat0 - pad_lat, lon1 + pad_lon, lat1 + pad_lat)
     own = ax is None
     if own:
-        fig, ax = plt.subplots(figsize=(10, 5.2), constrained_layout=True)
+        ratio = (box[3] - box[1]) / ((box[2] - box[0]) * math.cos(math.radians(0.5 * (box[1] + box[3]))))
+        fig, ax = plt.subplots(figsize=(10, min(9.0, max(3.2, 8.4 * ratio + 1.2))), constrained_layout=True)
     ax.set_facecolor("#e8f1f8")
     import shapely
 

@@ -299,54 +299,55 @@ class GeoProblem:
         pad = 0.05
         self.geo_box = (float(blon.min() - pad), float(blat.min() - pad), float(blon.max() + pad),
                         float(blat.max() + pad))
-        geo_polys, kinds = [], []
+        groups = []  # (what a point inside means, kind, lon/lat polygons or None, plane polygons or None)
         if isinstance(land, (list, tuple)):
-            geo_polys += list(land)
-            kinds.append("land polygons given")
+            groups.append(("on land", "land polygons given", list(land), None))
         elif land in (None, "none"):
             pass
         elif land == "default":
-            polys = coastline(*self.geo_box)
-            geo_polys += polys
-            kinds.append("GSHHG full-resolution coastline (roaring-landmask)")
+            groups.append(("on land", "GSHHG full-resolution coastline (roaring-landmask)",
+                           coastline(*self.geo_box), None))
         else:
-            geo_polys += load_land(land)
-            kinds.append(f"land from {land}")
+            groups.append(("on land", f"land from {land}", load_land(land), None))
         if depth is not None:
             dg = cf.read_depth(depth)
             self.notes.extend(dg.notes)
             for name, p in (("start", self.start), ("target", self.target)):
                 if not bool(dg.covers(*p)):
-                    raise ConfigError(f"{dg.path}: the route's {name} ({p[0]:.4f}, {p[1]:.4f}) lies outside the "
-                                      f"depth grid's coverage {dg.extent}")
+                    raise ConfigError(f"{dg.path}: the route's {name} ({p[0]:.4f}, {p[1]:.4f}) lies outside "
+                                      f"the depth grid's coverage {dg.extent}")
             limit = draft + ukc
-            shallow = region_polygons(dg.lon, dg.lat, dg.values[0], limit)
-            geo_polys += shallow
-            kinds.append(f"water shallower than draft + UKC = {limit:g} m from {dg.path}")
+            groups.append((f"in water shallower than draft + UKC = {limit:g} m", f"depth < {limit:g} m in "
+                           f"{dg.path}", region_polygons(dg.lon, dg.lat, dg.values[0], limit), None))
             self.notes.append(f"depth grid {dg.path}: outside its coverage {dg.extent} the depth is unknown "
                               "and not checked")
-        self.land_geo = [p for p in geo_polys if p.intersects(shapely.box(*self.geo_box))]
-        to_plane = self._to_plane_geom
-        plane = [to_plane(p) for p in self.land_geo]
         nn, ee = self._nodes
         if self.current.grid is not None and np.any(self.wet < 0.5):
+            # region_polygons works in (x, y) = (east, north); flipped to (north, east)
             nan_polys = [shapely.Polygon(np.asarray(p.exterior.coords)[:, ::-1],
                                          [np.asarray(r.coords)[:, ::-1] for r in p.interiors])
                          for p in region_polygons(ee, nn, self.wet, 0.5)]
-            # region_polygons works in (x, y) = (east, north); flip to (north, east)
-            plane += nan_polys
-            kinds.append(f"NaN cells and the outside of {self.current.grid.path}")
-        self.land_kinds = kinds
+            groups.append((f"on a NaN (land) cell of {self.current.grid.path} or outside it",
+                           f"NaN cells and the outside of {self.current.grid.path}", None, nan_polys))
+        geo_box = shapely.box(*self.geo_box)
+        self.land_geo = [p for g in groups if g[2] for p in g[2] if p.intersects(geo_box)]
+        self.land_kinds = [g[1] for g in groups]
         box = shapely.box(n0, e0, n1, e1)
-        union = shapely.union_all([shapely.make_valid(p) for p in plane]) if plane else shapely.Polygon()
-        union = shapely.intersection(union, box.buffer(4 * self.clearance))
-        self.hard = union  # the obstacles themselves, (north, east) m
+        parts = []
+        for what, kind, geo_polys, plane_polys in groups:
+            plane = plane_polys if plane_polys is not None else [
+                self._to_plane_geom(p) for p in geo_polys if p.intersects(geo_box)]
+            if not plane:
+                continue
+            u = shapely.intersection(shapely.union_all([shapely.make_valid(p) for p in plane]),
+                                     box.buffer(4 * self.clearance))
+            for name, p, q in (("start", self.A, self.start), ("target", self.B, self.target)):
+                if u.contains(shapely.Point(p)):
+                    raise ConfigError(f"--{name} = {q[0]:.5f},{q[1]:.5f}: {what} ({kind})")
+            parts.append(u)
+        self.hard = shapely.union_all(parts) if parts else shapely.Polygon()  # (north, east) m
         shapely.prepare(self.hard)
-        for name, p, q in (("start", self.A, self.start), ("target", self.B, self.target)):
-            if not self.hard.is_empty and self.hard.contains(shapely.Point(p)):
-                what = ", ".join(kinds) if kinds else "an obstacle"
-                raise ConfigError(f"--{name} = {q[0]:.5f},{q[1]:.5f}: on land or in water too shallow "
-                                  f"({what})")
+        kinds = self.land_kinds
         if self.hard.is_empty:
             self.router_obstacles = []
             return

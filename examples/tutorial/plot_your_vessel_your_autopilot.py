@@ -1,0 +1,278 @@
+"""
+Your vessel, your autopilot
+===========================
+
+From a ship's main dimensions to a tuned heading autopilot checked in waves and in a Monte Carlo,
+in one script (it runs at every build of this site, so every number and figure below is what the
+code gives today). The steps:
+
+1. a linear manoeuvring model from the main dimensions (Clarke, Gedling & Hine 1983);
+2. the model as a shipgnc vessel, its rudder-step and turning response;
+3. a PID heading autopilot designed on the Nomoto model and tuned with python-control;
+4. the autopilot on the simulated ship, with its steering machine;
+5. the same in irregular waves;
+6. a Monte Carlo: thirty ships, each in its own sea and with its own initial heading.
+
+Download the script at the bottom of the page and change the dimensions to your ship's.
+"""
+
+# %%
+# 1. A model from the main dimensions
+# -----------------------------------
+# A 60 m coaster at 12 knots. :func:`~shipgnc.models.linear3dof.clarke83` returns the inertia
+# matrix M and the damping matrix N(U) of M ν̇ + N ν = τ over (surge, sway, yaw), from Clarke et
+# al.'s regressions; :func:`~shipgnc.models.linear3dof.rudder_input` gives the rudder's force and
+# moment per radian, B.
+
+import math
+from dataclasses import dataclass
+
+import control
+import matplotlib.pyplot as plt
+import numpy as np
+
+from shipgnc import simulate
+from shipgnc.guidance.schedule import CourseSchedule
+from shipgnc.models.base import Signal
+from shipgnc.models.linear3dof import clarke83, rudder_input
+
+L, B, T, Cb = 60.0, 11.0, 3.5, 0.6           # length, beam, draft [m], block coefficient
+U = 12 * 1852 / 3600                          # speed [m/s]
+M, N = clarke83(U, L, B, T, Cb, R66=0.25 * L, xg=0.0, T_surge=L)
+b = rudder_input(U, L, T)                     # (3, 1): [X, Y, N] per rad of rudder
+print("M =\n", M.round(0), "\nN =\n", N.round(0), "\nb =", b.ravel().round(0))
+
+# %%
+# The sway–yaw part is a two-state linear system with the rudder as input; python-control gives
+# its transfer function r/δ, a second-order Nomoto model K(1 + T₃s)/((1 + T₁s)(1 + T₂s)) (here
+# with a complex pair of poles), and its first-order reduction K/(1 + Ts) with T = T₁ + T₂ − T₃.
+
+A_sy = -np.linalg.solve(M[1:, 1:], N[1:, 1:])
+B_sy = np.linalg.solve(M[1:, 1:], b[1:])
+yaw = control.ss(A_sy, B_sy, [[0.0, 1.0]], [[0.0]])     # δ [rad] → r [rad/s]
+G_r = control.tf(yaw)
+K = float(control.dcgain(G_r))
+T1_plus_T2 = float(np.real(-np.sum(1.0 / control.poles(G_r))))   # Σ −1/pᵢ, real or complex pair
+T3 = float(-1.0 / np.real(control.zeros(G_r))[0])
+T_nomoto = T1_plus_T2 - T3
+print(f"poles {np.round(control.poles(G_r), 4)} (course-stable: both in the left half-plane)")
+print(f"Nomoto: K = {K:.4f} 1/s, T1 + T2 = {T1_plus_T2:.2f} s, T3 = {T3:.2f} s, T = {T_nomoto:.2f} s")
+assert K > 0 and all(np.real(control.poles(G_r)) < 0)
+
+# %%
+# 2. The model as a shipgnc vessel
+# --------------------------------
+# A vessel is a small class with named states, inputs and disturbances and a vectorised
+# ``derivatives`` (:doc:`/extending`). Here the state is the catalogue vessels' layout
+# (north, east, ψ, u, v, r, δ), the input the commanded rudder, the steering machine a first-order
+# lag with a rate limit, and the disturbance a body-frame force [X, Y, N] that waves will fill.
+
+@dataclass(frozen=True, eq=False)
+class MyShip:
+    M: np.ndarray
+    N: np.ndarray
+    b: np.ndarray
+    U: float
+    delta_max: float = math.radians(35.0)
+    delta_rate: float = math.radians(2.32)    # IMO: 35° to the other side's 30° in 28 s
+    T_delta: float = 1.0
+    states = (Signal("north", "m"), Signal("east", "m"), Signal("psi", "rad", angle=True),
+              Signal("u", "m/s"), Signal("v", "m/s"), Signal("r", "rad/s"),
+              Signal("delta", "rad", "rudder angle", angle=True))
+    inputs = (Signal("delta_c", "rad", "commanded rudder angle", angle=True),)
+    disturbances = (Signal("X_env", "N"), Signal("Y_env", "N"), Signal("N_env", "N*m"))
+    state_limits = (1e8, 1e8, 1e4, 50.0, 50.0, 5.0, 2.0)
+
+    @property
+    def params(self):
+        return self
+
+    def input_limits(self):
+        return np.array([-self.delta_max]), np.array([self.delta_max])
+
+    def derivatives(self, x, u, d=None):
+        psi, delta = x[..., 2], x[..., 6]
+        nu = np.stack([x[..., 3] - self.U, x[..., 4], x[..., 5]], axis=-1)   # surge about U
+        tau = delta[..., None] * self.b[:, 0]
+        if d is not None:
+            tau = tau + d
+        nu_dot = np.linalg.solve(self.M, (tau - nu @ self.N.T)[..., None])[..., 0]
+        c, s = np.cos(psi), np.sin(psi)
+        delta_dot = np.clip((u[..., 0] - delta) / self.T_delta, -self.delta_rate, self.delta_rate)
+        return np.stack([x[..., 3] * c - x[..., 4] * s, x[..., 3] * s + x[..., 4] * c, x[..., 5],
+                         nu_dot[..., 0], nu_dot[..., 1], nu_dot[..., 2], delta_dot], axis=-1)
+
+
+ship = MyShip(M, N, b, U)
+straight = np.array([0.0, 0.0, 0.0, U, 0.0, 0.0, 0.0])
+
+# %%
+# **Rudder step and turning circle.** Ten degrees of rudder, held: the yaw rate settles at the
+# steady turn N ν = B δ, and the track is a circle of radius U/r. The simulated ship includes the
+# steering machine, which the transfer function does not; the steady states agree.
+
+delta = math.radians(10.0)
+turn = simulate(ship, straight, t_end=400.0, dt=0.1, u0=np.array([delta]))
+r_ss = np.linalg.solve(N, b[:, 0] * delta)[2]
+print(f"steady yaw rate: simulated {float(turn.r[-1]):.5f}, N ν = B δ gives {r_ss:.5f} rad/s; "
+      f"radius {U / r_ss:.0f} m")
+assert abs(float(turn.r[-1]) - r_ss) < 1e-3 * abs(r_ss)
+
+# the vessel catalogue builds the same model from the same dimensions (shipgnc vessels list)
+try:
+    from shipgnc.vessels import get_vessel
+    catalogue = get_vessel("linear-3dof").build(U, L=L, B=B, T=T, Cb=Cb)
+    print("catalogue's linear-3dof steady turn:", catalogue.steady_turn(delta).round(5))
+except ImportError:      # an installation without the vessel catalogue
+    pass
+
+t_lin, r_lin = control.step_response(G_r * delta, T=np.linspace(0, 150, 301))
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+ax1.plot(turn.time, np.degrees(turn.r), label="simulated (with the steering machine)")
+ax1.plot(t_lin, np.degrees(r_lin), "--", label="transfer function r/δ")
+ax1.set(xlim=(0, 150), xlabel="time [s]", ylabel="yaw rate [deg/s]", title="10° rudder step")
+ax1.legend()
+ax2.plot(turn.east, turn.north)
+ax2.set(xlabel="east [m]", ylabel="north [m]", aspect="equal", title="turning circle, 10° rudder")
+fig.tight_layout()
+
+# %%
+# 3. Designing the autopilot
+# --------------------------
+# A PID on the heading error, δ = −K_P e − K_D r − K_I ∫e (the catalogue's
+# :class:`~shipgnc.vessels.autopilot.HeadingAutopilot`), placed on the first-order Nomoto model
+# ψ/δ = K/(s(1 + Ts)): the closed loop's characteristic polynomial is matched to
+# (s² + 2ζω s + ω²)(s + ω/10), a well-damped pair with a slow integrator.
+
+def pid_gains(omega, zeta):
+    kp = T_nomoto * omega**2 * (1 + zeta / 5) / K
+    kd = (T_nomoto * omega * (2 * zeta + 0.1) - 1) / K
+    ki = T_nomoto * omega**3 / (10 * K)
+    return kp, kd, ki
+
+
+# %%
+# **Tuning with python-control.** This ship's yaw poles are a complex pair, so the first-order
+# Nomoto model is only a rough design model: the loop is therefore checked on the full
+# second-order model with the steering machine as a first-order lag — its phase and gain margins
+# and its closed-loop step response — for a bandwidth ω = 0.2 rad/s and three damping ratios.
+
+s = control.tf("s")
+psi_over_delta = G_r / s / (1 + s)                     # heading per commanded rudder
+OMEGA = 0.2
+fig, ax = plt.subplots(figsize=(7, 3.8))
+for zeta in (0.8, 1.0, 1.2):
+    kp, kd, ki = pid_gains(OMEGA, zeta)
+    C = kp + kd * s + ki / s                           # on ψ; the D term acts on r = sψ
+    loop = C * psi_over_delta
+    gm, pm = control.stability_margins(loop)[:2]
+    t, y = control.step_response(control.feedback(loop, 1), T=np.linspace(0, 120, 601))
+    ax.plot(t, np.ravel(y), label=f"ζ = {zeta:g}: phase margin {pm:.0f}°")
+    print(f"ζ = {zeta}: Kp = {kp:.2f}, Kd = {kd:.2f} s, Ki = {ki:.4f} 1/s; phase margin {pm:.1f}°, "
+          f"overshoot {100 * (np.max(y) - 1):.0f} %")
+ax.set(xlabel="time [s]", ylabel="heading / heading command", title="closed-loop step, linear, ω = 0.2 rad/s")
+ax.legend()
+fig.tight_layout()
+
+# %%
+# ζ = 0.8 leaves 45° of phase margin and almost 30 % overshoot on the full model; ζ = 1.2 gives about
+# 70° and single-digit overshoot with a larger derivative gain. We take ζ = 1.2.
+
+from shipgnc.vessels.autopilot import HeadingAutopilot  # noqa: E402
+
+kp, kd, ki = pid_gains(OMEGA, 1.2)
+C = kp + kd * s + ki / s
+pm = control.stability_margins(C * psi_over_delta)[1]
+assert kp > 0 and kd > 0 and ki > 0 and pm > 60.0
+
+
+def autopilot():
+    return HeadingAutopilot(kp, kd, ki, Ts=0.5, delta_max=ship.delta_max)
+
+
+# %%
+# 4. On the simulated ship
+# ------------------------
+# Course changes of +20° and −30°, with the rudder's saturation and rate limit in the loop.
+
+course = CourseSchedule([0.0, 100.0], np.radians([20.0, -10.0]))
+calm = simulate(ship, straight, t_end=300.0, dt=0.1, controller=autopilot(), guidance=course)
+fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
+ax1.plot(calm.time, np.degrees(calm.psi), label="ψ")
+ax1.step([0, 100, 300], [20, -10, -10], where="post", color="k", ls=":", label="ψ_d")
+ax1.set(ylabel="heading [deg]", title="course changes in calm water")
+ax1.legend()
+ax2.plot(calm.time, np.degrees(calm.delta), label="rudder")
+ax2.plot(calm.time, np.degrees(calm.delta_c), lw=0.8, label="command")
+ax2.set(xlabel="time [s]", ylabel="rudder [deg]")
+ax2.legend()
+fig.tight_layout()
+final_error = float(np.degrees(abs(calm.psi_error.sel(time=slice(250, None)))).max())
+print(f"heading error over the last 50 s: {final_error:.3f}°")
+assert final_error < 1.0
+
+# %%
+# The overshoot comes from the rudder's rate limit, which the linear design leaves out: the
+# rudder needs 10 s to reach 25°. The slow integrator (a pole at ω/10) then takes the last degrees
+# back over a minute or two — the price of no steady error under a constant yaw moment.
+
+# %%
+# 5. In waves
+# -----------
+# Irregular bow-quartering seas of significant height 2 m and modal period 8 s (a modified
+# Pierson–Moskowitz spectrum) act on the hull through their Froude–Krylov loads
+# (:class:`~shipgnc.environment.waves.FroudeKrylovWaveLoads`, a box of the ship's main dimensions;
+# ``backend="numpy"`` skips compiling its kernel for this short run). The autopilot cannot and
+# should not cancel the wave-frequency yaw; what matters is that the course is held and the rudder
+# does not chase every wave.
+
+from shipgnc.environment.waves import FroudeKrylovWaveLoads, WaveSpectrum  # noqa: E402
+
+sea = WaveSpectrum.modified_pierson_moskowitz(2.0, 8.0)
+
+
+def waves():
+    return FroudeKrylovWaveLoads(sea, direction=math.radians(200.0), n_components=60, length=L,
+                                 beam=B, draft=T, rho=1025.0, backend="numpy")
+
+
+rough = simulate(ship, straight, t_end=300.0, dt=0.1, controller=autopilot(), guidance=course,
+                 disturbance=waves(), seed=3)
+fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
+for res, name in ((calm, "calm"), (rough, "waves, Hs 2 m")):
+    ax1.plot(res.time, np.degrees(res.psi), label=name)
+    ax2.plot(res.time, np.degrees(res.delta), label=name)
+ax1.set(ylabel="heading [deg]", title="the same autopilot in waves")
+ax2.set(xlabel="time [s]", ylabel="rudder [deg]")
+ax1.legend()
+fig.tight_layout()
+steady = rough.sel(time=slice(200, None))
+rms = {name: float(np.degrees(np.sqrt((steady[name] ** 2).mean()))) for name in ("psi_error", "delta")}
+print(f"in waves, last 100 s: heading error RMS {rms['psi_error']:.2f}°, rudder RMS {rms['delta']:.2f}°")
+
+# %%
+# 6. A Monte Carlo
+# ----------------
+# Thirty ships in one batched run: each starts with its own heading error (uniform ±20°) and meets
+# its own realisation of the same sea (``seed`` fixes them all). The batch axis comes first in
+# every array; the result has dimensions (time, ship).
+
+rng = np.random.default_rng(0)
+x0 = np.tile(straight, (30, 1))
+x0[:, 2] = np.radians(rng.uniform(-20.0, 20.0, 30))
+fleet = simulate(ship, x0, t_end=180.0, dt=0.1, controller=autopilot(),
+                 guidance=CourseSchedule([0.0], [0.0]), disturbance=waves(), seed=11)
+late = fleet.sel(time=slice(120, None))
+err_rms = np.degrees(np.sqrt((late.psi_error**2).mean("time"))).values
+rud_rms = np.degrees(np.sqrt((late.delta**2).mean("time"))).values
+print(f"{fleet.sizes['ship']} ships: heading error RMS median {np.median(err_rms):.2f}°, "
+      f"max {err_rms.max():.2f}°; rudder RMS median {np.median(rud_rms):.2f}°")
+assert err_rms.max() < 5.0
+
+fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8))
+ax1.plot(fleet.time, np.degrees(fleet.psi_error), color="C0", lw=0.5, alpha=0.5)
+ax1.set(xlabel="time [s]", ylabel="heading error [deg]", title="30 ships, each in its own sea")
+ax2.scatter(err_rms, rud_rms)
+ax2.set(xlabel="heading error RMS after 120 s [deg]", ylabel="rudder RMS [deg]",
+        title="what the autopilot costs")
+fig.tight_layout()
