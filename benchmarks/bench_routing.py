@@ -7,7 +7,8 @@ Times:
 (a) the batched sweep: 1440 initial costate angles integrated together with RK4 over 30 h in 0.01 h steps
     (3000 steps), reported as extremals per second and extremal-steps per second (integration only);
 (b) the full global sweep with Levenberg–Marquardt polishing and the conjugate-point check;
-(c) the level set (WENO5 / TVD-RK3, numba kernel) at 0.04 nm on the domain of note 002-2.9.2 N [−2.5, 2] × E [−1, 6] nm,
+(c) the level set (WENO5 / TVD-RK3, numba kernel) at 0.04 nm on the domain of note 002-2.9.2 N [−2.5, 2] × E
+[−1, 6] nm,
     wall time and its error against the PMP optimum; 0.02 nm as well unless ``--quick``.
 
 Writes ``benchmarks/results/bench_routing.json`` (``..._quick.json`` with ``--quick``).

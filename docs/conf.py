@@ -50,7 +50,8 @@ _LITERAL = re.compile(r"(``.*?``|:[a-z:]+:`[^`]*`)")
 _SHAPE_STAR = re.compile(r"(\(|, )\*(?=[A-Za-z_])")  # (*batch, *t.shape)
 
 
-_LITERAL_GLUED = re.compile(r"(``[^`]+``)(?=[^\s.,;:!?)\]}'\"/\\–—-])")  # ``bias_std``² needs an escaped space
+# ``bias_std``² : a literal glued to a letter needs an escaped space after it
+_LITERAL_GLUED = re.compile(r"(``[^`]+``)(?=[^\s.,;:!?)\]}'\"/\\–—-])")
 _LONE_STRONG = re.compile(r"\*\*(?=[A-Za-z_])")                               # **params in a signature
 
 

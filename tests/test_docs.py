@@ -1,5 +1,7 @@
-"""The documentation site: it builds without a warning, every page's Python example runs, and every
-figure a page shows is one ``docs/make_figures.py`` produces from the code (issue: documentation)."""
+"""The documentation site: it builds without a warning, every page's Python example runs, every
+gallery script and the tutorial (``examples/``, sphinx-gallery) run at the build and draw their
+figures, and every figure a page shows is one ``docs/make_figures.py`` produces from the code
+(issues: documentation, 21)."""
 
 from __future__ import annotations
 
@@ -32,8 +34,16 @@ def test_site_builds_without_warnings(tmp_path):
                           cwd=ROOT, timeout=600)
     assert proc.returncode == 0, proc.stderr[-4000:]
     for page in ("index", "concepts", "studies", "rl", "extending", "000_mariner_tracking",
-                 "004_catamaran_fsm", "api/sim"):
+                 "004_catamaran_fsm", "api/sim", "references", "cite", "changelog", "gallery/index",
+                 "tutorial/plot_your_vessel_your_autopilot"):
         assert (tmp_path / "site" / f"{page}.html").stat().st_size > 5000
+    # the gallery and the tutorial ran (sphinx-gallery, abort_on_example_error): every example's
+    # page carries at least one figure it drew
+    examples = sorted((ROOT / "examples" / "gallery").glob("plot_*.py"))
+    assert len(examples) >= 10
+    for script in [*examples, ROOT / "examples" / "tutorial" / "plot_your_vessel_your_autopilot.py"]:
+        html = tmp_path / "site" / script.parent.name / f"{script.stem}.html"
+        assert f"sphx_glr_{script.stem}_001" in html.read_text(encoding="utf-8"), f"{script.name}: no figure"
 
 
 @pytest.mark.parametrize("blocks", list(_pages_with_examples()))

@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import xml.etree.ElementTree as ET
@@ -108,7 +109,7 @@ def test_a_land_polygon_across_the_geodesic_is_gone_round(walled):
     assert shapely.LineString(geodesic_points(a, b)).intersects(island)  # the geodesic crosses it
     assert route.reachable and route.land_clear
     w = route.waypoints
-    for p, q in zip(w[:-1], w[1:], strict=True):
+    for p, q in itertools.pairwise(w):
         leg = shapely.LineString(geodesic_points((p["lat"], p["lon"]), (q["lat"], q["lon"])))
         assert not leg.intersects(island)
     # round an island 0.6° long: longer than the geodesic, not absurdly

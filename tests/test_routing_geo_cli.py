@@ -48,7 +48,7 @@ def files(tmp_path_factory):
 
 
 def test_geo_json_keys_and_files(files, tmp_path):
-    d, land, nc = files
+    _d, land, nc = files
     out = tmp_path / "run"
     r = invoke("--geo", "--start", "50.5,-11.1", "--target", "50.5,-9.9", "--speed", "10", "--units", "nautical",
                "--field", nc, "--land", land, "--depart", "2026-06-01T03:00Z", "--xte-m", "50", "--json",
@@ -69,7 +69,7 @@ def test_geo_json_keys_and_files(files, tmp_path):
 
 
 def test_geo_numeric_depart_is_an_offset_from_the_files_first_time(files):
-    _, land, nc = files
+    _, _land, nc = files
     r = invoke("--geo", "--start", "50.5,-11.1", "--target", "50.5,-10.8", "--speed", "10", "--units",
                "nautical", "--field", nc, "--land", "none", "--depart", "2", "--json")
     assert r.exit_code == 0, r.stderr
@@ -123,7 +123,7 @@ def test_sailed_check_arrives_near_the_optimum():
 
     route = GeoProblem((50.45, -11.0), (50.46, -10.985), 1.5, current=(0.3, -0.4), land="none").solve(None)
     assert route.reachable
-    got = sail_check(route, dt=0.1, margin=0.15, backend="compiled")
+    got = sail_check(route, dt=0.1, margin=0.15, backend="numpy")
     assert got["sail_arrived"]
     # a 2 m boat under LOS through the waypoints arrives within 2 % of the optimum
     assert got["sail_ratio"] == pytest.approx(1.0, abs=0.02)

@@ -58,14 +58,14 @@ def route(
     horizon: Annotated[float | None, typer.Option("--horizon", help="Search horizon \\[s | h] "
                                                   "(default 4·|AB|/V).")] = None,
     radius: Annotated[float, typer.Option("--radius", help="Target disc radius \\[m | nm].")] = 0.0,
-    depart: Annotated[str, typer.Option("--depart", help="Departure time t0 \\[s | h], or with --geo an ISO 8601 "
-                                        "UTC time (default: the current file's first time).")] = "0",
+    depart: Annotated[str, typer.Option("--depart", help="Departure time t0 \\[s | h], or with --geo an ISO "
+                                        "8601 UTC time (default: the current file's first time).")] = "0",
     grid: Annotated[float | None, typer.Option("--grid",
                                                help="Level-set / graph grid spacing \\[m | nm].")] = None,
     geo: Annotated[bool, typer.Option("--geo", help="Start/target as LAT,LON on WGS84; --field a CF-NetCDF "
                                       "file; land avoided (docs/routing_geo.md).")] = False,
     land: Annotated[str, typer.Option("--land", help="With --geo: default (GSHHG coastline), none, or a "
-                                      "GeoJSON/shapefile of land polygons [lon, lat].")] = "default",
+                                      "GeoJSON/shapefile of land polygons \\[lon, lat].")] = "default",
     depth: Annotated[Path | None, typer.Option("--depth", help="With --geo: bathymetry CF-NetCDF; water "
                                                "shallower than draft + UKC is avoided.")] = None,
     draft: Annotated[float, typer.Option("--draft", help="Ship's draught \\[m] (with --depth).")] = 0.0,
@@ -94,8 +94,8 @@ def route(
         vel = KNOT if nautical else 1.0
         tscale = 3600.0 if nautical else 1.0
         if geo:
-            _geo_route(start, target, speed * vel, field, method, obstacles, units, json_, out, horizon, radius,
-                       depart, grid, land, depth, draft, ukc, xte_m, length, tscale, sail)
+            _geo_route(start, target, speed * vel, field, method, obstacles, units, json_, out, horizon,
+                       radius, depart, grid, land, depth, draft, ukc, xte_m, length, tscale, sail)
             return
         depart_value = _number(depart, "--depart", "s | h; an ISO 8601 time needs --geo")
         geo_only = [name for name, given in (("--depth", depth is not None), ("--land", land != "default"),
@@ -151,7 +151,8 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     from shipgnc.errors import require
     from shipgnc.routing.geo.router import GeoProblem
 
-    require(obstacles is None, "--obstacles", str(obstacles), "is for the local plane; with --geo give --land")
+    require(obstacles is None, "--obstacles", str(obstacles),
+            "is for the local plane; with --geo give --land")
     require(radius == 0.0, "--radius", radius, "is not used with --geo (the target is a point)")
     a = _pair(start, "--start", 1.0)
     b = _pair(target, "--target", 1.0)
@@ -187,7 +188,14 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
                            "eta": payload["eta"], "xte_m": xte_m})
             write_rtz(tmp / "route.rtz", res.waypoints, xte_m=xte_m)
             geo_route_figure(res, tmp / "route.png")
-        stderr.print(f"wrote route.json, route.gpx, route.geojson, route.rtz, route.png to {out}", soft_wrap=True)
+        stderr.print(f"wrote route.json, route.gpx, route.geojson, route.rtz, route.png to {out}",
+                     soft_wrap=True)
+    if out is not None and not res.reachable:
+        from shipgnc.outputs import atomic_dir
+
+        with atomic_dir(out, command="route") as tmp:
+            (tmp / "route.json").write_text(text + "\n", encoding="utf-8")
+        stderr.print(f"wrote route.json to {out}", soft_wrap=True)
     if json_:
         sys.stdout.write(text + "\n")
     else:

@@ -124,7 +124,8 @@ def trial(
                                                "20/20).")] = None,
     side: Annotated[str | None, typer.Option("--side", help="port | starboard (default: both).")] = None,
     json_: Annotated[bool, typer.Option("--json", help="Print only the result JSON on stdout.")] = False,
-    out: Annotated[Path | None, typer.Option("--out", help="Write trial.json and the figures here.")] = None,
+    out: Annotated[Path | None, typer.Option(
+        "--out", help="Write trial.json, the figures and each manoeuvre's time series (.nc) here.")] = None,
 ) -> None:
     """Standard manoeuvring trials (IMO MSC.137(76)) of a vessel; see docs/trials.md."""
     from shipgnc.cli import friendly_errors, stderr, stdout
@@ -140,10 +141,11 @@ def trial(
         if out is not None:
             from shipgnc.outputs import atomic_dir
             from shipgnc.trials.figures import trial_figures
+            from shipgnc.trials.series import write_series
 
             with atomic_dir(out, command="trial") as tmp:
                 (tmp / "trial.json").write_text(text + "\n", encoding="utf-8")
-                written = trial_figures(res, tmp)
+                written = trial_figures(res, tmp) + write_series(res, tmp)
             stderr.print(f"wrote trial.json, {', '.join(p.name for p in written)} to {out}", soft_wrap=True)
         if json_:
             sys.stdout.write(text + "\n")

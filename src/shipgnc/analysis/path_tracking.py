@@ -16,7 +16,8 @@ time before the first leg switch.
   ±180°, not 0);
 * ``rudder_rms_deg``; ``saturation_fraction``: share of samples with |δ| at δ_max;
 * ``stable`` (the one definition, :func:`shipgnc.analysis.metrics.stable_arrays`): the run
-  reached its end without the divergence guard, |y_r| stayed below max(3 nm, 2|y_r(0)|) (note 000-0.8, [A]), over the last 20 % of the run y_r oscillates about its trend by at most 0.05 nm (the
+  reached its end without the divergence guard, |y_r| stayed below max(3 nm, 2|y_r(0)|) (note 000-0.8, [A]),
+  over the last 20 % of the run y_r oscillates about its trend by at most 0.05 nm (the
   settling band) and the rudder is not pinned at both limits ±δ_max (no limit cycle, no
   saturated oscillation), and the ship is not ``reversed``;
 * ``reversed``: the run ends with |heading error| > 90° (the final heading error above, the

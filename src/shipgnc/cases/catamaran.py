@@ -229,7 +229,8 @@ def robustness(preset_name: str = DEFAULT_PRESET, n: int = 40, seed: int = 10, o
 
 def montecarlo(n: int = 1000, seed: int = 16, t_end: float = 300.0,
                preset_name: str = "si") -> CatamaranCase:
-    """Check 16: 1000 draws, ``si`` (check 16 of note 004-4.12; any preset by name), law (21), ω* = 0.06, 300 s."""
+    """Check 16: 1000 draws, ``si`` (check 16 of note 004-4.12; any preset by name), law (21), ω* = 0.06,
+    300 s."""
     return robustness(preset_name, n=n, seed=seed, t_end=t_end)
 
 

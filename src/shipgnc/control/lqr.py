@@ -1,4 +1,5 @@
-"""LQR trajectory tracking of document 000 (Mariner, de Wit–Oppe plant), notes 000-0.4, 000-A6–000-A8, 000-A12.
+"""LQR trajectory tracking of document 000 (Mariner, de Wit–Oppe plant), notes 000-0.4, 000-A6–000-A8,
+000-A12.
 
 Design model, eq. (7)–(9): the path-frame kinematics ẏ_r = Uψ_r (sway neglected) with the
 linear yaw equation ṙ = −a r + c δ and the integral e_I = ∫ y_r dt::

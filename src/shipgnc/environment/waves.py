@@ -708,7 +708,8 @@ class FroudeKrylovWaveLoads:
     Give ``spreading`` (e.g. 1, the ITTC cos² sea) for yaw in head seas too. ``gains`` scale the three
     channels for calibration or to switch one off.
 
-    **Defaults — CyberShip II** (notes 003-3.5–003-3.6, model scale 1:70): L = 1.255 m, B = 0.29 m, T = 0.05 m,
+    **Defaults — CyberShip II** (notes 003-3.5–003-3.6, model scale 1:70): L = 1.255 m, B = 0.29 m, T = 0.05
+    m,
     ρ = 1014 kg/m³ as in the plant's rudder model. (The box's 18.5 kg displacement is below the ship's
     23.8 kg: the document's draft is taken as given.) At H_s = 42.9 mm, T₀ = 0.8 s, u = 0.3 m/s and a 150°
     encounter angle (the ±30° legs) the loads are ≈ 1.5 N, 0.86 N and 0.65 N·m RMS, at ω_e ≈ 10 rad/s: far

@@ -194,13 +194,14 @@ class Navigation:
         def table(k0: int, k1: int) -> np.ndarray:
             j0, j1 = -(-k0 // hold), -(-k1 // hold)
             out = np.zeros((max(0, j1 - j0), n, n_w))
-            for j in range(j0, j1):
-                at = 0
-                for sensor in sensors:
-                    k = len(sensor.measures)
-                    if j % sensor.every == 0:
-                        out[j - j0, :, at:at + 2 * k] = sensor.kernel_draws(n)
-                    at += 2 * k
+            at = 0
+            for sensor in sensors:
+                k = len(sensor.measures)
+                first = -(-j0 // sensor.every) * sensor.every  # its first due sample
+                rows = np.arange(first, j1, sensor.every) - j0
+                if rows.size:
+                    out[rows, :, at:at + 2 * k] = sensor.kernel_draws(rows.size, n)
+                at += 2 * k
             return out
 
         return NavigationKernel(nk.sensors_observe, nk_flat(params), state, table, n_w,

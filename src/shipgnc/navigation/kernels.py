@@ -262,11 +262,13 @@ def correct_c(zh, P, c, y, var, angle, Pc):
 
 
 @kernel_function
-def nees(err, P, n, idx, m):
+def nees(err, P, n, idx, m, work):
     """(x − x̂)ᵀ P_sub⁻¹ (x − x̂) over the ``m`` filter states ``idx`` (:meth:`GaussianFilter.nees`;
-    Gaussian elimination with partial pivoting, NaN for a singular block)."""
-    A = np.empty((m, m))
-    b = np.empty(m)
+    Gaussian elimination with partial pivoting, NaN for a singular block); ``work`` holds at
+    least m² + 3m numbers."""
+    A = work[:m * m].reshape((m, m))
+    b = work[m * m:m * m + m]
+    sol = work[m * m + m:m * m + 2 * m]
     for a in range(m):
         b[a] = err[a]
         for c in range(m):
@@ -289,7 +291,6 @@ def nees(err, P, n, idx, m):
             for c in range(col, m):
                 A[r, c] -= f * A[col, c]
             b[r] -= f * b[col]
-    sol = np.empty(m)
     for r in range(m - 1, -1, -1):
         acc = b[r]
         for c in range(r + 1, m):

@@ -197,18 +197,37 @@ class Sensor:
     def _kernel_bias_state(self):
         return 0.0
 
-    def kernel_draws(self, n_ships: int) -> np.ndarray:
-        """The draws of one due sample, ``(n_ships, 2k)``: ``[bias step, noise]``, taken from the
-        sensor's stream in the order :meth:`_measure` takes them (zeros where it takes none)."""
+    def kernel_draws(self, count: int, n_ships: int) -> np.ndarray:
+        """The draws of the sensor's next ``count`` due samples, ``(count, n_ships, 2k)``:
+        ``[bias step, noise]`` each, taken from the sensor's stream in the order :meth:`_measure`
+        takes them (zeros where it takes none), in one call per kind of stream: ``count``
+        successive draws of shape ``(*batch, k)`` are one draw of ``(count, *batch, k)`` (per
+        member for :class:`~shipgnc.sim.streams.MemberStreams`)."""
+        from shipgnc.sim.streams import MemberStreams
+
         k = len(self.measures)
-        out = np.zeros((n_ships, 2 * k))
+        out = np.zeros((count, n_ships, 2 * k))
         bstd, _a, bscale = self._kernel_bias()
-        if (self.kernel_kind == 0 and bstd > 0) or (self.kernel_kind == 2 and bscale > 0):
-            if not self._first:
-                out[:, :k] = self._draw().reshape(n_ships, k)
+        biased = (self.kernel_kind == 0 and bstd > 0) or (self.kernel_kind == 2 and bscale > 0)
+        start = 0
+        if biased and self._first and count > 0:  # the first sample draws its noise only
+            if self.noise_std > 0:
+                out[0, :, k:] = self._draw().reshape(n_ships, k)
             self._first = False
-        if self.noise_std > 0:
-            out[:, k:] = self._draw().reshape(n_ships, k)
+            start = 1
+        m = count - start
+        parts = int(biased) + int(self.noise_std > 0)
+        if m > 0 and parts:
+            if isinstance(self.rng, MemberStreams):
+                d = np.asarray(self.rng.standard_normal((n_ships, m, parts, k)), dtype=float)
+                d = d.transpose(1, 2, 0, 3)
+            else:
+                d = np.asarray(self.rng.standard_normal((m, parts, *self.batch_shape, k)),
+                               dtype=float).reshape(m, parts, n_ships, k)
+            if biased:
+                out[start:, :, :k] = d[:, 0]
+            if self.noise_std > 0:
+                out[start:, :, k:] = d[:, parts - 1]
         return out
 
     # ---- what the estimators read -------------------------------------------------------------

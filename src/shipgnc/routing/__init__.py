@@ -2,7 +2,8 @@
 
 * :mod:`~shipgnc.routing.fields`: current fields v(x, t) (note 002-2.9.1), usable by the router and
   as a ship's current in the simulation loop;
-* :mod:`~shipgnc.routing.pmp`: Pontryagin extremals, shooting, the batched global sweep (notes 002-2.4–002-2.6, 002-2.9.4);
+* :mod:`~shipgnc.routing.pmp`: Pontryagin extremals, shooting, the batched global sweep (notes
+  002-2.4–002-2.6, 002-2.9.4);
 * :mod:`~shipgnc.routing.levelset` and :mod:`~shipgnc.routing.graph`: global checks (note 002-2.9.2);
 * :mod:`~shipgnc.routing.obstacles`: polygons, vertex decomposition (note 002-2.9.3);
 * :mod:`~shipgnc.routing.router`: :func:`solve_route`, the front door returning a

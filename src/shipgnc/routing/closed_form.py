@@ -1,4 +1,5 @@
-"""Closed forms and exact checks of document 002: the linear shear (note 002-2.5), uniform and tidal currents (2.10, F1,
+"""Closed forms and exact checks of document 002: the linear shear (note 002-2.5), uniform and tidal
+currents (2.10, F1,
 F1b, 2.9.5) and the straight course (F6). SI throughout: m, s, m/s, rad, k in 1/s.
 """
 

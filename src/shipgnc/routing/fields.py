@@ -145,7 +145,8 @@ class UniformCurrent(CurrentField):
 
 @dataclass(frozen=True)
 class AffineCurrent(CurrentField):
-    """v = v₀ + G (x − x_ref) (note 002-2.9.1); the document's shear is G = [[0, 0], [k, 0]] (note 002-2.5)."""
+    """v = v₀ + G (x − x_ref) (note 002-2.9.1); the document's shear is G = [[0, 0], [k, 0]] (note
+    002-2.5)."""
 
     v0: tuple[float, float] = (0.0, 0.0)
     gradient: tuple[tuple[float, float], tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))

@@ -1,4 +1,5 @@
-"""The router's result (note 002-2.9.6): one object for a route or an explicit, worded failure (note 002-2.8)."""
+"""The router's result (note 002-2.9.6): one object for a route or an explicit, worded failure (note
+002-2.8)."""
 
 from __future__ import annotations
 

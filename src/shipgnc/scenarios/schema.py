@@ -259,7 +259,8 @@ class ActuatorConfig(Strict):
 class InitialState(Strict):
     """``simulation.initial_state``. ``u: null``: the vessel's straight-run surge equilibrium,
     computed when the scenario is validated (``shipgnc show`` prints the number): CyberShip II's
-    at ``vessel.propeller_rps`` (2T(n, u) = d₁₁(u)u, δ = 0; 0.29583… m/s at 8.13 rps, note 003-3.5), the Mariner's U = S/f."""
+    at ``vessel.propeller_rps`` (2T(n, u) = d₁₁(u)u, δ = 0; 0.29583… m/s at 8.13 rps, note 003-3.5), the
+    Mariner's U = S/f."""
 
     north: Finite = 0.0
     east: Finite = 0.0

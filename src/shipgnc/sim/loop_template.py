@@ -50,6 +50,7 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
         zni = row[o_zn:o_zn + nzn].copy()   # navigation: its state and held logged signals
         nsg = row[o_nsg:o_nsg + nnsig].copy()
         seen = np.empty(nx if has_nav else 0)  # the state guidance and controller see
+        nwk = np.empty(nav_work if has_nav else 0)  # the navigation step's scratch space
         j0 = (k0 + hold - 1) // hold  # the chunk's first control sample (row 0 of Wn)
         done = row[o_done]
         start = np.empty(nu)
@@ -70,7 +71,8 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
             t = k * dt
             if ic == 0:
                 if has_nav:  # Navigation.observe: the estimate (or measurements) from the truth
-                    nav_observe(t, x, applied, zni, pn, Wn[k // hold - j0, i], seen, nsg, pm)
+                    nav_observe(t, x, applied, zni, pn, Wn[k // hold - j0, i], seen, nsg, pm,
+                                nwk)
                 if has_guid:
                     if guid_fn(t, seen if has_nav else x, zgi, pg, ref, gout):
                         done = 1.0

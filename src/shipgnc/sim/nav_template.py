@@ -23,30 +23,45 @@ from shipgnc.navigation.kernels import (
 )
 
 
-def nav_observe(t, x, u, zn, pn, w, seen, nsg, pm):
+def nav_observe(t, x, u, zn, pn, w, seen, nsg, pm, wk):
     """The state the guidance and the controller see (``seen``) and the logged navigation signals
     (``nsg``) at control sample ``t`` from the true state ``x`` and the input ``u`` applied over
-    the last sample; ``zn`` the ship's navigation state, ``w`` its table row of this sample."""
+    the last sample; ``zn`` the ship's navigation state, ``w`` its table row of this sample,
+    ``wk`` scratch space (:data:`nav_work`)."""
     sensors_observe(t, x, zn, pn, w, seen, nsg)
     if est_kind == 1:
-        observer_step(u, zn, pn, pm)
+        observer_step(u, zn, pn, pm, wk)
         observer_outputs(zn, pn, seen, nsg)
     elif est_kind == 2:
-        ekf_step(u, zn, pn, pm)
-        gaussian_outputs(x, zn, pn, seen, nsg)
+        ekf_step(u, zn, pn, pm, wk)
+        gaussian_outputs(x, zn, pn, seen, nsg, wk)
     elif est_kind == 3:
         kf_step(u, zn, pn)
-        gaussian_outputs(x, zn, pn, seen, nsg)
+        gaussian_outputs(x, zn, pn, seen, nsg, wk)
     zn[0] = 0.0
 
 
-def observer_step(u, zn, pn, pm):
+#: scratch numbers per ship of the navigation step (views into it: no allocation per sample)
+nav_work = 7 * nx * nx + 10 * nx + nd + nu + 96
+
+
+def observer_step(u, zn, pn, pm, wk):
     """:meth:`PassiveObserver.update`: RK4 over the control period, ``substeps`` steps, y, u and
     ψ_y held (layout: :mod:`shipgnc.navigation.kernels`)."""
     e = int(pn[3])
     ez = int(pn[5])
-    y = np.empty(3)
-    val = np.empty(3)
+    y = wk[0:3]
+    val = wk[3:6]
+    fnu = wk[6:9]
+    s = wk[9:24]
+    ss = wk[24:39]
+    kq = wk[39:54]
+    acc = wk[54:69]
+    xt = wk[69:69 + nx]
+    fx = wk[69 + nx:69 + 2 * nx]
+    f0 = wk[69 + 2 * nx:69 + 3 * nx]
+    d0 = wk[69 + 3 * nx:69 + 3 * nx + nd]
+    u0 = wk[69 + 3 * nx + nd:69 + 3 * nx + nd + nu]
     for q in range(3):
         ok = zn[int(pn[e + 12 + q])] != 0.0
         val[q] = 1.0 if ok else 0.0
@@ -59,14 +74,14 @@ def observer_step(u, zn, pn, pm):
     model = pn[e] != 0.0
     substeps = int(pn[e + 1])
     Ts = pn[e + 2]
-    xt = zn[ez + 18:ez + 18 + nx].copy()
-    fx = np.empty(nx)
-    fnu = np.empty(3)
-    tau = zn[ez + 15:ez + 18].copy()
-    d0 = np.zeros(nd)
+    for j in range(nx):
+        xt[j] = zn[ez + 18 + j]
+    for j in range(nd):
+        d0[j] = 0.0
+    tau = zn[ez + 15:ez + 18]
     if not model:  # τ = M [ν̇(x̂, u) − ν̇(x̂, 0)], held over the sample
-        f0 = np.empty(nx)
-        u0 = np.zeros(nu)
+        for j in range(nu):
+            u0[j] = 0.0
         for q in range(3):
             xt[int(pn[e + 3 + q])] = zn[ez + 6 + q]
             xt[int(pn[e + 6 + q])] = zn[ez + 12 + q]
@@ -78,12 +93,8 @@ def observer_step(u, zn, pn, pm):
         g2 = fx[int(pn[e + 8])] - f0[int(pn[e + 8])]
         for q in range(3):
             tau[q] = g0 * pn[M + 3 * q] + g1 * pn[M + 3 * q + 1] + g2 * pn[M + 3 * q + 2]
-        for q in range(3):
-            zn[ez + 15 + q] = tau[q]
-    s = zn[ez:ez + 15].copy()
-    ss = np.empty(15)
-    kq = np.empty(15)
-    acc = np.empty(15)
+    for j in range(15):
+        s[j] = zn[ez + j]
     h = Ts / substeps
     for _ in range(substeps):
         for stage in range(4):
@@ -117,26 +128,42 @@ def observer_step(u, zn, pn, pm):
         zn[ez + j] = s[j]
 
 
-def ekf_step(u, zn, pn, pm):
+def ekf_step(u, zn, pn, pm, wk):
     """:meth:`ExtendedKalmanFilter.update`: predict (RK4 on the model, the central-difference
     Jacobian, F by the 4th-order series, Q_d) unless first, then one scalar correction per state
-    whose sensor delivered now."""
+    whose sensor delivered now. Small dense loops on views of ``wk`` (no BLAS call, no
+    allocation: at n = 5 or 6 these cost less than a call)."""
     e = int(pn[3])
     ez = int(pn[5])
     n = nx
-    zh = zn[ez:ez + n].copy()
-    P = zn[ez + n:ez + n + n * n].copy()
+    nn = n * n
+    zh = zn[ez:ez + n]
+    P = zn[ez + n:ez + n + nn]
     substeps = int(pn[e])
     Ts = pn[e + 1]
     held = pn[e + 2] != 0.0
     nrows = int(pn[e + 3])
     q0 = e + 4 + 5 * nrows          # Q_c diagonal
-    d0 = np.zeros(nd)
+    A = wk[0:nn]
+    At = wk[nn:2 * nn]
+    F = wk[2 * nn:3 * nn]
+    T1 = wk[3 * nn:4 * nn]
+    T2 = wk[4 * nn:5 * nn]
+    Qd = wk[5 * nn:6 * nn]
+    G = wk[6 * nn:7 * nn]
+    v = 7 * nn
+    fp = wk[v:v + n]
+    fm = wk[v + n:v + 2 * n]
+    xp = wk[v + 2 * n:v + 3 * n]
+    k1 = wk[v + 3 * n:v + 4 * n]
+    k2 = wk[v + 4 * n:v + 5 * n]
+    k3 = wk[v + 5 * n:v + 6 * n]
+    k4 = wk[v + 6 * n:v + 7 * n]
+    Pc = wk[v + 7 * n:v + 8 * n]
+    d0 = wk[v + 8 * n:v + 8 * n + nd]
+    for j in range(nd):
+        d0[j] = 0.0
     if zn[0] == 0.0:
-        fp = np.empty(n)
-        fm = np.empty(n)
-        xp = np.empty(n)
-        A = np.empty((n, n))
         for j in range(n):
             hj = 1e-6 * max(1.0, abs(zh[j]))
             for i in range(n):
@@ -146,38 +173,50 @@ def ekf_step(u, zn, pn, pm):
             xp[j] = zh[j] - hj
             model_fn(xp, u, d0, pm, fm)
             for i in range(n):
-                A[i, j] = (fp[i] - fm[i]) / (2.0 * hj)
-        At = A * Ts
-        F = np.eye(n) + At
-        term = At
+                A[i * n + j] = (fp[i] - fm[i]) / (2.0 * hj)
+        for i in range(nn):
+            At[i] = A[i] * Ts
+        for i in range(n):   # F = I + At + At²/2 + At³/6 + At⁴/24 (term = term·At / k)
+            for j in range(n):
+                F[i * n + j] = (1.0 if i == j else 0.0) + At[i * n + j]
+        for i in range(nn):
+            T1[i] = At[i]
         for k in range(2, 5):
-            term = (term @ At) / k
-            F = F + term
-        Qd = np.zeros((n, n))
-        if held:
-            G = Ts * (np.eye(n) + At / 2 + (At @ At) / 6)
-            GQ = np.empty((n, n))
             for i in range(n):
                 for j in range(n):
-                    GQ[i, j] = G[i, j] * pn[q0 + j]
-            Qd = (GQ @ G.T) / Ts
-        else:
-            AQ = np.empty((n, n))
+                    acc = 0.0
+                    for m in range(n):
+                        acc += T1[i * n + m] * At[m * n + j]
+                    T2[i * n + j] = acc / k
+            for i in range(nn):
+                T1[i] = T2[i]
+                F[i] = F[i] + T2[i]
+        if held:  # Γ (Q_c/Ts) Γᵀ, Γ = Ts (I + At/2 + At²/6)
             for i in range(n):
                 for j in range(n):
-                    AQ[i, j] = A[i, j] * pn[q0 + j]
-            X = ((AQ + AQ.T) * Ts**2) / 2
-            Y = ((AQ @ A.T) * Ts**3) / 3
+                    acc = 0.0
+                    for m in range(n):
+                        acc += At[i * n + m] * At[m * n + j]
+                    G[i * n + j] = Ts * ((1.0 if i == j else 0.0) + At[i * n + j] / 2 + acc / 6)
             for i in range(n):
                 for j in range(n):
+                    acc = 0.0
+                    for m in range(n):
+                        acc += (G[i * n + m] * pn[q0 + m]) * G[j * n + m]
+                    Qd[i * n + j] = acc / Ts
+        else:  # Q_c Ts + (A Q_c + Q_c Aᵀ) Ts²/2 + A Q_c Aᵀ Ts³/3
+            Ts2 = Ts**2
+            Ts3 = Ts**3
+            for i in range(n):
+                for j in range(n):
+                    acc = 0.0
+                    for m in range(n):
+                        acc += (A[i * n + m] * pn[q0 + m]) * A[j * n + m]
+                    x_ = ((A[i * n + j] * pn[q0 + j] + A[j * n + i] * pn[q0 + i]) * Ts2) / 2
                     qc = pn[q0 + i] if i == j else 0.0
-                    Qd[i, j] = qc * Ts + X[i, j] + Y[i, j]
+                    Qd[i * n + j] = qc * Ts + x_ + (acc * Ts3) / 3
         # x̂⁻ = Φ(x̂, u): RK4, substeps per Ts
         h = Ts / substeps
-        k1 = np.empty(n)
-        k2 = np.empty(n)
-        k3 = np.empty(n)
-        k4 = np.empty(n)
         for _ in range(substeps):
             model_fn(zh, u, d0, pm, k1)
             for i in range(n):
@@ -191,23 +230,28 @@ def ekf_step(u, zn, pn, pm):
             model_fn(xp, u, d0, pm, k4)
             for i in range(n):
                 zh[i] = zh[i] + (h / 6.0) * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i])
-        Pm = P.reshape((n, n))
-        Pn = (F @ Pm) @ F.T + Qd
+        for i in range(n):   # P⁻ = F P Fᵀ + Q_d, symmetrised
+            for j in range(n):
+                acc = 0.0
+                for m in range(n):
+                    acc += F[i * n + m] * P[m * n + j]
+                T1[i * n + j] = acc
         for i in range(n):
             for j in range(n):
-                P[i * n + j] = 0.5 * (Pn[i, j] + Pn[j, i])
-    Pc = np.empty(n)
+                acc = 0.0
+                for m in range(n):
+                    acc += T1[i * n + m] * F[j * n + m]
+                T2[i * n + j] = acc + Qd[i * n + j]
+        for i in range(n):
+            for j in range(n):
+                P[i * n + j] = 0.5 * (T2[i * n + j] + T2[j * n + i])
     for r in range(nrows):
         o = e + 4 + 5 * r
         if zn[int(pn[o + 2])] != 0.0:  # fresh
             correct_row(zh, P, int(pn[o]), zn[int(pn[o + 1])], pn[o + 3], pn[o + 4] != 0.0, Pc)
-    for i in range(n):
-        zn[ez + i] = zh[i]
-    for i in range(n * n):
-        zn[ez + n + i] = P[i]
 
 
-def gaussian_outputs(x, zn, pn, seen, nsg):
+def gaussian_outputs(x, zn, pn, seen, nsg, wk):
     """A Gaussian filter's estimates of the model states into ``seen`` and its logged signals
     ``<s>_hat``, ``<s>_std`` (√ of P's diagonal) and ``nees`` (:meth:`GaussianFilter.nees`);
     its map at ``pn[6]``: ``[n, n_mapped, (filter index, model index, angle) × n_mapped]``."""
@@ -216,8 +260,10 @@ def gaussian_outputs(x, zn, pn, seen, nsg):
     g = int(pn[6])                   # the filter's map block
     n = int(pn[g])
     m = int(pn[g + 1])
-    err = np.empty(m)
-    idx = np.empty(m)
+    need = m * m + 5 * m
+    work = wk[:need] if need <= wk.shape[0] else np.empty(need)
+    err = work[0:m]
+    idx = work[m:2 * m]
     for a in range(m):
         i = int(pn[g + 2 + 3 * a])
         j = int(pn[g + 3 + 3 * a])
@@ -228,7 +274,8 @@ def gaussian_outputs(x, zn, pn, seen, nsg):
     for i in range(n):
         nsg[so + i] = zn[ez + i]
         nsg[so + n + i] = math.sqrt(max(zn[ez + n + i * n + i], 0.0))
-    nsg[so + 2 * n] = nees(err, zn[ez + n:ez + n + n * n], n, idx, m) if m > 0 else np.nan
+    nsg[so + 2 * n] = (nees(err, zn[ez + n:ez + n + n * n], n, idx, m, work[2 * m:]) if m > 0
+                       else np.nan)
 
 
 _OPTIONS = {**JIT_OPTIONS, "cache": CACHE}

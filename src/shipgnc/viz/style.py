@@ -1,7 +1,8 @@
 """One place for the look of every shipgnc figure.
 
 Colours, line styles (commanded = dashed, applied = solid, references dashed/dotted), the figure
-resolution, the degree conversions used for display only (SI radians everywhere else, note 001-1.1), and :func:`use_headless_backend` to pick Agg when there is no display.
+resolution, the degree conversions used for display only (SI radians everywhere else, note 001-1.1), and
+:func:`use_headless_backend` to pick Agg when there is no display.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The level set round a coastline: the reachability front of document 002 §2.9.2 (Lolla et al., ICRA 2012;
+"""The level set round a coastline: the reachability front of note 002-2.9.2 (Lolla et al., ICRA 2012;
 WENO5, Godunov upwinding, TVD-RK3, the compiled right-hand side of :mod:`shipgnc.routing.levelset`) with
 land cells frozen, started from a **clipped** signed distance.
 

@@ -27,8 +27,10 @@ def _gshhg():
 
     try:
         import roaring_landmask as rl
-    except ImportError:  # pragma: no cover - a core dependency
-        raise ConfigError("the default coastline needs roaring-landmask: pip install roaring-landmask") from None
+    except ImportError:  # the optional extra: `pip install "shipgnc[geo]"`
+        raise ConfigError("the default coastline needs the optional package roaring-landmask (≈ 100 MB): "
+                          "pip install 'shipgnc[geo]'; or give your own polygons with --land FILE, or "
+                          "--land none for open sea") from None
     geoms = shapely.get_parts(shapely.from_wkb(rl.Shapes.wkb(rl.LandmaskProvider.Gshhg)))
     return geoms, shapely.STRtree(geoms)
 

@@ -68,7 +68,8 @@ class RouteProjection:
 
     def scale(self, lat, lon) -> np.ndarray:
         """Point scale factor k (conformal: the same in every direction)."""
-        f = self._proj.get_factors(np.atleast_1d(np.asarray(lon, float)), np.atleast_1d(np.asarray(lat, float)))
+        f = self._proj.get_factors(np.atleast_1d(np.asarray(lon, float)),
+                                   np.atleast_1d(np.asarray(lat, float)))
         return np.asarray(f.parallel_scale, float)
 
     def rotate(self, lat, lon, vn, ve):

@@ -209,8 +209,8 @@ class GeoProblem:
             self.notes.extend(current.grid.notes)
             for name, p in (("start", self.start), ("target", self.target)):
                 if not bool(current.grid.covers(*p)):
-                    raise ConfigError(f"{current.grid.path}: the route's {name} ({p[0]:.4f}, {p[1]:.4f}) lies "
-                                      f"outside the file's coverage {current.grid.extent}")
+                    raise ConfigError(f"{current.grid.path}: the route's {name} ({p[0]:.4f}, {p[1]:.4f}) "
+                                      f"lies outside the file's coverage {current.grid.extent}")
         self._plane_field(current)
         # ---- obstacles
         self._obstacles(land, depth, draft, ukc)
@@ -247,14 +247,15 @@ class GeoProblem:
             X = np.column_stack([one, N.ravel() - ref[0], E.ravel() - ref[1]])
             coef, *_ = np.linalg.lstsq(X, v, rcond=None)
             resid = float(np.max(np.hypot(*(X @ coef - v).T)))
-            self.field = UniformCurrent(0.0, 0.0) if not (vn or ve) else AffineCurrent((float(coef[0, 0]), float(coef[0, 1])),
-                                       ((float(coef[1, 0]), float(coef[2, 0])), (float(coef[1, 1]), float(coef[2, 1]))),
-                                       ref)
+            grad = ((float(coef[1, 0]), float(coef[2, 0])), (float(coef[1, 1]), float(coef[2, 1])))
+            self.field = (AffineCurrent((float(coef[0, 0]), float(coef[0, 1])), grad, ref) if (vn or ve)
+                          else UniformCurrent(0.0, 0.0))
             self.field_spacing = float(nn[1] - nn[0])
             self.wet = np.ones(N.shape)
             if vn or ve:
-                self.notes.append(f"uniform current ({vn:g}, {ve:g}) m/s true north/east; in the plane turned by "
-                                  f"the meridian convergence, an affine field (fit residual {resid:.1e} m/s)")
+                self.notes.append(f"uniform current ({vn:g}, {ve:g}) m/s true north/east; in the plane "
+                                  f"turned by the meridian convergence, an affine field (fit residual "
+                                  f"{resid:.1e} m/s)")
             return
         idx, w = grid.weights(lat, lon)
         v = grid.bilinear(np.nan_to_num(grid.values, nan=0.0), idx, w)  # (time, n, 2) true
@@ -293,8 +294,9 @@ class GeoProblem:
 
         proj = self.projection
         (n0, n1), (e0, e1) = self.box
-        bn = np.concatenate([np.linspace(n0, n1, 50), np.full(50, n1), np.linspace(n1, n0, 50), np.full(50, n0)])
-        be = np.concatenate([np.full(50, e0), np.linspace(e0, e1, 50), np.full(50, e1), np.linspace(e1, e0, 50)])
+        up, down = np.linspace(0.0, 1.0, 50), np.linspace(1.0, 0.0, 50)
+        bn = n0 + (n1 - n0) * np.concatenate([up, np.ones(50), down, np.zeros(50)])
+        be = e0 + (e1 - e0) * np.concatenate([np.zeros(50), up, np.ones(50), down])
         blat, blon = proj.to_geo(bn, be)
         pad = 0.05
         self.geo_box = (float(blon.min() - pad), float(blat.min() - pad), float(blon.max() + pad),
@@ -378,8 +380,8 @@ class GeoProblem:
                 return None
             depart_s = float(times[0]) + float(offset_s)
         if times is not None and times.size > 1 and not times[0] <= depart_s <= times[-1]:
-            raise ConfigError(f"{self.current.grid.path}: the departure {iso(depart_s)} lies outside the file's "
-                              f"time coverage {self.current.grid.time_extent()}")
+            raise ConfigError(f"{self.current.grid.path}: the departure {iso(depart_s)} lies outside the "
+                              f"file's time coverage {self.current.grid.time_extent()}")
         return float(depart_s)
 
     def field_from(self, depart_s):
@@ -434,8 +436,9 @@ class GeoProblem:
         else:
             notes.append(f"gridded current: the level set (global method), grid {self.h:.0f} m")
         if ls.arrival is None:
-            res.reason = (f"target not reachable round the land within {horizon:.0f} s ({horizon / 3600:.1f} h) "
-                          f"at {self.speed:.3f} m/s: the front's closest approach is {ls.closest_approach:.0f} m")
+            res.reason = (f"target not reachable round the land within {horizon:.0f} s "
+                          f"({horizon / 3600:.1f} h) at {self.speed:.3f} m/s: the front's closest approach "
+                          f"is {ls.closest_approach:.0f} m")
             res.closest_approach_m = ls.closest_approach
             return res
         r = ls.route

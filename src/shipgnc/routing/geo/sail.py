@@ -23,7 +23,8 @@ class _WaypointRoute:
 
     def __init__(self, route):
         pr = route.problem
-        n, e = pr.projection.to_plane([w["lat"] for w in route.waypoints], [w["lon"] for w in route.waypoints])
+        n, e = pr.projection.to_plane([w["lat"] for w in route.waypoints],
+                                      [w["lon"] for w in route.waypoints])
         self.xy = np.column_stack([n, e])
         self.start, self.target = self.xy[0], self.xy[-1]
         self.speed, self.t0 = float(pr.speed), 0.0
