@@ -13,6 +13,21 @@ The scheme is the one the reference numbers of note 002-2.9.2 come from:
 
 The route is recovered by integrating ẋ = V∇φ/‖∇φ‖ + v backwards from (B, T(B)) over stored fronts. Obstacle
 cells (2.9.3) are frozen: their φ never changes and their speed is zero. SI throughout.
+
+**Narrow band** (Sethian 1999, *Level set methods and fast marching methods*, §7; Adalsteinsson & Sethian,
+J. Comput. Phys. 118, 1995): φ is clipped, φ ← min(φ, b·h), at the start and after every time step
+(``band`` = b cells, 6 by default). Started from the plain signed distance, φ ≈ |x − A| everywhere and
+V‖∇φ‖ lowers it at every cell from the first step — behind a wall of frozen cells too, and where the WENO
+stencils straddle frozen cells holding large values, faster than V: behind land the front then "arrives"
+as if the land were not there. With the clip, ∇φ = 0 ahead of the band and φ falls only where the front
+has come, so behind an obstacle it arrives by the way round. The band's edge lies ``band`` cells ahead of
+the front, where the characteristics (velocity V∇φ/‖∇φ‖ + v, outward when V > |v|) carry nothing back to
+φ = 0, so obstacle-free results are unchanged (measured: tests/test_routing_levelset_band.py).
+``band=None`` gives the unclipped scheme.
+
+**Times**: ``arrival``, ``snapshot_times`` and the steps are times since departure t₀; the recovered
+:class:`LevelSetRoute` is on the clock (``t`` from t₀ to t₀ + arrival, like every route of
+:class:`~shipgnc.routing.result.RouteResult`), so ``position(t)`` and ``heading(t)`` take clock times.
 """
 
 from __future__ import annotations
@@ -124,12 +139,17 @@ def _front_rate_kernel(g, h, speed, vn, ve, out):
 
 @dataclass
 class LevelSetRoute:
-    """A route recovered from the fronts: arrays on time, with position(t) and heading(t)."""
+    """A route recovered from the fronts: arrays on the clock, with position(t) and heading(t).
 
-    t: np.ndarray
+    ``t`` runs from t₀ (departure) to t₀ + arrival [s]: ``position``/``heading`` take clock times, the
+    convention of every route in :class:`~shipgnc.routing.result.RouteResult` (times outside clamp to the
+    ends)."""
+
+    t: np.ndarray  #: clock times [s], t₀ … t₀ + arrival
     xy: np.ndarray
     psi: np.ndarray
     miss: float
+    t0: float = 0.0  #: departure [s] (the clock time of ``t[0]``)
 
     @property
     def heading_start(self) -> float:
@@ -162,6 +182,8 @@ class LevelSetResult:
     closest_approach: float  #: distance from B to the front at the end [m] (0 when reached)
     steps: int
     notes: list
+    frozen: np.ndarray | None = None  #: obstacle cells (north, east), frozen (2.9.3)
+    band: float | None = None  #: narrow-band half-width b·h [m] (φ ≤ b·h), None if unclipped
     _grads: dict = dc_field(default_factory=dict, repr=False)
 
     def isochrones(self, every: float = 3600.0):
