@@ -20,6 +20,7 @@ from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build
 from shipgnc.sim import compose
 from shipgnc.sim.simulator import simulate
+from shipgnc.sim.streams import MemberStreams, member_seeds
 
 T_END = 20.0
 
@@ -32,18 +33,19 @@ def sensors():
             nav.SpeedLog(0.05)]
 
 
-def run(navigation, backend: str, **kw):
+def run(navigation, backend: str, seed=7, **kw):
     scenario = load_scenario("boat-los-gnss")
     s = build(scenario)
     x0 = np.stack([s.x0, s.x0 + np.array([1.0, -2.0, 0.1, 0.0, 0.0, 0.0])])
     return simulate(s.model, x0, t_end=T_END, dt=scenario.simulation.dt, controller=s.controller,
                     actuator=s.actuator, guidance=s.guidance, disturbance=s.disturbance,
-                    u0=s.u0, seed=7, navigation=navigation, backend=backend, **kw)
+                    u0=s.u0, seed=seed() if callable(seed) else seed, navigation=navigation,
+                    backend=backend, **kw)
 
 
-def assert_same(make_navigation, rtol=1e-9, atol=1e-12, **kw):
-    ref = run(make_navigation(), "numpy")
-    got = run(make_navigation(), "compiled", **kw)
+def assert_same(make_navigation, rtol=1e-9, atol=1e-12, seed=7, **kw):
+    ref = run(make_navigation(), "numpy", seed=seed)
+    got = run(make_navigation(), "compiled", seed=seed, **kw)
     assert got.attrs["backend"] == "compiled" and ref.attrs["backend"] == "numpy"
     assert list(got.data_vars) == list(ref.data_vars)
     for var in ref.data_vars:
@@ -53,10 +55,12 @@ def assert_same(make_navigation, rtol=1e-9, atol=1e-12, **kw):
 
 
 def test_sensors_and_passive_observer_compiled_equal_numpy():
-    for velocity_model in ("linear", "model"):
+    # a generator for the batch, then one stream per ship (a sweep's members)
+    for velocity_model, seed in (("linear", 7),
+                                 ("model", lambda: MemberStreams(member_seeds(3, 2)))):
         got = assert_same(lambda vm=velocity_model: nav.Navigation(
             sensors(), nav.PassiveObserver(1.0, velocity_model=vm,
-                                           x0_offset={"north": 2.0, "psi": 0.05})))
+                                           x0_offset={"north": 2.0, "psi": 0.05})), seed=seed)
         valid = got["gnss_valid"].values[:, 0]
         t = got.time.values
         # a fix taken at t is delivered 2 control samples later; none taken in [5, 8] s arrives

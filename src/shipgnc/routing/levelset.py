@@ -8,22 +8,24 @@ The scheme is the one the reference numbers of note 002-2.9.2 come from:
 * Osher–Sethian (Godunov) upwinding for V‖∇φ‖ and upwind advection for v·∇φ;
 * TVD-RK3 (Shu–Osher) time stepping at CFL 0.5;
 * the front started at t₀ + r₀/V from the endpoints of the short-time extremal field (F8),
-  r₀ = max(5h, |AB|/20);
+  r₀ = max(5h, |AB|/20) (with obstacles: at most their distance from A less 2h, at least 1.2h);
 * the crossing at B found by cubic interpolation in time (B is a grid node).
 
 The route is recovered by integrating ẋ = V∇φ/‖∇φ‖ + v backwards from (B, T(B)) over stored fronts. Obstacle
 cells (2.9.3) are frozen: their φ never changes and their speed is zero. SI throughout.
 
-**Narrow band** (Sethian 1999, *Level set methods and fast marching methods*, §7; Adalsteinsson & Sethian,
-J. Comput. Phys. 118, 1995): φ is clipped, φ ← min(φ, b·h), at the start and after every time step
-(``band`` = b cells, 6 by default). Started from the plain signed distance, φ ≈ |x − A| everywhere and
-V‖∇φ‖ lowers it at every cell from the first step — behind a wall of frozen cells too, and where the WENO
-stencils straddle frozen cells holding large values, faster than V: behind land the front then "arrives"
-as if the land were not there. With the clip, ∇φ = 0 ahead of the band and φ falls only where the front
-has come, so behind an obstacle it arrives by the way round. The band's edge lies ``band`` cells ahead of
-the front, where the characteristics (velocity V∇φ/‖∇φ‖ + v, outward when V > |v|) carry nothing back to
-φ = 0, so obstacle-free results are unchanged (measured: tests/test_routing_levelset_band.py).
-``band=None`` gives the unclipped scheme.
+**Narrow band** (Sethian 1999, *Level set methods and fast marching methods*; Adalsteinsson & Sethian, J.
+Comput. Phys. 118, 1995): φ is clipped, φ ← min(φ, b·h), at the start and after every time step (``band`` = b
+cells, 6 by default). Started from the plain signed distance, φ ≈ |x − A| everywhere and V‖∇φ‖ lowers it at
+every cell from the first step — behind a wall of frozen cells too, and where the WENO stencils straddle
+frozen cells holding large values (a water cell in a pocket of land), faster than V: behind land the front
+then "arrives" as if the land were not there. With the clip, ∇φ = 0 ahead of the band and φ falls only where
+the front has come, so behind an obstacle it arrives by the way round. The band's edge lies ``band`` cells
+ahead of the front, where the characteristics (velocity V∇φ/‖∇φ‖ + v, outward when V > |v|) carry nothing back
+to φ = 0; only the WENO stencils of the three RK stages reach it numerically. Measured without obstacles on
+note 002-2.9.2's problem at h = 0.04 nm (still water, a uniform current, the shear): the arrival moves by at
+most 1.3·10⁻⁴ (relative), the size of the scheme's own error against the closed form, so the band is on by
+default everywhere. ``band=None`` gives the unclipped scheme.
 
 **Times**: ``arrival``, ``snapshot_times`` and the steps are times since departure t₀; the recovered
 :class:`LevelSetRoute` is on the clock (``t`` from t₀ to t₀ + arrival, like every route of
@@ -229,19 +231,76 @@ def _signed_distance(poly, nn, ee, h):
     return np.where(inside, -best, best).reshape(nn.shape)
 
 
+class _GridSlices:
+    """A gridded, time-varying field (``GriddedCurrent``-like: ``times``, ``_slice(k, n, e, deriv)``)
+    on the level-set grid: each time slice is interpolated onto the grid once, when first needed, and the
+    grid's velocity at t is then their linear interpolation in time — the formula of
+    :meth:`GriddedCurrent._eval`, so the result equals ``field._velocity(t, nn, ee)``; a step costs one
+    blend instead of a spatial interpolation of every cell. Slices behind the clock are dropped (at most
+    three held)."""
+
+    def __init__(self, field, nn, ee):
+        self.field, self.times = field, np.asarray(field.times, float)
+        (n0, n1), (e0, e1) = field.bounds
+        self.fn, self.fe = np.clip(nn.ravel(), n0, n1), np.clip(ee.ravel(), e0, e1)
+        self.shape = (*nn.shape, 2)
+        self.cache: dict = {}
+
+    @staticmethod
+    def applies(field) -> bool:
+        times = getattr(field, "times", None)
+        return (not field.steady and times is not None and np.size(times) > 1 and hasattr(field, "_slice")
+                and getattr(field, "bounds", None) is not None)
+
+    def _get(self, k):
+        if k not in self.cache:
+            for old in [j for j in self.cache if j < k - 1]:
+                del self.cache[old]
+            self.cache[k] = self.field._slice(k, self.fn, self.fe, False).reshape(self.shape)
+        return self.cache[k]
+
+    def __call__(self, t):
+        times = self.times
+        k = int(np.clip(np.searchsorted(times, t, side="right") - 1, 0, times.size - 2))
+        w = min(max((t - times[k]) / (times[k + 1] - times[k]), 0.0), 1.0)
+        return (1 - w) * self._get(k) + w * self._get(k + 1)
+
+
+def _initial_radius(spacing, dist, start, obstacles):
+    """r₀ = max(5h, |AB|/20) (note 002-2.9.2); with obstacles no more than the distance from A to the
+    nearest one less 2h (the short-time extremals ignore obstacles), and at least 1.2h."""
+    r0 = max(5 * spacing, dist / 20)
+    if obstacles:
+        import shapely
+
+        gap = min(float(p.distance(shapely.Point(*start))) for p in obstacles)
+        r0 = min(r0, max(1.2 * spacing, gap - 2 * spacing))
+    return r0
+
+
 def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizon=None, obstacles=None,
-                 cfl=0.5, store_every=None, recover=True, compiled=True) -> LevelSetResult:
+                 cfl=0.5, store_every=None, recover=True, compiled=True, band=6, r0=None, n_rays=720,
+                 ray_steps=60) -> LevelSetResult:
     """Propagate the reachability front from ``start`` until it covers ``target`` (note 002-2.9.2).
 
     ``domain`` = ((north_min, north_max), (east_min, east_max)) [m]; ``spacing`` h [m]; ``obstacles`` a
-    list of shapely polygons (frozen cells). Returns a :class:`LevelSetResult`. ``compiled=False`` uses
-    the numpy reference of the right-hand side (:func:`front_rate`) instead of its numba twin.
+    list of shapely polygons (frozen cells). ``t0`` is the departure on the field's clock [s]; the
+    result's times are since t0, its route's on the clock (module docstring). ``band`` (cells): φ is
+    clipped to min(φ, band·h) at the start and after every step (the narrow band, module docstring);
+    ``None`` leaves it unclipped. ``r0`` [m]: radius of the first front (default max(5h, |AB|/20), kept off
+    the obstacles), drawn by ``n_rays`` short-time extremals of ``ray_steps`` steps. A gridded,
+    time-varying field (:class:`~shipgnc.routing.fields.GriddedCurrent`) is interpolated onto the grid one
+    time slice at a time (:class:`_GridSlices`, equal results). Returns a :class:`LevelSetResult`.
+    ``compiled=False`` uses the numpy reference of the right-hand side (:func:`front_rate`) instead of its
+    numba twin.
     """
     from shipgnc.routing import pmp
 
     start = np.asarray(start, float)
     target = np.asarray(target, float)
     require(spacing > 0 and math.isfinite(spacing), "grid_spacing", spacing, "must be > 0 m")
+    require(band is None or (math.isfinite(band) and band >= 3), "band", band,
+            "must be None (unclipped) or at least 3 cells (the WENO5 stencil)")
     (n0, n1), (e0, e1) = domain
     for name, p in (("start", start), ("target", target)):
         require(n0 <= p[0] <= n1 and e0 <= p[1] <= e1, name, p.tolist(),
@@ -262,11 +321,15 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     if horizon is None:
         horizon = 4.0 * dist / speed
     # --- initial front: endpoints of the short-time extremal field (F8)
-    r0 = max(5 * spacing, dist / 20)
+    if r0 is None:
+        r0 = _initial_radius(spacing, dist, start, obstacles)
     t_init = r0 / speed
-    ends = pmp.integrate_family(field, speed, start, np.linspace(0, TWO_PI, 720, endpoint=False), t0, t_init,
-                                60)[-1]
+    rays = np.linspace(0, TWO_PI, n_rays, endpoint=False)
+    ends = pmp.integrate_family(field, speed, start, rays, t0, t_init, ray_steps)[-1]
     phi = _signed_distance(ends, nn, ee, spacing)
+    cap = None if band is None else band * spacing
+    if cap is not None:
+        phi = np.minimum(phi, cap)
     frozen = np.zeros(nn.shape, bool)
     if obstacles:
         from shipgnc.routing.obstacles import inside_any
@@ -275,16 +338,25 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     steady = field.steady
     vmax = field.max_speed(((north[0], north[-1]), (east[0], east[-1])), t0)
     v_grid = field._velocity(t0, nn, ee) if steady else None
+    on_grid = _GridSlices(field, nn, ee) if not steady and _GridSlices.applies(field) else None
     speed_grid = np.where(frozen, 0.0, speed)
+    any_frozen = bool(frozen.any())
 
     kernel = _compiled_rate() if compiled else None
 
     def rate(t, ph):
-        v = v_grid if steady else field._velocity(t, nn, ee)
-        vn, ve = np.where(frozen, 0.0, v[..., 0]), np.where(frozen, 0.0, v[..., 1])
+        if steady:
+            v = v_grid
+        elif on_grid is not None:
+            v = on_grid(t)
+        else:
+            v = field._velocity(t, nn, ee)
+        vn, ve = v[..., 0], v[..., 1]
+        if any_frozen:
+            vn, ve = np.where(frozen, 0.0, vn), np.where(frozen, 0.0, ve)
         if kernel is not None:
             out = np.empty_like(ph)
-            kernel(_pad3(ph), spacing, speed_grid, vn, ve, out)
+            kernel(_pad3(ph), spacing, speed_grid, np.ascontiguousarray(vn), np.ascontiguousarray(ve), out)
             return out
         return front_rate(ph, spacing, speed_grid, vn, ve)
 
@@ -304,6 +376,8 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
             p1 = phi + dt * rate(tt, phi)
             p2 = 0.75 * phi + 0.25 * (p1 + dt * rate(tt + dt, p1))
             phi = phi / 3 + 2 / 3 * (p2 + dt * rate(tt + dt / 2, p2))
+            if cap is not None:
+                phi = np.minimum(phi, cap)  # the narrow band: nothing ahead of it moves
             t += dt
             steps += 1
             history_t.append(t)
@@ -324,7 +398,7 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
         gap = np.hypot(nn - target[0], ee - target[1])
         closest = float(np.min(gap[reached])) if np.any(reached) else dist
     res = LevelSetResult(arrival, float(spacing), north, east, np.array(snaps_t), np.array(snaps), None,
-                         closest, steps, notes)
+                         closest, steps, notes, frozen, cap)
     if arrival is not None and recover:
         res.route = _recover(field, speed, start, target, res, t0, t_init, ends)
         margin = min(np.min(res.route.xy[:, 0] - north[0]), np.min(north[-1] - res.route.xy[:, 0]),
@@ -367,7 +441,8 @@ def _grad_at(res: LevelSetResult, k, x):
 
 
 def _recover(field, speed, start, target, res: LevelSetResult, t0, t_init, ends) -> LevelSetRoute:
-    """Integrate ẋ = V∇φ/‖∇φ‖ + v backwards from (B, T(B)) over the stored fronts (note 002-2.9.2)."""
+    """Integrate ẋ = V∇φ/‖∇φ‖ + v backwards from (B, T(B)) over the stored fronts (note 002-2.9.2).
+    Works in time since departure; the route returned is on the clock (t₀ + …)."""
     times = res.snapshot_times
     t_arr = res.arrival
     n_sub = 4
@@ -406,4 +481,4 @@ def _recover(field, speed, start, target, res: LevelSetResult, t0, t_init, ends)
     psis.append(theta0)
     order = np.argsort(ts)
     psi = np.mod(np.array(psis)[order], TWO_PI)
-    return LevelSetRoute(np.array(ts)[order], np.array(xs)[order], psi, 0.0)
+    return LevelSetRoute(t0 + np.array(ts)[order], np.array(xs)[order], psi, 0.0, float(t0))

@@ -83,7 +83,8 @@ class RouteResult:
         return self.path.heading(t)
 
     def position(self, t):
-        """Route position (north, east) [m] at time(s) t."""
+        """Route position (north, east) [m] at clock time(s) t [s], t₀ … t₀ + time_s: every route (extremal,
+        level set, graph, chain) takes the field's clock, not the time since departure."""
         if self.path is None:
             return np.broadcast_to(self.start, (*np.shape(t), 2)).copy()
         return self.path.position(t)
@@ -94,7 +95,7 @@ class RouteResult:
         return t, self.heading(t)
 
     def sample(self, n: int = 1001):
-        """(t, north, east, heading) arrays along the route."""
+        """(t, north, east, heading) arrays along the route, on n clock times t from t₀ to t₀ + time_s."""
         t = np.linspace(self.t0, self.t_end, n)
         x = self.position(t)
         return t, x[:, 0], x[:, 1], self.heading(t)

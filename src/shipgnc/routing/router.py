@@ -275,7 +275,7 @@ def _levelset_check(res, polys, grid_spacing, horizon, domain):
             res.notes.append(f"level set confirms: not reached within {horizon:.0f} s; front's closest "
                              f"approach {ls.closest_approach:.1f} m")
         return
-    if polys and ls.route is not None and _leaks(ls.route, polys, ls.arrival, res.t0):
+    if polys and ls.route is not None and _leaks(ls.route, polys, ls.arrival, res.t0, ls.spacing):
         res.notes.append("level-set check discarded: its front crossed an obstacle (refine the grid)")
         res.global_check = {"method": "levelset", "time_s": None, "rel_diff": None}
         return
@@ -290,13 +290,25 @@ def _levelset_check(res, polys, grid_spacing, horizon, domain):
                          "polished")
 
 
-def _leaks(route, polys, arrival, t0) -> bool:
-    """Does a recovered level-set route pass through an obstacle? (The frozen cells slow the front
-    down but a thin wall does not stop the level-set equation, whose φ falls everywhere.)"""
+def _leaks(route, polys, arrival, t0, spacing=0.0) -> bool:
+    """Does a recovered level-set route pass through an obstacle? The narrow band
+    (:mod:`~shipgnc.routing.levelset`) keeps the front behind walls of frozen cells, but a wall thinner
+    than the WENO5 stencil (about three cells) can still be crossed: this is the last check. ``route``
+    takes clock times (t₀ … t₀ + arrival), as every route of a :class:`RouteResult`.
+
+    The grid resolves an obstacle's outline to a cell: a route that only cuts a corner by less than half
+    a cell (``spacing``/2) is not a leak. Each polygon is shrunk by ``spacing``/2 (a polygon thinner than a
+    cell is tested whole); a route through a wall crosses that core."""
     from shipgnc.routing.obstacles import path_hits
 
     t = np.linspace(t0, t0 + arrival, 2001)
-    return path_hits(polys, np.asarray(route.position(t), dtype=float).reshape(-1, 2))
+    cores = polys
+    if spacing > 0:
+        cores = []
+        for p in polys:
+            c = p.buffer(-0.5 * spacing)
+            cores.append(p if c.is_empty else c)
+    return path_hits(cores, np.asarray(route.position(t), dtype=float).reshape(-1, 2))
 
 
 def _polish_from_seed(res, theta0, duration):
@@ -321,7 +333,7 @@ def _levelset_primary(res, polys, grid_spacing, horizon, domain):
         res.closest_approach_m = ls.closest_approach
         return
     route = ls.route
-    if polys and _leaks(route, polys, ls.arrival, res.t0):
+    if polys and _leaks(route, polys, ls.arrival, res.t0, ls.spacing):
         res.reason = ("the level-set front crossed an obstacle (a wall a few grid cells thick does not "
                       "stop it): no trustworthy route; refine --grid or use --method graph")
         return
@@ -336,6 +348,9 @@ def _levelset_primary(res, polys, grid_spacing, horizon, domain):
     res.heading_start, res.heading_end = route.heading_start, route.heading_end
     res.miss_m, res.path = route.miss, route
     res.notes.append("level-set route (not polished)")
+    if polys and _leaks(route, polys, ls.arrival, res.t0):
+        res.notes.append(f"the level-set route cuts an obstacle's corner by less than half a grid cell "
+                         f"({0.5 * ls.spacing:.0f} m, the grid's resolution of its outline)")
 
 
 def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles):
