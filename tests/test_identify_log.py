@@ -248,6 +248,16 @@ def test_time_not_increasing_names_the_row(tmp_path):
     assert "time not strictly increasing at line 12" in _cli_error(path)
 
 
+def test_a_gap_in_time_is_refused_not_interpolated(tmp_path):
+    """One wrong time stamp (1e9 s at the end) would make a 2·10⁹-sample uniform grid: refused with
+    the line of the gap instead of filling memory with invented samples."""
+    cols = _good()
+    cols["time"][-1] = 1e9
+    path = _write_csv(tmp_path / "log.csv", cols)
+    msg = _cli_error(path)
+    assert "a gap of" in msg and f"line {len(cols['time']) + 1}" in msg
+
+
 def test_nan_rows_are_named(tmp_path):
     cols = _good()
     cols["r"][3] = np.nan

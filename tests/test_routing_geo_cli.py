@@ -127,3 +127,10 @@ def test_sailed_check_arrives_near_the_optimum():
     assert got["sail_arrived"]
     # a 2 m boat under LOS through the waypoints arrives within 2 % of the optimum
     assert got["sail_ratio"] == pytest.approx(1.0, abs=0.02)
+
+
+def test_start_equal_to_target_is_one_line():
+    r = invoke("--geo", "--start", "50,1", "--target", "50,1", "--speed", "5", "--field", "still",
+               "--land", "none")
+    assert r.exit_code == 2
+    assert "the same point" in r.output and "internal error" not in r.output

@@ -156,6 +156,8 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     require(radius == 0.0, "--radius", radius, "is not used with --geo (the target is a point)")
     a = _pair(start, "--start", 1.0)
     b = _pair(target, "--target", 1.0)
+    if a == b:
+        raise ConfigError(f"--start = --target = {start!r}: the same point, nothing to route")
     current = _geo_field(field, units)
     try:
         offset, iso_depart = _number(depart, "--depart", "") * tscale, None

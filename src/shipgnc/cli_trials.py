@@ -30,22 +30,10 @@ def _vessel(text: str) -> tuple[str, float | None, dict]:
     """(catalogue name, speed from the file or None, build parameters) from --vessel."""
     p = Path(text)
     if text.endswith((".yaml", ".yml")) or (p.suffix and p.is_file()):
-        import yaml
+        from shipgnc.vessels.files import load_vessel_file
 
-        try:
-            data = yaml.safe_load(p.read_text(encoding="utf-8"))
-        except OSError as exc:
-            raise ConfigError(f"--vessel {text!r}: cannot read the file ({exc.strerror})") from None
-        except yaml.YAMLError as exc:
-            raise ConfigError(f"--vessel {text!r}: not valid YAML ({' '.join(str(exc).split())})") from None
-        if isinstance(data, dict) and isinstance(data.get("vessel"), dict):
-            data = data["vessel"]
-        if not isinstance(data, dict) or not isinstance(data.get("model"), str):
-            raise ConfigError(f"--vessel {text!r}: expected a mapping 'vessel: {{model: NAME, ...}}'")
-        data = dict(data)
-        name = data.pop("model")
-        speed = data.pop("speed_mps", None)
-        return name, speed, data
+        config = load_vessel_file(p, f"--vessel {text!r}")
+        return config.model, config.speed_mps, config.params()
     return text, None, {}
 
 

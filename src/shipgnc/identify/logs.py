@@ -28,6 +28,9 @@ import numpy as np
 
 from shipgnc.errors import ConfigError
 
+#: uneven steps up to this many median steps are interpolated; a longer gap is refused
+MAX_GAP_STEPS = 10
+
 #: the roles a log's columns play, in order
 ROLES = ("time", "rudder", "heading", "yaw_rate", "u", "v")
 #: default column names of each role, first match wins (shipgnc's result.nc first)
@@ -348,6 +351,12 @@ def read_log(path, *, required=("time", "rudder"), optional=("heading", "yaw_rat
         notes.append(table.batch_note)
     h = float(np.median(steps))
     if not np.allclose(steps, h, rtol=1e-6, atol=1e-9):
+        gap = int(np.argmax(steps))
+        if steps[gap] > MAX_GAP_STEPS * h:  # a gap, not jitter: interpolating across it invents data
+            raise ConfigError(f"LOG {shown}: a gap of {steps[gap]:.6g} s in time at "
+                              f"{table.rows([gap + 1])} (t = {t[gap]:.6g} → {t[gap + 1]:.6g} s), "
+                              f"more than {MAX_GAP_STEPS} × the median step {h:.4g} s; split the log "
+                              "there or cut it")
         m = math.floor((t[-1] - t[0]) / h + 1e-9) + 1
         grid = t[0] + h * np.arange(m)
         values = {role: np.interp(grid, t, arr) for role, arr in values.items()}

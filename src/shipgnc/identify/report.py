@@ -16,8 +16,6 @@ from pathlib import Path
 
 import numpy as np
 
-from shipgnc.errors import ConfigError
-
 _LABELS = {"u": ("u [m/s]", 1.0), "v": ("v [m/s]", 1.0), "r": ("r [deg/s]", 180.0 / math.pi)}
 
 
@@ -96,15 +94,11 @@ def vessel_yaml(ident, *, source: str = "") -> str:
 
 
 def build_vessel(spec: dict):
-    """A catalogue model from a vessel section (``{"model": ..., params, "speed_mps": ...}``)."""
-    from shipgnc.vessels import get_vessel
+    """A catalogue model from a vessel section (``{"model": ..., params, "speed_mps": ...}``),
+    validated as a scenario's ``vessel:`` section is."""
+    from shipgnc.vessels.files import vessel_config
 
-    spec = dict(spec)
-    name = spec.pop("model", None)
-    if name is None:
-        raise ConfigError("vessel: no 'model' key")
-    speed = spec.pop("speed_mps", None)
-    return get_vessel(name).build(speed, **spec)
+    return vessel_config(spec, "vessel").build()
 
 
 def resimulate(model, t, delta, x0: np.ndarray) -> np.ndarray:
@@ -112,6 +106,7 @@ def resimulate(model, t, delta, x0: np.ndarray) -> np.ndarray:
     the logged ``delta`` (linear between samples; the steering machine bypassed), RK4 at the
     log's step."""
     from shipgnc.models.base import state_index
+    from shipgnc.sim.integrators import rk4_step
 
     i_delta = state_index(model, "delta")
     t = np.asarray(t, dtype=float)
@@ -120,7 +115,8 @@ def resimulate(model, t, delta, x0: np.ndarray) -> np.ndarray:
     out = np.empty((t.size, x.size))
     u_in = np.zeros(len(model.inputs))
 
-    def f(xs, d):
+    def rhs(tq, xs):  # the logged rudder, linear between samples, replaces the rudder state
+        d = float(np.interp(tq, t, delta))
         xs = xs.copy()
         xs[i_delta] = d
         u_in[0] = d
@@ -131,14 +127,7 @@ def resimulate(model, t, delta, x0: np.ndarray) -> np.ndarray:
     x[i_delta] = delta[0]
     out[0] = x
     for k in range(t.size - 1):
-        h = t[k + 1] - t[k]
-        d0, d1 = delta[k], delta[k + 1]
-        dm = 0.5 * (d0 + d1)
-        k1 = f(x, d0)
-        k2 = f(x + 0.5 * h * k1, dm)
-        k3 = f(x + 0.5 * h * k2, dm)
-        k4 = f(x + h * k3, d1)
-        x = x + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-        x[i_delta] = d1
+        x = rk4_step(rhs, t[k], x, t[k + 1] - t[k])
+        x[i_delta] = delta[k + 1]
         out[k + 1] = x
     return out

@@ -182,39 +182,34 @@ def ekf_step(u, zn, pn, pm, wk):
         for i in range(nn):
             T1[i] = At[i]
         for k in range(2, 5):
-            for i in range(n):
-                for j in range(n):
-                    acc = 0.0
-                    for m in range(n):
-                        acc += T1[i * n + m] * At[m * n + j]
-                    T2[i * n + j] = acc / k
+            matmul(T1, At, T2, False)
             for i in range(nn):
-                T1[i] = T2[i]
-                F[i] = F[i] + T2[i]
+                T1[i] = T2[i] / k
+                F[i] = F[i] + T1[i]
         if held:  # Γ (Q_c/Ts) Γᵀ, Γ = Ts (I + At/2 + At²/6)
+            matmul(At, At, T2, False)
             for i in range(n):
                 for j in range(n):
-                    acc = 0.0
-                    for m in range(n):
-                        acc += At[i * n + m] * At[m * n + j]
-                    G[i * n + j] = Ts * ((1.0 if i == j else 0.0) + At[i * n + j] / 2 + acc / 6)
+                    G[i * n + j] = Ts * ((1.0 if i == j else 0.0) + At[i * n + j] / 2
+                                         + T2[i * n + j] / 6)
             for i in range(n):
                 for j in range(n):
-                    acc = 0.0
-                    for m in range(n):
-                        acc += (G[i * n + m] * pn[q0 + m]) * G[j * n + m]
-                    Qd[i * n + j] = acc / Ts
+                    T1[i * n + j] = G[i * n + j] * pn[q0 + j]
+            matmul(T1, G, Qd, True)
+            for i in range(nn):
+                Qd[i] = Qd[i] / Ts
         else:  # Q_c Ts + (A Q_c + Q_c Aᵀ) Ts²/2 + A Q_c Aᵀ Ts³/3
             Ts2 = Ts**2
             Ts3 = Ts**3
             for i in range(n):
                 for j in range(n):
-                    acc = 0.0
-                    for m in range(n):
-                        acc += (A[i * n + m] * pn[q0 + m]) * A[j * n + m]
-                    x_ = ((A[i * n + j] * pn[q0 + j] + A[j * n + i] * pn[q0 + i]) * Ts2) / 2
+                    T1[i * n + j] = A[i * n + j] * pn[q0 + j]
+            matmul(T1, A, T2, True)
+            for i in range(n):
+                for j in range(n):
+                    x_ = ((T1[i * n + j] + T1[j * n + i]) * Ts2) / 2
                     qc = pn[q0 + i] if i == j else 0.0
-                    Qd[i * n + j] = qc * Ts + x_ + (acc * Ts3) / 3
+                    Qd[i * n + j] = qc * Ts + x_ + (T2[i * n + j] * Ts3) / 3
         # x̂⁻ = Φ(x̂, u): RK4, substeps per Ts
         h = Ts / substeps
         for _ in range(substeps):
@@ -230,18 +225,10 @@ def ekf_step(u, zn, pn, pm, wk):
             model_fn(xp, u, d0, pm, k4)
             for i in range(n):
                 zh[i] = zh[i] + (h / 6.0) * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i])
-        for i in range(n):   # P⁻ = F P Fᵀ + Q_d, symmetrised
-            for j in range(n):
-                acc = 0.0
-                for m in range(n):
-                    acc += F[i * n + m] * P[m * n + j]
-                T1[i * n + j] = acc
-        for i in range(n):
-            for j in range(n):
-                acc = 0.0
-                for m in range(n):
-                    acc += T1[i * n + m] * F[j * n + m]
-                T2[i * n + j] = acc + Qd[i * n + j]
+        matmul(F, P, T1, False)   # P⁻ = F P Fᵀ + Q_d, symmetrised
+        matmul(T1, F, T2, True)
+        for i in range(nn):
+            T2[i] = T2[i] + Qd[i]
         for i in range(n):
             for j in range(n):
                 P[i * n + j] = 0.5 * (T2[i * n + j] + T2[j * n + i])
@@ -249,6 +236,24 @@ def ekf_step(u, zn, pn, pm, wk):
         o = e + 4 + 5 * r
         if zn[int(pn[o + 2])] != 0.0:  # fresh
             correct_row(zh, P, int(pn[o]), zn[int(pn[o + 1])], pn[o + 3], pn[o + 4] != 0.0, Pc)
+
+
+def matmul(X, Y, out, transposed):
+    """``out`` = X Y (or X Yᵀ) of n × n row-major matrices, each entry summed over m in order (as
+    a dot product) but with the n entries of a row accumulated side by side: independent sums
+    that the processor overlaps (a sum at a time waits on each add)."""
+    n = nx
+    for i in range(n):
+        for j in range(n):
+            out[i * n + j] = 0.0
+        for m in range(n):
+            a = X[i * n + m]
+            if transposed:
+                for j in range(n):
+                    out[i * n + j] += a * Y[j * n + m]
+            else:
+                for j in range(n):
+                    out[i * n + j] += a * Y[m * n + j]
 
 
 def gaussian_outputs(x, zn, pn, seen, nsg, wk):
@@ -279,6 +284,7 @@ def gaussian_outputs(x, zn, pn, seen, nsg, wk):
 
 
 _OPTIONS = {**JIT_OPTIONS, "cache": CACHE}
+matmul = numba.njit(**_OPTIONS)(matmul)
 observer_step = numba.njit(**_OPTIONS)(observer_step)
 ekf_step = numba.njit(**_OPTIONS)(ekf_step)
 gaussian_outputs = numba.njit(**_OPTIONS)(gaussian_outputs)

@@ -62,6 +62,14 @@ class VesselEntry:
             if key not in allowed:
                 raise ConfigError(f"vessel {self.name}: unknown parameter {key!r}; allowed: "
                                   f"{', '.join(allowed)}")
+        for key in STEERING_PARAMS:
+            value = params.get(key)
+            if value is None:
+                continue
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if not ok or not 0 < value < math.inf or (key == "rudder_max_deg" and value > 90):
+                rule = "a number in (0, 90]" if key == "rudder_max_deg" else "a positive number"
+                raise ConfigError(f"vessel {self.name}: {key} = {value!r}; allowed: {rule}")
         steering = {
             "delta_max": math.radians(params.pop("rudder_max_deg"))
             if params.get("rudder_max_deg") is not None else self.max_rudder_rad,

@@ -1,0 +1,37 @@
+"""A vessel section read from a file or a mapping, validated once (the scenario schema's
+:class:`~shipgnc.scenarios.schema.CatalogueVesselConfig`), for ``shipgnc trial --vessel FILE``,
+the YAML ``shipgnc identify`` writes, and a scenario's ``vessel:`` section alike."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from shipgnc.errors import ConfigError
+
+
+def vessel_config(data: object, source: str):
+    """``{model: NAME, speed_mps: …, params…}`` (or ``{vessel: {…}}``) as a validated
+    :class:`~shipgnc.scenarios.schema.CatalogueVesselConfig`; a one-line :class:`ConfigError`
+    naming the field, the value and the rule otherwise."""
+    from pydantic import ValidationError
+
+    from shipgnc.scenarios.schema import CatalogueVesselConfig, format_validation_error
+
+    if isinstance(data, dict) and isinstance(data.get("vessel"), dict):
+        data = data["vessel"]
+    if not isinstance(data, dict) or not isinstance(data.get("model"), str):
+        raise ConfigError(f"{source}: expected a mapping 'vessel: {{model: NAME, ...}}' "
+                          "(names: shipgnc vessels)")
+    try:
+        return CatalogueVesselConfig.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError(format_validation_error(exc, source).removeprefix("scenario ")) from None
+
+
+def load_vessel_file(path: str | Path, source: str | None = None):
+    """The vessel section of a YAML file (size-bounded, strict YAML as for scenarios)."""
+    from shipgnc.scenarios.registry import _read_text, _read_yaml
+
+    source = source or repr(str(path))
+    text = _read_text(Path(path), source)
+    return vessel_config(_read_yaml(text, source), source)
