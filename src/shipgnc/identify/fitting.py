@@ -370,7 +370,8 @@ def _lsim2_sp(K, S, P, T3, t, delta, r0):
     C = np.array([[K / P, K * T3 / P]])
     x0 = np.array([r0 / C[0, 0] if C[0, 0] != 0 else 0.0, 0.0])
     sys = signal.StateSpace(A, np.array([[0.0], [1.0]]), C, np.zeros((1, 1)))
-    _, y, _ = signal.lsim(sys, delta, t - t[0], X0=x0, interp=True)
+    with np.errstate(all="ignore"):  # a trial point with T₁T₂ → 0 overflows: a large residual, not a message
+        _, y, _ = signal.lsim(sys, delta, t - t[0], X0=x0, interp=True)
     return np.asarray(y, dtype=float).reshape(-1)
 
 
@@ -623,7 +624,7 @@ def identify_linear3dof(t, delta, u, v, r, *, holdout: float = 0.3, horizon: flo
     else:
         a_uu = 0.0
         U = float(speed) if speed is not None else mean_u
-        u_sim = np.full_like(u, u[0])
+        u_sim = np.full_like(u, U)  # as the vessel YAML below sails it
         notes.append(f"surge not identified: the speed changes by {np.ptp(uf):.3g} m/s "
                      f"(< {100 * SURGE_MIN_CHANGE:g} % of its mean {mean_u:.4g} m/s); the vessel "
                      "YAML keeps u constant (N_uu = 0) at U = "
