@@ -80,8 +80,11 @@ def connect(scheduler: str | None, workers: str):
     # the workers start with Ctrl-C ignored (an ignored signal stays ignored in a child process):
     # Ctrl-C reaches the whole terminal's process group, and this process alone answers it
     with _sigint_ignored():
+        # worker logs at CRITICAL only: a failing task reaches us as its exception, and the
+        # workers' shutdown chatter ("failed to communicate with scheduler during heartbeat",
+        # logged at ERROR when a loaded machine closes the scheduler first) is not an error of ours
         cluster = LocalCluster(n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
+                               dashboard_address=None, silence_logs=logging.CRITICAL)
     return Client(cluster)
 
 
