@@ -204,6 +204,24 @@ def observer_outputs(z, p, seen, sig):
 # ----------------------------------------------------------------------------------------------
 
 @kernel_function
+def apply_gain(zh, P, Pc, S, innov):
+    """The scalar Kalman update shared by both corrections: with Pc = P cᵀ and S = c P cᵀ + var,
+    x̂ += Pc/S·innov, P −= Pc Pcᵀ/S (then symmetrised), P row-major flat n × n."""
+    n = zh.shape[0]
+    for a in range(n):
+        zh[a] = zh[a] + Pc[a] / S * innov
+    for a in range(n):
+        Ka = Pc[a] / S
+        for b in range(n):
+            P[a * n + b] = P[a * n + b] - Ka * Pc[b]
+    for a in range(n):
+        for b in range(a + 1, n):
+            m = 0.5 * (P[a * n + b] + P[b * n + a])
+            P[a * n + b] = m
+            P[b * n + a] = m
+
+
+@kernel_function
 def correct_row(zh, P, j, y, var, angle, Pc):
     """:meth:`GaussianFilter.correct_row` for one ship and a row c = e_j (a measured state):
     scalar update of the mean ``zh`` (n) and the covariance ``P`` (n × n, row-major flat)."""
@@ -216,17 +234,7 @@ def correct_row(zh, P, j, y, var, angle, Pc):
     innov = y - zh[j]
     if angle:
         innov = wrap(innov)
-    for a in range(n):
-        zh[a] = zh[a] + Pc[a] / S * innov
-    for a in range(n):
-        Ka = Pc[a] / S
-        for b in range(n):
-            P[a * n + b] = P[a * n + b] - Ka * Pc[b]
-    for a in range(n):
-        for b in range(a + 1, n):
-            m = 0.5 * (P[a * n + b] + P[b * n + a])
-            P[a * n + b] = m
-            P[b * n + a] = m
+    apply_gain(zh, P, Pc, S, innov)
 
 
 @kernel_function
@@ -248,17 +256,7 @@ def correct_c(zh, P, c, y, var, angle, Pc):
     innov = y - yc
     if angle:
         innov = wrap(innov)
-    for a in range(n):
-        zh[a] = zh[a] + Pc[a] / S * innov
-    for a in range(n):
-        Ka = Pc[a] / S
-        for b in range(n):
-            P[a * n + b] = P[a * n + b] - Ka * Pc[b]
-    for a in range(n):
-        for b in range(a + 1, n):
-            m = 0.5 * (P[a * n + b] + P[b * n + a])
-            P[a * n + b] = m
-            P[b * n + a] = m
+    apply_gain(zh, P, Pc, S, innov)
 
 
 @kernel_function
