@@ -117,6 +117,24 @@ def test_a_land_polygon_across_the_geodesic_is_gone_round(walled):
     assert d < route.distance_m < 1.5 * d
 
 
+def test_a_shapefile_of_land_reads_as_the_same_polygons(walled, tmp_path):
+    """--land FILE.shp (pyshp, the [geo] extra): the island written as a shapefile is read back as
+    the GeoJSON's polygon (same area and bounds), the other format the issue names."""
+    import shapefile
+
+    from shipgnc.routing.geo.land import load_land
+
+    _, path, island, *_ = walled
+    with shapefile.Writer(str(tmp_path / "island"), shapeType=shapefile.POLYGON) as w:
+        w.field("name", "C")
+        w.poly([list(island.exterior.coords)[::-1]])  # shapefile outer rings run clockwise
+        w.record("island")
+    (from_shp,) = load_land(tmp_path / "island.shp")
+    (from_json,) = load_land(path)
+    assert from_shp.area == pytest.approx(from_json.area, rel=1e-12)
+    assert from_shp.bounds == pytest.approx(from_json.bounds, abs=1e-12)
+
+
 def test_start_on_land_is_refused_in_one_line(walled):
     _, path, *_ = walled
     with pytest.raises(ConfigError, match=r"^--start = 50\.50000,-10\.50000: on land \(land from ") as exc:

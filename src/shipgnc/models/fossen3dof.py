@@ -265,6 +265,52 @@ class VectoredThrustBoat:
             u_dot, v_dot = u_dot + sr * current[1], v_dot - sr * current[0]
         return np.stack([north_dot, east_dot, sr, u_dot, v_dot, r_dot], axis=-1)
 
+    def state_jacobian(self, x, u, d=None):
+        """A = ∂f/∂x of :meth:`derivatives` at (x, u, d), analytic: (..., 6, 6), A[..., i, j] =
+        ∂ẋ_i/∂x_j (the input and the forces enter additively; the current rotates with ψ).
+
+        With ν_r = (u − u_c, v − v_c), (u_c, v_c) = R(ψ)ᵀ v_c, ∂(u_c, v_c)/∂ψ = (v_c, −u_c)::
+
+            ∂(ṅ, ė)/∂ψ = (−ė, ṅ),  ∂(ṅ, ė)/∂(u, v) = R(ψ),  ∂ψ̇/∂r = 1
+            ∂u̇/∂(u, v, r) = (X_u, M₂₂ r, M₂₂ v_r)/M₁₁ + (0, 0, v_c)
+            ∂v̇/∂(u, v, r) = (−M₁₁ r, Y_v, −M₁₁ u_r)/M₂₂ + (0, 0, −u_c)
+            ∂ṙ/∂(u, v, r) = (k v_r, k u_r, N_r + 2 N_|r|r |r|)/M₃₃
+
+        (eq. (9)–(11') differentiated; k = c_M (Y_v̇ − X_u̇)); used by the EKF
+        (:class:`~shipgnc.navigation.ekf.ExtendedKalmanFilter`) in place of central differences.
+        """
+        p = self.params
+        x = np.asarray(x, dtype=float)
+        psi, su, sv, sr = x[..., 2], x[..., 3], x[..., 4], x[..., 5]
+        c, s = np.cos(psi), np.sin(psi)
+        current = body_current(psi, d)
+        zero = np.zeros_like(psi)
+        uc, vc = (zero, zero) if current is None else current
+        ur, vr = su - uc, sv - vc
+        k = p.munk_coefficient
+        A = np.zeros((*psi.shape, 6, 6))
+        A[..., 0, 2] = -s * su - c * sv
+        A[..., 0, 3] = c
+        A[..., 0, 4] = -s
+        A[..., 1, 2] = c * su - s * sv
+        A[..., 1, 3] = s
+        A[..., 1, 4] = c
+        A[..., 2, 5] = 1.0
+        # ∂u_r/∂ψ = −v_c, ∂v_r/∂ψ = u_c
+        A[..., 3, 2] = (p.M22 * sr * uc - p.X_u * vc) / p.M11 - sr * uc
+        A[..., 3, 3] = p.X_u / p.M11
+        A[..., 3, 4] = p.M22 * sr / p.M11
+        A[..., 3, 5] = p.M22 * vr / p.M11 + vc
+        A[..., 4, 2] = (p.M11 * sr * vc + p.Y_v * uc) / p.M22 - sr * vc
+        A[..., 4, 3] = -p.M11 * sr / p.M22
+        A[..., 4, 4] = p.Y_v / p.M22
+        A[..., 4, 5] = -p.M11 * ur / p.M22 - uc
+        A[..., 5, 2] = k * (ur * uc - vr * vc) / p.M33
+        A[..., 5, 3] = k * vr / p.M33
+        A[..., 5, 4] = k * ur / p.M33
+        A[..., 5, 5] = (p.N_r + 2.0 * p.N_rr * np.abs(sr)) / p.M33
+        return A
+
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`boat_current_rhs`)."""
         p = self.params
@@ -324,3 +370,42 @@ def _boat_rhs(x, u, d, p, xdot, current_north, current_east):
     xdot[3] = du + sr * vc
     xdot[4] = dv - sr * uc
     xdot[5] = dr
+
+
+@kernel_function
+def boat_current_rhs_jacobian(x, u, d, p, A):
+    """:meth:`VectoredThrustBoat.state_jacobian` for one ship: ∂ẋ/∂x of
+    :func:`boat_current_rhs` into ``A`` (6 × 6, row-major flat), the current ``d[3:5]`` when
+    ``d`` has it; ``p`` as :func:`boat_current_rhs`. Found by the composed loop's EKF by its
+    name (:func:`shipgnc.navigation.kernels.jacobian_kernel`)."""
+    M11, M22, M33, X_u, Y_v, N_r, N_rr, k = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
+    su, sv, sr = x[3], x[4], x[5]
+    c, s = math.cos(x[2]), math.sin(x[2])
+    uc = 0.0
+    vc = 0.0
+    if d.shape[0] >= 5:
+        uc = c * d[3] + s * d[4]
+        vc = -s * d[3] + c * d[4]
+    ur = su - uc
+    vr = sv - vc
+    for i in range(36):
+        A[i] = 0.0
+    A[2] = -s * su - c * sv
+    A[3] = c
+    A[4] = -s
+    A[6 + 2] = c * su - s * sv
+    A[6 + 3] = s
+    A[6 + 4] = c
+    A[12 + 5] = 1.0
+    A[18 + 2] = (M22 * sr * uc - X_u * vc) / M11 - sr * uc
+    A[18 + 3] = X_u / M11
+    A[18 + 4] = M22 * sr / M11
+    A[18 + 5] = M22 * vr / M11 + vc
+    A[24 + 2] = (M11 * sr * vc + Y_v * uc) / M22 - sr * vc
+    A[24 + 3] = -M11 * sr / M22
+    A[24 + 4] = Y_v / M22
+    A[24 + 5] = -M11 * ur / M22 - uc
+    A[30 + 2] = k * (ur * uc - vr * vc) / M33
+    A[30 + 3] = k * vr / M33
+    A[30 + 4] = k * ur / M33
+    A[30 + 5] = (N_r + 2.0 * N_rr * abs(sr)) / M33

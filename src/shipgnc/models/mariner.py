@@ -211,6 +211,36 @@ class MarinerWitOppe:
         u_dot = -p.f * su - p.W * sr * sr + p.S
         return np.stack([north_dot, east_dot, sr, u_dot, r_dot], axis=-1)
 
+    def state_jacobian(self, x, u, d=None):
+        """A = ∂f/∂x of :meth:`derivatives` at (x, u, d), analytic: (..., 5, 5), A[..., i, j] =
+        ∂ẋ_i/∂x_j (δ and d enter additively). With v = r₁ r + r₂ r³, v' = r₁ + 3 r₂ r²::
+
+            ∂(ẋ, ẏ)/∂ψ = (−u sin ψ − v cos ψ, u cos ψ − v sin ψ)
+            ∂(ẋ, ẏ)/∂u = (cos ψ, sin ψ),   ∂(ẋ, ẏ)/∂r = (−v' sin ψ, v' cos ψ)
+            ∂ψ̇/∂r = 1,   ∂u̇/∂(u, r) = (−f, −2 W r),   ∂ṙ/∂r = −a − 3 b r²
+
+        (eq. (25) differentiated); used by the EKF
+        (:class:`~shipgnc.navigation.ekf.ExtendedKalmanFilter`) in place of central differences.
+        """
+        p = self.params
+        x = np.asarray(x, dtype=float)
+        psi, su, sr = x[..., 2], x[..., 3], x[..., 4]
+        c, s = np.cos(psi), np.sin(psi)
+        v = p.sway(sr)
+        dv = p.r1 + 3.0 * p.r2 * sr * sr
+        A = np.zeros((*psi.shape, 5, 5))
+        A[..., 0, 2] = -s * su - c * v
+        A[..., 0, 3] = c
+        A[..., 0, 4] = -s * dv
+        A[..., 1, 2] = c * su - s * v
+        A[..., 1, 3] = s
+        A[..., 1, 4] = c * dv
+        A[..., 2, 4] = 1.0
+        A[..., 3, 3] = -p.f
+        A[..., 3, 4] = -2.0 * p.W * sr
+        A[..., 4, 4] = -p.a - 3.0 * p.b * sr * sr
+        return A
+
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`mariner_rhs`)."""
         p = self.params
@@ -232,6 +262,30 @@ def mariner_rhs(x, u, d, p, xdot):
     xdot[2] = sr
     xdot[3] = -f * su - W * sr * sr + S
     xdot[4] = -a * sr - b * r3 + c_rudder * u[0] + d[0]
+
+
+@kernel_function
+def mariner_rhs_jacobian(x, u, d, p, A):
+    """:meth:`MarinerWitOppe.state_jacobian` for one ship: ∂ẋ/∂x of :func:`mariner_rhs` into
+    ``A`` (5 × 5, row-major flat); ``p`` as :func:`mariner_rhs`. Found by the composed loop's EKF
+    by its name (:func:`shipgnc.navigation.kernels.jacobian_kernel`)."""
+    a, b, r1, r2, f, W = p[0], p[1], p[3], p[4], p[5], p[6]
+    psi, su, sr = x[2], x[3], x[4]
+    v = r1 * sr + r2 * sr * sr * sr
+    dv = r1 + 3.0 * r2 * sr * sr
+    c, s = math.cos(psi), math.sin(psi)
+    for i in range(25):
+        A[i] = 0.0
+    A[2] = -s * su - c * v
+    A[3] = c
+    A[4] = -s * dv
+    A[5 + 2] = c * su - s * v
+    A[5 + 3] = s
+    A[5 + 4] = c * dv
+    A[10 + 4] = 1.0
+    A[15 + 3] = -f
+    A[15 + 4] = -2.0 * W * sr
+    A[20 + 4] = -a - 3.0 * b * sr * sr
 
 
 def rudder(params: MarinerParams, *, rate_limit: bool = True, rate_mode: str = "ramp") -> Actuator:

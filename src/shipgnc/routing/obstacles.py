@@ -60,6 +60,24 @@ def as_polygons(obstacles) -> list:
 MAX_GEOJSON_BYTES = 64 << 20
 
 
+def read_geojson(path, where: str) -> object:
+    """The parsed JSON of a GeoJSON file, read up to ``MAX_GEOJSON_BYTES`` (a device or FIFO reports
+    size 0, so the cap is on what is read); one-line ConfigErrors starting with ``where``."""
+    try:
+        with open(path, "rb") as handle:
+            raw = handle.read(MAX_GEOJSON_BYTES + 1)
+    except OSError as exc:
+        raise ConfigError(f"{where}: cannot read ({exc.strerror or exc})") from None
+    if len(raw) > MAX_GEOJSON_BYTES:
+        raise ConfigError(f"{where}: more than {MAX_GEOJSON_BYTES >> 20} MiB; polygon files are "
+                          f"limited to that")
+    try:
+        return json.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError) as exc:
+        reason = str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__
+        raise ConfigError(f"{where}: not GeoJSON ({reason})") from None
+
+
 def load_geojson(path, units: str = "si") -> list:
     """Polygons from a GeoJSON file ([east, north] coordinates in m, or nm with ``units="nautical"``).
 
@@ -67,19 +85,7 @@ def load_geojson(path, units: str = "si") -> list:
     naming the feature, never a shapely or GEOS error."""
     shapely = _shapely()
     where = f"--obstacles = {str(path)!r}"
-    try:
-        with open(path, "rb") as handle:  # a device reports size 0: read at most the cap
-            raw = handle.read(MAX_GEOJSON_BYTES + 1)
-    except OSError as exc:
-        raise ConfigError(f"{where}: cannot read ({exc.strerror or exc})") from None
-    if len(raw) > MAX_GEOJSON_BYTES:
-        raise ConfigError(f"{where}: more than {MAX_GEOJSON_BYTES >> 20} MiB; obstacle files are "
-                          f"limited to that")
-    try:
-        data = json.loads(raw.decode("utf-8"))
-    except (UnicodeDecodeError, ValueError, RecursionError) as exc:
-        reason = str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__
-        raise ConfigError(f"{where}: not GeoJSON ({reason})") from None
+    data = read_geojson(path, where)
     feats = data.get("features", [data]) if isinstance(data, dict) else []
     if not isinstance(feats, list):
         raise ConfigError(f"{where}: 'features' must be a list")

@@ -60,28 +60,35 @@ def solve(cfg):
 
 
 def sail(route, field, heading, *, dt: float, t_end: float, seed: int = 0,
-         backend: str = "auto"):
+         backend: str = "auto", model=None, controller=None):
     """Simulate the Mariner steering ``heading(t)`` [rad] from the route's start through ``field``.
 
     Returns ``(dataset, closest_s, miss_m)``: the run, the time of the closest approach to the
     route's target and that distance (the scenario's arrival is the acceptance radius instead,
     :func:`~shipgnc.routing.sailing.arrival`). ``backend`` as :func:`~shipgnc.sim.simulator.simulate`'s.
+    ``model``: a :class:`~shipgnc.models.mariner.MarinerWitOppe` (default the document's, U = 15 kn;
+    the ship starts at its U). ``controller``: a path controller with its own path (e.g.
+    :class:`~shipgnc.control.feedback_linearization.LOSFL`, ``los_fl`` through waypoints; used by
+    :func:`shipgnc.routing.geo.sail.sail_check`) instead of :class:`HeadingFL` on ``heading``, which
+    then only gives the initial heading.
     """
     from shipgnc.control.feedback_linearization import HeadingFL
     from shipgnc.guidance.schedule import HeadingProfile
     from shipgnc.models.mariner import MarinerDisturbance, MarinerWitOppe, rudder
     from shipgnc.sim.simulator import simulate
 
-    model = MarinerWitOppe()
+    model = MarinerWitOppe() if model is None else model
     p = model.params
     t0 = route.t0
     x0 = np.array([route.start[0], route.start[1], float(heading(t0)), p.U, 0.0])
     steps = max(1, math.ceil(t_end / dt))
     # the autopilot samples every step (Ts = dt): the programme's table for the compiled loop
     samples = np.arange(steps + 1) * dt
-    ds = simulate(model, x0, t_end=steps * dt, dt=dt, controller=HeadingFL(p, Ts=dt),
-                  actuator=rudder(p),
-                  guidance=HeadingProfile(lambda t: heading(t0 + t), samples=samples),
+    guidance = None if controller is not None else \
+        HeadingProfile(lambda t: heading(t0 + t), samples=samples)
+    ds = simulate(model, x0, t_end=steps * dt, dt=dt,
+                  controller=HeadingFL(p, Ts=dt) if controller is None else controller,
+                  actuator=rudder(p), guidance=guidance,
                   disturbance=MarinerDisturbance(0.0, current=_shifted(field, t0)), seed=seed,
                   backend=backend)
     distance = np.hypot(ds["north"].values - route.target[0], ds["east"].values - route.target[1])

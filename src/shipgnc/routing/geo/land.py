@@ -12,7 +12,6 @@
 
 from __future__ import annotations
 
-import json
 from functools import lru_cache
 from pathlib import Path
 
@@ -61,17 +60,16 @@ def load_land(path) -> list:
         try:
             import shapefile  # pyshp
         except ImportError:
-            raise ConfigError(f"--land = {name!r}: reading a shapefile needs pyshp (pip install pyshp); or "
-                              "give GeoJSON") from None
+            raise ConfigError(f"--land = {name!r}: reading a shapefile needs pyshp (pip install "
+                              "'shipgnc[geo]'); or give GeoJSON") from None
         try:
             geoms = [shapely.geometry.shape(s.__geo_interface__) for s in shapefile.Reader(name).shapes()]
         except Exception as exc:
             raise ConfigError(f"--land = {name!r}: cannot read the shapefile ({exc})") from None
     else:
-        try:
-            data = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, ValueError) as exc:
-            raise ConfigError(f"--land = {name!r}: not GeoJSON ({str(exc).splitlines()[0][:120]})") from None
+        from shipgnc.routing.obstacles import read_geojson
+
+        data = read_geojson(p, f"--land = {name!r}")
         feats = data.get("features", [data]) if isinstance(data, dict) else []
         geoms = []
         for k, f in enumerate(feats if isinstance(feats, list) else []):
