@@ -7,7 +7,8 @@ Prediction over one control period Ts with the input applied over the last sampl
 disturbance taken as zero (it is what the process noise stands for)::
 
     x̂⁻ = Φ(x̂, u)                        (RK4 on model.derivatives, ``substeps`` per Ts)
-    A  = ∂f/∂x (x̂, u)                   (central differences, vectorised over the batch)
+    A  = ∂f/∂x (x̂, u)                   (the model's analytic ``state_jacobian`` if it has one,
+                                          else central differences, vectorised over the batch)
     F  = I + A Ts + (A Ts)²/2 + (A Ts)³/6 + (A Ts)⁴/24     (RK4 applied to the linearisation)
     Q_d = Q_c Ts + (A Q_c + Q_c Aᵀ) Ts²/2 + A Q_c Aᵀ Ts³/3   (∫₀^Ts e^{As} Q_c e^{Aᵀs} ds, 2nd order)
     P⁻ = F P Fᵀ + Q_d
@@ -107,7 +108,16 @@ class ExtendedKalmanFilter(GaussianFilter):
         return self.model.derivatives(x, u, None)
 
     def jacobian(self, x, u) -> np.ndarray:
-        """A = ∂f/∂x at (x, u) by central differences, one batched call: (*batch, n, n)."""
+        """A = ∂f/∂x at (x, u): the model's analytic ``state_jacobian(x, u, d)`` when it has one
+        (the boat, the Mariner), else central differences, one batched call: (*batch, n, n)."""
+        analytic = getattr(self.model, "state_jacobian", None)
+        if callable(analytic):
+            return analytic(x, u, None)
+        return self.numerical_jacobian(x, u)
+
+    def numerical_jacobian(self, x, u) -> np.ndarray:
+        """A = ∂f/∂x at (x, u) by central differences (step 1e-6·max(1, |x_j|)), one batched call:
+        (*batch, n, n)."""
         n = x.shape[-1]
         h = 1e-6 * np.maximum(1.0, np.abs(x))                        # (*batch, n)
         eye = np.eye(n)

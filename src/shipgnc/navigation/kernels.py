@@ -203,6 +203,34 @@ def observer_outputs(z, p, seen, sig):
 # the Kalman filters (estimator.GaussianFilter, ekf.ExtendedKalmanFilter, kalman.KalmanFilter)
 # ----------------------------------------------------------------------------------------------
 
+#: the name of a model kernel's analytic state Jacobian: ``<kernel name>_jacobian`` beside it
+JACOBIAN_SUFFIX = "_jacobian"
+
+
+def jacobian_kernel(model_fn):
+    """The analytic state Jacobian kernel of the vessel model kernel ``model_fn``, or None: the
+    function ``<name>_jacobian(x, u, d, p, A)`` of the kernel's own module (A = ∂ẋ/∂x into the
+    flat row-major ``A``, n × n, with the kernel's parameters ``p``; e.g.
+    :func:`shipgnc.models.mariner.mariner_rhs_jacobian`). The composed loop's EKF calls it in
+    place of the central differences (:mod:`shipgnc.sim.nav_template`)."""
+    import importlib
+
+    py = getattr(model_fn, "py_func", model_fn)
+    try:
+        module = importlib.import_module(py.__module__)
+        fn = getattr(module, py.__qualname__ + JACOBIAN_SUFFIX, None)
+    except (ImportError, AttributeError, TypeError):
+        return None
+    return fn if fn is not None and hasattr(fn, "py_func") else None
+
+
+@kernel_function
+def no_jacobian(x, u, d, p, A):
+    """Stand-in for a model without an analytic Jacobian (never called: the EKF then takes
+    central differences)."""
+    pass
+
+
 @kernel_function
 def apply_gain(zh, P, Pc, S, innov):
     """The scalar Kalman update shared by both corrections: with Pc = P cᵀ and S = c P cᵀ + var,

@@ -2,7 +2,8 @@
 the generated module of a combination before the loop body (:mod:`shipgnc.sim.loop_template`), so
 the estimators call the vessel model's kernel ``model_fn`` by name (a numba function passed as an
 argument would make the loop uncacheable). Free names: ``model_fn``, ``nx``, ``nu``, ``nd``,
-``est_kind``, ``CACHE``. The arithmetic is :mod:`shipgnc.navigation.kernels`; this is
+``est_kind``, ``CACHE``; ``jac_fn`` (the model's analytic state Jacobian,
+:func:`shipgnc.navigation.kernels.jacobian_kernel`) is found from ``model_fn``. The arithmetic is :mod:`shipgnc.navigation.kernels`; this is
 :meth:`shipgnc.navigation.Navigation.observe` for one ship at one control sample.
 """
 # ruff: noqa: F821
@@ -15,12 +16,21 @@ import numpy as np
 from shipgnc.kernels import JIT_OPTIONS, wrap
 from shipgnc.navigation.kernels import (
     correct_row,
+    jacobian_kernel,
     kf_step,
     nees,
+    no_jacobian,
     observer_outputs,
     observer_rhs,
     sensors_observe,
 )
+
+#: the model's analytic state Jacobian kernel (``<model kernel>_jacobian`` beside it), if any:
+#: the EKF's A then costs one call instead of 2n model calls
+jac_fn = jacobian_kernel(model_fn)
+has_jac = jac_fn is not None
+if jac_fn is None:
+    jac_fn = no_jacobian
 
 
 def nav_observe(t, x, u, zn, pn, w, seen, nsg, pm, wk):
@@ -129,8 +139,8 @@ def observer_step(u, zn, pn, pm, wk):
 
 
 def ekf_step(u, zn, pn, pm, wk):
-    """:meth:`ExtendedKalmanFilter.update`: predict (RK4 on the model, the central-difference
-    Jacobian, F by the 4th-order series, Q_d) unless first, then one scalar correction per state
+    """:meth:`ExtendedKalmanFilter.update`: predict (RK4 on the model, its analytic Jacobian
+    ``jac_fn`` when it has one, else central differences, F by the 4th-order series, Q_d) unless first, then one scalar correction per state
     whose sensor delivered now. Small dense loops on views of ``wk`` (no BLAS call, no
     allocation: at n = 5 or 6 these cost less than a call)."""
     e = int(pn[3])
@@ -164,16 +174,19 @@ def ekf_step(u, zn, pn, pm, wk):
     for j in range(nd):
         d0[j] = 0.0
     if zn[0] == 0.0:
-        for j in range(n):
-            hj = 1e-6 * max(1.0, abs(zh[j]))
-            for i in range(n):
-                xp[i] = zh[i]
-            xp[j] = zh[j] + hj
-            model_fn(xp, u, d0, pm, fp)
-            xp[j] = zh[j] - hj
-            model_fn(xp, u, d0, pm, fm)
-            for i in range(n):
-                A[i * n + j] = (fp[i] - fm[i]) / (2.0 * hj)
+        if has_jac:  # the model's analytic ∂f/∂x
+            jac_fn(zh, u, d0, pm, A)
+        else:  # central differences
+            for j in range(n):
+                hj = 1e-6 * max(1.0, abs(zh[j]))
+                for i in range(n):
+                    xp[i] = zh[i]
+                xp[j] = zh[j] + hj
+                model_fn(xp, u, d0, pm, fp)
+                xp[j] = zh[j] - hj
+                model_fn(xp, u, d0, pm, fm)
+                for i in range(n):
+                    A[i * n + j] = (fp[i] - fm[i]) / (2.0 * hj)
         for i in range(nn):
             At[i] = A[i] * Ts
         for i in range(n):   # F = I + At + At²/2 + At³/6 + At⁴/24 (term = term·At / k)
