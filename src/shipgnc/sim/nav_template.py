@@ -3,7 +3,8 @@ the generated module of a combination before the loop body (:mod:`shipgnc.sim.lo
 the estimators call the vessel model's kernel ``model_fn`` by name (a numba function passed as an
 argument would make the loop uncacheable). Free names: ``model_fn``, ``nx``, ``nu``, ``nd``,
 ``est_kind``, ``CACHE``; ``jac_fn`` (the model's analytic state Jacobian,
-:func:`shipgnc.navigation.kernels.jacobian_kernel`) is found from ``model_fn``. The arithmetic is :mod:`shipgnc.navigation.kernels`; this is
+:func:`shipgnc.navigation.kernels.jacobian_kernel`) is found from ``model_fn``. The
+arithmetic is :mod:`shipgnc.navigation.kernels`; this is
 :meth:`shipgnc.navigation.Navigation.observe` for one ship at one control sample.
 """
 # ruff: noqa: F821
@@ -140,9 +141,9 @@ def observer_step(u, zn, pn, pm, wk):
 
 def ekf_step(u, zn, pn, pm, wk):
     """:meth:`ExtendedKalmanFilter.update`: predict (RK4 on the model, its analytic Jacobian
-    ``jac_fn`` when it has one, else central differences, F by the 4th-order series, Q_d) unless first, then one scalar correction per state
-    whose sensor delivered now. Small dense loops on views of ``wk`` (no BLAS call, no
-    allocation: at n = 5 or 6 these cost less than a call)."""
+    ``jac_fn`` when it has one, else central differences, F by the 4th-order series, Q_d) unless
+    first, then one scalar correction per state whose sensor delivered now. Small dense loops on
+    views of ``wk`` (no BLAS call, no allocation: at n = 5 or 6 these cost less than a call)."""
     e = int(pn[3])
     ez = int(pn[5])
     n = nx
