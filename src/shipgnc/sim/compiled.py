@@ -50,7 +50,9 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
     before each call (e.g. to fill the chunk's input tables). As the numpy loop stops the whole
     batch at the first bad sample, or once every ship has finished, the chunk holding that event
     is replayed up to it: ``S`` then holds every ship's command of that sample or state after that
-    step. The chunks give bit-identical results.
+    step. With ``on_divergence="mask"`` a diverged ship stops alone (the kernel skips a ship whose
+    ``div_event`` is set) and counts as finished from its divergence on. The chunks give
+    bit-identical results.
     """
     import numba
 
@@ -76,16 +78,24 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
     if setup.progress is not None:
         setup.progress(0, n_steps)
     done_through = -1  # the last step every ship has completed (Ctrl-C keeps the log up to it)
+    masking = setup.on_divergence == "mask"
     try:
         for k0, k1 in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
             if prepare is not None:
                 prepare(k0, k1)
             start = S.copy()
             done_start = None if done_at is None else done_at.copy()
+            event_start = div_event.copy()
             limited(k0, k1, n_steps)
-            event = int(div_event[div_event >= 0].min()) if (div_event >= 0).any() else None
+            event = None
+            if not masking and (div_event >= 0).any():
+                event = int(div_event[div_event >= 0].min())
             k_done = None
-            if done_at is not None and n_ships and bool(np.all(done_at >= 0)):
+            if masking and done_at is not None and n_ships:
+                ends = finish_steps(done_at, div_event)
+                if bool(np.all(ends >= 0)):
+                    k_done = int(ends.max())  # every ship finished or stopped
+            elif done_at is not None and n_ships and bool(np.all(done_at >= 0)):
                 k_done = int(done_at.max())  # every ship finished: the run ends at this sample ...
                 if event is not None and event < 2 * k_done + 1:
                     k_done = None  # ... unless a ship diverged before
@@ -95,7 +105,7 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
                     setup.progress(k1 - 1, n_steps)
                 continue
             S[:] = start
-            div_event[:] = -1
+            div_event[:] = event_start
             if done_start is not None:
                 done_at[:] = done_start
             if k_done is not None:
@@ -110,6 +120,15 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
     return Stop(None, n_steps)
 
 
+def finish_steps(done_at: np.ndarray, div_event: np.ndarray) -> np.ndarray:
+    """``on_divergence="mask"``: the step from which each ship counts as done (its guidance
+    finished, or it diverged: at its bad command's sample k, or at step k + 1 after its bad state
+    of step k), −1 while it runs on (the numpy loop's ``finished | ~alive``)."""
+    died = np.where(div_event >= 0, div_event // 2 + div_event % 2, -1)
+    both = (done_at >= 0) & (died >= 0)
+    return np.where(both, np.minimum(done_at, died), np.maximum(done_at, died))
+
+
 class Stop(NamedTuple):
     """How a compiled run ended: the first divergence ``event`` (or None), the last step run
     ``k_end``, and whether Ctrl-C ended it (the log then holds the samples up to ``k_end``)."""
@@ -120,11 +139,14 @@ class Stop(NamedTuple):
 
 
 def make_log(setup, signals, out: np.ndarray, S: np.ndarray, event: int | None, *, state_slot: int,
-             cmd_slot: int, k_end: int | None = None, interrupted: bool = False):
+             cmd_slot: int, k_end: int | None = None, interrupted: bool = False,
+             events: np.ndarray | None = None):
     """The run's ``Log`` from the kernel's ``out`` (variable, sample, ship), the first divergence
     ``event`` and the last step run ``k_end`` (see :func:`drive`): the numpy loop's sample times,
     status and divergence error (``S[:, state_slot:]`` holds the states, ``S[:, cmd_slot:]`` the
-    commands). Raises the error for ``on_divergence="raise"``."""
+    commands). Raises the error for ``on_divergence="raise"``; with ``"mask"`` each ship's
+    ``events`` entry (see :func:`drive`) ends its own record
+    (:func:`~shipgnc.sim.simulator.mask_diverged`)."""
     from shipgnc.sim.simulator import Log, check_divergence
 
     batch = setup.batch_shape
@@ -157,6 +179,23 @@ def make_log(setup, signals, out: np.ndarray, S: np.ndarray, event: int | None, 
             raise error
         status.update(diverged=1, message=str(error))
     data = {name: out[col, :n_logged].reshape(n_logged, *batch) for col, name in enumerate(signals)}
-    return Log(time=log_steps[:n_logged] * dt, data=data, signals=signals, status=status)
+    log = Log(time=log_steps[:n_logged] * dt, data=data, signals=signals, status=status)
+    if setup.on_divergence != "mask" or events is None:
+        return log
+    from shipgnc.sim.simulator import mask_diverged
+
+    k = events // 2
+    diverged_at = np.where(events < 0, np.nan, np.where(events % 2 == 0, k * dt, k * dt + dt))
+    first = None
+    if (events >= 0).any():
+        e = int(events[events >= 0].min())
+        ships = (events == e)[:, None]
+        if e % 2 == 0:
+            command = np.where(ships, S[:, cmd_slot:cmd_slot + n_inputs], 0.0)
+            first = check_divergence(setup, (e // 2) * dt, command=command.reshape(*batch, n_inputs))
+        else:
+            x = np.where(ships, S[:, state_slot:state_slot + n_states], 0.0)
+            first = check_divergence(setup, (e // 2) * dt + dt, x.reshape(*batch, n_states))
+    return mask_diverged(log, diverged_at.reshape(batch), first, dt)
 
 

@@ -339,7 +339,7 @@ def run(setup):
         if k is not None and k.restore is not None:
             k.restore(S[:, lay[key]:lay[key] + width].copy())
     return make_log(setup, signals, out, S, stop.event, state_slot=0, cmd_slot=lay["cmd"],
-                    k_end=stop.k_end, interrupted=stop.interrupted)
+                    k_end=stop.k_end, interrupted=stop.interrupted, events=event_at)
 
 
 def _param_rows(kernel: Kernel, n_ships: int) -> np.ndarray:

@@ -23,6 +23,8 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
          err, out, event, done_at, Wu, pu_rows, Wn, pn_rows):
     n_ships = S.shape[0]
     for i in numba.prange(n_ships):
+        if event[i] >= 0:  # stopped by its divergence (on_divergence="mask"): skipped
+            continue
         row = S[i]
         # a component's parameters: one row for every ship, or a row per ship (1 or n rows)
         ship = np.int64(i)  # the prange index may be unsigned: int64 keeps min() an integer

@@ -20,12 +20,7 @@ from shipgnc.errors import ConfigError
 def build_dataset(log, batch_shape: tuple[int, ...], batch_dims: tuple[str, ...] | None,
                   attrs: dict) -> xr.Dataset:
     """Turn a loop's :class:`~shipgnc.sim.simulator.Log` into a labelled Dataset."""
-    if batch_dims is None:
-        batch_dims = ("ship",) if len(batch_shape) == 1 else tuple(
-            f"batch{i}" for i in range(len(batch_shape)))
-    if len(batch_dims) != len(batch_shape):
-        raise ConfigError(f"batch_dims = {batch_dims!r}: need {len(batch_shape)} names for a "
-                          f"batch of shape {batch_shape}")
+    batch_dims = batch_dim_names(batch_shape, batch_dims)
     dims = ("time", *batch_dims)
     variables = {name: (dims, values, log.signals[name].attrs())
                  for name, values in log.data.items()}
@@ -38,6 +33,19 @@ def build_dataset(log, batch_shape: tuple[int, ...], batch_dims: tuple[str, ...]
               for k, v in log.status.items()}
     clean = {k: _netcdf_attr(v) for k, v in {**attrs, **status}.items() if v is not None}
     return xr.Dataset(variables, coords=coords, attrs=clean)
+
+
+def batch_dim_names(batch_shape: tuple[int, ...], batch_dims: tuple[str, ...] | None
+                    ) -> tuple[str, ...]:
+    """The names of a run's batch dimensions: ``batch_dims``, or ``("ship",)`` for one batch
+    axis and ``batch0, batch1, ...`` for several."""
+    if batch_dims is None:
+        batch_dims = ("ship",) if len(batch_shape) == 1 else tuple(
+            f"batch{i}" for i in range(len(batch_shape)))
+    if len(batch_dims) != len(batch_shape):
+        raise ConfigError(f"batch_dims = {batch_dims!r}: need {len(batch_shape)} names for a "
+                          f"batch of shape {batch_shape}")
+    return tuple(batch_dims)
 
 
 def _netcdf_attr(value):

@@ -32,6 +32,8 @@ from shipgnc.sim.streams import MemberStreams, is_generator
 
 INTEGRATORS = ("rk4", "solve_ivp")
 BACKENDS = ("auto", "numpy", "compiled", "compiled-or-numpy")
+#: what a run does when a ship diverges (see :func:`simulate`)
+ON_DIVERGENCE = ("raise", "stop", "mask")
 #: ``backend="auto"`` uses a compiled twin from this batch size (compilation then pays off) ...
 COMPILED_MIN_BATCH = 64
 #: ... or from this much work, ships × steps (a long run of a few ships: the numpy loop needs
@@ -58,6 +60,8 @@ class Log:
     data: dict[str, np.ndarray]
     signals: dict[str, Signal]
     status: dict = field(default_factory=dict)
+    #: ``on_divergence="mask"``: each ship's divergence time [s] (NaN: it ran to the end)
+    diverged_at: np.ndarray | None = None
 
 
 @dataclass
@@ -108,7 +112,12 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     integrator : ``"rk4"`` (fixed step) or ``"solve_ivp"`` (adaptive, ``method``/``rtol``/``atol``,
         one call per ``dt`` with the batch flattened).
     on_divergence : ``"raise"`` (default) raises :class:`DivergenceError` naming time, state,
-        value and ship; ``"stop"`` returns the partial result with ``attrs["diverged"] = 1``.
+        value and ship; ``"stop"`` returns the partial result with ``attrs["diverged"] = 1``;
+        ``"mask"`` stops only the ships that diverge: each one's record is NaN from the sample
+        its divergence was found at (its command at that sample, or its state after the step
+        before), the others run on exactly as they would alone; the result gets a per-ship
+        variable ``diverged_at`` [s] (NaN: never), ``attrs["diverged"]`` = the number of ships
+        that diverged and ``attrs["message"]`` the first one's error.
     observer : ``observer(t, x, command, applied)`` at every logged sample (live plots); it may
         raise :class:`StopSimulation` to end the run and keep the result. Ctrl-C (a
         KeyboardInterrupt) ends either loop too: it raises :class:`~shipgnc.errors.Interrupted`
@@ -166,7 +175,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
             evaluator = getattr(disturbance, "evaluator", None)
             if evaluator is not None and evaluator() != "numpy":
                 ran_on = f"{ran_on}+{evaluator()}"
-    from shipgnc.sim.result import build_dataset
+    from shipgnc.sim.result import batch_dim_names, build_dataset
 
     run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold,
                  "t_end": t_end, "model": type(model).__name__, **(attrs or {})}
@@ -174,7 +183,12 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         last = float(log.time[-1]) if log.time.size else 0.0
         raise Interrupted(last, partial=lambda: build_dataset(log, setup.batch_shape, batch_dims,
                                                                run_attrs))
-    return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
+    result = build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
+    if log.diverged_at is not None:
+        dims = batch_dim_names(setup.batch_shape, batch_dims)
+        result["diverged_at"] = (dims, log.diverged_at.reshape(setup.batch_shape),
+                                 {"units": "s", "long_name": "time the ship diverged (NaN: never)"})
+    return result
 
 
 def _compiled_twin(setup: SimSetup):
@@ -245,8 +259,8 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
             f"must be a whole multiple of dt = {dt:g} s")
     require(integrator in INTEGRATORS, "integrator", integrator,
             f"allowed: {', '.join(INTEGRATORS)}")
-    require(on_divergence in ("raise", "stop"), "on_divergence", on_divergence,
-            "allowed: raise, stop")
+    require(on_divergence in ON_DIVERGENCE, "on_divergence", on_divergence,
+            f"allowed: {', '.join(ON_DIVERGENCE)}")
     require(isinstance(log_every, int) and log_every >= 1, "log_every", log_every,
             "must be an integer >= 1")
     n_states = len(model.states)
@@ -489,6 +503,10 @@ def run_numpy(setup: SimSetup) -> Log:
     status: dict = {"diverged": 0, "stopped_early": 0, "message": ""}
     n_logged = 0
     progress_every = max(1, setup.n_steps // 100)
+    masking = setup.on_divergence == "mask"
+    alive = np.ones(batch, dtype=bool)
+    diverged_at = np.full(batch, np.nan)
+    first_error = None
 
     t = 0.0
     try:
@@ -507,7 +525,14 @@ def run_numpy(setup: SimSetup) -> Log:
                     command = np.asarray(command, dtype=float)
                     act.check_command_shape(command)
                     extra.update(ctrl.signal_values())
-                    error = check_divergence(setup, t, command=command)
+                    if masking:  # a ship whose command is bad stops here, the others run on
+                        bad, error = newly_diverged(setup, t, alive, command=command)
+                        if bad is not None:
+                            first_error = first_error or error
+                            diverged_at[bad] = t
+                            alive &= ~bad
+                        command = np.where(alive[..., None], command, 0.0)
+                    error = None if masking else check_divergence(setup, t, command=command)
                     if error is not None:
                         if setup.on_divergence == "raise":
                             raise error
@@ -519,7 +544,7 @@ def run_numpy(setup: SimSetup) -> Log:
                 held_d = dist(t, x)
             last = k == setup.n_steps
             finished = gd.finished() if gd is not None else None
-            all_done = finished is not None and bool(np.all(finished))
+            all_done = finished is not None and bool(np.all(finished | ~alive))
             if k % setup.log_every == 0 or last or all_done:
                 times[n_logged] = t
                 for i, s in enumerate(model.states):
@@ -546,9 +571,19 @@ def run_numpy(setup: SimSetup) -> Log:
                 setup.progress(k, setup.n_steps)
             if last or all_done:
                 break
+            x_before, lag_before = x, lag
             x, lag = advance_plant(setup, t, x, lag, plan, command, ref, held_d)
+            if masking:  # a ship whose state is bad stops here; a stopped ship's state is held
+                bad, error = newly_diverged(setup, t + dt, alive, x=x)
+                if bad is not None:
+                    first_error = first_error or error
+                    diverged_at[bad] = t + dt
+                    alive &= ~bad
+                held = ~alive[..., None]
+                x = np.where(held, x_before, x)
+                lag = None if lag is None else np.where(held, lag_before, lag)
             applied = act.input_at(plan, 1.0, lag)
-            error = check_divergence(setup, t + dt, x)
+            error = None if masking else check_divergence(setup, t + dt, x)
             if error is not None:
                 if setup.on_divergence == "raise":
                     raise error
@@ -557,5 +592,41 @@ def run_numpy(setup: SimSetup) -> Log:
     except KeyboardInterrupt:  # Ctrl-C: keep the samples logged so far (see simulate)
         last = float(times[n_logged - 1]) if n_logged else 0.0
         status.update(stopped_early=1, interrupted=1, message=f"interrupted at t = {last:.6g} s")
-    return Log(time=times[:n_logged], data={k: v[:n_logged] for k, v in data.items()},
-               signals=signals, status=status)
+    log = Log(time=times[:n_logged], data={k: v[:n_logged] for k, v in data.items()},
+              signals=signals, status=status)
+    return mask_diverged(log, diverged_at, first_error, dt) if masking else log
+
+
+def newly_diverged(setup: SimSetup, t: float, alive: np.ndarray, *, x: np.ndarray | None = None,
+                   command: np.ndarray | None = None):
+    """``on_divergence="mask"``: which ships still running have a bad state ``x`` (or
+    ``command``) at ``t`` — a boolean mask over the batch, or None — and the first one's
+    :class:`DivergenceError` (:func:`check_divergence`; ships already stopped are not checked)."""
+    values = x if x is not None else command
+    sane = np.where(alive[..., None], values, 0.0)
+    error = check_divergence(setup, t, sane) if x is not None else check_divergence(
+        setup, t, command=sane)
+    if error is None:
+        return None, None
+    bad = ~np.isfinite(sane)
+    if x is not None:
+        bad |= np.abs(sane) > np.asarray(setup.model.state_limits, dtype=float)
+    return bad.any(axis=-1), error
+
+
+def mask_diverged(log: Log, diverged_at: np.ndarray, first_error, dt: float) -> Log:
+    """``on_divergence="mask"``, both loops: each diverged ship's record NaN from its
+    divergence time ``diverged_at`` on (NaN: it ran to the end); ``status`` counts the ships
+    that diverged and carries the first one's message."""
+    flat = diverged_at.reshape(-1)
+    after = log.time[:, None] >= flat[None, :] - 0.5 * dt  # NaN compares False: kept
+    for name, values in log.data.items():
+        rows = values.reshape(values.shape[0], -1)
+        rows[after] = np.nan
+        log.data[name] = rows.reshape(values.shape)
+    n = int(np.count_nonzero(np.isfinite(flat)))
+    if n:
+        log.status.update(diverged=n, message=f"{first_error} ({n} of {flat.size} ships diverged: "
+                                              "each one's record is NaN from then on; the others ran on)")
+    log.diverged_at = diverged_at
+    return log

@@ -139,7 +139,7 @@ def numeric_metrics(metrics: dict) -> dict[str, float]:
     return out
 
 
-def _simulate(setup, scenario, x0, streams, backend: str, log_every: int):
+def _simulate(setup, scenario, x0, streams, backend: str, log_every: int, on_divergence: str):
     from shipgnc.sim.simulator import simulate
 
     sim = scenario.simulation
@@ -148,7 +148,7 @@ def _simulate(setup, scenario, x0, streams, backend: str, log_every: int):
                     navigation=setup.navigation,
                     u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
                     atol=sim.atol, seed=streams, log_every=log_every, backend=backend,
-                    on_divergence="stop", batch_dims=("member",))
+                    on_divergence=on_divergence, batch_dims=("member",))
 
 
 def ends_early(setup) -> bool:
@@ -180,10 +180,11 @@ def route_series(series, scenario, done_at: np.ndarray):
     return series.where(mask).isel(time=np.flatnonzero(keep.any(axis=1)))
 
 
-def _run_batch(setup, scenario, x0, seeds, backend: str, route: bool):
+def _run_batch(setup, scenario, x0, seeds, backend: str, route: bool, on_divergence: str = "stop"):
     """One loop call for ``x0``'s members: the result and, for a route, each member's completion
     time (NaN: not completed). A batch is logged at every step, so that its metrics see every
-    step whatever ``log_every`` (see :func:`run_chunk`)."""
+    step whatever ``log_every`` (see :func:`run_chunk`). ``on_divergence="mask"``: a member that
+    diverges stops alone (its time in ``diverged_at``)."""
     from shipgnc.sim.simulator import scoring_log_every
 
     sim = scenario.simulation
@@ -191,7 +192,7 @@ def _run_batch(setup, scenario, x0, seeds, backend: str, route: bool):
         scoring_log_every(setup.model, x0, sim.t_end, sim.dt, sim.log_every,
                           fewer="lower --chunk-size")
     try:
-        result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend, 1)
+        result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend, 1, on_divergence)
     except ConfigError as exc:
         if route and str(exc).startswith("log size"):
             raise ConfigError(f"{exc} (a route study logs every step of a chunk, so that each "
@@ -206,6 +207,14 @@ def _run_batch(setup, scenario, x0, seeds, backend: str, route: bool):
     return result, np.asarray(done_at, dtype=float).reshape(-1).round(9)
 
 
+def _survivor(result, done_at, i: int):
+    """Member ``i`` of a batch in which another member diverged: its own run (the batch's
+    ``diverged`` status is the others')."""
+    own = result.isel(member=[i])
+    own.attrs = {**result.attrs, "diverged": 0, "message": ""}
+    return own, None if done_at is None else done_at[i:i + 1]
+
+
 def _alone(setup, i: int):
     """``setup`` for its batch's member ``i`` alone (its own plant, when the members have theirs)."""
     model = setup.model
@@ -217,10 +226,10 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     with ``study.series`` every time series; ``attrs["backend"]`` says which code ran it.
 
     The batch runs in one call of the loop, logged at every step: the metrics see every step,
-    and only the series kept with ``study.series`` are thinned to ``simulation.log_every``. If a
-    member diverges (which stops a batch), the chunk is run again member by member, so that every
-    member's figures are its own run's whatever chunk it shares (a diverged member is flagged
-    ``diverged = 1`` with its figures up to then).
+    and only the series kept with ``study.series`` are thinned to ``simulation.log_every``. A
+    member that diverges stops alone (``on_divergence="mask"``: the others run on, each its own
+    run whatever chunk it shares) and is run again by itself up to its divergence, so that it is
+    flagged ``diverged = 1`` with its figures up to then.
 
     A route (guidance that finishes at its last waypoint) ends a batch when its last member
     completes; the others keep sailing until then, and the step the batch ends on depends on its
@@ -241,11 +250,13 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
         setup = replace(setup, model=member_plant(study, setup.model, chunk.start, chunk.stop, drawn))
     seeds = [study.member_stream(m, 1) for m in range(chunk.start, chunk.stop)]
     route = ends_early(setup)
-    result, done_at = _run_batch(setup, scenario, x0, seeds, backend, route)
+    result, done_at = _run_batch(setup, scenario, x0, seeds, backend, route, "mask")
+    diverged = np.isfinite(result["diverged_at"].values)
+    result = result.drop_vars("diverged_at")
     arrays = None
-    if result.attrs.get("diverged", 0):
+    if diverged.any():
         runs = [_run_batch(_alone(setup, i), scenario, x0[i:i + 1], seeds[i:i + 1], backend, route)
-                for i in range(chunk.size)]
+                if diverged[i] else _survivor(result, done_at, i) for i in range(chunk.size)]
         ran_on = {r.attrs.get("backend") for r, _ in runs}
         members = [r.isel(member=0) for r, _ in runs]
         result = xr.concat([r for r, _ in runs], dim="member", join="outer")
