@@ -214,16 +214,28 @@ class _Shooter:
         return np.stack([d_theta, d_t], axis=-1)
 
 
+#: an extremal reaches the target when it ends within this fraction of |AB| of it (at most ``tol_m``):
+#: a tolerance in the problem's own scale, so a 1 m problem is held to 0.1 mm, a 100 km one to 1 m
+MISS_REL = 1e-4
+
+
+def miss_tolerance(start, target, tol_m: float = 1.0) -> float:
+    """The largest miss [m] at which an extremal counts as reaching ``target``: MISS_REL·|AB|,
+    at most ``tol_m``."""
+    dist = float(np.hypot(*(np.asarray(target, float) - np.asarray(start, float))))
+    return min(float(tol_m), MISS_REL * dist)
+
+
 def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol_m=1.0, rtol=1e-11):
     """Polish one extremal from a guess (θ₀, t_f − t₀) with Levenberg–Marquardt (note 002-2.9.4).
 
     Returns an :class:`Extremal` or ``None`` when the solver fails, returns t_f ≤ 0 (F4), misses by more
-    than ``tol_m`` metres, or ends with an inadmissible costate V + e(u_f)ᵀv(B) ≤ 0 (F5, (2.4)).
+    than :func:`miss_tolerance` (``MISS_REL``·|AB|, at most ``tol_m`` metres), or ends with an
+    inadmissible costate V + e(u_f)ᵀv(B) ≤ 0 (F5, (2.4)).
     """
     from scipy.optimize import least_squares
 
     sh = _Shooter(field, speed, np.asarray(start, float), target, t0, radius, rtol=rtol)
-    scale = max(float(np.hypot(*(np.asarray(target, float) - np.asarray(start, float)))), 1.0)
     try:
         sol = least_squares(sh.residual, [float(theta0), float(duration)], jac=sh.jacobian, method="lm",
                             x_scale=[1.0, max(float(duration), 1.0)], xtol=1e-15, ftol=1e-15, gtol=1e-15,
@@ -234,7 +246,7 @@ def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol
     if not (dur > 0 and np.all(np.isfinite(sol.fun))):
         return None
     miss = float(np.hypot(*sol.fun))
-    if miss > tol_m or miss > 1e-3 * scale + tol_m:
+    if miss > miss_tolerance(start, target, tol_m):
         return None
     return finish_extremal(field, speed, start, target, theta, dur, t0, radius, rtol=rtol)
 
