@@ -4,12 +4,14 @@
                   [--obstacles FILE.geojson] [--units si|nautical] [--json] [--out DIR]
     shipgnc route --geo --start LAT,LON --target LAT,LON --speed V --field FILE.nc|uniform:..|still
                   [--depart 2026-06-01T06:00Z] [--land default|none|FILE] [--depth FILE.nc --draft M --ukc M]
-                  [--xte-m 100] [--json] [--out DIR]
+                  [--xte-m 100] [--sail [--sail-vessel auto|boat|mariner]] [--json] [--out DIR]
 
 ``--geo`` (docs/routing_geo.md): positions in decimal degrees on WGS84, currents from CF-NetCDF, land from
 the GSHHG coastline (or ``--land``), shallow water from ``--depth``; ``--out`` writes route.gpx,
 route.geojson, route.rtz, route.json and route.png; the JSON adds ``distance_nm``, ``eta`` and
-``waypoints`` ([lat, lon, eta]) to today's keys.
+``waypoints`` ([lat, lon, eta]) to today's keys. ``--sail`` adds the sailed check
+(:func:`shipgnc.routing.geo.sail.sail_check`, the ``sail_*`` keys): the Otter-class boat or the Mariner
+(``--sail-vessel``) sails the exported waypoints with LOS guidance through the same current.
 
 SI by default; ``--units nautical`` reads positions in nm, speeds in kn, k and ω in 1/h, Γ in nm²/h and prints
 times in h beside s. JSON keys stay SI. Exit codes: 0 a route, 2 bad input, 3 unreachable (one-line reason on
@@ -72,8 +74,13 @@ def route(
     ukc: Annotated[float, typer.Option("--ukc", help="Under-keel clearance \\[m] (with --depth).")] = 0.0,
     xte_m: Annotated[float, typer.Option("--xte-m", help="With --geo: cross-track tolerance of the "
                                          "waypoints \\[m].")] = 100.0,
-    sail: Annotated[bool, typer.Option("--sail", help="With --geo: the sailed check, the Otter-class boat "
-                                       "with LOS through the waypoints (sail_* keys).")] = False,
+    sail: Annotated[bool, typer.Option("--sail", help="With --geo: the sailed check, a vessel with LOS "
+                                       "guidance sails the exported waypoints through the same current "
+                                       "(sail_* keys).")] = False,
+    sail_vessel: Annotated[str, typer.Option("--sail-vessel", help="With --sail: auto (the Otter-class boat "
+                                             "when the speed is within its reach, else the Mariner) | boat "
+                                             "(2 m, up to ≈ 2.3 m/s) | mariner (161 m, sails at 15 kn "
+                                             "only).")] = "auto",
 ) -> None:
     """Time-optimal route through a current field (Zermelo's problem)."""
     from shipgnc.cli import friendly_errors, stderr, stdout
@@ -95,12 +102,14 @@ def route(
         tscale = 3600.0 if nautical else 1.0
         if geo:
             _geo_route(start, target, speed * vel, field, method, obstacles, units, json_, out, horizon,
-                       radius, depart, grid, land, depth, draft, ukc, xte_m, length, tscale, sail)
+                       radius, depart, grid, land, depth, draft, ukc, xte_m, length, tscale, sail,
+                       sail_vessel)
             return
         depart_value = _number(depart, "--depart", "s | h; an ISO 8601 time needs --geo")
         geo_only = [name for name, given in (("--depth", depth is not None), ("--land", land != "default"),
                                              ("--draft", draft != 0.0), ("--ukc", ukc != 0.0),
-                                             ("--xte-m", xte_m != 100.0), ("--sail", sail)) if given]
+                                             ("--xte-m", xte_m != 100.0), ("--sail", sail),
+                                             ("--sail-vessel", sail_vessel != "auto")) if given]
         require(not geo_only, geo_only[0] if geo_only else "", "given", "needs --geo")
         a = _pair(start, "--start", length)
         b = _pair(target, "--target", length)
@@ -145,11 +154,17 @@ def _number(text: str, name: str, rule: str) -> float:
 
 
 def _geo_route(start, target, speed, field, method, obstacles, units, json_, out, horizon, radius, depart,
-               grid, land, depth, draft, ukc, xte_m, length, tscale, sail=False) -> None:
+               grid, land, depth, draft, ukc, xte_m, length, tscale, sail=False, sail_vessel="auto") -> None:
     """``route --geo`` (docs/routing_geo.md)."""
     from shipgnc.cli import stderr, stdout
     from shipgnc.errors import require
     from shipgnc.routing.geo.router import GeoProblem
+
+    require(sail or sail_vessel == "auto", "--sail-vessel", sail_vessel, "needs --sail")
+    if sail:  # the vessel that can sail the route's speed, before any work
+        from shipgnc.routing.geo.sail import choose_vessel
+
+        sail_vessel = choose_vessel(speed, sail_vessel)
 
     require(obstacles is None, "--obstacles", str(obstacles),
             "is for the local plane; with --geo give --land")
@@ -175,7 +190,7 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     if sail and res.reachable:
         from shipgnc.routing.geo.sail import sail_check
 
-        payload.update(sail_check(res))
+        payload.update(sail_check(res, vessel=sail_vessel))
     text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
     if out is not None and res.reachable:
         from shipgnc.outputs import atomic_dir
@@ -251,9 +266,13 @@ def _print_geo(console, js) -> None:
         row("initial heading [deg]", f"{js['heading_start_deg']:.2f}")
         row("clear of land and shallow water", {True: "yes", False: "NO", None: "—"}[js["land_clear"]])
     if "sail_arrived" in js:
-        row("sailed check: arrived", "yes" if js["sail_arrived"] else f"no (miss {js['sail_miss_m']:.1f} m)")
+        row("sailed check: vessel", js["sail_vessel"])
+        row("sailed check: arrived", (f"yes (within {js['sail_acceptance_radius_m']:.4g} m)"
+                                      if js["sail_arrived"] else f"no (miss {js['sail_miss_m']:.1f} m)"))
         if js["sail_time_s"] is not None:
             row("sailed check: time / optimum", f"{js['sail_time_s']:.0f} s / {js['sail_ratio']:.4f}")
+        if js["sail_crosstrack_max_m"] is not None:
+            row("sailed check: max cross-track [m]", f"{js['sail_crosstrack_max_m']:.1f}")
     row("method", js["method"])
     gc = js["global_check"]
     if gc and gc.get("time_s") is not None and js["method"] != "levelset":

@@ -23,6 +23,14 @@ are left out — both small against the boat's own dynamics here (k/2 ≈ 4·10�
 constant 1 s). The disturbance vector is document 001's ``[X_env, Y_env, N_env]`` plus the current
 ``[current_north, current_east]`` [m/s], filled by :class:`FieldCurrent` at every RK stage.
 
+**The Mariner** (:func:`mariner_sail`). Document 000's de Wit–Oppe model
+(:class:`~shipgnc.models.mariner.MarinerWitOppe`, U = S/f = 15 kn), its current added to the kinematics
+(eq. (25): ẋ = u cos ψ − v sin ψ + c_N, ẏ = u sin ψ + v cos ψ + c_E) from the route's field on the ship's
+clock (:class:`ShiftedField`, every RK stage), steered either by the heading autopilot
+(:class:`~shipgnc.control.feedback_linearization.HeadingFL`) on a heading programme ψ(t) or by a path
+controller with its own waypoints (e.g. :class:`~shipgnc.control.feedback_linearization.LOSFL`, integral
+LOS feeding the FL yaw loop, note 000-0.5).
+
 **Arrival** (:func:`arrival`). A ship has arrived when it comes within the acceptance radius R of the
 target; its arrival time is the first such instant (interpolated between samples). A ship that never
 comes within R has *not arrived*: no arrival time, only its closest approach (the miss distance).
@@ -217,6 +225,69 @@ def boat_sail(route, field, mode: str, *, preset: str = "otter", dt: float = 0.0
                     controller=HeadingSpeedAutopilot(boat.params, Ts=dt),
                     actuator=Actuator.for_model(model), guidance=guidance,
                     disturbance=FieldCurrent(field, t0), seed=seed, backend=backend)
+
+
+class ShiftedField:
+    """A current field seen by a ship whose clock starts at the departure t0: ``__call__(t, x)`` is
+    ``field(t0 + t, x)``; evaluated at every RK stage (``per_stage``), the disturbance protocol of
+    :class:`~shipgnc.models.mariner.MarinerDisturbance`'s ``current``."""
+
+    def __init__(self, field, t0: float):
+        self.field, self.t0 = field, float(t0)
+        self.per_stage = True
+
+    def reset(self, batch_shape, rng=None) -> None:
+        pass
+
+    def __call__(self, t, x):
+        return self.field(self.t0 + t, x)
+
+    def current_kernel(self):
+        """The field's compiled form evaluated at t0 + t (raises NotCompiled without one)."""
+        make = getattr(self.field, "current_kernel", None)
+        if not callable(make):
+            raise NotCompiled(f"current {type(self.field).__name__} has no kernel")
+        return make(t0=self.t0)
+
+
+def mariner_sail(route, field, heading, *, dt: float, t_end: float, seed: int = 0,
+                 backend: str = "auto", model=None, controller=None):
+    """Simulate document 000's Mariner steering ``heading(t)`` [rad] from the route's start through
+    ``field`` (module docstring).
+
+    ``route``: anything with ``start``, ``target`` (north, east) [m] and ``t0`` [s] (the departure on the
+    field's clock). Returns ``(dataset, closest_s, miss_m)``: the run, the time of the closest approach to
+    the route's target and that distance (an arrival is judged by the acceptance radius instead,
+    :func:`arrival`). ``backend`` as :func:`~shipgnc.sim.simulator.simulate`'s. ``model``: a
+    :class:`~shipgnc.models.mariner.MarinerWitOppe` (default the document's, U = 15 kn; the ship starts at
+    its U on the heading ``heading(t0)``). ``controller``: a path controller with its own path (e.g.
+    :class:`~shipgnc.control.feedback_linearization.LOSFL` through waypoints, as
+    :func:`shipgnc.routing.geo.sail.sail_check` sails a chart's route) instead of
+    :class:`~shipgnc.control.feedback_linearization.HeadingFL` on ``heading``, which then only gives the
+    initial heading.
+    """
+    from shipgnc.control.feedback_linearization import HeadingFL
+    from shipgnc.guidance.schedule import HeadingProfile
+    from shipgnc.models.mariner import MarinerDisturbance, MarinerWitOppe, rudder
+    from shipgnc.sim.simulator import simulate
+
+    model = MarinerWitOppe() if model is None else model
+    p = model.params
+    t0 = route.t0
+    x0 = np.array([route.start[0], route.start[1], float(heading(t0)), p.U, 0.0])
+    steps = max(1, math.ceil(t_end / dt))
+    # the autopilot samples every step (Ts = dt): the programme's table for the compiled loop
+    samples = np.arange(steps + 1) * dt
+    guidance = None if controller is not None else \
+        HeadingProfile(lambda t: heading(t0 + t), samples=samples)
+    ds = simulate(model, x0, t_end=steps * dt, dt=dt,
+                  controller=HeadingFL(p, Ts=dt) if controller is None else controller,
+                  actuator=rudder(p), guidance=guidance,
+                  disturbance=MarinerDisturbance(0.0, current=ShiftedField(field, t0)), seed=seed,
+                  backend=backend)
+    distance = np.hypot(ds["north"].values - route.target[0], ds["east"].values - route.target[1])
+    k = int(np.argmin(distance))
+    return ds, float(ds["time"].values[k]), float(distance[k])
 
 
 def _takes_arrays(fn) -> bool:

@@ -24,10 +24,9 @@ composed loop (the programme tabulated at the control samples, the field by its 
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
+from shipgnc.routing.sailing import ShiftedField as _shifted  # noqa: F401  (its earlier name here)
 from shipgnc.scenarios.schema import Scenario
 from shipgnc.units import KNOT, NAUTICAL_MILE
 
@@ -61,62 +60,13 @@ def solve(cfg):
 
 def sail(route, field, heading, *, dt: float, t_end: float, seed: int = 0,
          backend: str = "auto", model=None, controller=None):
-    """Simulate the Mariner steering ``heading(t)`` [rad] from the route's start through ``field``.
+    """The Mariner steering ``heading(t)`` from the route's start through ``field``:
+    :func:`shipgnc.routing.sailing.mariner_sail` (its arguments and its ``(dataset, closest_s,
+    miss_m)``)."""
+    from shipgnc.routing.sailing import mariner_sail
 
-    Returns ``(dataset, closest_s, miss_m)``: the run, the time of the closest approach to the
-    route's target and that distance (the scenario's arrival is the acceptance radius instead,
-    :func:`~shipgnc.routing.sailing.arrival`). ``backend`` as :func:`~shipgnc.sim.simulator.simulate`'s.
-    ``model``: a :class:`~shipgnc.models.mariner.MarinerWitOppe` (default the document's, U = 15 kn;
-    the ship starts at its U). ``controller``: a path controller with its own path (e.g.
-    :class:`~shipgnc.control.feedback_linearization.LOSFL`, ``los_fl`` through waypoints; used by
-    :func:`shipgnc.routing.geo.sail.sail_check`) instead of :class:`HeadingFL` on ``heading``, which
-    then only gives the initial heading.
-    """
-    from shipgnc.control.feedback_linearization import HeadingFL
-    from shipgnc.guidance.schedule import HeadingProfile
-    from shipgnc.models.mariner import MarinerDisturbance, MarinerWitOppe, rudder
-    from shipgnc.sim.simulator import simulate
-
-    model = MarinerWitOppe() if model is None else model
-    p = model.params
-    t0 = route.t0
-    x0 = np.array([route.start[0], route.start[1], float(heading(t0)), p.U, 0.0])
-    steps = max(1, math.ceil(t_end / dt))
-    # the autopilot samples every step (Ts = dt): the programme's table for the compiled loop
-    samples = np.arange(steps + 1) * dt
-    guidance = None if controller is not None else \
-        HeadingProfile(lambda t: heading(t0 + t), samples=samples)
-    ds = simulate(model, x0, t_end=steps * dt, dt=dt,
-                  controller=HeadingFL(p, Ts=dt) if controller is None else controller,
-                  actuator=rudder(p), guidance=guidance,
-                  disturbance=MarinerDisturbance(0.0, current=_shifted(field, t0)), seed=seed,
-                  backend=backend)
-    distance = np.hypot(ds["north"].values - route.target[0], ds["east"].values - route.target[1])
-    k = int(np.argmin(distance))
-    return ds, float(ds["time"].values[k]), float(distance[k])
-
-
-class _shifted:
-    """The field seen by a ship whose clock starts at the departure time t0."""
-
-    def __init__(self, field, t0: float):
-        self.field, self.t0 = field, float(t0)
-        self.per_stage = True
-
-    def reset(self, batch_shape, rng=None) -> None:
-        pass
-
-    def __call__(self, t, x):
-        return self.field(self.t0 + t, x)
-
-    def current_kernel(self):
-        """The field's compiled form evaluated at t0 + t (raises NotCompiled without one)."""
-        make = getattr(self.field, "current_kernel", None)
-        if not callable(make):
-            from shipgnc.kernels import NotCompiled
-
-            raise NotCompiled(f"current {type(self.field).__name__} has no kernel")
-        return make(t0=self.t0)
+    return mariner_sail(route, field, heading, dt=dt, t_end=t_end, seed=seed, backend=backend,
+                        model=model, controller=controller)
 
 
 #: the vessels that can sail a route, with their default simulation step [s]
