@@ -333,7 +333,9 @@ def _print(console, res, nautical: bool) -> None:
     if gc:
         name = {"levelset": "level set", "graph": "graph search"}.get(gc["method"], gc["method"])
         val = ("—" if gc["time_s"] is None
-               else f"{gc['time_s']:.1f} s (relative difference {gc['rel_diff']:+.2e})")
+               else f"{gc['time_s']:.1f} s (relative difference {gc['rel_diff']:+.2e}"
+               + ("" if "agrees" not in gc else
+                  f"; {'agrees' if gc['agrees'] else 'DISAGREES'} within {gc['tolerance']:.2%}") + ")")
         row(f"global check by {name}: time to target", val)
     console.print(table)
     for note in js["notes"]:

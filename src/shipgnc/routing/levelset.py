@@ -41,7 +41,7 @@ from dataclasses import field as dc_field
 import numba
 import numpy as np
 
-from shipgnc.errors import require
+from shipgnc.errors import ConfigError, require
 
 TWO_PI = 2.0 * math.pi
 
@@ -204,6 +204,12 @@ def _axis(b, lo, hi, h):
     return b + h * np.arange(i0, i1 + 1)
 
 
+class FrontOutOfGrid(ConfigError):
+    """The level set's initial front does not fit its grid: over the short time it is started with,
+    the current carries the extremals far beyond the domain (a current that outruns the ship by
+    orders of magnitude at this scale)."""
+
+
 def _signed_distance(poly, nn, ee, h):
     """Signed distance to a closed polygon (negative inside): exact near the polygon, a k-d tree of its
     densified outline elsewhere (error below h/8 there, where it does not move the front)."""
@@ -326,6 +332,13 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     t_init = r0 / speed
     rays = np.linspace(0, TWO_PI, n_rays, endpoint=False)
     ends = pmp.integrate_family(field, speed, start, rays, t0, t_init, ray_steps)[-1]
+    perimeter = float(np.sum(np.hypot(*(np.roll(ends, -1, axis=0) - ends).T)))
+    if not (math.isfinite(perimeter) and perimeter / (spacing / 4) <= 4 * nn.size):
+        raise FrontOutOfGrid(
+            f"level set: its initial front (the extremals' ends after r0/V = {t_init:.3g} s) has a "
+            f"perimeter of {perimeter:.3g} m, beyond its {north.size}×{east.size} grid of {spacing:.3g} m "
+            f"cells: the current outruns the ship (V = {speed:.3g} m/s) at this scale; use the "
+            "extremal sweep alone (method pmp) or a smaller problem")
     phi = _signed_distance(ends, nn, ee, spacing)
     cap = None if band is None else band * spacing
     if cap is not None:

@@ -153,14 +153,50 @@ class Extremal:
         return np.stack([y[0], y[1]], axis=-1)
 
 
-def _solve(field, speed, start, thetas, t0, duration, dense=False, rtol=1e-11):
-    """solve_ivp (DOP853) of a small batch of extremals; returns the OdeResult."""
+#: the effort bound of polishing extremals (deterministic, counted in right-hand-side evaluations):
+#: one solve_ivp call of a polish, and all the polishes of one sweep. A regular route takes a few
+#: hundred to a few thousand per call; one that needs tens of thousands is stiff (a current far
+#: stronger than the ship over a long route) and is stopped, said in the route's notes and reason
+MAX_EVALS_PER_SOLVE = 50_000
+MAX_EVALS_PER_SWEEP = 2_000_000
+
+
+class EffortExceeded(Exception):
+    """A polish stopped at the effort bound (:data:`MAX_EVALS_PER_SOLVE`, :data:`MAX_EVALS_PER_SWEEP`)."""
+
+
+@dataclass
+class Effort:
+    """Right-hand-side evaluations spent polishing, against the bounds; ``stopped`` counts the
+    polishes the bound cut short."""
+
+    per_solve: int = field(default_factory=lambda: MAX_EVALS_PER_SOLVE)
+    total: int = field(default_factory=lambda: MAX_EVALS_PER_SWEEP)
+    spent: int = 0
+    stopped: int = 0
+
+    def describe(self) -> str:
+        return (f"the effort bound stopped {self.stopped} polish(es) ({self.per_solve:,} "
+                f"right-hand-side evaluations per integration, {self.total:,} per sweep; "
+                f"{self.spent:,} spent): the extremals are stiff here (a current much stronger than "
+                "the ship over a long route)")
+
+
+def _solve(field, speed, start, thetas, t0, duration, dense=False, rtol=1e-11, effort=None):
+    """solve_ivp (DOP853) of a small batch of extremals; returns the OdeResult. With ``effort``
+    (:class:`Effort`) it raises :class:`EffortExceeded` past the bounds."""
     from scipy.integrate import solve_ivp
 
     y0, _ = initial_state(field, speed, start, np.asarray(thetas, float), t0)
     shape = y0.shape
+    calls = [0]
 
     def f(t, y):
+        if effort is not None:
+            calls[0] += 1
+            effort.spent += 1
+            if calls[0] > effort.per_solve or effort.spent > effort.total:
+                raise EffortExceeded
         return rhs(field, speed, t, y.reshape(shape)).ravel()
 
     length = max(speed * abs(duration), 1e-300)  # unit-invariant tolerances (positions ~ V·T, p ~ 1)
@@ -172,9 +208,9 @@ def _solve(field, speed, start, thetas, t0, duration, dense=False, rtol=1e-11):
 class _Shooter:
     """Residual and Jacobian of x(t₀ + T; θ₀) − B (point) or x + R e(u) − B (disc, Z12) for least_squares."""
 
-    def __init__(self, field, speed, start, target, t0, radius=0.0, h=1e-6, rtol=1e-11):
+    def __init__(self, field, speed, start, target, t0, radius=0.0, h=1e-6, rtol=1e-11, effort=None):
         self.field, self.speed, self.start, self.t0 = field, speed, start, t0
-        self.rtol = rtol
+        self.rtol, self.effort = rtol, effort
         self.target, self.radius, self.h = np.asarray(target, float), float(radius), h
         self.cache: dict = {}
 
@@ -185,7 +221,7 @@ class _Shooter:
             if not dur > 0:
                 dur = 1e-9
             res = _solve(self.field, self.speed, self.start, [theta - self.h, theta, theta + self.h],
-                         self.t0, dur, rtol=self.rtol)
+                         self.t0, dur, rtol=self.rtol, effort=self.effort)
             y = res.y[:, -1].reshape(3, 4)
             if not res.success or not np.all(np.isfinite(y)):
                 y = np.full((3, 4), 1e12)
@@ -226,20 +262,26 @@ def miss_tolerance(start, target, tol_m: float = 1.0) -> float:
     return min(float(tol_m), MISS_REL * dist)
 
 
-def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol_m=1.0, rtol=1e-11):
+def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol_m=1.0, rtol=1e-11,
+          effort: Effort | None = None):
     """Polish one extremal from a guess (θ₀, t_f − t₀) with Levenberg–Marquardt (note 002-2.9.4).
 
     Returns an :class:`Extremal` or ``None`` when the solver fails, returns t_f ≤ 0 (F4), misses by more
     than :func:`miss_tolerance` (``MISS_REL``·|AB|, at most ``tol_m`` metres), or ends with an
-    inadmissible costate V + e(u_f)ᵀv(B) ≤ 0 (F5, (2.4)).
+    inadmissible costate V + e(u_f)ᵀv(B) ≤ 0 (F5, (2.4)). ``effort`` (default: a fresh
+    :class:`Effort`) bounds the work; a polish it stops returns None and counts in ``effort.stopped``.
     """
     from scipy.optimize import least_squares
 
-    sh = _Shooter(field, speed, np.asarray(start, float), target, t0, radius, rtol=rtol)
+    effort = Effort() if effort is None else effort
+    sh = _Shooter(field, speed, np.asarray(start, float), target, t0, radius, rtol=rtol, effort=effort)
     try:
         sol = least_squares(sh.residual, [float(theta0), float(duration)], jac=sh.jacobian, method="lm",
                             x_scale=[1.0, max(float(duration), 1.0)], xtol=1e-15, ftol=1e-15, gtol=1e-15,
                             max_nfev=60)
+    except EffortExceeded:
+        effort.stopped += 1
+        return None
     except (ValueError, FloatingPointError):
         return None
     theta, dur = float(sol.x[0]), float(sol.x[1])
@@ -248,13 +290,18 @@ def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol
     miss = float(np.hypot(*sol.fun))
     if miss > miss_tolerance(start, target, tol_m):
         return None
-    return finish_extremal(field, speed, start, target, theta, dur, t0, radius, rtol=rtol)
+    try:
+        return finish_extremal(field, speed, start, target, theta, dur, t0, radius, rtol=rtol,
+                               effort=effort)
+    except EffortExceeded:
+        effort.stopped += 1
+        return None
 
 
-def finish_extremal(field, speed, start, target, theta, dur, t0=0.0, radius=0.0, rtol=1e-11):
+def finish_extremal(field, speed, start, target, theta, dur, t0=0.0, radius=0.0, rtol=1e-11, effort=None):
     """Dense extremal with its costate scaled by (2.4); ``None`` if inadmissible or off a gridded domain."""
     theta = float(np.mod(theta, TWO_PI))
-    res = _solve(field, speed, start, [theta], t0, dur, dense=True, rtol=rtol)
+    res = _solve(field, speed, start, [theta], t0, dur, dense=True, rtol=rtol, effort=effort)
     y_end = res.y[:, -1]
     pe = y_end[2:] / math.hypot(y_end[2], y_end[3])
     vb = field._velocity(t0 + dur, y_end[0], y_end[1])
@@ -335,6 +382,7 @@ class SweepResult:
     horizon: float
     n_left_domain: int = 0
     n_inadmissible: int = 0
+    effort: Effort | None = None  #: the polishes' effort (``effort.stopped``: cut short by its bound)
 
 
 def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n_steps=None,
@@ -384,6 +432,7 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
     candidates = _candidates(dist_tab, pos, th.size, speed * dt) if th.size > 2 else []
     extremals: list[Extremal] = []
     seeds: list[tuple[int, int]] = []
+    effort = Effort()
     dth = TWO_PI / n_angles
     for k, i in candidates:
         if len(seeds) >= max_candidates:
@@ -395,7 +444,7 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
                and abs(k * dt - o.duration) <= 0.03 * o.duration for o in extremals):
             continue
         seeds.append((k, i))
-        ext = shoot(field, speed, start, target, th[i], k * dt, t0=t0, radius=radius)
+        ext = shoot(field, speed, start, target, th[i], k * dt, t0=t0, radius=radius, effort=effort)
         if ext is None or ext.duration > horizon * (1 + 1e-9):
             continue
         if any(abs(ext.duration - o.duration) <= 1e-6 * o.duration
@@ -412,7 +461,7 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
         else:
             ext.status = "global optimum" if j == 0 else "local minimum, no conjugate point"
     return SweepResult(extremals, closest, closest_t, n_angles, float(horizon), n_left,
-                       int(np.sum(~admissible)))
+                       int(np.sum(~admissible)), effort)
 
 
 def _candidates(dist_tab, pos, n, step_len):

@@ -182,6 +182,15 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps):
             res.notes.append(f"closest approach {sol.closest_approach:.1f} m at t = "
                              f"{sol.closest_time:.1f} s")
             return res
+        if sol.duration > horizon * (1 + 1e-12):  # the horizon is a limit (5b)
+            res.reason = (f"target not reachable within T_max = {horizon:.6g} s: the straight route in "
+                          f"this uniform current takes {sol.duration:.6g} s")
+            # the reachable set at t is the disc of radius V·t about A + c·t: its distance to B
+            t = np.linspace(0.0, horizon, 2001)
+            gap = np.hypot(*(B[:, None] - A[:, None] - c[:, None] * t)) - V * t
+            k = int(np.argmin(gap))
+            res.closest_approach_m, res.closest_time_s = float(max(gap[k], 0.0)), float(t[k])
+            return res
         e = np.array([math.cos(sol.heading), math.sin(sol.heading)])
         res.reachable, res.time_s = True, sol.duration
         res.heading_start = res.heading_end = sol.heading
@@ -207,11 +216,16 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps):
         res.notes.append(f"{sw.n_left_domain} of {sw.n_angles} extremals left the gridded field's domain "
                          f"{_extent(fld)} and were stopped there")
     optimal = [e for e in sw.extremals if e.conjugate_at is None]
+    stopped = sw.effort is not None and sw.effort.stopped > 0
+    if stopped:
+        res.notes.append(sw.effort.describe())
     if not optimal:
         res.closest_approach_m, res.closest_time_s = sw.closest_approach, sw.closest_time
         extra = ""
         if sw.n_left_domain:
             extra = f"; {sw.n_left_domain} extremals left the gridded field's domain {_extent(fld)}"
+        if stopped:
+            extra += f"; {sw.effort.describe()}"
         res.reason = (f"target not reachable within T_max = {horizon:.0f} s ({horizon / 3600:.2f} h) in "
                       f"{fld.describe()} at ship speed {V:.4f} m/s: closest approach "
                       f"{sw.closest_approach:.1f} m at t = {sw.closest_time:.0f} s{extra}")
@@ -264,7 +278,13 @@ def _levelset_run(res, polys, grid_spacing, horizon, domain):
 
 
 def _levelset_check(res, polys, grid_spacing, horizon, domain):
-    ls = _levelset_run(res, polys, grid_spacing, horizon, domain)
+    from shipgnc.routing.levelset import FrontOutOfGrid
+
+    try:
+        ls = _levelset_run(res, polys, grid_spacing, horizon, domain)
+    except FrontOutOfGrid as exc:  # the check cannot run: said, the sweep's answer stands
+        res.notes.append(f"global check skipped: {exc}")
+        return
     res.isochrones = ls
     res.grid_spacing = ls.spacing
     if ls.arrival is None:
