@@ -144,6 +144,18 @@ def test_sincos_within_an_ulp_of_libm():
     assert all(math.isnan(v) for v in wave_kernel.sincos(math.nan))
 
 
+@pytest.mark.parametrize("n", [1, 7, 8, 9, 15, 16, 127, 128, 129, 200, 257, 1000, 4099])
+def test_the_three_sums_are_numpys_to_the_bit(n):
+    """The wave loads' sums (:func:`wave_kernel.pairwise_sum3`, three rows added eight lanes per
+    vector add) equal ``np.sum`` (numpy's pairwise order) to the bit, as the one-row form does."""
+    rng = np.random.default_rng(n)
+    a = np.concatenate([[7.0, 7.0], rng.standard_normal(3 * n) * 10.0 ** rng.integers(-8, 8, 3 * n)])
+    got = wave_kernel.pairwise_sum3(a, 2, n, n)
+    for k in range(3):
+        row = a[2 + k * n:2 + (k + 1) * n]
+        assert got[k] == np.sum(row) == wave_kernel.pairwise_sum(a, 2 + k * n, n)
+
+
 # ----------------------------------------------------------------------------------------------
 # the loop: backends and the scenarios
 # ----------------------------------------------------------------------------------------------

@@ -86,6 +86,9 @@ def loads(t: float, north, east, psi, arrays: dict, length: float, beam: float,
 # ----------------------------------------------------------------------------------------------
 
 import numba  # noqa: E402
+from llvmlite import ir  # noqa: E402
+from numba.core import cgutils, types  # noqa: E402
+from numba.core.extending import intrinsic  # noqa: E402
 
 from shipgnc.kernels import JIT_OPTIONS, kernel_function  # noqa: E402
 
@@ -131,6 +134,70 @@ def pairwise_sum(a, lo, n):
     return pairwise_sum(a, lo, n2) + pairwise_sum(a, lo + n2, n - n2)
 
 
+@intrinsic
+def _lane_sums3(typingctx, a, lo, m, stride):
+    """Three 8-lane partial-sum blocks at once: for each row k = 0, 1, 2 (starting at
+    lo + k·stride) lane l adds a[lo + k·stride + 8i + l] for i = 0 … m − 1 in that order, and the
+    lanes are combined as ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7)) — numpy's block
+    (:func:`pairwise_sum`) written as one 8-wide vector add per step (plain IEEE adds, no
+    reassociation: the same sum to the bit). numba does not SLP-vectorise the scalar form."""
+    if not (isinstance(a, types.Array) and a.ndim == 1 and a.dtype == types.float64
+            and a.layout == "C"):
+        return None
+    sig = types.UniTuple(types.float64, 3)(a, types.intp, types.intp, types.intp)
+
+    def codegen(context, builder, signature, args):
+        data = context.make_array(signature.args[0])(context, builder, args[0]).data
+        lo_, m_, stride_ = args[1], args[2], args[3]
+        f64 = ir.DoubleType()
+        vec = ir.VectorType(f64, 8)
+        rows = [builder.gep(data, [builder.add(lo_, builder.mul(stride_, ir.Constant(lo_.type, k)))],
+                            source_etype=f64) for k in range(3)]
+        accs = [cgutils.alloca_once_value(builder, builder.load(r, typ=vec, align=8)) for r in rows]
+        one = ir.Constant(lo_.type, 1)
+        with cgutils.for_range_slice(builder, one, m_, one, inc=True) as (i, _):
+            offset = builder.mul(i, ir.Constant(i.type, 8))
+            for row, acc in zip(rows, accs, strict=True):
+                block = builder.load(builder.gep(row, [offset], source_etype=f64), typ=vec, align=8)
+                builder.store(builder.fadd(builder.load(acc), block), acc)
+        sums = []
+        for acc in accs:
+            r = builder.load(acc)
+            e = [builder.extract_element(r, ir.Constant(ir.IntType(32), k)) for k in range(8)]
+            sums.append(builder.fadd(builder.fadd(builder.fadd(e[0], e[1]), builder.fadd(e[2], e[3])),
+                                     builder.fadd(builder.fadd(e[4], e[5]), builder.fadd(e[6], e[7]))))
+        return context.make_tuple(builder, signature.return_type, sums)
+
+    return sig, codegen
+
+
+@kernel_function
+def pairwise_sum3(a, lo, n, stride):
+    """(Σ a[lo:lo + n], Σ a[lo + s:lo + s + n], Σ a[lo + 2s:lo + 2s + n]) with s = ``stride``,
+    each exactly as :func:`pairwise_sum` (numpy's order); the three rows' blocks are added side by
+    side, eight lanes per vector add (:func:`_lane_sums3`)."""
+    if n < 8:
+        sx = sy = sz = 0.0
+        for i in range(n):
+            sx += a[lo + i]
+            sy += a[lo + stride + i]
+            sz += a[lo + 2 * stride + i]
+        return sx, sy, sz
+    if n <= 128:
+        m = n // 8
+        sx, sy, sz = _lane_sums3(a, lo, m, stride)
+        for i in range(lo + 8 * m, lo + n):
+            sx += a[i]
+            sy += a[i + stride]
+            sz += a[i + 2 * stride]
+        return sx, sy, sz
+    n2 = n // 2
+    n2 -= n2 % 8
+    ax, ay, az = pairwise_sum3(a, lo, n2, stride)
+    bx, by, bz = pairwise_sum3(a, lo + n2, n - n2, stride)
+    return ax + bx, ay + by, az + bz
+
+
 # sin and cos of many arguments in one vectorisable loop (no libm call per element): Cody–Waite
 # reduction by π/2 in three parts (exact products for |x| < 2²⁰·π/2) and fdlibm's kernels
 # __kernel_sin / __kernel_cos on |r| ≤ π/4 (error < 1 ulp; libm's own reduction and kernels)
@@ -138,6 +205,8 @@ _PIO2_1 = 1.57079632673412561417e+00
 _PIO2_2 = 6.07710050630396597660e-11
 _PIO2_3 = 2.02226624871116645580e-21
 _INV_PIO2 = 6.36619772367581382433e-01
+#: 1.5·2⁵²: (y + _ROUND) − _ROUND rounds |y| < 2⁵¹ to the nearest integer
+_ROUND = 6755399441055744.0
 #: beyond this |x| the three-part reduction loses bits: those arguments go to libm
 SINCOS_LIMIT = 1.0e6
 _S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
@@ -149,8 +218,9 @@ _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.1359
 @numba.njit(inline="always", **JIT_OPTIONS)
 def sincos(x):
     """(sin x, cos x) within 1 ulp of libm for |x| ≤ :data:`SINCOS_LIMIT`, branch-free (so a loop
-    of it vectorises); NaN stays NaN."""
-    q = math.floor(x * _INV_PIO2 + 0.5)
+    of it vectorises); NaN stays NaN. q = nearest integer to 2x/π by the 1.5·2⁵² rounding trick
+    (no floor, one float → int conversion for the quadrant: the cheapest form found)."""
+    q = (x * _INV_PIO2 + _ROUND) - _ROUND
     r = x - q * _PIO2_1
     r = r - q * _PIO2_2
     r = r - q * _PIO2_3
@@ -160,10 +230,10 @@ def sincos(x):
     hz = 0.5 * z
     w = 1.0 - hz
     c = w + (((1.0 - w) - hz) + z * rc)
-    m = q - 4.0 * math.floor(q * 0.25)  # quadrant 0..3
-    sn = s if m == 0.0 else (c if m == 1.0 else (-s if m == 2.0 else -c))
-    cs = c if m == 0.0 else (-s if m == 1.0 else (-c if m == 2.0 else s))
-    return sn, cs
+    m = int(q)  # quadrant: bit 0 swaps sin and cos, bit 1 (of m, m + 1) flips their signs
+    a = c if m & 1 else s
+    b = s if m & 1 else c
+    return (-a if m & 2 else a), (-b if (m + 1) & 2 else b)
 
 
 @numba.njit(inline="always", **JIT_OPTIONS)
@@ -199,7 +269,7 @@ def froude_krylov_sample(t, x, z, p, w, d):
         N = Σ w_N,ᵢ (L² sin vᵢ j₁(uᵢ) − B² sin uᵢ j₁(vᵢ)) cos θᵢ,
 
     operation for operation as :meth:`~FroudeKrylovWaveLoads.loads_numpy`, the sums in numpy's
-    order (:func:`pairwise_sum`). The cost is three sin/cos pairs per component and stage: they
+    order (:func:`pairwise_sum3`). The cost is three sin/cos pairs per component and stage: they
     are evaluated by :func:`sincos` in one vectorised loop over the components (libm for any
     argument beyond :data:`SINCOS_LIMIT`). ``z`` holds the ship's sea (:data:`ROWS`) and the
     scratch rows of the terms; ``p`` = [n_components, L, B, long-crested, i_north, i_east, i_psi]."""
@@ -241,6 +311,4 @@ def froude_krylov_sample(t, x, z, p, w, d):
             v = z[5 * n + j] * math.sin(beta)
             _terms(z, j, n, o_t, length, beam, L2, B2, math.sin(theta), math.cos(theta),
                    math.sin(u), math.cos(u), math.sin(v), math.cos(v), u, v)
-    d[0] = pairwise_sum(z, o_t, n)
-    d[1] = pairwise_sum(z, o_t + n, n)
-    d[2] = pairwise_sum(z, o_t + 2 * n, n)
+    d[0], d[1], d[2] = pairwise_sum3(z, o_t, n, n)
