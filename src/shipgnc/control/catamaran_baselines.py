@@ -362,7 +362,7 @@ def pole_placement_step(t, x, ref, z, p, cmd, sig):
     z[0] += 1.0
     w = rate_value(t, x, ref, p, PLACE_SOURCE, z, 2)
     o = PLACE_MODEL
-    _, Y, N = _hull_forces(x, p, o)
+    _, Y, N = _hull_forces(x[0], x[1], x[2], p, o)
     sd = math.sin(x[DELTA])
     v_dot = (Y - p[o + 7] * sd + 0.0) / p[o + 1]
     r_dot = (N + p[o + 8] * sd + 0.0) / p[o + 2]
@@ -428,7 +428,8 @@ def designed_pi_step(t, x, ref, z, p, cmd, sig):
     w = rate_value(t, x, ref, p, DPI_SOURCE, z, 2)
     u = p[0] * (w - x[R]) - p[1] * catamaran_yaw_acceleration(x, p, DPI_MODEL)
     delta = x[DELTA]
-    if p[2] != 0.0 and abs(delta) >= p[3] and sign(u) == sign(delta):
+    clamp, delta_max = p[2], p[3]  # read before the branch: no reference counting of p
+    if clamp != 0.0 and abs(delta) >= delta_max and sign(u) == sign(delta):
         u = 0.0
     z[1] = w
     sig[0] = w

@@ -62,9 +62,9 @@ from shipgnc.models.catamaran import (
     PSI,
     Catamaran,
     R,
-    catamaran_yaw_acceleration,
     kernel_params,
     kernel_params_reason,
+    yaw_acceleration_of,
 )
 
 EVENT_KINDS = ("omega_ref_above_max", "delta_clamped", "delta_reached_90")
@@ -355,18 +355,25 @@ def rate_value(t, x, ref, p, o, z, oz):
     heading capture (17) latches K(t₀) there at the first call with t ≥ t₀, as
     :class:`HeadingCapture` does); ``ref`` the held guidance references (source
     ``RATE_GUIDANCE``: ``ref[0]``). Offsets, not slices: no array view per call."""
+    # every array element read once, up front, and the latch written back unconditionally: an
+    # array whose last use sits inside a conditional keeps numba's reference counting (atomic
+    # increments and decrements of every array argument) in the caller's hot path
     kind = p[o]
+    p1, p2, p3, p4 = p[o + 1], p[o + 2], p[o + 3], p[o + 4]
+    omega, latched, psi0 = z[oz], z[oz + 1], z[oz + 2]
+    psi = x[PSI]
     if kind == RATE_CONSTANT:
-        return z[oz] if t >= p[o + 1] else 0.0 * z[oz]
+        return omega if t >= p1 else 0.0 * omega
     if kind == RATE_SINE:
-        return p[o + 1] * math.sin(2.0 * math.pi * t / p[o + 2])
+        return p1 * math.sin(2.0 * math.pi * t / p2)
     if kind == RATE_CAPTURE:
-        psi_target, omega_c, t0, ramp = p[o + 1], p[o + 2], p[o + 3], p[o + 4]
-        if z[oz + 1] == 0.0 and t >= t0:
-            z[oz + 1], z[oz + 2] = 1.0, x[PSI]
-        if z[oz + 1] == 0.0:
+        psi_target, omega_c, t0, ramp = p1, p2, p3, p4
+        if latched == 0.0 and t >= t0:
+            latched, psi0 = 1.0, psi
+        z[oz + 1], z[oz + 2] = latched, psi0
+        if latched == 0.0:
             return 0.0
-        diff = wrap(psi_target - z[oz + 2])
+        diff = wrap(psi_target - psi0)
         t_star = t0 + abs(diff) / omega_c
         if ramp > 0:
             frac = clip((t_star + ramp / 2 - t) / ramp, 0.0, 1.0)
@@ -619,32 +626,35 @@ def yaw_rate_fsm_step(t, x, ref, z, p, cmd, sig):
     law (20) u = (ω* − ω − h Φ₃)/(T_u W₃₇) or (21) u = (ω* − ω)/(T_u W₃₇) with W₃₇ = h L T_v
     cos δ / J (eq. (19)); cos δ frozen beyond δ_f; u = 0 pushing |δ| beyond δ_max; the command
     u or v_a = (δ + T_a u)/k_a (eq. (23)). Events recorded in ``z`` (see :meth:`YawRateFSM.kernel`)."""
+    # the state and the parameters read once, up front, and each output written once: an array
+    # whose last use sits inside a conditional (a call in one branch, a write in one branch)
+    # keeps numba's reference counting of every array argument in the RK stages' hot path
     z[0] += 1.0
     w = rate_value(t, x, ref, p, FSM_SOURCE, z, FSM_STATE - N_RATE_STATE)
-    if p[5] != 0.0 and abs(w) > p[6]:
+    su, sv, sr, delta = x[0], x[1], x[R], x[DELTA]
+    law20, T_u, h, hLT_v, J, check_max, omega_max = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
+    if check_max != 0.0 and abs(w) > omega_max:
         _first(z, 0, t, abs(w))
-    delta = x[DELTA]
     if abs(delta) >= math.pi / 2:
         _first(z, 1, t, abs(delta))
-    T_u, h = p[1], p[2]
-    w37 = p[3] * math.cos(delta) / p[4]
-    if p[0] != 0.0:
-        omega_bar = x[R] + h * catamaran_yaw_acceleration(x, p, FSM_MODEL)
+    cd = math.cos(delta)
+    w37 = hLT_v * cd / J
+    if law20 != 0.0:
+        omega_bar = sr + h * yaw_acceleration_of(su, sv, sr, delta, p, FSM_MODEL)
         u = (w - omega_bar) / (T_u * w37)
     else:
-        u = (w - x[R]) / (T_u * w37)
-    if p[7] != 0.0:
-        frozen = clip(delta, -p[8], p[8])
-        u = u * (math.cos(delta) / math.cos(frozen))
-    if p[9] != 0.0 and abs(delta) >= p[10] and sign(u) == sign(delta):
+        u = (w - sr) / (T_u * w37)
+    freeze, delta_f, clamp, delta_max = p[7], p[8], p[9], p[10]
+    inverse, T_a, k_a = p[11], p[12], p[13]
+    if freeze != 0.0:
+        frozen = clip(delta, -delta_f, delta_f)
+        u = u * (cd / math.cos(frozen))
+    if clamp != 0.0 and abs(delta) >= delta_max and sign(u) == sign(delta):
         _first(z, 2, t, 0.0)
         u = 0.0
     sig[0], sig[1] = w, u
     z[10], z[11] = w, u
-    if p[11] != 0.0:
-        cmd[0] = (delta + p[12] * u) / p[13]
-    else:
-        cmd[0] = u
+    cmd[0] = (delta + T_a * u) / k_a if inverse != 0.0 else u
 
 
 def default_gains(preset_name: str) -> tuple[float, float]:

@@ -29,10 +29,13 @@ directionally unstable, note 004-C3). The document-frame form (x forward, y to p
 clockwise) is :func:`document_derivatives`, with :func:`to_document`/:func:`from_document`.
 
 **Compiled** (:mod:`shipgnc.kernels`): :meth:`Catamaran.kernel` is :meth:`Catamaran.derivatives`
-for one ship (:func:`catamaran_rhs`, every option above; :func:`catamaran_yaw_acceleration` is Φ₃
-for the laws' kernels). Per-ship plant factors (arrays of ``m_x_factor``, ``m_y_factor``,
-``J_factor``, the Monte Carlo of S10) have no kernel: a model kernel has one parameter array for
-all ships, so such a run stays in the numpy loop (:meth:`Catamaran.kernel_reason`).
+for one ship (:func:`catamaran_rhs`, every option above; :func:`catamaran_yaw_acceleration` and,
+on scalars, :func:`yaw_acceleration_of` are Φ₃ for the laws' kernels). The kernels pass scalars,
+not arrays, to their helpers and make no arrays: numba then keeps no reference counts (atomic
+operations on every array argument) in the loop's RK stages. Per-ship plant factors (arrays of
+``m_x_factor``, ``m_y_factor``, ``J_factor``, the Monte Carlo of S10) have no kernel: a model
+kernel has one parameter array for all ships, so such a run stays in the numpy loop
+(:meth:`Catamaran.kernel_reason`).
 """
 
 from __future__ import annotations
@@ -441,14 +444,19 @@ def kernel_params(params: CatamaranParams) -> np.ndarray:
 
 
 @kernel_function
-def _hull_forces(x, p, o):
-    """(X, Y, N) of the hull alone for one ship: :meth:`Catamaran.hull_forces` operation for
-    operation — resistance R(V)/V of eq. (8) (continued below V_m unless literal), Coriolis with
-    sign σ (eq. (1)–(2)), the moment of R at x_p(β), yaw damping c_D V r and the Munk moment (3).
-    ``p[o:]`` holds :func:`kernel_params` (an offset, not a slice: no array view per call)."""
+def _hull_forces(su, sv, sr, p, o):
+    """(X, Y, N) of the hull alone for one ship at (u, v, r) = (``su``, ``sv``, ``sr``):
+    :meth:`Catamaran.hull_forces` operation for operation — resistance R(V)/V of eq. (8)
+    (continued below V_m unless literal), Coriolis with sign σ (eq. (1)–(2)), the moment of R at
+    x_p(β), yaw damping c_D V r and the Munk moment (3). ``p[o:]`` holds :func:`kernel_params` (an
+    offset, not a slice: no array view per call). Scalars in, scalars out: no array is made or
+    passed, so the callers keep no reference counts in their hot path.
+
+    Two exact identities replace numpy's library calls (results move at round-off level only):
+    V = √(u² + v²) for ``hypot`` (|u|, |v| ≤ 50 m/s by the state limits: no overflow), and
+    |β| = |atan2(v, u)| = atan(|v|/u) for u > 0 (atan2(|v|, u) otherwise), about half the cost."""
     m_y, sig_m_x, munk, c_D, x_p0 = p[o + 1], p[o + 3], p[o + 4], p[o + 5], p[o + 6]
-    su, sv, sr = x[0], x[1], x[2]
-    speed = math.hypot(su, sv)
+    speed = math.sqrt(su * su + sv * sv)
     a0, a1, a2 = RK_COEFFS
     if p[o + 9] != 0.0:  # literal fit, 0 at V = 0
         r_over_v = 2000.0 * (a0 / speed + a1 + a2 * speed) if speed > 0 else 0.0
@@ -456,11 +464,12 @@ def _hull_forces(x, p, o):
         r_over_v = 2000.0 * (a0 / speed + a1 + a2 * speed)
     else:
         r_over_v = p[o + 11] * speed
-    beta = math.atan2(sv, su)
-    x_p = x_p0 * (0.5 - abs(beta) / math.pi)
+    abs_v = abs(sv)
+    abs_beta = math.atan(abs_v / su) if su > 0.0 else math.atan2(abs_v, su)
+    x_p = x_p0 * (0.5 - abs_beta / math.pi)
     X = -r_over_v * su + m_y * sv * sr
     Y = -r_over_v * sv + sig_m_x * su * sr
-    Y = Y + (p[o + 15] * speed * sv + p[o + 16] * speed * sr + p[o + 17] * abs(sv) * sv)
+    Y = Y + (p[o + 15] * speed * sv + p[o + 16] * speed * sr + p[o + 17] * abs_v * sv)
     N = -x_p * r_over_v * sv - c_D * speed * sr + munk * su * sv
     return X, Y, N
 
@@ -477,16 +486,13 @@ def catamaran_rhs(x, u, d, p, xdot):
     in_current = d.shape[0] > 4 and (d[3] != 0.0 or d[4] != 0.0)
     uc = 0.0
     vc = 0.0
+    su, sv = x[0], x[1]
     if in_current:  # the hull sees ν_r = ν − R(ψ)ᵀ[V_N, V_E]
         uc = c * d[3] + s * d[4]
         vc = -s * d[3] + c * d[4]
-        xr = np.empty(3)
-        xr[0] = x[0] - uc
-        xr[1] = x[1] - vc
-        xr[2] = x[2]
-        X, Y, N = _hull_forces(xr, p, 0)
-    else:
-        X, Y, N = _hull_forces(x, p, 0)
+        su = x[0] - uc
+        sv = x[1] - vc
+    X, Y, N = _hull_forces(su, sv, x[2], p, 0)
     cd, sd = math.cos(delta), math.sin(delta)
     X = X + two_T_v * cd + d[0]
     Y = Y - two_T_v * sd + d[1]
@@ -507,12 +513,20 @@ def catamaran_rhs(x, u, d, p, xdot):
 
 
 @kernel_function
+def yaw_acceleration_of(su, sv, sr, delta, p, o):
+    """Φ₃ = ṙ of eq. (3) without disturbance at (u, v, r, δ) = (``su``, ``sv``, ``sr``, ``delta``):
+    :meth:`Catamaran.yaw_acceleration` on scalars (``p[o:]``: :func:`kernel_params`), for laws that
+    read the state once and keep it out of conditional calls."""
+    N = _hull_forces(su, sv, sr, p, o)[2]
+    N = N + p[o + 8] * math.sin(delta)
+    return N / p[o + 2]
+
+
+@kernel_function
 def catamaran_yaw_acceleration(x, p, o):
     """Φ₃ = ṙ of eq. (3) at one ship's state without disturbance:
     :meth:`Catamaran.yaw_acceleration` (``p[o:]``: :func:`kernel_params`)."""
-    N = _hull_forces(x, p, o)[2]
-    N = N + p[o + 8] * math.sin(x[6])
-    return N / p[o + 2]
+    return yaw_acceleration_of(x[0], x[1], x[2], x[6], p, o)
 
 
 def slew_actuator(model: Catamaran, rate_deg_s: float) -> Actuator:
