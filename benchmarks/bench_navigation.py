@@ -1,4 +1,4 @@
-"""Cost of navigation (sensors and estimators, issue 18) in the composed compiled loop.
+"""Cost of navigation (sensors and estimators) in the composed compiled loop.
 
     python benchmarks/bench_navigation.py [--quick]
 
@@ -11,40 +11,27 @@ back to back in one run (ratios within a run are the reliable figures on a share
 
 Each is a batch of ships (the scenario's initial state repeated), warmed up first (the loops are
 compiled or loaded from their cache by a short run) and timed as the best of a few repeats. Prints
-the cost per ship-step of each and the ratios a/b (target ≤ 2, issue 18) and c/a, and writes
+the cost per ship-step of each and the ratios a/b (target ≤ 2) and c/a, and writes
 ``benchmarks/results/bench_navigation.json`` (``_quick`` with ``--quick``).
 """
 
 from __future__ import annotations
 
 import argparse
-import datetime as dt_
-import json
-import math
-import os
-import platform
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
-RESULTS = Path(__file__).resolve().parent / "results"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_boat import best_time, machine_info, write_report
+
 #: (scenario, controller variant or None, t_end [s]): the controller reads the navigation system
 #: (the full t_end of the boat and the Mariner: the Python set-up of a run is then negligible)
 CASES = (("cybership-waves-observer", "pd_measured", 60.0),   # compass + rate gyro
          ("cybership-waves-observer", "pd_observer", 60.0),   # + the passive observer
          ("boat-los-gnss", None, 300.0),                       # EKF at the control rate
          ("mariner-los-ekf", None, 6000.0))                    # EKF at the control rate
-
-
-def best_time(run, repeats: int) -> float:
-    best = math.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        run()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 def make_run(name: str, variant, t_end: float, n_ships: int, *, navigation: bool, backend: str):
@@ -93,13 +80,7 @@ def main(argv=None) -> int:
         label = f"{name} {variant or ''}"
         print(f"{label:40s} {cost['a']:10.3f} {cost['b']:10.3f} {cost['c']:10.3f} "
               f"{row['nav_over_no_nav']:6.2f} {row['numpy_over_compiled']:7.1f}", flush=True)
-    RESULTS.mkdir(exist_ok=True)
-    out = RESULTS / f"bench_navigation{'_quick' if args.quick else ''}.json"
-    out.write_text(json.dumps({
-        "date": dt_.datetime.now(dt_.timezone.utc).isoformat(timespec="seconds"),
-        "python": sys.version.split()[0], "platform": platform.platform(),
-        "cpus": os.cpu_count(), "rows": rows}, indent=2) + "\n")
-    print(f"wrote {out}")
+    write_report("bench_navigation", {"machine": machine_info(), "rows": rows}, args.quick)
     return 0
 
 
