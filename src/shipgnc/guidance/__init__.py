@@ -1,1 +1,2 @@
-"""Guidance: references for the controller (schedules, waypoint paths, LOS)."""
+"""Guidance: references for the controller (schedules, waypoint paths, LOS, heading reference
+models)."""

@@ -169,7 +169,8 @@ def _guidance(g):
                                  [e.u for e in g.schedule])
     if g.type == "los":
         return LOSGuidance(WaypointPath(g.waypoints), lookahead=g.lookahead, speed=g.speed,
-                           switch_radius=g.switch_radius, integral_gain=g.integral_gain)
+                           switch_radius=g.switch_radius, integral_gain=g.integral_gain,
+                           adaptive_gain=g.adaptive_gain)
     from shipgnc.guidance.schedule import CourseSchedule
 
     return CourseSchedule([e.t for e in g.schedule], [deg(e.psi_deg) for e in g.schedule])

@@ -490,6 +490,15 @@ class LOSConfig(Strict):
     capture_distance: NonNegative = 20.0
     #: σ of integral LOS against currents and steady side forces (0 = plain LOS)
     integral_gain: NonNegative = 0.0
+    #: γ [rad/m²] of adaptive LOS, the crab-angle estimate (0 = none; not with integral_gain)
+    adaptive_gain: NonNegative = 0.0
+
+    @model_validator(mode="after")
+    def _one_correction(self) -> LOSConfig:
+        if self.integral_gain > 0 and self.adaptive_gain > 0:
+            raise ValueError("integral_gain and adaptive_gain are alternatives (integral LOS or "
+                             "adaptive LOS): set one of the two to 0")
+        return self
 
 
 class CourseEntry(Strict):
