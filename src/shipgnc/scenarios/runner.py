@@ -44,7 +44,7 @@ class Setup:
     path: WaypointPath | None = None
     #: document 004's case this setup runs (a :class:`~shipgnc.cases.catamaran.CatamaranCase`)
     case: object | None = None
-    #: sensors and estimator between the true state and the controller (issue 18), or None
+    #: sensors and estimator between the true state and the controller, or None
     navigation: object | None = None
 
 

@@ -306,7 +306,7 @@ class CommandEntry(Strict):
 
 
 class Navigated(Strict):
-    """What a controller reads when the scenario has navigation (issue 18): ``truth`` (the true
+    """What a controller reads when the scenario has navigation: ``truth`` (the true
     state, as without navigation), ``measurement`` (the held sensor values) or ``estimate`` (the
     estimator's); default: the estimate when there is an estimator, else the measurement when
     there are sensors, else the truth. A comparison can so set the same law on each."""
@@ -431,7 +431,7 @@ class LOSFLConfig(Navigated):
     ``delta_nm`` Δ, yaw-loop gains in the document's units. By default the controller does **not**
     know the disturbances: integral LOS (gain ``integral_gain_nm_min`` κ, default U/4 =
     0.0625 nm/min, critically damped) removes the offset of the unknown current and yaw bias, and
-    ẏ_r comes from successive positions (issue 17). ``knows_disturbance: true`` is the
+    ẏ_r comes from successive positions. ``knows_disturbance: true`` is the
     document's oracle: b_r and d_y handed to the law (crab compensation −asin(d_y/u), A13) and
     κ = 0 unless set."""
 
@@ -666,7 +666,7 @@ class MarinerDisturbanceConfig(Strict):
     RMS ``wave_sigma_rad_min2`` (0 = off), period ``wave_period`` [s], damping ``wave_zeta``
     (seeded by ``simulation.seed``).
 
-    ``wave_heading_sigma_deg`` calibrates the noise to a sea state instead (issue 17): σ_w =
+    ``wave_heading_sigma_deg`` calibrates the noise to a sea state instead: σ_w =
     ω₀²·σ_ψw, ω₀ = 2π/``wave_period``, so that the free ship's wave-frequency heading has RMS
     σ_ψw (its yaw rate σ_ψw·ω₀; :func:`shipgnc.environment.filtered_noise.calibrated_yaw_sigma`).
     Set it or ``wave_sigma_rad_min2``, not both."""
@@ -799,7 +799,7 @@ class QualityConfig(Strict):
 
 
 class _SensorBase(Strict):
-    """Common sensor settings (issue 18; :mod:`shipgnc.navigation.sensors`): its own sample rate
+    """Common sensor settings (:mod:`shipgnc.navigation.sensors`): its own sample rate
     (a whole multiple of the control period; default every control sample), a latency in control
     samples, and intervals ``[t0, t1]`` [s] without measurements."""
 
@@ -912,7 +912,7 @@ class Scenario(Strict):
     document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
     #: an earth-fixed current on the vessel (boat, CyberShip II), with any force disturbance
     current: CurrentConfig | None = None
-    #: navigation (issue 18): the sensors between the true state and the controller, and an
+    #: navigation: the sensors between the true state and the controller, and an
     #: estimator between the sensors and the controller (the controller acts on its estimate)
     sensors: list[SensorConfig] = Field(default_factory=list)
     estimator: EstimatorConfig | None = None
