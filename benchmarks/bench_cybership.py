@@ -1,4 +1,4 @@
-"""Speed of document 003's CyberShip II runs (issue: time of ``cybership-calm``; batch throughput).
+"""Speed of document 003's CyberShip II runs (targets: time of ``cybership-calm``; batch throughput).
 
     python benchmarks/bench_cybership.py [--quick]
 

@@ -10,8 +10,8 @@ over the batch) and each batch size (1 000 and 10 000 ships; ``--quick``: 1 000)
 not depend on the run length), the log thinned to about 100 samples, and prints ship-steps/s and
 the ratio. The first-compile cost of each family is measured in a fresh
 process with empty numba and shipgnc caches (``NUMBA_CACHE_DIR``, ``SHIPGNC_CACHE_DIR``), and
-``shipgnc run NAME --no-figures`` end to end in a fresh process with warm caches. Targets (issue
-"speed for every combination"): ≥ 1e7 ship-steps/s compiled (wave loads ≥ 1e6) and ≥ 20× numpy.
+``shipgnc run NAME --no-figures`` end to end in a fresh process with warm caches. Targets (speed
+for every combination): ≥ 1e7 ship-steps/s compiled (wave loads ≥ 1e6) and ≥ 20× numpy.
 Writes ``benchmarks/results/bench_families.json``.
 """
 

@@ -1,4 +1,4 @@
-"""Speed of document 000's Mariner runs (issue: ``mariner-compare`` under 2 s; 1 000-run batch at
+"""Speed of document 000's Mariner runs (targets: ``mariner-compare`` under 2 s; 1 000-run batch at
 ≥ 10^6 ship-steps/s).
 
     python benchmarks/bench_mariner.py [--quick]

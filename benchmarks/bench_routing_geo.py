@@ -1,4 +1,4 @@
-"""Speed of ``shipgnc route --geo`` (docs/routing_geo.md) on the issue's target case.
+"""Speed of ``shipgnc route --geo`` (docs/routing_geo.md) on the target case.
 
     python benchmarks/bench_routing_geo.py [--quick]
 

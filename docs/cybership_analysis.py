@@ -1,5 +1,5 @@
 """Numbers and the figure of docs/003_cybership_autopilot.md, sections "Identified design model",
-"Wave-load calibration" and "Why the PD's ψ_E is lower in waves" (issue 17 item 4).
+"Wave-load calibration" and "Why the PD's ψ_E is lower in waves".
 
 Run: ``python docs/cybership_analysis.py`` (about a minute); writes
 ``docs/figures/cybership-analysis.png`` and prints the tables.

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
-#: pages whose tables are generated (the lead extends this list page by page)
+#: pages whose tables are generated (the list grows page by page)
 PAGES = ("001_vectored_thrust_boat.md", "003_cybership_autopilot.md")
 BLOCK = re.compile(r"(?P<open><!-- table: (?P<name>[A-Za-z0-9_.\-]+)(?P<options>[^>]*?)\s*-->\n)"
                    r"(?P<body>.*?)(?P<close><!-- /table -->)", re.S)

@@ -1,4 +1,4 @@
-"""The physically consistent catamaran (issue 17): preset ``si-consistent`` is the scenarios'
+"""The physically consistent catamaran: preset ``si-consistent`` is the scenarios'
 default; the printed-sign and paper-unit presets stay as flagged reproductions; equal-bandwidth
 baselines (pole placement, designed PI) at the FSM's poles."""
 

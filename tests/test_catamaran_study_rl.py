@@ -1,5 +1,5 @@
 """Document 004's catamaran scenarios in studies (``shipgnc sweep``) and as ``shipgnc.rl``
-environments (issue: catamaran sweeps and environments).
+environments.
 
 A study's member is the scenario's case with the member's initial-state offsets, scored with the
 catamaran metrics ``shipgnc run`` prints, to the bit in any chunking; a builder with several runs

@@ -161,7 +161,7 @@ def test_no_rudder_rate_limit_and_a_single_controller(tmp_path):
 def test_start_surge_and_rudder_rate_are_the_exact_values():
     """Notes 003-3.8/003-B8 round them to 0.2958 m/s and 19.4°/s; the scenarios use the exact ones: the
     surge equilibrium of the propeller model at the scenario's rps (``initial_state.u: null``,
-    computed at validation, so ``shipgnc show`` prints it) and 2.32·√70 °/s (issue 15)."""
+    computed at validation, so ``shipgnc show`` prints it) and 2.32·√70 °/s."""
     from shipgnc.models.cybership2 import DELTA_RATE_DEG_S, CyberShip2Params, surge_equilibrium
     from shipgnc.scenarios.registry import scenario_yaml
 
@@ -197,7 +197,7 @@ def test_equilibrium_start_is_refused_where_it_is_not_defined():
 
 
 def test_identified_smc_holds_the_course_without_a_saturated_limit_cycle(calm):
-    """Issue 17 item 4: the SMC designed on the identified model settles within 2° of each course
+    """The SMC designed on the identified model settles within 2° of each course
     (new ``stable``: bounded, converged, no saturated oscillation), its rudder well inside 35°
     and slewing far below the 19.41°/s limit on average in calm water, and its index is of the
     order of the document's 234–257 (Table 2)."""
@@ -210,7 +210,7 @@ def test_identified_smc_holds_the_course_without_a_saturated_limit_cycle(calm):
 
 
 def test_hs_zero_is_calm_water():
-    """Issue 17 item 9: ``disturbance.hs=0`` is accepted and means no wave load at all: the
+    """``disturbance.hs=0`` is accepted and means no wave load at all: the
     wave scenario then gives the calm-water run to the bit."""
     from shipgnc.scenarios.runner import build
 

@@ -98,12 +98,21 @@ def test_a_route_batch_ends_when_the_ships_still_running_have_finished(backend):
     assert ds.attrs["diverged"] == 1
 
 
-def test_a_whole_batch_that_diverges_keeps_its_time_axis():
+@pytest.mark.parametrize("backend", ["numpy", "compiled"])
+def test_a_whole_batch_that_diverges_keeps_its_time_axis(backend):
+    """Guidance that cannot finish (a reference schedule): the run keeps its t_end in both loops."""
     x0 = batch()
     x0[:, 5] = 45.0
-    ds = run("boat-autopilot", x0, member_seeds(1, 3), "numpy", t_end=2.0, on_divergence="mask")
+    ds = run("boat-autopilot", x0, member_seeds(1, 3), backend, t_end=2.0, on_divergence="mask")
     assert ds.sizes["time"] == 41 and ds.attrs["diverged"] == 3
     assert np.all(np.isnan(ds["psi"].values[1:]))
+
+
+def test_mask_needs_the_fixed_step_integrator():
+    scenario, s = setup()
+    with pytest.raises(ConfigError, match="'mask' needs integrator 'rk4'"):
+        simulate(s.model, batch(), t_end=1.0, dt=scenario.simulation.dt, integrator="solve_ivp",
+                 on_divergence="mask")
 
 
 def test_a_bad_command_stops_its_ship_at_that_sample():

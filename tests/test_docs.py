@@ -1,7 +1,6 @@
 """The documentation site: it builds without a warning, every page's Python example runs, every
 gallery script and the tutorial (``examples/``, sphinx-gallery) run at the build and draw their
-figures, and every figure a page shows is one ``docs/make_figures.py`` produces from the code
-(issues: documentation, 21)."""
+figures, and every figure a page shows is one ``docs/make_figures.py`` produces from the code."""
 
 from __future__ import annotations
 

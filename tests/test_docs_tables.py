@@ -1,6 +1,6 @@
 """Documentation tables are generated from the runs they describe (``docs/tables.py``): a number a
 page documents between ``<!-- table: NAME -->`` markers that drifts from ``shipgnc run NAME``
-fails here (issue 17: documented numbers went stale)."""
+fails here, so documented numbers cannot go stale."""
 
 from __future__ import annotations
 

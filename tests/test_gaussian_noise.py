@@ -1,5 +1,5 @@
 """``gaussian`` force noise defined by a spectral density: the boat autopilot's heading statistics do
-not depend on the simulation step (issue 17, item 6); the old per-step σ stays reachable and shows
+not depend on the simulation step; the old per-step σ stays reachable and shows
 the √dt unit error it had."""
 
 from __future__ import annotations

@@ -1,6 +1,5 @@
 """Hostile scenario files and values: each refused with one line and exit 2, before any work,
-in bounded time and memory (issue: nothing silently wrong; rows 8, 15, 16, 20 and the smaller
-ones)."""
+in bounded time and memory (nothing silently wrong)."""
 
 from __future__ import annotations
 

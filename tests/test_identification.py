@@ -1,4 +1,4 @@
-"""Steering-model identification (shipgnc.analysis.identification; issue 17 item 4a)."""
+"""Steering-model identification (shipgnc.analysis.identification)."""
 
 from __future__ import annotations
 

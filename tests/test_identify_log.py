@@ -1,4 +1,4 @@
-"""Identification from a logged run (``shipgnc identify``; shipgnc.identify; issue 19 items 3–4).
+"""Identification from a logged run (``shipgnc identify``; shipgnc.identify).
 
 Truths are published models, never our own output: van Amerongen's frigate (1982; data as in
 Fossen's MSS ``frigate.m``: at U = 9 m/s, K = 0.18 1/s, T = 27 s, Norrbin n₃ = 0.6) and a
@@ -97,7 +97,7 @@ def frigate_fit(frigate_log):
 
 
 def test_frigate_nomoto_gains_recovered_from_a_noisy_zigzag(frigate_fit):
-    """Issue 19 item 4: K and T of van Amerongen's frigate within 5 % from its noisy 20/20
+    """K and T of van Amerongen's frigate within 5 % from its noisy 20/20
     zig-zag (the Norrbin cubic term n₃r³ is < 1 % of r at these yaw rates)."""
     assert frigate_fit.value("K") == pytest.approx(FRIGATE_K, rel=0.05)
     assert frigate_fit.value("T") == pytest.approx(FRIGATE_T, rel=0.05)
@@ -143,7 +143,7 @@ def linear_fit(tmp_path_factory):
 
 
 def test_clarke83_linear_coefficients_recovered(linear_fit):
-    """Issue 19 item 4: every coefficient of −M⁻¹N, M⁻¹B within 10 %, truth inside the 95 %
+    """Every coefficient of −M⁻¹N, M⁻¹B within 10 %, truth inside the 95 %
     interval widened by 2 (coloured residuals aside, a sanity check of the interval's scale)."""
     ident, truth, _ = linear_fit
     assert set(ident.parameters) == set(truth)

@@ -1,5 +1,5 @@
 """Metrics never depend on log thinning: every metric set is computed from every step, whatever
-``simulation.log_every`` keeps in the written result (issue 16, item 1)."""
+``simulation.log_every`` keeps in the written result."""
 
 from __future__ import annotations
 

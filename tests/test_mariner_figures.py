@@ -1,4 +1,4 @@
-"""Document 000's Figs. 3–5 draw every run, frame the bounded ones and say so (issue 17 item 7):
+"""Document 000's Figs. 3–5 draw every run, frame the bounded ones and say so:
 an unbounded run (the literal FL, 18 nm off) must not swamp the axes of the readable runs."""
 
 from __future__ import annotations

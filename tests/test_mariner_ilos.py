@@ -1,4 +1,4 @@
-"""``los_fl`` without disturbance knowledge (issue 17): integral LOS removes the standing offset
+"""``los_fl`` without disturbance knowledge: integral LOS removes the standing offset
 an unknown cross current and yaw bias leave under plain LOS, and the document's oracle law
 (``knows_disturbance: true``) still reproduces note 000-0.8."""
 
@@ -43,7 +43,7 @@ def test_plain_los_without_knowledge_keeps_the_predicted_offset():
 def test_integral_los_removes_the_offset_without_knowledge():
     m = run(*STRAIGHT)
     assert m["stable"]
-    assert abs(m["final_crosstrack_nm"]) < 0.02  # the issue's bound; the run gives < 1e-3
+    assert abs(m["final_crosstrack_nm"]) < 0.02  # the required bound; the run gives < 1e-3
     assert m["final_heading_error_deg"] == pytest.approx(-math.degrees(math.asin(D_Y / U)), abs=0.05)
     assert m["final_rudder_deg"] == pytest.approx(-math.degrees(B_R / 3.553), abs=0.05)
 

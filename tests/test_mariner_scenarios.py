@@ -131,7 +131,7 @@ def test_every_parameter_is_settable():
     assert dist.waves.sigma == pytest.approx(0.3 / MIN**2)
     assert build(s, "fl_lookahead").controller.lookahead == pytest.approx(0.2 * NM)
     los = build(s, "los_fl").controller
-    assert los.delta_los == pytest.approx(0.8 * NM) and los.d_y == 0.0  # told nothing (issue 17)
+    assert los.delta_los == pytest.approx(0.8 * NM) and los.d_y == 0.0  # told nothing
     assert los.integral_gain == pytest.approx(0.05 * NM / MIN) and los.rate_from_positions
     oracle = build(s, "los_fl_oracle").controller  # the document's law, handed the disturbances
     assert oracle.d_y == pytest.approx(0.02 * NM / MIN) and oracle.current_frame == "global"
@@ -216,7 +216,7 @@ def test_metric_definitions_on_a_synthetic_run():
 def test_a_ship_sailing_its_leg_backwards_is_reversed_not_stable():
     """The look-ahead FL has a second stable equilibrium, ψ_r = π (note 000-0.5): started heading
     opposite to the leg it settles there, |y_r| bounded (l·d_y/U) but sailing the leg backwards.
-    That is ``reversed`` and not ``stable`` (issue 15); the same start heading along the leg is
+    That is ``reversed`` and not ``stable``; the same start heading along the leg is
     neither."""
     backwards = run("mariner-fl-lookahead", *STRAIGHT, "simulation.initial_state.psi_deg=180").metrics
     assert backwards["reversed"] is True and backwards["stable"] is False

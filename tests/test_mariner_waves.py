@@ -1,4 +1,4 @@
-"""Wave noise calibrated to a sea state (issue 17): σ_w = ω₀² σ_ψw makes the free Mariner's
+"""Wave noise calibrated to a sea state: σ_w = ω₀² σ_ψw makes the free Mariner's
 wave-frequency heading RMS σ_ψw (yaw rate σ_ψw ω₀), and the Monte Carlo's sea is that one."""
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
-"""Navigation (issue 18): sensors and estimators between the true state and the controller.
+"""Navigation: sensors and estimators between the true state and the controller.
 
-The checks that can fail (issue item 6): the Kalman filter's steady-state gain is python-control's
+The checks that can fail: the Kalman filter's steady-state gain is python-control's
 ``dlqe``; an EKF started 50 m and 30° wrong converges; the EKF's NEES over a batched Monte Carlo
 lies in its 95 % χ² band; dead reckoning through a GNSS dropout; the passive observer removes the
 wave-frequency heading; perfect sensors give the true-state run; seeds; bad configurations.
@@ -135,7 +135,7 @@ def _nees_run(n_ships: int, seed: int = 7, backend: str = "numpy"):
 
 
 def test_ekf_nees_in_chi2_band_and_dead_reckoning_through_dropout():
-    """The issue's 1 000-run Monte Carlo: 1 000 ships in one call of the compiled loop (its EKF
+    """A 1 000-run Monte Carlo: 1 000 ships in one call of the compiled loop (its EKF
     equals the numpy one to 1e-9: tests/test_compose_navigation.py), truth driven by white force noise of the density the EKF assumes
     (held over each step, as the simulator holds it: ``noise="held"``), initial errors drawn from
     P0: the ensemble-mean NEES (n = 6 states) lies inside its 95 % band

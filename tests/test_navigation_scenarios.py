@@ -1,4 +1,4 @@
-"""Navigation in scenario files (issue 18): ``sensors`` and ``estimator`` sections, the controller
+"""Navigation in scenario files: ``sensors`` and ``estimator`` sections, the controller
 acting on the estimate, the navigation metrics, and one-line errors for what cannot work."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Outputs are atomic (issue 16, items 4 and 5c): a temporary directory beside ``--out`` moved into
+"""Outputs are atomic: a temporary directory beside ``--out`` moved into
 place when complete; an earlier run replaced whole; a foreign directory refused; ``--out`` checked
 before any work; a diverged run written only with ``--keep-partial``; ENOSPC / EACCES one line."""
 

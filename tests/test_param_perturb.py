@@ -1,5 +1,5 @@
 """``shipgnc sweep --perturb vessel.params.NAME=...``: a Monte Carlo over the plant's parameters
-(issue: Monte Carlo over parameters, not only initial states). Each member's plant is its own draw
+(not only initial states). Each member's plant is its own draw
 from its own stream, recorded as ``param_<NAME>``; the controller keeps its nominal design; one
 result to the bit however the study is chunked; bad draws and names are one-line errors."""
 

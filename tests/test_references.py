@@ -1,4 +1,4 @@
-"""References resolve inside the repository (issue 21): every ``note NNN-X`` anchor cited in the code,
+"""References resolve inside the repository: every ``note NNN-X`` anchor cited in the code,
 the docs, the examples or the README is defined on its document's page; nothing points at a file
 outside the repository (the project's former ``spec/`` reconstructions, ``../shared``); every
 document page cites its source document; every public module has an API page."""

@@ -1,4 +1,4 @@
-"""``shipgnc.rl``: gymnasium environments over the scenarios (issue: gymnasium environment).
+"""``shipgnc.rl``: gymnasium environments over the scenarios.
 
 The reward is the scenario's own metric sample by sample, so the scenario's controller used as the
 policy must earn exactly the metric that ``shipgnc run`` reports; the vectorised env must equal N

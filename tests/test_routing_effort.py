@@ -55,6 +55,12 @@ def test_the_default_effort_bound_leaves_the_documents_route_alone():
     assert not any("effort bound" in n for n in r.notes)
 
 
+def test_the_default_horizon_does_not_limit_the_closed_form():
+    # a head current of 0.8 V: 5 000 s, beyond the sweep's default bound 4|AB|/V = 4 000 s
+    r = solve_route(UniformCurrent(-0.8, 0.0), 1.0, (0.0, 0.0), (1000.0, 0.0))
+    assert r.reachable and r.time_s == pytest.approx(5000.0)
+
+
 @pytest.mark.parametrize("horizon, reachable", [(500.0, False), (999.0, False), (1001.0, True)])
 def test_a_horizon_limits_the_uniform_current_too(horizon, reachable):
     r = solve_route(UniformCurrent(0.0, 0.0), 1.0, (0.0, 0.0), (0.0, 1000.0), horizon=horizon)

@@ -1,4 +1,4 @@
-"""Route figures (note 002-2.9.6, issue 17): every extremal drawn with the global one highlighted,
+"""Route figures (note 002-2.9.6): every extremal drawn with the global one highlighted,
 isochrones labelled with their times, the current arrows with a scale key, titles from the data."""
 
 from __future__ import annotations

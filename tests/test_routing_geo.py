@@ -119,7 +119,7 @@ def test_a_land_polygon_across_the_geodesic_is_gone_round(walled):
 
 def test_a_shapefile_of_land_reads_as_the_same_polygons(walled, tmp_path):
     """--land FILE.shp (pyshp, the [geo] extra): the island written as a shapefile is read back as
-    the GeoJSON's polygon (same area and bounds), the other format the issue names."""
+    the GeoJSON's polygon (same area and bounds), the other format ``--land`` reads."""
     import shapefile
 
     from shipgnc.routing.geo.land import load_land

@@ -69,7 +69,7 @@ def _outcomes_are_consistent(m, prefixes):
 
 def test_a_miss_is_not_an_arrival():
     """The earlier Mariner sail (kept as zermelo-sail-mariner): four constant-heading legs sailed open
-    loop miss B by kilometres; that is reported as not arrived, with no arrival ratio (issue 17: it
+    loop miss B by kilometres; that is reported as not arrived, with no arrival ratio (it
     used to read 0.90 × the optimum, the closest approach within 1.2 t_f)."""
     m = run_scenario("zermelo-sail-mariner", overrides=["sail.margin=0.1", "sail.dt=0.6"]).metrics
     assert m["vessel"] == "mariner" and m["acceptance_radius_m"] == pytest.approx(2 * 160.93)

@@ -1,6 +1,6 @@
 """``stable`` means bounded *and* converged, defined once (``metrics.stable_arrays``) for every
 metric set: a run in a limit cycle with its rudder slamming between the stops is not stable
-(issue 17: CyberShip ``smc_consistent`` in a ±23° limit cycle read ``stable: true``)."""
+(CyberShip ``smc_consistent`` in a ±23° limit cycle once read ``stable: true``)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """``shipgnc sweep`` and :mod:`shipgnc.study`: one result to the bit however the study is chunked
-or wherever it runs; per-member streams; outputs; bad input (issue: sweeps on dask)."""
+or wherever it runs; per-member streams; outputs; bad input."""
 
 from __future__ import annotations
 
@@ -308,7 +308,7 @@ def test_chunks_from_different_loops_are_flagged():
 
 
 def test_a_foreign_output_directory_is_refused_not_mixed(tmp_path, local_result):
-    # outputs are atomic (issue 16): a directory holding files that are not a shipgnc run is
+    # outputs are atomic: a directory holding files that are not a shipgnc run is
     # refused (its files untouched) unless overwrite, which replaces it whole
     from shipgnc.cli_sweep import write_study
     from shipgnc.errors import ConfigError

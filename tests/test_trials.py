@@ -1,4 +1,4 @@
-"""Standard manoeuvring trials (shipgnc.trials; issue 19 items 2 and 4; docs/trials.md).
+"""Standard manoeuvring trials (shipgnc.trials; docs/trials.md).
 
 Every expected value comes from a closed form or from the published coefficients, never from
 shipgnc's own output:

@@ -22,7 +22,7 @@ PARAMS = {"nomoto": {"K": 0.05, "T": 20.0}, "nomoto2": {"K": 0.05, "T1": 20.0, "
           "linear-3dof": {"L": 100.0, "B": 15.0, "T": 6.0, "Cb": 0.7}}
 
 
-def test_catalogue_lists_the_issue_entries_with_the_contract_states():
+def test_catalogue_lists_its_entries_with_the_contract_states():
     for name in ("mariner-cst", "frigate", "kvlcc2", "linear-3dof", "nomoto", "nomoto2"):
         entry = get_vessel(name)
         model = entry.build(**PARAMS.get(name, {}))

@@ -1,5 +1,5 @@
 """Document 000's wave noise (note 000-A11) as the simulator holds it: the exact step average of the
-filtered process over each step (issue 15). Its spectrum matches the analytic one of the
+filtered process over each step. Its spectrum matches the analytic one of the
 step-averaged process down to periods of 100 min, where point samples held over the step have a
 white floor orders of magnitude above it; and the yaw it drives stays bounded."""
 

@@ -2,8 +2,8 @@
 
 ``x @ M`` on a batch hands the sum to BLAS, which picks its blocking (and so the order of the
 additions) from the array sizes: the same ship can come out a last bit different in a batch of 3
-and in a batch of 1000. A study must give each member the same result however it is chunked
-(issue 8), so the small products on the simulation path are written here as sums in a fixed
+and in a batch of 1000. A study must give each member the same result however it is chunked,
+so the small products on the simulation path are written here as sums in a fixed
 left-to-right order, elementwise over the batch.
 """
 

@@ -10,7 +10,7 @@ heading error for heading runs), ``thruster_travel_deg`` and ``peak_delta_rate_d
 the applied thruster rate, °/s): both keys are kept (the name of note 004-4.7 and the comparison's), the
 second defined from the first in :func:`add_aliases` (:data:`ALIASES`). Beside every quality
 figure the thruster's effort: ``thruster_travel_deg`` (∫|δ̇| dt) and ``delta_rate_rms_deg_s``
-(RMS of δ̇ over the run, issue 17).
+(RMS of δ̇ over the run).
 
 Settling: the time from t = 0 after which the signal stays within ±2 % of its value at t_end.
 Events: the controller's (``controller.events`` or ``ds.attrs["events"]``, see :func:`attach_events`)
@@ -262,7 +262,7 @@ def comparison_metrics(ds, heading_target: float | None = None) -> dict:
 
 def model_fields(model, preset_name: str | None = None) -> dict:
     """``model_note`` (what the hull is, in words) and ``reproduction`` (true for the document's
-    printed Coriolis sign or paper units) of a run's catamaran (issue 17)."""
+    printed Coriolis sign or paper units) of a run's catamaran."""
     from shipgnc.models.catamaran import model_note
 
     note, reproduction = model_note(model.params, preset_name or getattr(model, "preset_name", None))

@@ -1,4 +1,4 @@
-"""Steering-model identification from a simulated manoeuvre (notes 003-3.3–003-3.4, issue 17 item 4).
+"""Steering-model identification from a simulated manoeuvre (notes 003-3.3–003-3.4).
 
 Document 003 designs its sliding-mode autopilot on the first-order Nomoto model (18),
 ṙ = a₂₂ r + b₂ δ, reduced from the linear model (17): a₂₂ = 0.1057 s⁻¹, b₂ = −0.0040 s⁻². That

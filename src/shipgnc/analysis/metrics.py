@@ -412,7 +412,7 @@ def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
 
 
 def navigation_arrays(ds) -> dict[str, np.ndarray]:
-    """The navigation figures of a run with sensors / an estimator (issue 18), ``(ship,)`` arrays
+    """The navigation figures of a run with sensors / an estimator, ``(ship,)`` arrays
     over every logged sample where the quantity exists (NaN-free samples only):
 
     ``heading_est_rmse_deg`` √mean(wrap(ψ̂ − ψ)²), ``position_est_rmse_m`` √mean((N̂ − N)² + (Ê − E)²),

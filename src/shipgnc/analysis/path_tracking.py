@@ -22,7 +22,7 @@ time before the first leg switch.
   saturated oscillation), and the ship is not ``reversed``;
 * ``reversed``: the run ends with |heading error| > 90° (the final heading error above, the
   circular mean over the last 10 min): the reversed equilibrium ψ_r = π of note 000-0.5, a ship
-  sailing its leg backwards with y_r bounded, which is not tracking (issue 15).
+  sailing its leg backwards with y_r bounded, which is not tracking.
 """
 
 from __future__ import annotations

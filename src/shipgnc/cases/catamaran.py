@@ -13,7 +13,7 @@ or simply ``ds = case.run()`` (``backend="auto"``: the composed compiled loop wh
 or batched and every component has a kernel, see ``simulate``). Common settings: u(0) = 4 m/s,
 everything else 0; RK4 with dt = 0.0625 s; t_f = 1500 s; gains per preset (``paper``:
 T_u = 0.1 s, h = 0.0625 s; ``si`` and ``si-consistent``: T_u = h = 2.5 s); the laws in continuous
-mode; preset ``si-consistent`` (the physically consistent hull, issue 17) unless given — ``si``
+mode; preset ``si-consistent`` (the physically consistent hull) unless given — ``si``
 (printed Coriolis sign) and ``paper`` (the listing's units) are the document's reproductions.
 ``vessel`` (a dict of :class:`~shipgnc.models.catamaran.CatamaranParams` overrides,
 e.g. ``{"coriolis": "consistent"}``) changes the catamaran itself — plant and the controller's
@@ -252,7 +252,7 @@ def compare(preset_name: str = DEFAULT_PRESET, vessel: dict | None = None) -> di
     return comparison_cases(preset_name, vessel=vessel)
 
 
-#: ``catamaran-compare``'s baseline sets: the equal-bandwidth designs (issue 17), the
+#: ``catamaran-compare``'s baseline sets: the equal-bandwidth designs, the
 #: note 004-4.11.3 baselines kept as reproductions (run keys ``pi``, ``lqr``), or both
 BASELINES = ("all", "designed", "reproduction")
 #: what each comparison run is (figure legends, docs)

@@ -11,7 +11,7 @@
 
 Both are kept as named reproductions (the note 004-4.11.3 baselines): the "PI" is law (20) with
 cos δ frozen, and the LQR's dominant poles (−0.043 ± 0.006j s⁻¹) are ten times slower than the
-FSM. The comparison's baselines of record are designed for the FSM's bandwidth (issue 17):
+FSM. The comparison's baselines of record are designed for the FSM's bandwidth:
 
 * :class:`PolePlacementRate` — state feedback on the linearised sway–yaw model about straight
   running, augmented with the yaw-rate error integral ξ = ∫(r − ω*) dt (= ψ − ψ_ref), the
@@ -241,7 +241,7 @@ def heading_lqr_step(t, x, ref, z, p, cmd, sig):
     cmd[0] = -total
 
 
-# --- equal-bandwidth baselines (issue 17) ----------------------------------------------------------
+# --- equal-bandwidth baselines --------------------------------------------------------------------
 #: default thruster-angle limit of :class:`DesignedPI`'s anti-windup [rad] (85°, note 004-4.11.1 [A])
 DELTA_LIMIT = math.radians(85.0)
 

@@ -27,7 +27,7 @@ switching A6, ``reference_names = ()``):
   k_p = 1 /min², k_d = 2 /min. With ``integral_gain`` κ > 0 the LOS is **integral LOS**
   (Børhaug, Pavlov & Pettersen 2008; Fossen 2021 §12.4), which removes the steady cross-track
   offset of an *unknown* current and yaw bias; ``rate_from_positions`` takes ẏ_r from successive
-  GPS positions instead of the known current (issue 17).
+  GPS positions instead of the known current.
 
 With r₂ ≠ 0 the laws use ∂v/∂r = r₁ + 3r₂r² where note 000-0.5 (r₂ = 0) has r₁; for the Mariner
 (r₂ = 0) they are the formulas of note 000-0.5 term by term.

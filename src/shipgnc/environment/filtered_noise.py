@@ -11,7 +11,7 @@ var(x₂) = q²/(4ζω₀), so q = σ √(4ζω₀). The filter starts in its st
 **What is held over a step.** The simulator samples a disturbance at each step's start and holds
 it over the step. Holding the *point* value w(t_k) would alias the narrow band: the held sequence
 then has a white floor ≈ q²h²/(12π) at low frequencies, far above the filter's own spectrum, and
-the yaw rate it drives random-walks (issue 15). The value held over [t_k, t_k + h] is therefore
+the yaw rate it drives random-walks. The value held over [t_k, t_k + h] is therefore
 the **exact step average** w̄_k = (1/h)∫ w dt of the filtered process over that step: the
 filter is augmented with y' = w and propagated exactly in distribution over each step::
 
@@ -185,7 +185,7 @@ def pm_significant_height(period: float) -> float:
 
 def calibrated_yaw_sigma(heading_sigma: float, period: float) -> float:
     """RMS σ_w [rad/s²] of the yaw acceleration (A11) that gives a wave-frequency heading of RMS
-    ``heading_sigma`` σ_ψw [rad] at peak period ``period`` T₀ [s] (issue 17)::
+    ``heading_sigma`` σ_ψw [rad] at peak period ``period`` T₀ [s]::
 
         σ_w = ω₀² σ_ψw,   ω₀ = 2π/T₀.
 

@@ -1,5 +1,5 @@
 """Navigation, the N in GNC: sensor models and state estimators between the true state and the
-controller (issue 18; docs/navigation.md).
+controller (docs/navigation.md).
 
     true state x ──▶ sensors (GNSS, compass, rate gyro, speed log) ──▶ estimator (KF | EKF |
     passive observer) ──▶ x̂ ──▶ guidance and controller

@@ -59,7 +59,8 @@ class RouteResult:
     extremals: list[dict] = dc_field(default_factory=list)  #: every extremal found: time_s, headings, status
     #: the extremals themselves (``pmp.Extremal``: ``sample``, ``position``), for figures; not in JSON
     extremal_paths: list = dc_field(default_factory=list, repr=False)
-    global_check: dict | None = None  #: {"method", "time_s", "rel_diff"} or None
+    #: {"method", "time_s", "rel_diff", and for the level set "agrees", "tolerance"} or None
+    global_check: dict | None = None
     reason: str | None = None
     notes: list[str] = dc_field(default_factory=list)  #: failure modes and remarks, in words (note 002-2.8)
     grid_spacing: float | None = None  #: of the global method [m]

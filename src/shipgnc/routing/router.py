@@ -130,6 +130,7 @@ def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0
         res.method = "pmp" if method == "auto" else method
         res.notes.append("start and target coincide: t_f = 0 and an empty route")
         return res
+    horizon_given = horizon is not None
     if horizon is None:
         horizon = 4.0 * dist / speed
     require(math.isfinite(horizon) and horizon > 0, "horizon", horizon, "must be a finite time > 0 s")
@@ -147,7 +148,7 @@ def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0
 
             route_around(res, polys, horizon=horizon, n_angles=n_angles)
         else:
-            _pmp(res, horizon, n_angles, n_steps)
+            _pmp(res, horizon, n_angles, n_steps, horizon_given)
         if method == "auto" and (global_check is None or global_check) and res.reachable:
             _levelset_check(res, polys, grid_spacing, horizon, domain)
         elif global_check and res.reachable:
@@ -167,7 +168,7 @@ def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0
     return res
 
 
-def _pmp(res: RouteResult, horizon, n_angles, n_steps):
+def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = True):
     from shipgnc.routing import pmp
     from shipgnc.routing.closed_form import uniform_solution
 
@@ -182,7 +183,7 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps):
             res.notes.append(f"closest approach {sol.closest_approach:.1f} m at t = "
                              f"{sol.closest_time:.1f} s")
             return res
-        if sol.duration > horizon * (1 + 1e-12):  # the horizon is a limit (5b)
+        if horizon_given and sol.duration > horizon * (1 + 1e-12):  # a horizon given is a limit
             res.reason = (f"target not reachable within T_max = {horizon:.6g} s: the straight route in "
                           f"this uniform current takes {sol.duration:.6g} s")
             # the reachable set at t is the disc of radius V·t about A + c·t: its distance to B
@@ -348,9 +349,12 @@ def _adopt_levelset(res, ls, polys, why: str) -> None:
         res.notes.append("level-set route discarded: its front crossed an obstacle (refine the grid)")
         return
     ext = None if polys else _polish_from_seed(res, route.heading_start, ls.arrival)
+    # a reachable answer: the sweep's "not reachable" findings no longer apply
+    res.reason, res.closest_approach_m, res.closest_time_s = None, None, None
     if ext is not None and abs(ext.duration - ls.arrival) <= 0.05 * ls.arrival:
         _from_extremal(res, ext, "pmp")
         res.extremals = [_ext_dict(ext, res.speed)]
+        res.extremal_paths = [ext]
         rel = (ls.arrival - ext.duration) / ext.duration
         tol = agreement_tolerance(ls.spacing, res.speed, ext.duration)
         res.global_check = {"method": "levelset", "time_s": float(ls.arrival), "rel_diff": float(rel),
@@ -360,7 +364,6 @@ def _adopt_levelset(res, ls, polys, why: str) -> None:
     res.reachable, res.method, res.time_s = True, "levelset", float(ls.arrival)
     res.heading_start, res.heading_end = route.heading_start, route.heading_end
     res.miss_m, res.path = route.miss, route
-    res.reason = None
     res.notes.append(f"{why}: the level-set route (not polished; accurate to its grid, "
                      f"{ls.spacing:.3g} m)")
     if polys and _leaks(route, polys, ls.arrival, res.t0):
@@ -402,7 +405,13 @@ def _polish_from_seed(res, theta0, duration):
 
 
 def _levelset_primary(res, polys, grid_spacing, horizon, domain):
-    ls = _levelset_run(res, polys, grid_spacing, horizon, domain)
+    from shipgnc.routing.levelset import FrontOutOfGrid
+
+    try:
+        ls = _levelset_run(res, polys, grid_spacing, horizon, domain)
+    except FrontOutOfGrid as exc:  # no answer from this method: said as the reason (exit 3)
+        res.reason = str(exc)
+        return
     res.isochrones, res.grid_spacing = ls, ls.spacing
     if ls.arrival is None:
         res.reason = (f"target not reachable within T_max = {horizon:.0f} s in {res.field.describe()} "

@@ -51,7 +51,8 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
     batch at the first bad sample, or once every ship has finished, the chunk holding that event
     is replayed up to it: ``S`` then holds every ship's command of that sample or state after that
     step. With ``on_divergence="mask"`` a diverged ship stops alone (the kernel skips a ship whose
-    ``div_event`` is set) and counts as finished from its divergence on. The chunks give
+    ``div_event`` is set) and, when the guidance can finish (``done_at`` given), counts as finished
+    from its divergence on. The chunks give
     bit-identical results.
     """
     import numba

@@ -311,7 +311,9 @@ def run(setup):
         raise RuntimeError(f"compiled loop: {n_columns} log columns for {list(signals)}")
     out = np.empty((n_columns, log_length(setup), n))
     event_at = np.full(n, -1, dtype=np.int64)
-    done_at = np.full(n, -1, dtype=np.int64) if gd is not None else None
+    # only guidance that can finish (a route's last waypoint) ends a run early
+    can_finish = gd is not None and gd.finished() is not None
+    done_at = np.full(n, -1, dtype=np.int64) if can_finish else None
     params = [_param_rows(k, n) for k in (km, kc_, kg_, kd_)]
     pa = act.kernel_params()
     limits = np.asarray(model.state_limits, dtype=np.float64)

@@ -117,7 +117,9 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         its divergence was found at (its command at that sample, or its state after the step
         before), the others run on exactly as they would alone; the result gets a per-ship
         variable ``diverged_at`` [s] (NaN: never), ``attrs["diverged"]`` = the number of ships
-        that diverged and ``attrs["message"]`` the first one's error.
+        that diverged and ``attrs["message"]`` the first one's error (``integrator="rk4"`` only;
+        a stopped ship's controller and guidance keep running on its held state in the numpy loop
+        and are skipped in the compiled one: only its record is defined).
     observer : ``observer(t, x, command, applied)`` at every logged sample (live plots); it may
         raise :class:`StopSimulation` to end the run and keep the result. Ctrl-C (a
         KeyboardInterrupt) ends either loop too: it raises :class:`~shipgnc.errors.Interrupted`
@@ -261,6 +263,9 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
             f"allowed: {', '.join(INTEGRATORS)}")
     require(on_divergence in ON_DIVERGENCE, "on_divergence", on_divergence,
             f"allowed: {', '.join(ON_DIVERGENCE)}")
+    require(on_divergence != "mask" or integrator == "rk4", "on_divergence", on_divergence,
+            f"'mask' needs integrator 'rk4' ({integrator!r} steps the whole batch as one system, so "
+            "one ship's blow-up stops them all)")
     require(isinstance(log_every, int) and log_every >= 1, "log_every", log_every,
             "must be an integer >= 1")
     n_states = len(model.states)
@@ -626,7 +631,9 @@ def mask_diverged(log: Log, diverged_at: np.ndarray, first_error, dt: float) -> 
         log.data[name] = rows.reshape(values.shape)
     n = int(np.count_nonzero(np.isfinite(flat)))
     if n:
-        log.status.update(diverged=n, message=f"{first_error} ({n} of {flat.size} ships diverged: "
-                                              "each one's record is NaN from then on; the others ran on)")
+        said = f"{first_error} ({n} of {flat.size} ships diverged: each one's record is NaN from then "
+        said += "on; the others ran on)"
+        earlier = log.status.get("message")  # an interrupt or an observer's stop keeps its word
+        log.status.update(diverged=n, message=f"{earlier}; {said}" if earlier else said)
     log.diverged_at = diverged_at
     return log

@@ -5,7 +5,7 @@ Drawn from plain arrays (:func:`path_series`, :func:`montecarlo_series`) in the 
 for display (time in min, positions in nm, angles in deg), so a worker process needs no xarray.
 North is up and east to the right (NED, the document's x up, y right under the caption reading).
 
-**Unbounded runs** (issue 17): a run whose |y_r| passes the ``stable`` bound max(3 nm, 2|y_r(0)|)
+**Unbounded runs**: a run whose |y_r| passes the ``stable`` bound max(3 nm, 2|y_r(0)|)
 of note 000-0.8 (the literal FL, 18 nm off after 100 min) would swamp the axes. Every run is
 still drawn, but the axes limits come from the bounded runs: Fig. 3 adds a panel with every track
 whole, Fig. 4 marks the unbounded runs as leaving the frame, Fig. 5 draws them in a panel of
