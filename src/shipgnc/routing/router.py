@@ -325,7 +325,12 @@ def _compare(res, ls, polys) -> None:
         if ext is not None and ext.conjugate_at is None and ext.duration < res.time_s * (1 - 1e-9):
             before = res.time_s
             _from_extremal(res, ext, "pmp")
+            for old in res.extremals:  # the sweep's best is now a local minimum
+                if old["status"] == "global optimum":
+                    old["status"] = "local minimum, no conjugate point"
+            ext.status = "global optimum (polished from the level-set route)"
             res.extremals = [_ext_dict(ext, res.speed), *res.extremals]
+            res.extremal_paths = [ext, *res.extremal_paths]
             res.notes.append(f"the sweep missed the optimum: polished from the level-set route, "
                              f"{ext.duration:.6g} s instead of {before:.6g} s")
             rel = (ls.arrival - res.time_s) / res.time_s
