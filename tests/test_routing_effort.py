@@ -3,8 +3,8 @@
 * A target 10⁹ nm away in a shear whose current outruns the ship by orders of magnitude: answered
   in seconds (exit 3, the reason and the skipped check said), not a level-set front densified into
   gigabytes.
-* The polish of extremals has a deterministic effort bound (right-hand-side evaluations): a polish
-  it stops is counted and said in the reason.
+* The polish of extremals has a deterministic effort bound (right-hand-side evaluations, or RK4 steps
+  of the compiled integration): a polish it stops is counted and said in the reason.
 * A horizon is a limit for the closed-form uniform current too (a route longer than it is
   unreachable, with the closest approach of the reachable disc A + c·t ± V·t).
 """
@@ -36,7 +36,8 @@ def test_a_target_a_billion_miles_away_is_answered_in_seconds():
 
 
 def test_the_polish_stops_at_its_effort_bound_and_says_so(monkeypatch):
-    monkeypatch.setattr(pmp, "MAX_EVALS_PER_SOLVE", 20)
+    monkeypatch.setattr(pmp, "MAX_EVALS_PER_SOLVE", 20)  # solve_ivp's bound (a field without a kernel)
+    monkeypatch.setattr(pmp, "MAX_STEPS_PER_SOLVE", 20)  # the compiled integration's
     f = parse_field("shear:k=-0.5", "nautical")
     r = solve_route(f, 0.5 * KN, (-1.86 * NM, 3.66 * NM), (0.0, 0.0), method="pmp")
     assert not r.reachable

@@ -23,6 +23,7 @@ _LAZY = {
     "RigidRotation": "shipgnc.routing.fields",
     "RankineVortex": "shipgnc.routing.fields",
     "LambOseenVortex": "shipgnc.routing.fields",
+    "DoubleGyre": "shipgnc.routing.fields",
     "SumField": "shipgnc.routing.fields",
     "Modulated": "shipgnc.routing.fields",
     "GriddedCurrent": "shipgnc.routing.fields",

@@ -5,6 +5,8 @@
     rotation:omega=..,north=..,east=..       ω [rad/s | rad/h] about (north, east) [m | nm]
     lamb-oseen:gamma=..,rc=..,north=..,east=..   Γ [m²/s | nm²/h], r_c and centre [m | nm]
     rankine:gamma=..,rc=..,north=..,east=..
+      …,drift_north=..,drift_east=..         a vortex whose centre moves [m/s | kn]
+    gyre:speed=..,length=..,north=..,east=..  double gyre, U [m/s | kn], cell L and centre [m | nm]
     A+B                                      the sum
     path/to/file.nc[:cubic]                  gridded field (SI data)
 
@@ -29,7 +31,11 @@ _SPECS = {
                    "north": (False, NAUTICAL_MILE), "east": (False, NAUTICAL_MILE)},
     "rankine": {"gamma": (True, NAUTICAL_MILE**2 / HOUR), "rc": (True, NAUTICAL_MILE),
                 "north": (False, NAUTICAL_MILE), "east": (False, NAUTICAL_MILE)},
+    "gyre": {"speed": (True, KNOT), "length": (True, NAUTICAL_MILE), "north": (False, NAUTICAL_MILE),
+             "east": (False, NAUTICAL_MILE)},
 }
+for _vortex in ("lamb-oseen", "rankine"):
+    _SPECS[_vortex].update({"drift_north": (False, KNOT), "drift_east": (False, KNOT)})
 UNITS = ("si", "nautical")
 
 
@@ -61,8 +67,11 @@ def _term(text: str, units: str):
         return F.shear(values["k"])
     if name == "rotation":
         return F.RigidRotation(values["omega"], centre)
+    if name == "gyre":
+        return F.DoubleGyre(values["speed"], values["length"], centre)
     cls = F.LambOseenVortex if name == "lamb-oseen" else F.RankineVortex
-    return cls(values["gamma"], values["rc"], centre)
+    drift = (values.get("drift_north", 0.0), values.get("drift_east", 0.0))
+    return cls(values["gamma"], values["rc"], centre, drift)
 
 
 def parse_field(text: str, units: str = "si"):

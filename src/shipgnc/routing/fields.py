@@ -17,7 +17,9 @@ composed loop (:mod:`shipgnc.kernels`): :func:`field_velocity` evaluates ``veloc
 of one point from the flat ``params`` (a list of terms, each one field of this module with an optional tidal
 factor), operation for operation as the numpy methods (which stay the reference). Uniform, affine (shear),
 rigid-rotation, Lamb–Oseen and Rankine fields, their sums and a :class:`Modulated` factor over them have
-it; a gridded field, or a factor over a factor, raises :class:`~shipgnc.kernels.NotCompiled`.
+it; a factor over a factor raises :class:`~shipgnc.kernels.NotCompiled`, and so does bilinear gridded
+data unless asked for with ``grids=True`` (the router, which watches the domain itself; a ship's current
+off its grid must raise). :func:`field_state` adds the Jacobian (the router's extremals).
 """
 
 from __future__ import annotations
@@ -25,14 +27,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from shipgnc.errors import ConfigError, require
-from shipgnc.kernels import NotCompiled, flat, kernel_function
+from shipgnc.kernels import JIT_OPTIONS, NotCompiled, flat, kernel_function
 
 __all__ = [
     "AffineCurrent",
     "CurrentField",
+    "DoubleGyre",
     "FieldDomainError",
     "GriddedCurrent",
     "LambOseenVortex",
@@ -96,18 +100,39 @@ class CurrentField:
         return SumField([self, other])
 
     # --- compiled form (module docstring) ---
-    def _terms(self) -> list[tuple[int, tuple[float, ...]]]:
-        """``[(code, numbers)]``: this field as terms of :func:`field_velocity` (one here)."""
+    def _terms(self, grids: bool = False) -> list[tuple]:
+        """``[(code, numbers[, data])]``: this field as terms of :func:`field_state` (one here); a gridded
+        term carries its grid as ``data`` (only with ``grids``, see :meth:`current_kernel`)."""
         raise NotCompiled(f"current {type(self).__name__} has no kernel (no compiled form)")
 
-    def current_kernel(self, t0: float = 0.0):
-        """``(field_velocity, params)``: :func:`field_velocity` evaluates this field at ``t0 + t`` from
-        ``params``; raises :class:`~shipgnc.kernels.NotCompiled` for a field without a compiled form."""
-        terms = []
-        for code, numbers in self._terms():
+    def current_kernel(self, t0: float = 0.0, grids: bool = False):
+        """``(field_velocity, params)``: :func:`field_velocity` (and :func:`field_state`, which adds the
+        Jacobian) evaluates this field at ``t0 + t`` from ``params``; raises
+        :class:`~shipgnc.kernels.NotCompiled` for a field without a compiled form.
+
+        ``grids=True`` compiles gridded data too, clamped at the grid's edge like the unchecked
+        ``_velocity``: for integrators that watch the domain themselves (the router's). A ship's
+        current leaves it off, so a query off the grid raises :class:`FieldDomainError` (numpy loop)."""
+        terms, tails, raw = [], [], self._terms(grids)
+        offset = 2 + _TERM * len(raw)  # where the first term's data starts, counted from o
+        for code, numbers, *data in raw:
             numbers = tuple(float(v) for v in numbers)
+            if data:
+                numbers = (*numbers[:3], float(offset), *numbers[4:])
+                tails.append(data[0])
+                offset += data[0].size
             terms.append(flat(code, numbers, np.zeros(_TERM - 1 - len(numbers))))
-        return field_velocity, flat(float(t0), len(terms), *terms)
+        return field_velocity, flat(float(t0), len(terms), *terms, *tails)
+
+    def rate_bound(self) -> float:
+        """An upper bound [1/s] of the Jacobian's Frobenius norm ‖∂v/∂x‖ over space and time: the
+        rate at which the current turns an extremal's heading and costate (2.3, 2.5); it sets the
+        router's fixed integration step (:mod:`shipgnc.routing.extremal_kernels`)."""
+        raise NotCompiled(f"current {type(self).__name__} has no rate bound")
+
+    def grid_cell(self) -> float:
+        """The smallest grid spacing [m] of gridded data in this field (``inf`` for analytic fields)."""
+        return math.inf
 
     def max_speed(self, bounds, t=0.0, n: int = 81) -> float:
         """Largest |v| [m/s] sampled on an n×n grid over ``bounds`` (a CFL and scale estimate)."""
@@ -139,8 +164,11 @@ class UniformCurrent(CurrentField):
     def describe(self):
         return f"uniform current ({self.north:.6g}, {self.east:.6g}) m/s"
 
-    def _terms(self):
+    def _terms(self, grids=False):
         return [(_UNIFORM, (self.north, self.east))]
+
+    def rate_bound(self):
+        return 0.0
 
 
 @dataclass(frozen=True)
@@ -174,7 +202,10 @@ class AffineCurrent(CurrentField):
             return f"shear v_E = k·(x_N − {self.ref[0]:g} m), k = {g[1, 0]:.6g} 1/s"
         return f"affine current v0 = {tuple(self.v0)} m/s, G = {g.tolist()} 1/s"
 
-    def _terms(self):
+    def rate_bound(self):
+        return float(np.linalg.norm(np.asarray(self.gradient, float)))
+
+    def _terms(self, grids=False):
         g = np.asarray(self.gradient, dtype=float)
         return [(_AFFINE, (self.v0[0], self.v0[1], g[0, 0], g[0, 1], g[1, 0], g[1, 1], self.ref[0],
                            self.ref[1]))]
@@ -209,8 +240,11 @@ class RigidRotation(CurrentField):
     def describe(self):
         return f"rigid rotation ω = {self.omega:.6g} rad/s about {tuple(self.centre)} m"
 
-    def _terms(self):
+    def _terms(self, grids=False):
         return [(_ROTATION, (self.omega, self.centre[0], self.centre[1]))]
+
+    def rate_bound(self):
+        return math.sqrt(2.0) * abs(self.omega)
 
 
 class _Vortex(CurrentField):
@@ -223,14 +257,30 @@ class _Vortex(CurrentField):
     def _check(self, name):
         _finite(self.gamma, f"{name}.gamma")
         require(_finite(self.rc, f"{name}.rc") > 0, f"{name}.rc", self.rc, "core radius must be > 0 m")
+        for k, value in enumerate(self.drift):
+            _finite(value, f"{name}.drift[{k}]")
+
+    def _where(self) -> str:
+        moving = "" if self.steady else f", drifting at {tuple(self.drift)} m/s"
+        return f"at {tuple(self.centre)} m{moving}"
 
     def _f(self, q):  # returns f(q), f'(q)
         raise NotImplementedError
 
+    @property
+    def steady(self) -> bool:
+        return self.drift[0] == 0.0 and self.drift[1] == 0.0
+
+    def centre_at(self, t):
+        """The centre at time t [s]: ``centre + drift·t`` (north, east) [m], each broadcast with t."""
+        t = np.asarray(t, float)
+        return self.centre[0] + self.drift[0] * t, self.centre[1] + self.drift[1] * t
+
     def _parts(self, t, north, east):
         shape = _shape(t, north, east)
-        rn = np.broadcast_to(np.asarray(north, float) - self.centre[0], shape)
-        re = np.broadcast_to(np.asarray(east, float) - self.centre[1], shape)
+        cn, ce = self.centre_at(t) if not self.steady else self.centre
+        rn = np.broadcast_to(np.asarray(north, float) - cn, shape)
+        re = np.broadcast_to(np.asarray(east, float) - ce, shape)
         return rn, re, *self._f(rn * rn + re * re)
 
     def velocity(self, t, north, east):
@@ -251,6 +301,15 @@ class _Vortex(CurrentField):
         r = np.asarray(r, dtype=float)
         return r * self._f(r * r)[0]
 
+    def rate_bound(self):
+        # ‖J‖ depends on r alone and decays as 1/r² outside the core: its peak lies within a few r_c
+        # (at r = 0 for Lamb–Oseen, anywhere in the core for Rankine); sampled 4 000 radii to 20 r_c
+        r = np.linspace(0.0, 20.0 * self.rc, 4001)
+        f, df = self._f(r * r)
+        # J = f R + a ⊗ 2f'r (jacobian): entries as there, on the ray r_E = 0
+        j = np.stack([np.zeros_like(r), -f, f + 2 * df * r * r, np.zeros_like(r)])
+        return float(np.max(np.sqrt(np.sum(j * j, axis=0))))
+
 
 @dataclass(frozen=True)
 class LambOseenVortex(_Vortex):
@@ -259,6 +318,7 @@ class LambOseenVortex(_Vortex):
     gamma: float
     rc: float
     centre: tuple[float, float] = (0.0, 0.0)
+    drift: tuple[float, float] = (0.0, 0.0)  #: velocity of the centre [m/s] (a moving vortex)
 
     def __post_init__(self):
         self._check("lamb-oseen")
@@ -274,11 +334,10 @@ class LambOseenVortex(_Vortex):
         return a * f, a * df
 
     def describe(self):
-        return (f"Lamb–Oseen vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m "
-                f"at {tuple(self.centre)} m")
+        return f"Lamb–Oseen vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m {self._where()}"
 
-    def _terms(self):  # a = Γ/2π and c = r_c² as _f forms them
-        return [(_LAMB_OSEEN, (self.gamma / (2 * math.pi), self.rc**2, self.centre[0], self.centre[1]))]
+    def _terms(self, grids=False):  # a = Γ/2π and c = r_c² as _f forms them
+        return [(_LAMB_OSEEN, (self.gamma / (2 * math.pi), self.rc**2, *self.centre, *self.drift))]
 
 
 @dataclass(frozen=True)
@@ -288,6 +347,7 @@ class RankineVortex(_Vortex):
     gamma: float
     rc: float
     centre: tuple[float, float] = (0.0, 0.0)
+    drift: tuple[float, float] = (0.0, 0.0)  #: velocity of the centre [m/s] (a moving vortex)
 
     def __post_init__(self):
         self._check("rankine")
@@ -300,11 +360,58 @@ class RankineVortex(_Vortex):
         return a * np.where(inside, 1 / c, 1 / qs), a * np.where(inside, 0.0, -1 / qs**2)
 
     def describe(self):
-        return (f"Rankine vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m "
-                f"at {tuple(self.centre)} m")
+        return f"Rankine vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m {self._where()}"
 
-    def _terms(self):
-        return [(_RANKINE, (self.gamma / (2 * math.pi), self.rc**2, self.centre[0], self.centre[1]))]
+    def _terms(self, grids=False):
+        return [(_RANKINE, (self.gamma / (2 * math.pi), self.rc**2, *self.centre, *self.drift))]
+
+
+@dataclass(frozen=True)
+class DoubleGyre(CurrentField):
+    """The steady double gyre, a classic test of routing in a current (e.g. Lolla et al. 2014):
+
+        v_N = −U sin(π e′/L) cos(π n′/L),  v_E = U cos(π e′/L) sin(π n′/L),
+        n′ = north − centre_N,  e′ = east − centre_E,
+
+    cells of size L [m] turning alternately, speed up to U [m/s], divergence-free."""
+
+    speed: float
+    length: float
+    centre: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self):
+        _finite(self.speed, "gyre.speed")
+        require(_finite(self.length, "gyre.length") > 0, "gyre.length", self.length, "must be > 0 m")
+
+    def _phases(self, t, north, east):
+        shape = _shape(t, north, east)
+        k = math.pi / self.length
+        a = np.broadcast_to(k * (np.asarray(east, float) - self.centre[1]), shape)
+        b = np.broadcast_to(k * (np.asarray(north, float) - self.centre[0]), shape)
+        return k, np.sin(a), np.cos(a), np.sin(b), np.cos(b)
+
+    def velocity(self, t, north, east):
+        _, sa, ca, sb, cb = self._phases(t, north, east)
+        return np.stack([-self.speed * sa * cb, self.speed * ca * sb], axis=-1)
+
+    def jacobian(self, t, north, east):
+        k, sa, ca, sb, cb = self._phases(t, north, east)
+        u = self.speed * k
+        j = np.empty((*sa.shape, 2, 2))
+        j[..., 0, 0] = u * sa * sb
+        j[..., 0, 1] = -u * ca * cb
+        j[..., 1, 0] = u * ca * cb
+        j[..., 1, 1] = -u * sa * sb
+        return j
+
+    def rate_bound(self):
+        return math.sqrt(2.0) * abs(self.speed) * math.pi / self.length
+
+    def describe(self):
+        return f"double gyre U = {self.speed:.6g} m/s, L = {self.length:.6g} m about {tuple(self.centre)} m"
+
+    def _terms(self, grids=False):
+        return [(_GYRE, (self.speed, math.pi / self.length, *self.centre))]
 
 
 class SumField(CurrentField):
@@ -338,8 +445,14 @@ class SumField(CurrentField):
     def describe(self):
         return " + ".join(f.describe() for f in self.fields)
 
-    def _terms(self):
-        return [term for f in self.fields for term in f._terms()]
+    def _terms(self, grids=False):
+        return [term for f in self.fields for term in f._terms(grids)]
+
+    def rate_bound(self):
+        return sum(f.rate_bound() for f in self.fields)
+
+    def grid_cell(self):
+        return min(f.grid_cell() for f in self.fields)
 
 
 class Modulated(CurrentField):
@@ -386,16 +499,22 @@ class Modulated(CurrentField):
         return (f"({self.field.describe()}) × ({self.mean:g} + {self.amplitude:g}·cos(2πt/"
                 f"{self.period:g} s + {self.phase:g}))")
 
-    def _terms(self):
+    def _terms(self, grids=False):
         # m(t)·(w₁ + w₂ + …) as m(t)·w₁ + m(t)·w₂ + … (the same up to round-off)
         terms = []
-        for code, numbers in self.field._terms():
+        for code, numbers, *data in self.field._terms(grids):
             if code >= _MODULATED:
                 raise NotCompiled("a tidal factor over a tidal factor has no compiled form")
             terms.append((code + _MODULATED, (*numbers, *[0.0] * (_FACTOR - len(numbers)),
                                               self.mean, self.amplitude, 2 * np.pi / self.period,
-                                              self.phase)))
+                                              self.phase), *data))
         return terms
+
+    def rate_bound(self):
+        return (abs(self.mean) + abs(self.amplitude)) * self.field.rate_bound()
+
+    def grid_cell(self):
+        return self.field.grid_cell()
 
 
 class GriddedCurrent(CurrentField):
@@ -510,6 +629,25 @@ class GriddedCurrent(CurrentField):
                           + ww * self._slice(kk + 1, nn[m], ee[m], deriv))
         return out.reshape((*shape, 2, 2) if deriv else (*shape, 2))
 
+    def _terms(self, grids=False):
+        if not grids:
+            raise NotCompiled("current GriddedCurrent has no kernel for a ship (a query off its grid must "
+                              "raise, so the simulation keeps it in numpy)")
+        if self._splines is not None:
+            raise NotCompiled("current GriddedCurrent (cubic) has no kernel: the bicubic spline")
+        sizes = (self.times.size, self.n.size, self.e.size)
+        data = np.concatenate([self.times, self.n, self.e, self.data.ravel()])
+        return [(_GRIDDED, (*sizes, 0.0), data)]  # the 0 becomes the data's offset (current_kernel)
+
+    def rate_bound(self):
+        # the bilinear Jacobian is linear in each cell's coordinates: its entries peak at the cell edges
+        dn = np.abs(np.diff(self.data, axis=1)) / np.diff(self.n)[None, :, None, None]
+        de = np.abs(np.diff(self.data, axis=2)) / np.diff(self.e)[None, None, :, None]
+        return float(math.sqrt(2.0 * (np.max(dn) ** 2 + np.max(de) ** 2)))
+
+    def grid_cell(self):
+        return float(min(np.min(np.diff(self.n)), np.min(np.diff(self.e))))
+
     def _slice(self, k, nn, ee, deriv):
         if self._splines is not None:
             sp = self._splines[k]
@@ -534,22 +672,71 @@ class GriddedCurrent(CurrentField):
 # compiled form: one point of a field from its terms (CurrentField.current_kernel)
 # ----------------------------------------------------------------------------------------------
 
-#: term codes of :func:`field_velocity`; a :class:`Modulated` term adds ``_MODULATED`` to its code
-_UNIFORM, _AFFINE, _ROTATION, _LAMB_OSEEN, _RANKINE, _MODULATED = 1, 2, 3, 4, 5, 8
+#: term codes of :func:`field_state`; a :class:`Modulated` term adds ``_MODULATED`` to its code
+_UNIFORM, _AFFINE, _ROTATION, _LAMB_OSEEN, _RANKINE, _GRIDDED, _GYRE, _MODULATED = 1, 2, 3, 4, 5, 6, 7, 8
 #: numbers per term (code first), and where among a term's numbers a modulated term's factor
 #: [mean, amplitude, ω = 2π/period, phase] starts
 _TERM, _FACTOR = 13, 8
 
 
 @kernel_function
-def field_velocity(t, north, east, p, o):
-    """``velocity(t0 + t, north, east)`` of one point, ``(v_N, v_E)``, from the terms in ``p[o:]`` =
-    [t0, n, n × (code, 12 numbers)] (:meth:`CurrentField.current_kernel`); each term follows its
-    class's numpy method operation for operation, a sum adds them in order from 0."""
+def _cell(p, start, size, x):
+    """``searchsorted(axis, x, side="right") − 1`` clipped to [0, size − 2] for the axis
+    ``p[start:start + size]`` (increasing): the cell holding ``x``, by bisection."""
+    lo = 0
+    hi = size
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if p[start + mid] <= x:
+            lo = mid + 1
+        else:
+            hi = mid
+    return min(max(lo - 1, 0), size - 2)
+
+
+@kernel_function
+def _bilinear(p, base, k, nt, nn, ne, north, east):
+    """One time slice ``k`` of gridded data at a point clamped to the grid, and its Jacobian, as
+    :meth:`GriddedCurrent._slice` forms them: (v_N, v_E, ∂v_N/∂n, ∂v_N/∂e, ∂v_E/∂n, ∂v_E/∂e)."""
+    sn = base + nt
+    se = sn + nn
+    x = min(max(north, p[sn]), p[sn + nn - 1])
+    y = min(max(east, p[se]), p[se + ne - 1])
+    i = _cell(p, sn, nn, x)
+    j = _cell(p, se, ne, y)
+    axn0, axn1, axe0, axe1 = p[sn + i], p[sn + i + 1], p[se + j], p[se + j + 1]
+    hn = axn1 - axn0
+    he = axe1 - axe0
+    a = (x - axn0) / hn
+    b = (y - axe0) / he
+    d = base + nt + nn + ne + k * nn * ne * 2
+    r0 = d + (i * ne + j) * 2  # f00 of v_N; f01 two further, f10 one row (ne·2) further
+    r1 = r0 + ne * 2
+    f00, f01, f10, f11 = p[r0], p[r0 + 2], p[r1], p[r1 + 2]
+    g00, g01, g10, g11 = p[r0 + 1], p[r0 + 3], p[r1 + 1], p[r1 + 3]
+    vn = (1 - a) * (1 - b) * f00 + (1 - a) * b * f01 + a * (1 - b) * f10 + a * b * f11
+    ve = (1 - a) * (1 - b) * g00 + (1 - a) * b * g01 + a * (1 - b) * g10 + a * b * g11
+    jnn = ((1 - b) * (f10 - f00) + b * (f11 - f01)) / hn
+    jne = ((1 - a) * (f01 - f00) + a * (f11 - f10)) / he
+    jen = ((1 - b) * (g10 - g00) + b * (g11 - g01)) / hn
+    jee = ((1 - a) * (g01 - g00) + a * (g11 - g10)) / he
+    return vn, ve, jnn, jne, jen, jee
+
+
+@numba.njit(**JIT_OPTIONS, inline="always")
+def field_state(t, north, east, p, o):
+    """``velocity`` and ``jacobian`` at ``(t0 + t, north, east)`` of one point, ``(v_N, v_E, J₀₀, J₀₁,
+    J₁₀, J₁₁)`` with J[i, j] = ∂v_i/∂x_j, from the terms in ``p[o:]`` = [t0, n, n × (code, 12
+    numbers), gridded data] (:meth:`CurrentField.current_kernel`); each term follows its class's
+    numpy methods operation for operation, a sum adds them in order from 0."""
     tt = p[o] + t
     n = int(p[o + 1])
     vn = 0.0
     ve = 0.0
+    jnn = 0.0
+    jne = 0.0
+    jen = 0.0
+    jee = 0.0
     for j in range(n):
         b = o + 2 + j * _TERM
         code = int(p[b])
@@ -557,33 +744,77 @@ def field_velocity(t, north, east, p, o):
         kind = code - _MODULATED if code > _MODULATED else code
         if kind == _UNIFORM:
             wn, we = q[0], q[1]
+            gnn = gne = gen = gee = 0.0
         elif kind == _AFFINE:
             dn, de = north - q[6], east - q[7]
             wn = q[0] + q[2] * dn + q[3] * de
             we = q[1] + q[4] * dn + q[5] * de
+            gnn, gne, gen, gee = q[2], q[3], q[4], q[5]
         elif kind == _ROTATION:
             wn = -q[0] * (east - q[2])
             we = q[0] * (north - q[1])
-        else:  # _Vortex: v = f(r²)·(−r_E, r_N)
+            gnn, gne, gen, gee = 0.0, -q[0], q[0], 0.0
+        elif kind == _GYRE:
+            k = q[1]
+            ph_e, ph_n = k * (east - q[3]), k * (north - q[2])
+            sa, ca, sb, cb = math.sin(ph_e), math.cos(ph_e), math.sin(ph_n), math.cos(ph_n)
+            u = q[0] * k
+            wn, we = -q[0] * sa * cb, q[0] * ca * sb
+            gnn, gne, gen, gee = u * sa * sb, -u * ca * cb, u * ca * cb, -u * sa * sb
+        elif kind == _GRIDDED:
+            nt, nn, ne = int(q[0]), int(q[1]), int(q[2])
+            base = o + int(q[3])
+            if nt == 1:
+                wn, we, gnn, gne, gen, gee = _bilinear(p, base, 0, nt, nn, ne, north, east)
+            else:
+                k = _cell(p, base, nt, tt)
+                w = min(max((tt - p[base + k]) / (p[base + k + 1] - p[base + k]), 0.0), 1.0)
+                an, ae, ann, ane, aen, aee = _bilinear(p, base, k, nt, nn, ne, north, east)
+                bn, be, bnn, bne, ben, bee = _bilinear(p, base, k + 1, nt, nn, ne, north, east)
+                wn, we = (1 - w) * an + w * bn, (1 - w) * ae + w * be
+                gnn, gne = (1 - w) * ann + w * bnn, (1 - w) * ane + w * bne
+                gen, gee = (1 - w) * aen + w * ben, (1 - w) * aee + w * bee
+        else:  # _Vortex: v = f(r²)·(−r_E, r_N), J = f R + (−r_E, r_N) ⊗ 2f'(r_N, r_E)
             a, c = q[0], q[1]
-            rn, re = north - q[2], east - q[3]
+            rn, re = north - (q[2] + q[4] * tt), east - (q[3] + q[5] * tt)
             r2 = rn * rn + re * re
             if kind == _LAMB_OSEEN:
                 if r2 < 1e-6 * c:
                     f = (1 - r2 / (2 * c) + r2 * r2 / (6 * c * c)) / c
+                    df = -1 / (2 * c * c) + r2 / (3 * c ** 3)
                 else:
                     f = -math.expm1(-r2 / c) / r2
+                    df = math.exp(-r2 / c) / (c * r2) + math.expm1(-r2 / c) / (r2 * r2)
+            elif r2 <= c:
+                f, df = 1 / c, 0.0
             else:
-                f = 1 / c if r2 <= c else 1 / r2
+                f, df = 1 / r2, -1 / (r2 * r2)
             f = a * f
+            df = a * df
             wn = -f * re
             we = f * rn
+            gnn = -re * 2 * df * rn
+            gne = -f - re * 2 * df * re
+            gen = f + rn * 2 * df * rn
+            gee = rn * 2 * df * re
         if code > _MODULATED:
             m = q[_FACTOR] + q[_FACTOR + 1] * math.cos(q[_FACTOR + 2] * tt + q[_FACTOR + 3])
-            wn = m * wn
-            we = m * we
+            wn, we = m * wn, m * we
+            gnn, gne, gen, gee = m * gnn, m * gne, m * gen, m * gee
         vn = vn + wn
         ve = ve + we
+        jnn = jnn + gnn
+        jne = jne + gne
+        jen = jen + gen
+        jee = jee + gee
+    return vn, ve, jnn, jne, jen, jee
+
+
+@kernel_function
+def field_velocity(t, north, east, p, o):
+    """``velocity(t0 + t, north, east)`` of one point, ``(v_N, v_E)``: :func:`field_state` without
+    its Jacobian (the ship's current in the composed loop)."""
+    vn, ve, _, _, _, _ = field_state(t, north, east, p, o)
     return vn, ve
 
 

@@ -10,10 +10,15 @@ unit costate; its scale follows from H(t_f) = 0, p(t_f) = e(u_f)/(V + e(u_f)ᵀ 
 
 * :func:`integrate_family` — batched fixed-step RK4 over N initial costate angles (2.9.4);
 * :func:`shoot` — polish (θ₀, t_f) with Levenberg–Marquardt (scipy ``least_squares``) on a dense
-  ``solve_ivp`` extremal; checks t_f > 0, both end conditions and admissibility (F4, F5);
+  extremal; checks t_f > 0, both end conditions and admissibility (F4, F5);
 * :func:`sweep` — the global sweep: all extremals through B below a horizon, each polished and checked for
   conjugate points (F2, F3);
 * :func:`conjugate_time` — det[∂x/∂θ₀, ẋ] along a forward extremal (F3).
+
+A field with a compiled form (every analytic field, their sums and tides, bilinear gridded data) is
+integrated by the kernels of :mod:`~shipgnc.routing.extremal_kernels` (fixed-step RK4, dense output by
+cubic Hermite interpolation; its docstring derives the step); any other field by these numpy forms and
+``solve_ivp`` (DOP853, rtol 10⁻¹¹).
 
 All arguments in SI: positions (north, east) [m], V [m/s], times [s], angles [rad].
 """
@@ -26,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from shipgnc.errors import require
+from shipgnc.routing import extremal_kernels
 
 TWO_PI = 2.0 * math.pi
 
@@ -90,9 +96,14 @@ def integrate_family(field, speed, start, theta0, t0, duration, n_steps, record=
 
     Returns positions of shape (n_steps + 1, N, 2) (or, with ``record(k, t, y, alive)`` given, calls it
     after each step and returns the final state). Extremals that leave a gridded field's domain are frozen
-    where they left (``alive`` false from then on).
+    where they left (``alive`` false from then on). A field with a compiled form runs
+    :func:`~shipgnc.routing.extremal_kernels.family_kernel` (these operations, compiled) unless ``record``
+    is given.
     """
     y, _ = initial_state(field, speed, start, theta0, t0)
+    cf = extremal_kernels.compiled(field) if record is None and y.ndim == 2 else None
+    if cf is not None:
+        return extremal_kernels.family(cf, speed, y, t0, duration, n_steps, start, 0.0)[0]
     dt = duration / n_steps
     alive = np.ones(y.shape[:-1], bool)
     bounds = field.bounds
@@ -126,7 +137,7 @@ class Extremal:
     t0: float
     heading_end: float  #: u(t_f) [rad]
     miss: float  #: |x(t_f) − B| [m] (distance to the disc for a disc target)
-    solution: object = field(repr=False, default=None)  #: solve_ivp dense solution over [t₀, t_f]
+    solution: object = field(repr=False, default=None)  #: dense solution over [t₀, t_f]
     conjugate_at: float | None = None  #: time of a conjugate point after t₀ [s] (F3), or None
     status: str = ""
     hamiltonian_max: float = math.nan  #: max |H| along the extremal (steady fields) with the (2.4) scale
@@ -159,6 +170,11 @@ class Extremal:
 #: stronger than the ship over a long route) and is stopped, said in the route's notes and reason
 MAX_EVALS_PER_SOLVE = 50_000
 MAX_EVALS_PER_SWEEP = 2_000_000
+#: the same bound for the compiled fixed-step integration (:mod:`~shipgnc.routing.extremal_kernels`),
+#: counted in RK4 steps of one integration (a few thousand for a regular route: ‖J‖·T / 2·10⁻³) and of
+#: all the polishes of one sweep; a compiled step costs ≈ 1/500 of a numpy right-hand side
+MAX_STEPS_PER_SOLVE = 250_000
+MAX_STEPS_PER_SWEEP = 25_000_000
 
 
 class EffortExceeded(Exception):
@@ -172,22 +188,43 @@ class Effort:
 
     per_solve: int = field(default_factory=lambda: MAX_EVALS_PER_SOLVE)
     total: int = field(default_factory=lambda: MAX_EVALS_PER_SWEEP)
+    steps_per_solve: int = field(default_factory=lambda: MAX_STEPS_PER_SOLVE)
+    steps_total: int = field(default_factory=lambda: MAX_STEPS_PER_SWEEP)
     spent: int = 0
+    steps: int = 0
     stopped: int = 0
 
+    def charge_steps(self, n: int) -> None:
+        """Count a compiled integration of ``n`` RK4 steps before it runs; raise past the bounds."""
+        if n > self.steps_per_solve or self.steps + n > self.steps_total:
+            raise EffortExceeded
+        self.steps += n
+
     def describe(self) -> str:
-        return (f"the effort bound stopped {self.stopped} polish(es) ({self.per_solve:,} "
-                f"right-hand-side evaluations per integration, {self.total:,} per sweep; "
-                f"{self.spent:,} spent): the extremals are stiff here (a current much stronger than "
-                "the ship over a long route)")
+        if self.steps:
+            bound = (f"{self.steps_per_solve:,} RK4 steps per integration, {self.steps_total:,} per "
+                     f"sweep; {self.steps:,} spent")
+        else:
+            bound = (f"{self.per_solve:,} right-hand-side evaluations per integration, {self.total:,} "
+                     f"per sweep; {self.spent:,} spent")
+        return (f"the effort bound stopped {self.stopped} polish(es) ({bound}): the extremals are stiff "
+                "here (a current much stronger than the ship over a long route)")
 
 
-def _solve(field, speed, start, thetas, t0, duration, dense=False, rtol=1e-11, effort=None):
-    """solve_ivp (DOP853) of a small batch of extremals; returns the OdeResult. With ``effort``
-    (:class:`Effort`) it raises :class:`EffortExceeded` past the bounds."""
+def _solve(field, speed, start, thetas, t0, duration, dense=False, rtol=1e-11, effort=None, coarsen=1):
+    """A small batch of extremals: compiled RK4 (:func:`extremal_kernels.integrate`) for a field with a
+    compiled form, else solve_ivp (DOP853); returns what the callers read of an OdeResult (``y``,
+    ``success``, ``sol``). ``coarsen`` divides the compiled step count (the polish's first phase). With
+    ``effort`` (:class:`Effort`) it raises :class:`EffortExceeded` past the bounds."""
     from scipy.integrate import solve_ivp
 
     y0, _ = initial_state(field, speed, start, np.asarray(thetas, float), t0)
+    cf = extremal_kernels.compiled(field)
+    if cf is not None:
+        n = max(cf.steps(speed, duration) // coarsen, extremal_kernels.MIN_STEPS // 8)
+        if effort is not None:
+            effort.charge_steps(n)
+        return extremal_kernels.integrate(cf, speed, y0, t0, duration, dense=dense, n_steps=n)
     shape = y0.shape
     calls = [0]
 
@@ -208,9 +245,10 @@ def _solve(field, speed, start, thetas, t0, duration, dense=False, rtol=1e-11, e
 class _Shooter:
     """Residual and Jacobian of x(t₀ + T; θ₀) − B (point) or x + R e(u) − B (disc, Z12) for least_squares."""
 
-    def __init__(self, field, speed, start, target, t0, radius=0.0, h=1e-6, rtol=1e-11, effort=None):
+    def __init__(self, field, speed, start, target, t0, radius=0.0, h=1e-6, rtol=1e-11, effort=None,
+                 coarsen=1):
         self.field, self.speed, self.start, self.t0 = field, speed, start, t0
-        self.rtol, self.effort = rtol, effort
+        self.rtol, self.effort, self.coarsen = rtol, effort, coarsen
         self.target, self.radius, self.h = np.asarray(target, float), float(radius), h
         self.cache: dict = {}
 
@@ -221,7 +259,7 @@ class _Shooter:
             if not dur > 0:
                 dur = 1e-9
             res = _solve(self.field, self.speed, self.start, [theta - self.h, theta, theta + self.h],
-                         self.t0, dur, rtol=self.rtol, effort=self.effort)
+                         self.t0, dur, rtol=self.rtol, effort=self.effort, coarsen=self.coarsen)
             y = res.y[:, -1].reshape(3, 4)
             if not res.success or not np.all(np.isfinite(y)):
                 y = np.full((3, 4), 1e12)
@@ -253,6 +291,8 @@ class _Shooter:
 #: an extremal reaches the target when it ends within this fraction of |AB| of it (at most ``tol_m``):
 #: a tolerance in the problem's own scale, so a 1 m problem is held to 0.1 mm, a 100 km one to 1 m
 MISS_REL = 1e-4
+#: the polish's first phase integrates with 1/COARSEN of the compiled steps (:func:`shoot`)
+COARSEN = 8
 
 
 def miss_tolerance(start, target, tol_m: float = 1.0) -> float:
@@ -274,11 +314,21 @@ def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol
     from scipy.optimize import least_squares
 
     effort = Effort() if effort is None else effort
-    sh = _Shooter(field, speed, np.asarray(start, float), target, t0, radius, rtol=rtol, effort=effort)
+    start = np.asarray(start, float)
+    tol = miss_tolerance(start, target, tol_m)
+    guess = [float(theta0), float(duration)]
+    lm = {"method": "lm", "x_scale": [1.0, max(float(duration), 1.0)], "max_nfev": 60}
     try:
-        sol = least_squares(sh.residual, [float(theta0), float(duration)], jac=sh.jacobian, method="lm",
-                            x_scale=[1.0, max(float(duration), 1.0)], xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                            max_nfev=60)
+        if extremal_kernels.compiled(field) is not None:
+            # first phase at 1/COARSEN of the steps (error ~10⁻⁷ of the fine one): a seed that does not
+            # converge there is dropped for an eighth of the work, one that does needs a few fine steps
+            sc = _Shooter(field, speed, start, target, t0, radius, rtol=rtol, effort=effort, coarsen=COARSEN)
+            sol = least_squares(sc.residual, guess, jac=sc.jacobian, xtol=1e-12, ftol=1e-12, gtol=1e-12, **lm)
+            if not (sol.x[1] > 0 and np.all(np.isfinite(sol.fun)) and np.hypot(*sol.fun) <= 10 * tol):
+                return None
+            guess = [float(sol.x[0]), float(sol.x[1])]
+        sh = _Shooter(field, speed, start, target, t0, radius, rtol=rtol, effort=effort)
+        sol = least_squares(sh.residual, guess, jac=sh.jacobian, xtol=1e-15, ftol=1e-15, gtol=1e-15, **lm)
     except EffortExceeded:
         effort.stopped += 1
         return None
@@ -288,7 +338,7 @@ def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol
     if not (dur > 0 and np.all(np.isfinite(sol.fun))):
         return None
     miss = float(np.hypot(*sol.fun))
-    if miss > miss_tolerance(start, target, tol_m):
+    if miss > tol:
         return None
     try:
         return finish_extremal(field, speed, start, target, theta, dur, t0, radius, rtol=rtol,
@@ -421,7 +471,12 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
         pos[k] = y[:, :2]
         alive_tab = alive
 
-    if th.size:
+    cf = extremal_kernels.compiled(field)
+    if th.size and cf is not None:
+        y0, _ = initial_state(field, speed, start, th, t0)
+        pos, dist_tab, alive_tab = extremal_kernels.family(cf, speed, y0, t0, horizon, n_steps, target,
+                                                           radius, np.float32)
+    elif th.size:
         integrate_family(field, speed, start, th, t0, horizon, n_steps, record=record)
     n_left = int(np.sum(~alive_tab))
     finite = np.isfinite(dist_tab)
