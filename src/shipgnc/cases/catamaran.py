@@ -62,10 +62,13 @@ class CatamaranCase:
     actuator: object | None = None
     heading_target: float | None = None
     notes: dict = field(default_factory=dict)
+    #: the run's disturbance (None: calm water), e.g. an earth-fixed current with
+    #: :func:`with_current`
+    disturbance: object | None = None
 
     def simulate_kwargs(self) -> dict:
         return {"t_end": self.t_end, "dt": self.dt, "controller": self.controller, "actuator": self.actuator,
-                "guidance": self.guidance}
+                "guidance": self.guidance, "disturbance": self.disturbance}
 
     def run(self, **kwargs):
         """``simulate`` this case (``on_divergence="stop"``; ``backend="auto"``: the composed
@@ -84,6 +87,22 @@ class CatamaranCase:
 
         return {**catamaran_metrics(ds, None, self.heading_target),
                 **model_fields(self.model, self.notes.get("preset"))}
+
+
+def with_current(case: CatamaranCase, current, force=None) -> CatamaranCase:
+    """``case`` in an earth-fixed ``current`` (a :class:`~shipgnc.routing.fields.CurrentField`,
+    :class:`~shipgnc.environment.current_field.GaussMarkovCurrent` or a sum; a spec string of
+    :func:`~shipgnc.environment.current_field.parse_current`), with an optional body-axis ``force``
+    disturbance: the catamaran's disturbance ``[X_env, Y_env, N_env, current_north,
+    current_east]``, the hull forces on the velocity through the water
+    (:func:`~shipgnc.models.catamaran.relative_state`). Sets ``case.disturbance`` and returns
+    ``case``."""
+    from shipgnc.environment.current_field import CurrentDisturbance, parse_current
+
+    if isinstance(current, str):
+        current = parse_current(current)
+    case.disturbance = CurrentDisturbance(current, force, n_force=3, position_index=(3, 4))
+    return case
 
 
 def initial_state(u0: float = U0, delta0: float = 0.0, batch: int | None = None) -> np.ndarray:

@@ -8,9 +8,31 @@ Equations (note 000-0.3, eq. (25); signs restored, A3)::
 
 State ``[north, east, psi, u, r]`` (NED, ψ clockwise from north; the document's x, y are the
 toolkit's ``north``, ``east``), input ``[delta]`` [rad], disturbance ``[b_r, current_north,
-current_east]``: a yaw acceleration [rad/s²] added to ṙ (A9) and a current [m/s] added to the
-kinematics. The document's cross current d_y acts along the active leg's Y_r axis (A10); the
-scenario turns it into NED with the leg's angle ψ_r0, e.g. ``body_to_ned(psi_r0, 0.0, d_y)``.
+current_east]``: a yaw acceleration [rad/s²] added to ṙ (A9) and an earth-fixed current
+(c_N, c_E) [m/s] added to the kinematics. The document's cross current d_y acts along the active
+leg's Y_r axis (A10); the scenario turns it into NED with the leg's angle ψ_r0, e.g.
+``body_to_ned(psi_r0, 0.0, d_y)``.
+
+**Current as relative velocity** (Fossen 2021 §10.3, ν_r = ν − ν_c). u is the *total* surge speed
+(not a perturbation: u̇ = −f u − W r² + S settles at U = S/f), and u, the algebraic v and r are the
+velocity **through the water** ν_r = [u_r, v_r, r]: every hull term of eq. (25) sees relative
+velocity — the surge damping −f u, the speed loss in turns −W r² and the thrust S, the sway
+v = r₁ r + r₂ r³, and the yaw terms −a r − b r³ + c δ (a current has no yaw component, so r is the
+same through the water and over ground). Only the kinematics see the current::
+
+    [ẋ, ẏ] = R(ψ)[u_r, v_r]ᵀ + [c_N, c_E]ᵀ,    ν̇_r = f(ν_r, δ)   (the hull equations above)
+
+This is the boat's and the catamaran's formulation (:mod:`shipgnc.models.fossen3dof`: ν over
+ground as their state, ν̇ = ν̇_r + (r v_c, −r u_c, 0), ν_c = R(ψ)ᵀ[c_N, c_E]) written in ν_r: for a
+current constant in NED the two are the same equations, so the motion through the water is the
+still-water motion and the track over ground is the still-water track moved by c·t. For a current
+that changes in time or along the track this form lets the water's acceleration carry the ship
+(ν̇_r does not see it) where the boat's form neglects R(ψ)ᵀ ċ; the two agree to first order in
+the current's rate of change. The scenario's ``current`` section (uniform, Gauss–Markov, gridded:
+:mod:`shipgnc.environment.current_field`) fills (c_N, c_E) with the same field objects as the other
+vessels (:class:`MarinerYawDisturbance` is then the yaw channel beside it); document 000's d_y
+(:class:`~shipgnc.environment.current.CrossCurrent`) fills the same channels, and its path-frame
+form changes direction at each waypoint, where the ship's ground velocity jumps with it.
 
 **Sway is algebraic.** v is not a state: ``sway(r)`` = r₁ r + r₂ r³ is evaluated from the yaw rate
 wherever it is needed. With r₁ < 0 a starboard turn (r > 0) gives v < 0 at the centre of gravity;
@@ -199,7 +221,9 @@ class MarinerWitOppe:
         return self.params.sway(r)
 
     def derivatives(self, x, u, d=None):
-        """ẋ of eq. (25) for ``x`` (..., 5), ``u`` (..., 1) = [δ], ``d`` (..., 3) or None."""
+        """ẋ of eq. (25) for ``x`` (..., 5), ``u`` (..., 1) = [δ], ``d`` (..., 3) or None: the hull
+        terms on u, v, r through the water, the current ``d[..., 1:3]`` added to the kinematics
+        (module docstring)."""
         p = self.params
         psi, su, sr = x[..., 2], x[..., 3], x[..., 4]
         north_dot, east_dot = body_to_ned(psi, su, p.sway(sr))
@@ -250,7 +274,8 @@ class MarinerWitOppe:
 @kernel_function
 def mariner_rhs(x, u, d, p, xdot):
     """ẋ of eq. (25) for one ship: :meth:`MarinerWitOppe.derivatives`, operation for operation
-    (r³ = r·r·r, within an ulp of numpy's ``pow``; a zero ``d`` adds nothing); ``p`` = [a, b, c, r₁, r₂, f, W,
+    (r³ = r·r·r, within an ulp of numpy's ``pow``; a zero ``d`` adds nothing; the current ``d[1:3]``
+    enters the kinematics only, u and r being through the water); ``p`` = [a, b, c, r₁, r₂, f, W,
     S]."""
     a, b, c_rudder, r1, r2, f, W, S = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
     psi, su, sr = x[2], x[3], x[4]
@@ -413,6 +438,28 @@ class MarinerDisturbance:
 
         return Kernel(mariner_disturbance, params, leg[..., None], table=table,
                       n_table=int(waves is not None), restore=restore)
+
+
+class MarinerYawDisturbance(MarinerDisturbance):
+    """The yaw channel of :class:`MarinerDisturbance` alone: ``[b_r (+ waves)]`` (..., 1), the
+    force part of :class:`~shipgnc.environment.current_field.CurrentDisturbance` with ``n_force=1``
+    when the current is a scenario's ``current`` section (an earth-fixed field object: uniform,
+    Gauss–Markov, gridded), so the Mariner's current is filled by the same component, numpy and
+    compiled, as the other vessels'. Its kernel is :func:`mariner_disturbance` without a current
+    (it writes d[0] and zeros d[1:3], which the current's kernel then fills).
+
+    Evaluated at every RK stage unless there are waves (a constant b_r is the same at each stage;
+    the wave noise is held over each step, and the current with it)."""
+
+    def __init__(self, b_r: float = 0.0, waves=None):
+        super().__init__(b_r, current=None, waves=waves)
+
+    @property
+    def per_stage(self) -> bool:
+        return self.waves is None
+
+    def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
+        return super().__call__(t, x)[..., :1]
 
 
 def _field_kernel(current) -> np.ndarray:

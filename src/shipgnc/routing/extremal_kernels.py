@@ -43,7 +43,7 @@ from shipgnc.kernels import JIT_OPTIONS, NotCompiled, kernel_function
 from shipgnc.routing.fields import field_state
 
 #: the largest ‖J‖·h of a step: the current turns heading and costate by at most this per step [rad]
-TURN_PER_STEP = 2e-3
+TURN_PER_STEP = 4e-3
 #: steps per grid cell at the fastest ground speed, for gridded data (the Jacobian jumps at cell edges)
 CELL_STEPS = 4
 #: the fewest steps of one integration (straight lines in a uniform current need no more)
@@ -149,10 +149,10 @@ def family_kernel(speed, p, y0, t0, dt, n_steps, box, target, radius, pos, dist,
     ``pos`` (n + 1, N, 2), the distance to ``target`` (minus ``radius`` for a disc) ``dist`` (n + 1, N)
     (inf once frozen) and ``alive`` (N,)."""
     has_box = not math.isnan(box[0])
-    y = np.empty(4)
-    z = np.empty(4)
-    k1 = np.empty(4)
     for i in range(y0.shape[0]):
+        y = np.empty(4)
+        z = np.empty(4)
+        k1 = np.empty(4)
         for c in range(4):
             y[c] = y0[i, c]
         live = True
@@ -186,10 +186,10 @@ def trajectory_kernel(speed, p, y0, t0, duration, n_steps, nodes, slopes, store)
     states and slopes at the n + 1 nodes go to ``nodes`` and ``slopes`` (n + 1, K, 4)."""
     dt = duration / n_steps
     out = np.empty((y0.shape[0], 4))
-    y = np.empty(4)
-    z = np.empty(4)
-    k1 = np.empty(4)
     for i in range(y0.shape[0]):
+        y = np.empty(4)
+        z = np.empty(4)
+        k1 = np.empty(4)
         for c in range(4):
             y[c] = y0[i, c]
         for k in range(n_steps):

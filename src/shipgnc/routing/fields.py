@@ -755,10 +755,10 @@ def field_state(t, north, east, p, o):
             we = q[0] * (north - q[1])
             gnn, gne, gen, gee = 0.0, -q[0], q[0], 0.0
         elif kind == _GYRE:
-            k = q[1]
-            ph_e, ph_n = k * (east - q[3]), k * (north - q[2])
+            wave = q[1]  # π/L
+            ph_e, ph_n = wave * (east - q[3]), wave * (north - q[2])
             sa, ca, sb, cb = math.sin(ph_e), math.cos(ph_e), math.sin(ph_n), math.cos(ph_n)
-            u = q[0] * k
+            u = q[0] * wave
             wn, we = -q[0] * sa * cb, q[0] * ca * sb
             gnn, gne, gen, gee = u * sa * sb, -u * ca * cb, u * ca * cb, -u * sa * sb
         elif kind == _GRIDDED:

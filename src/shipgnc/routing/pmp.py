@@ -291,8 +291,10 @@ class _Shooter:
 #: an extremal reaches the target when it ends within this fraction of |AB| of it (at most ``tol_m``):
 #: a tolerance in the problem's own scale, so a 1 m problem is held to 0.1 mm, a 100 km one to 1 m
 MISS_REL = 1e-4
-#: the polish's first phase integrates with 1/COARSEN of the compiled steps (:func:`shoot`)
+#: the polish's first phase integrates with 1/COARSEN of the compiled steps (:func:`shoot`); on gridded
+#: data it drops a seed whose coarse miss stays above GRID_GATE·|AB|
 COARSEN = 8
+GRID_GATE = 1e-2
 
 
 def miss_tolerance(start, target, tol_m: float = 1.0) -> float:
@@ -318,15 +320,26 @@ def shoot(field, speed, start, target, theta0, duration, t0=0.0, radius=0.0, tol
     tol = miss_tolerance(start, target, tol_m)
     guess = [float(theta0), float(duration)]
     lm = {"method": "lm", "x_scale": [1.0, max(float(duration), 1.0)], "max_nfev": 60}
+    cf = extremal_kernels.compiled(field)
     try:
-        if extremal_kernels.compiled(field) is not None:
-            # first phase at 1/COARSEN of the steps (error ~10⁻⁷ of the fine one): a seed that does not
-            # converge there is dropped for an eighth of the work, one that does needs a few fine steps
+        if cf is not None:
+            # first phase at 1/COARSEN of the steps (error ~10⁻⁷ of the fine one on a smooth field): a
+            # seed that does not converge there is dropped for an eighth of the work; one that does needs
+            # a few fine iterations from the coarse solution. Across a grid's kinks coarse steps add
+            # spurious local minima of the miss: there the coarse phase only drops hopeless seeds (a miss
+            # above GRID_GATE·|AB|) and the fine phase starts from the seed itself
+            gridded = math.isfinite(cf.cell)
             sc = _Shooter(field, speed, start, target, t0, radius, rtol=rtol, effort=effort, coarsen=COARSEN)
             sol = least_squares(sc.residual, guess, jac=sc.jacobian, xtol=1e-12, ftol=1e-12, gtol=1e-12, **lm)
-            if not (sol.x[1] > 0 and np.all(np.isfinite(sol.fun)) and np.hypot(*sol.fun) <= 10 * tol):
+            gate = GRID_GATE * float(np.hypot(*np.subtract(target, start))) if gridded else 10 * tol
+            if not (sol.x[1] > 0 and np.all(np.isfinite(sol.fun)) and np.hypot(*sol.fun) <= gate):
                 return None
-            guess = [float(sol.x[0]), float(sol.x[1])]
+            if not gridded:
+                guess = [float(sol.x[0]), float(sol.x[1])]
+        if cf is not None and math.isfinite(cf.cell):
+            # gridded data: the miss is only piecewise smooth (the Jacobian jumps at cell edges), and LM
+            # with fixed scales stalls on kinks next to the solution; scaled by the Jacobian's columns
+            lm["x_scale"] = "jac"
         sh = _Shooter(field, speed, start, target, t0, radius, rtol=rtol, effort=effort)
         sol = least_squares(sh.residual, guess, jac=sh.jacobian, xtol=1e-15, ftol=1e-15, gtol=1e-15, **lm)
     except EffortExceeded:
@@ -499,7 +512,10 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
                and abs(k * dt - o.duration) <= 0.03 * o.duration for o in extremals):
             continue
         seeds.append((k, i))
-        ext = shoot(field, speed, start, target, th[i], k * dt, t0=t0, radius=radius, effort=effort)
+        seed = (th[i], k * dt)
+        if cf is not None:
+            seed = _refine_seed(cf, field, speed, start, target, th, i, k, dt, t0, radius)
+        ext = shoot(field, speed, start, target, *seed, t0=t0, radius=radius, effort=effort)
         if ext is None or ext.duration > horizon * (1 + 1e-9):
             continue
         if any(abs(ext.duration - o.duration) <= 1e-6 * o.duration
@@ -517,6 +533,26 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
             ext.status = "global optimum" if j == 0 else "local minimum, no conjugate point"
     return SweepResult(extremals, closest, closest_t, n_angles, float(horizon), n_left,
                        int(np.sum(~admissible)), effort)
+
+
+#: sub-angles between a candidate's neighbours in :func:`_refine_seed`
+REFINE_ANGLES = 64
+
+
+def _refine_seed(cf, field, speed, start, target, th, i, k, dt, t0, radius):
+    """A sweep candidate (θ_i, k·dt) refined on REFINE_ANGLES sub-angles between θ_{i−1} and θ_{i+1}
+    (the compiled family, same step): the closest approach of the finer fan. Where the extremals fan out
+    fast (a gyre's folds, a grid's kinks) the coarse fan's nearest approach can sit far from the
+    extremal through B, and Levenberg–Marquardt then fails from it."""
+    n = th.size
+    lo, hi = th[(i - 1) % n], th[(i + 1) % n]
+    sub = th[i] + np.linspace(math.remainder(lo - th[i], TWO_PI), math.remainder(hi - th[i], TWO_PI),
+                              REFINE_ANGLES + 1)
+    steps = k + 3
+    y0, _ = initial_state(field, speed, start, sub, t0)
+    _, dist, _ = extremal_kernels.family(cf, speed, y0, t0, steps * dt, steps, target, radius)
+    kk, j = np.unravel_index(np.argmin(dist), dist.shape)
+    return float(sub[j]), float(max(kk, 1) * dt)
 
 
 def _candidates(dist_tab, pos, n, step_len):

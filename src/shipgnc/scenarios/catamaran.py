@@ -5,7 +5,8 @@ A catamaran scenario names a ``case.builder`` and its ``case.options`` (the buil
 arguments, checked against its signature); ``vessel.preset``, ``simulation.t_end`` and
 ``simulation.dt`` are handed to the builder where it takes them. A builder may return several runs
 (e.g. laws (20) and (21)); they share the result's ``controller`` dimension and the metrics are
-keyed by run.
+keyed by run. The scenario's ``current`` section puts every run in that earth-fixed current
+(:func:`~shipgnc.cases.catamaran.with_current`; the hull forces on the velocity through the water).
 """
 
 from __future__ import annotations
@@ -87,6 +88,11 @@ def cases(scenario: Scenario) -> dict:
     if isinstance(built, CatamaranCase):
         law = getattr(built, "notes", {}).get("law")
         built = {f"law{law}" if law else cfg.builder: built}
+    if scenario.current is not None:  # every run in the same current, each with its own object
+        from shipgnc.cases.catamaran import with_current
+
+        for case in built.values():
+            with_current(case, scenario.current.build())
     return built
 
 
@@ -119,8 +125,8 @@ def run(scenario: Scenario, *, seed: int, progress=None, on_divergence: str = "r
         m = run.metrics(lambda ds, case=case: score(scenario, ds, case, case.controller))
         m["diverged"] = bool(ds.attrs.get("diverged", 0))
         results[key], metrics[key] = thin(ds, log_every // every), m
-        setups[key] = Setup(case.model, case.x0, case.actuator, case.controller, case.guidance, None,
-                            case=case)
+        setups[key] = Setup(case.model, case.x0, case.actuator, case.controller, case.guidance,
+                            case.disturbance, case=case)
         if run.interrupted:
             break
     first = next(iter(results))
@@ -166,7 +172,7 @@ def setup(scenario: Scenario, variant: str | None = None):
                           f"{case.dt:g} s, not simulation.t_end = {sim.t_end:g} s at dt = {sim.dt:g} s")
     actuator = case.actuator if case.actuator is not None else Actuator.for_model(case.model)
     return Setup(case.model, np.array(case.x0, dtype=float), actuator, case.controller, case.guidance,
-                 None, case=case)
+                 case.disturbance, case=case)
 
 
 def run_keys(scenario: Scenario) -> list[str]:

@@ -68,14 +68,33 @@ def controller(cfg, model, path: WaypointPath, scenario: Scenario):
                     rate_from_positions=not cfg.knows_disturbance, **known)
 
 
-def disturbance(d, path: WaypointPath):
-    """b_r, the cross current and the optional wave noise of note 000-0.6 (A9–A11), in SI."""
-    from shipgnc.environment.current import CrossCurrent
-    from shipgnc.environment.filtered_noise import SecondOrderNoise
-    from shipgnc.models.mariner import MarinerDisturbance
+def disturbance(d, path: WaypointPath, current=None):
+    """b_r, the current and the optional wave noise of note 000-0.6 (A9–A11), in SI.
 
-    current = CrossCurrent(d.d_y, path, frame=d.current_frame)
+    The current is the scenario's ``current`` section when it has one (``current``): an earth-fixed
+    field object
+    (uniform, Gauss–Markov, gridded) in :class:`~shipgnc.environment.current_field.CurrentDisturbance`
+    beside the yaw channel (:class:`~shipgnc.models.mariner.MarinerYawDisturbance`), as on the other
+    vessels; else document 000's cross current d_y (:class:`~shipgnc.environment.current.CrossCurrent`,
+    across the active leg or along east). ``d`` None: no b_r and no waves (None without a
+    current)."""
+    from shipgnc.environment.current import CrossCurrent
+    from shipgnc.environment.current_field import CurrentDisturbance
+    from shipgnc.environment.filtered_noise import SecondOrderNoise
+    from shipgnc.errors import require
+    from shipgnc.models.mariner import MarinerDisturbance, MarinerYawDisturbance
+
     waves = None
-    if d.wave_sigma > 0:  # the literal σ_w, or calibrated to a wave-frequency heading RMS
+    if d is not None and d.wave_sigma > 0:  # the literal σ_w, or calibrated to a heading RMS
         waves = SecondOrderNoise(d.wave_sigma, d.wave_period, d.wave_zeta)
-    return MarinerDisturbance(d.b_r, current=current, waves=waves)
+    b_r = 0.0 if d is None else d.b_r
+    if current is not None:
+        require(d is None or d.d_y_nm_min == 0.0, "disturbance.d_y_nm_min", d and d.d_y_nm_min,
+                "must be 0 with a current section (give the current once)")
+        field = current.build() if hasattr(current, "build") else current
+        return CurrentDisturbance(field, MarinerYawDisturbance(b_r, waves), n_force=1,
+                                  position_index=(0, 1))
+    if d is None:
+        return None
+    return MarinerDisturbance(b_r, current=CrossCurrent(d.d_y, path, frame=d.current_frame),
+                              waves=waves)

@@ -266,10 +266,11 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
         from shipgnc.scenarios import mariner
 
         path = mariner.mariner_path(scenario.guidance)
-        d = scenario.disturbance
+        d, current = scenario.disturbance, scenario.current
+        dist = None if d is None and current is None else mariner.disturbance(d, path, current)
         return Setup(model, x0, actuator,
                      mariner.controller(sampled(variants[name], scenario), model, path, scenario),
-                     None, None if d is None else mariner.disturbance(d, path), path=path,
+                     None, dist, path=path,
                      navigation=navigation(scenario, variants[name]))
     return Setup(model, x0, actuator, _controller(sampled(variants[name], scenario), model, scenario),
                  _guidance(scenario.guidance), _disturbance(scenario.disturbance, scenario), u0,

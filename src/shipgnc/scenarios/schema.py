@@ -603,7 +603,13 @@ class CurrentConfig(Strict):
     (``uniform:north=0,east=0.5`` [m/s], ``shear:k=..``, ``rotation:..``, vortices, a NetCDF file)
     or ``gauss-markov:speed=0.5,direction=90,speed_std=0.05,speed_tau=600,direction_std=10,
     direction_tau=900`` (m/s, degrees, s), joined with ``+``. A plain string is the ``field``.
-    Combines with the force ``disturbance`` (constant, gaussian, waves)."""
+    Combines with the force ``disturbance`` (constant, gaussian, waves; the Mariner's b_r and wave
+    noise). Vessels: :data:`CURRENT_VESSELS` — the boat, CyberShip II and the catamaran (its state
+    holds the velocity over ground, the hull forces see ν_r = ν − ν_c) and the Mariner (its u, r are
+    through the water; the current is added to its kinematics). A catamaran scenario's current acts
+    on every run of its case. The Mariner's document-000 cross current ``d_y_nm_min`` is a second,
+    legacy current: with a ``current`` section it must be 0, and a controller that
+    ``knows_disturbance`` (the document's oracle) is refused, since it knows b_r and d_y only."""
 
     field: Annotated[str, Field(min_length=1)]
 
@@ -631,7 +637,7 @@ class CurrentConfig(Strict):
 
 
 #: vessel models a scenario's ``current`` section applies to
-CURRENT_VESSELS = ("vectored-thrust-boat", "cybership2")
+CURRENT_VESSELS = ("vectored-thrust-boat", "cybership2", "catamaran", "mariner")
 
 
 class WavesConfig(Strict):
@@ -661,20 +667,26 @@ class WavesConfig(Strict):
 
 class MarinerDisturbanceConfig(Strict):
     """Document 000's disturbances in its units (notes 000-0.6, 000-A9–000-A11): yaw acceleration
-    ``b_r_rad_min2`` added to ṙ, cross current ``d_y_nm_min`` across the active leg
-    (``current_frame: path``) or along east (``global``), and narrow-band wave noise added to ṙ of
+    ``b_r_rad_min2`` added to ṙ, cross current ``d_y_nm_min`` along east (``current_frame:
+    global``, the default: earth-fixed) or across the active leg (``path``: the document's reading,
+    A10, which turns the current at every waypoint; every document-000 scenario sets it), and
+    narrow-band wave noise added to ṙ of
     RMS ``wave_sigma_rad_min2`` (0 = off), period ``wave_period`` [s], damping ``wave_zeta``
     (seeded by ``simulation.seed``).
 
     ``wave_heading_sigma_deg`` calibrates the noise to a sea state instead: σ_w =
     ω₀²·σ_ψw, ω₀ = 2π/``wave_period``, so that the free ship's wave-frequency heading has RMS
     σ_ψw (its yaw rate σ_ψw·ω₀; :func:`shipgnc.environment.filtered_noise.calibrated_yaw_sigma`).
-    Set it or ``wave_sigma_rad_min2``, not both."""
+    Set it or ``wave_sigma_rad_min2``, not both.
+
+    Any other current (a field, Gauss–Markov, gridded data) is the scenario's ``current`` section
+    (:class:`CurrentConfig`); with one, ``d_y_nm_min`` must be 0 and the section may be left out
+    (then b_r = 0 and no waves)."""
 
     type: Literal["mariner"]
     b_r_rad_min2: Finite = 0.1
     d_y_nm_min: Finite = 0.04
-    current_frame: Literal["path", "global"] = "path"
+    current_frame: Literal["path", "global"] = "global"
     wave_sigma_rad_min2: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
     wave_heading_sigma_deg: Annotated[float, Field(ge=0, le=30, allow_inf_nan=False)] | None = None
     wave_period: Annotated[float, Field(ge=0.5, le=600, allow_inf_nan=False)] = 8.0
@@ -910,7 +922,7 @@ class Scenario(Strict):
     sail: SailConfig | None = None
     #: the document's own figures, by controller (shown beside ours in comparison tables)
     document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
-    #: an earth-fixed current on the vessel (boat, CyberShip II), with any force disturbance
+    #: an earth-fixed current on the vessel (:data:`CURRENT_VESSELS`), with any force disturbance
     current: CurrentConfig | None = None
     #: navigation: the sensors between the true state and the controller, and an
     #: estimator between the sensors and the controller (the controller acts on its estimate)
@@ -923,12 +935,33 @@ class Scenario(Strict):
         if current is None:
             return current
         vessel = getattr(info.data.get("vessel"), "model", None)
-        if info.data.get("route") is not None or info.data.get("case") is not None or (
-                vessel not in CURRENT_VESSELS):
+        if info.data.get("route") is not None or vessel not in CURRENT_VESSELS:
+            what = "a route" if info.data.get("route") is not None else f"vessel model {vessel!r}"
             raise ValueError(f"a current section applies to vessel models "
-                             f"{', '.join(CURRENT_VESSELS)} (the Mariner's current is its "
-                             f"disturbance's d_y; a route takes its field from route.field)")
+                             f"{', '.join(CURRENT_VESSELS)}, not to {what} (a route takes its "
+                             f"field from route.field)")
         return current
+
+    @model_validator(mode="after")
+    def _mariner_current(self) -> Scenario:
+        """The Mariner's ``current`` section: one current (d_y = 0), no oracle controller (the
+        runner hands it to :func:`shipgnc.scenarios.mariner.disturbance`)."""
+        if self.current is None or self.vessel.model != "mariner" or self.route is not None:
+            return self
+        d = self.disturbance
+        if d is None or d.type != "mariner":
+            return self
+        if d.d_y_nm_min != 0.0:
+            raise ValueError(f"disturbance.d_y_nm_min = {d.d_y_nm_min!r} with a current section: "
+                             f"give the current once — set d_y_nm_min: 0 (document 000's cross "
+                             f"current) or leave the current section out")
+        for name, ctrl in self.variants.items():
+            if getattr(ctrl, "knows_disturbance", False):
+                where = "controller" if self.controller is not None else f"controllers.{name}"
+                raise ValueError(f"{where}.knows_disturbance = true with a current section: the "
+                                 f"document's oracle law knows b_r and d_y only, not the current; "
+                                 f"set knows_disturbance: false (integral LOS for los-fl)")
+        return self
 
     @property
     def variants(self) -> dict[str, object]:
@@ -940,15 +973,16 @@ class Scenario(Strict):
         be silently ignored, so :func:`~shipgnc.scenarios.registry.load_scenario` refuses it.
         Every scenario reads its identity (``name``, ``description``, ``document``, ``metrics``,
         ``document_figures``); a route reads ``route`` and ``sail``; a catamaran case
-        ``vessel``, ``simulation`` and ``case``; the others their vessel, simulation,
+        ``vessel``, ``simulation``, ``case`` and ``current``; the others their vessel, simulation,
         controller(s), guidance and disturbance, plus ``actuator`` (the boat), ``montecarlo``
-        (the Mariner) and ``quality`` (document 003's index)."""
+        (the Mariner), ``current`` (:data:`CURRENT_VESSELS`) and ``quality`` (document 003's
+        index)."""
         common = ("name", "description", "document", "metrics", "document_figures")
         if self.route is not None:
             return (*common, "route", "sail")
         vessel = self.vessel.model
         if vessel == "catamaran":
-            return (*common, "vessel", "simulation", "case")
+            return (*common, "vessel", "simulation", "case", "current")
         used = [*common, "vessel", "simulation", "controller", "controllers", "guidance",
                 "disturbance"]
         used += {"vectored-thrust-boat": ["actuator"], "mariner": ["montecarlo"]}.get(vessel, [])

@@ -1,0 +1,181 @@
+"""The router's compiled extremals against their numpy references (notes 002-2.9.1, 002-2.9.4).
+
+* :func:`~shipgnc.routing.fields.field_state` equals every field's numpy ``_velocity`` and ``_jacobian``
+  (analytic terms, sums, tides, a moving vortex, the double gyre, bilinear grids steady and in time,
+  clamped at the grid's edge as the unchecked numpy evaluation is);
+* the RK4 family kernel equals ``integrate_family``'s numpy loop, extremals leaving a grid frozen alike;
+* a polish on the compiled integrator equals the adaptive ``solve_ivp`` polish of the same field (a
+  wrapper without a compiled form) to 1e-9, and the sweep finds the same extremals;
+* each field's rate bound bounds ‖J‖ (it sets the fixed step);
+* the double gyre is divergence-free with the Jacobian of its velocity; a drifting vortex is the steady
+  one shifted; a gridded gyre routes to the analytic gyre's time within its interpolation error.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from shipgnc.routing import extremal_kernels as ek
+from shipgnc.routing import fields as F
+from shipgnc.routing import pmp
+from shipgnc.routing.field_spec import parse_field
+from shipgnc.routing.fields import field_state
+
+GRID = np.linspace(-0.5, 3.5, 101)
+GYRE = F.DoubleGyre(1.0, 1.0, (0.5, 0.5))
+MOVING = F.LambOseenVortex(2.0, 0.5, (0.1, 0.2), (0.01, -0.02))
+
+
+class NumpyOnly(F.CurrentField):
+    """The same field without a compiled form: the router integrates it with numpy and solve_ivp."""
+
+    def __init__(self, field):
+        self.field, self.steady, self.bounds = field, field.steady, field.bounds
+
+    def velocity(self, t, north, east):
+        return self.field._velocity(t, north, east)
+
+    def jacobian(self, t, north, east):
+        return self.field._jacobian(t, north, east)
+
+
+FIELDS = {
+    "uniform": F.UniformCurrent(0.3, -0.1),
+    "affine": F.AffineCurrent((0.1, 0.0), ((0.01, 0.02), (-0.03, 0.0)), (1.0, 2.0)),
+    "rotation": F.RigidRotation(0.2, (1.0, 1.0)),
+    "lamb-oseen": F.LambOseenVortex(2.0, 0.5, (0.1, 0.2)),
+    "rankine": F.RankineVortex(1.0, 1.0, (0.5, 0.5)),
+    "moving vortex": MOVING,
+    "gyre": GYRE,
+    "tidal sum": F.Modulated(F.shear(0.1) + F.RigidRotation(0.2, (1.0, 1.0)), 1.0, 0.5, 30.0, 0.3),
+    "grid": F.GriddedCurrent(F.sample_field(GYRE, GRID, GRID)),
+    "grid in time": F.GriddedCurrent(F.sample_field(MOVING, GRID, GRID, times=[0.0, 10.0, 25.0])),
+    "grid + uniform": F.GriddedCurrent(F.sample_field(GYRE, GRID, GRID)) + F.UniformCurrent(0.1, 0.0),
+}
+
+
+@pytest.mark.parametrize("name", FIELDS)
+def test_field_state_equals_the_numpy_field(name):
+    field = FIELDS[name]
+    _, params = field.current_kernel(0.0, grids=True)
+    rng = np.random.default_rng(7)
+    worst = 0.0
+    for t, n, e in zip(rng.uniform(-5, 40, 300), rng.uniform(-1, 4, 300), rng.uniform(-1, 4, 300),
+                       strict=True):  # some points off the grids: clamped as _velocity clamps
+        ref = np.concatenate([field._velocity(t, n, e), field._jacobian(t, n, e).ravel()])
+        got = np.array(field_state(t, n, e, params, 0))
+        worst = max(worst, float(np.max(np.abs(got - ref)) / max(1.0, np.max(np.abs(ref)))))
+    assert worst <= 1e-13
+
+
+@pytest.mark.parametrize("name", FIELDS)
+def test_the_rate_bound_bounds_the_jacobian(name):
+    field = FIELDS[name]
+    rng = np.random.default_rng(3)
+    j = field._jacobian(rng.uniform(0, 30, 5000), rng.uniform(-0.5, 3.5, 5000), rng.uniform(-0.5, 3.5, 5000))
+    assert np.max(np.sqrt(np.sum(j * j, axis=(-2, -1)))) <= field.rate_bound() * (1 + 1e-12)
+
+
+def test_a_ships_current_on_a_grid_stays_in_numpy():
+    from shipgnc.kernels import NotCompiled
+
+    with pytest.raises(NotCompiled, match="GriddedCurrent has no kernel"):
+        FIELDS["grid"].current_kernel()
+
+
+@pytest.mark.parametrize("name", ["rankine", "gyre", "grid", "grid in time", "tidal sum"])
+def test_the_family_kernel_equals_the_numpy_loop(name):
+    field = FIELDS[name]
+    start = np.array([0.6, 0.6])
+    theta = np.linspace(0.0, 2 * math.pi, 64, endpoint=False)
+    steps = []
+
+    def record(k, t, y, alive):
+        steps.append((y[:, :2].copy(), alive.copy()))
+
+    pmp.integrate_family(field, 1.0, start, theta, 0.0, 3.0, 300, record=record)  # numpy reference
+    y0, _ = pmp.initial_state(field, 1.0, start, theta, 0.0)
+    pos, _, alive = ek.family(ek.compiled(field), 1.0, y0, 0.0, 3.0, 300, np.array([2.4, 2.4]), 0.0)
+    ref = np.stack([s[0] for s in steps])
+    assert np.array_equal(alive, steps[-1][1])
+    assert np.max(np.abs(pos[1:] - ref)) <= 1e-10 * max(1.0, np.max(np.abs(ref)))
+    if field.bounds is not None:  # the grid is left by some extremals, frozen where they left it
+        assert 0 < np.sum(~alive) < theta.size
+
+
+@pytest.mark.parametrize("name, start, target, seed", [
+    ("rankine", (0.5, 0.2), (0.5, 1.3), (5.45, 55.0)),
+    ("gyre", (0.6, 0.6), (2.4, 2.4), (0.9, 2.9)),
+    ("tidal sum", (0.0, 0.0), (2.0, 1.0), (0.5, 2.0)),
+])
+def test_a_compiled_polish_equals_the_adaptive_one(name, start, target, seed):
+    speed = 0.01 if name == "rankine" else 1.0
+    field = FIELDS[name]
+    fast = pmp.shoot(field, speed, start, target, *seed)
+    ref = pmp.shoot(NumpyOnly(field), speed, start, target, *seed)
+    assert fast is not None and ref is not None
+    assert fast.duration == pytest.approx(ref.duration, rel=1e-9)
+    assert math.remainder(fast.theta0 - ref.theta0, 2 * math.pi) == pytest.approx(0.0, abs=1e-7)
+    t = np.linspace(fast.t0, fast.t_end, 50)  # the dense outputs (Hermite nodes vs DOP853) agree
+    assert np.max(np.abs(fast.position(t) - ref.position(t))) <= 1e-7 * np.hypot(*np.subtract(target, start))
+
+
+def test_the_gyre_sweep_finds_the_same_extremals():
+    # the gyre has a dozen extremals through B below 4 s; the compiled sweep (with its coarse first
+    # polish phase) and the numpy one polish the same candidates, and a seed between two basins may
+    # land in either: the optimum and nearly all of the others agree
+    fast = pmp.sweep(GYRE, 1.0, (0.6, 0.6), (2.4, 2.4), horizon=4.0, conjugate=False)
+    ref = pmp.sweep(NumpyOnly(GYRE), 1.0, (0.6, 0.6), (2.4, 2.4), horizon=4.0, conjugate=False)
+    assert fast.extremals[0].duration == pytest.approx(ref.extremals[0].duration, rel=1e-9)
+    ours = np.array([e.duration for e in fast.extremals])
+    found = [np.any(np.abs(ours / e.duration - 1) <= 1e-9) for e in ref.extremals]
+    assert len(ref.extremals) >= 10 and np.mean(found) >= 0.8
+
+
+def test_the_double_gyre_is_divergence_free_with_its_jacobian():
+    rng = np.random.default_rng(1)
+    n, e = rng.uniform(-2, 2, 200), rng.uniform(-2, 2, 200)
+    j = GYRE.jacobian(0.0, n, e)
+    assert np.max(np.abs(j[:, 0, 0] + j[:, 1, 1])) <= 1e-12
+    h = 1e-6
+    dn = (GYRE.velocity(0.0, n + h, e) - GYRE.velocity(0.0, n - h, e)) / (2 * h)
+    de = (GYRE.velocity(0.0, n, e + h) - GYRE.velocity(0.0, n, e - h)) / (2 * h)
+    assert np.max(np.abs(np.stack([dn, de], axis=-1) - j)) <= 1e-8
+    # no flow across a cell's edge: v_N = 0 on the line e′ = 0 (sin(π e′) = 0)
+    assert np.allclose(GYRE.velocity(0.0, n, 0.5)[:, 0], 0.0, atol=1e-15)
+
+
+def test_a_drifting_vortex_is_the_steady_one_shifted():
+    steady = F.LambOseenVortex(2.0, 0.5, (0.1, 0.2))
+    t = 7.0
+    shift = np.array(MOVING.drift) * t
+    n, e = np.linspace(-1, 2, 11), np.linspace(0, 3, 11)
+    assert not MOVING.steady and steady.steady
+    np.testing.assert_allclose(MOVING.velocity(t, n, e), steady.velocity(0.0, n - shift[0], e - shift[1]),
+                               rtol=1e-12, atol=1e-15)
+    assert parse_field("lamb-oseen:gamma=2,rc=0.5,north=0.1,east=0.2,drift_north=0.01,drift_east=-0.02") \
+        == MOVING
+    assert parse_field("gyre:speed=1,length=1,north=0.5,east=0.5") == GYRE
+
+
+def test_the_gridded_gyre_routes_to_the_analytic_time():
+    # the classic double gyre: a 101×101 bilinear grid over [−0.5, 3.5]² m (0.04 m
+    # cells) moves the optimum by the interpolant's error, O(h²·π²/8) ≈ 2·10⁻³ of the speed at most
+    grid = FIELDS["grid"]
+    a = pmp.sweep(GYRE, 1.0, (0.6, 0.6), (2.4, 2.4), horizon=3.0, conjugate=False).extremals[0]
+    g = pmp.sweep(grid, 1.0, (0.6, 0.6), (2.4, 2.4), horizon=3.0, conjugate=False).extremals[0]
+    assert g.duration == pytest.approx(a.duration, rel=2e-3)
+    assert a.duration < math.hypot(1.8, 1.8)  # the gyre helps: faster than the straight line in still water
+
+
+def test_the_step_follows_the_field():
+    cf = ek.compiled(GYRE)
+    n = cf.steps(1.0, 10.0)
+    assert n == math.ceil(10.0 * GYRE.rate_bound() / ek.TURN_PER_STEP)
+    grid = ek.compiled(FIELDS["grid"])
+    assert grid.cell == pytest.approx(0.04)
+    assert ek.compiled(F.UniformCurrent(0.1, 0.0)).steps(1.0, 1e6) == ek.MIN_STEPS
+    assert ek.compiled(NumpyOnly(GYRE)) is None
