@@ -19,8 +19,8 @@ from __future__ import annotations
 import math
 
 import pytest
-from scipy.optimize import brentq
 
+from shipgnc.routing.closed_form import rotation_time
 from shipgnc.routing.fields import RankineVortex
 from shipgnc.routing.pmp import MISS_REL
 from shipgnc.routing.router import agreement_tolerance, solve_route
@@ -30,17 +30,7 @@ V = 0.01
 
 def closed_form(scale: float) -> float:
     gamma, rc = 1.0 * scale, 1.0 * scale
-    a, b = 0.3 * scale, 0.8 * scale
-    omega = gamma / (2 * math.pi * rc**2)
-
-    def gap(T):
-        return math.sqrt(a * a + b * b + 2 * a * b * math.cos(omega * T)) - V * T
-
-    # |B' − A'| − VT starts at a + b > 0; its first zero, bracketed on a fine scan
-    T, step = 0.0, 0.5 * scale
-    while gap(T + step) > 0:
-        T += step
-    return brentq(gap, T, T + step, xtol=1e-12 * scale)
+    return rotation_time(gamma / (2 * math.pi * rc**2), V, 0.3 * scale, 0.8 * scale)
 
 
 def problem(scale: float):

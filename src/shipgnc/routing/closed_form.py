@@ -1,6 +1,6 @@
 """Closed forms and exact checks of document 002: the linear shear (note 002-2.5), uniform and tidal
-currents (2.10, F1,
-F1b, 2.9.5) and the straight course (F6). SI throughout: m, s, m/s, rad, k in 1/s.
+currents (2.10, F1, F1b, 2.9.5), a rigid rotation (a Rankine vortex's core) and the straight course
+(F6). SI throughout: m, s, m/s, rad, k in 1/s.
 """
 
 from __future__ import annotations
@@ -182,6 +182,24 @@ def tidal_uniform_solution(speed, drift, start, target, horizon, n_scan=20000):
     tf = brentq(lambda x: float(g(np.asarray(x))), t[idx[0]], t[idx[0] + 1], xtol=1e-10, rtol=1e-15)
     w = d - drift(np.asarray(tf))
     return tf, float(np.mod(math.atan2(w[1], w[0]), TWO_PI))
+
+
+def rotation_time(omega, speed, a, b) -> float:
+    """Minimum time through a rigid rotation ω [rad/s] (a Rankine vortex's core) from A to B on a line
+    through the centre, on opposite sides at distances a and b [m], the route staying in the rotation.
+
+    In the frame turning with the water the route is a straight line sailed at V towards B, which runs
+    backwards round the centre there: T is the first root of a² + b² + 2ab·cos(ωT) = (VT)² — scale-free
+    (lengths × s and ω fixed give T × s)."""
+    from scipy.optimize import brentq
+
+    def gap(t):
+        return math.sqrt(a * a + b * b + 2 * a * b * math.cos(omega * t)) - speed * t
+
+    t, step = 0.0, (a + b) / speed / 200.0  # the gap starts at a + b > 0; its first zero, bracketed
+    while gap(t + step) > 0:
+        t += step
+    return brentq(gap, t, t + step, xtol=1e-12 * (a + b) / speed)
 
 
 # --------------------------------------------------------------------------- straight course (F6)
