@@ -16,17 +16,16 @@ import json
 import math
 import xml.etree.ElementTree as ET
 
+import gpxpy
 import numpy as np
+import pyproj
 import pytest
+import shapely
+import xarray as xr
 
-pyproj = pytest.importorskip("pyproj")
-shapely = pytest.importorskip("shapely")
-gpxpy = pytest.importorskip("gpxpy")
-xr = pytest.importorskip("xarray")
-
-from shipgnc.errors import ConfigError  # noqa: E402
-from shipgnc.routing.geo.router import GeoProblem  # noqa: E402
-from shipgnc.routing.geo.timefmt import iso, parse_iso  # noqa: E402
+from shipgnc.errors import ConfigError
+from shipgnc.routing.geo.router import GeoProblem
+from shipgnc.routing.geo.timefmt import iso, parse_iso
 
 GEOD = pyproj.Geod(ellps="WGS84")
 T0 = parse_iso("2026-06-01T00:00Z")

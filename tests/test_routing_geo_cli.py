@@ -6,18 +6,16 @@ from __future__ import annotations
 import json
 import math
 
+import gpxpy
 import numpy as np
 import pytest
+import shapely
+import xarray as xr
+from typer.testing import CliRunner
 
-pytest.importorskip("pyproj")
-shapely = pytest.importorskip("shapely")
-gpxpy = pytest.importorskip("gpxpy")
-xr = pytest.importorskip("xarray")
-from typer.testing import CliRunner  # noqa: E402
-
-from shipgnc.cli import app  # noqa: E402
-from shipgnc.errors import ConfigError  # noqa: E402
-from shipgnc.routing.geo.router import GeoProblem  # noqa: E402
+from shipgnc.cli import app
+from shipgnc.errors import ConfigError
+from shipgnc.routing.geo.router import GeoProblem
 
 runner = CliRunner()
 TODAY = ("reachable", "time_s", "time_h", "heading_start_deg", "heading_end_deg", "miss_m", "method", "extremals",

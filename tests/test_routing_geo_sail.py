@@ -8,19 +8,16 @@ import json
 import math
 
 import numpy as np
+import pyproj
 import pytest
+from typer.testing import CliRunner
 
-pyproj = pytest.importorskip("pyproj")
-pytest.importorskip("shapely")
-pytest.importorskip("xarray")
-from typer.testing import CliRunner  # noqa: E402
-
-from shipgnc.cli import app  # noqa: E402
-from shipgnc.errors import ConfigError  # noqa: E402
-from shipgnc.models.mariner import MarinerWitOppe  # noqa: E402
-from shipgnc.routing.geo.router import GeoProblem  # noqa: E402
-from shipgnc.routing.geo.sail import choose_vessel, sail_check  # noqa: E402
-from shipgnc.units import KNOT, NAUTICAL_MILE  # noqa: E402
+from shipgnc.cli import app
+from shipgnc.errors import ConfigError
+from shipgnc.models.mariner import MarinerWitOppe
+from shipgnc.routing.geo.router import GeoProblem
+from shipgnc.routing.geo.sail import choose_vessel, sail_check
+from shipgnc.units import KNOT, NAUTICAL_MILE
 
 runner = CliRunner()
 MARINER = MarinerWitOppe()

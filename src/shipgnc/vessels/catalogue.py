@@ -170,7 +170,7 @@ def register(entry: VesselEntry) -> VesselEntry:
 
 register(VesselEntry(
     name="mariner-cst", title="Mariner-class cargo ship, nonlinear manoeuvring model",
-    source="Chislett & Strøm-Tejsen (1965), Report Hy-5, HyA Lyngby; Fossen (2021) Handbook of "
+    source="Chislett & Strøm-Tejsen (1965), Int. Shipbuilding Progress 12(129); Fossen (2021) Handbook of "
            "Marine Craft Hydrodynamics and Motion Control, MSS mariner.m",
     length_m=160.93, design_speed_mps=7.7175, speed_range_mps=(10 * KNOT, 20 * KNOT),
     max_rudder_rad=math.radians(40.0), max_rudder_rate_rad_s=math.radians(5.0),

@@ -1,8 +1,9 @@
 """Mariner-class cargo ship: the nonlinear manoeuvring model of Chislett & Strøm-Tejsen (1965).
 
 Source: M. S. Chislett and J. Strøm-Tejsen (1965), *Planar Motion Mechanism Tests and Full-Scale
-Steering and Manoeuvring Predictions for a Mariner Class Vessel*, Technical Report Hy-5, Hydro-
-and Aerodynamics Laboratory, Lyngby, Denmark; as given in T. I. Fossen (2021), *Handbook of Marine
+Steering and Manoeuvring Predictions for a Mariner Class Vessel*, International Shipbuilding Progress
+12(129), 201–224 (also Report Hy-6, Hydro- and Aerodynamics Laboratory, Lyngby, Denmark; MSS cites it as
+"Report Hy-5", the number of Abkowitz's 1964 lectures); as given in T. I. Fossen (2021), *Handbook of Marine
 Craft Hydrodynamics and Motion Control*, 2nd ed., Wiley (Mariner-class vessel, §7.2 / Appendix),
 and his MSS toolbox function ``mariner.m`` (the coefficient table below is that function's, checked
 against it). Distinct from document 000's de Wit–Oppe ``mariner`` (:mod:`shipgnc.models.mariner`).
