@@ -1,7 +1,7 @@
 """``shipgnc route``: time-optimal route in a current (note 002-2.9.6).
 
     shipgnc route --start N,E --target N,E --speed V --field FIELD [--method auto|pmp|levelset|graph]
-                  [--obstacles FILE.geojson] [--units si|nautical] [--json] [--out DIR]
+                  [--obstacles FILE.geojson] [--units si|nautical] [--json] [--out DIR] [--max-memory 4G]
     shipgnc route --geo --start LAT,LON --target LAT,LON --speed V --field FILE.nc|uniform:..|still
                   [--depart 2026-06-01T06:00Z] [--land default|none|FILE] [--depth FILE.nc --draft M --ukc M]
                   [--xte-m 100] [--sail [--sail-vessel auto|boat|mariner]] [--json] [--out DIR]
@@ -13,6 +13,11 @@ route.geojson, route.rtz, route.json and route.png; the JSON adds ``distance_nm`
 (:func:`shipgnc.routing.geo.sail.sail_check`, the ``sail_*`` keys): the Otter-class boat or the Mariner
 (``--sail-vessel``) sails the exported waypoints with LOS guidance through the same current.
 
+Before any work the memory the method needs is estimated (:mod:`shipgnc.routing.memory`: the sweep's
+family tables, the level set's grids and stored fronts, the graph's edges); beyond the memory available
+(or ``--max-memory``) the command stops with one line naming the estimate (exit 2). On a terminal a progress
+display on stderr follows the sweep's polish and the level set's advance (nothing when stderr is a pipe).
+
 SI by default; ``--units nautical`` reads positions in nm, speeds in kn, k and ω in 1/h, Γ in nm²/h and prints
 times in h beside s. JSON keys stay SI. Exit codes: 0 a route, 2 bad input, 3 unreachable (one-line reason on
 stderr, ``reachable: false`` in the JSON), 1 internal error.
@@ -23,6 +28,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
@@ -81,6 +87,9 @@ def route(
                                              "when the speed is within its reach, else the Mariner) | boat "
                                              "(2 m, up to ≈ 2.3 m/s) | mariner (161 m, sails at 15 kn "
                                              "only).")] = "auto",
+    max_memory: Annotated[str | None, typer.Option(
+        "--max-memory", help="Memory the route may hold, e.g. 4G or 500M (default: the memory "
+                             "available now); a larger estimate is refused before any work.")] = None,
 ) -> None:
     """Time-optimal route through a current field (Zermelo's problem)."""
     from shipgnc.cli import friendly_errors, stderr, stdout
@@ -96,6 +105,9 @@ def route(
             check_out(out)  # before any work
         require(units in ("si", "nautical"), "--units", units, "allowed: si, nautical")
         require(method in METHODS, "--method", method, f"allowed: {', '.join(METHODS)}")
+        from shipgnc.cli_sweep import parse_size
+
+        limit = None if max_memory is None else parse_size(max_memory, "--max-memory")
         nautical = units == "nautical"
         length = NAUTICAL_MILE if nautical else 1.0
         vel = KNOT if nautical else 1.0
@@ -103,7 +115,7 @@ def route(
         if geo:
             _geo_route(start, target, speed * vel, field, method, obstacles, units, json_, out, horizon,
                        radius, depart, grid, land, depth, draft, ukc, xte_m, length, tscale, sail,
-                       sail_vessel)
+                       sail_vessel, limit)
             return
         depart_value = _number(depart, "--depart", "s | h; an ISO 8601 time needs --geo")
         geo_only = [name for name, given in (("--depth", depth is not None), ("--land", land != "default"),
@@ -121,9 +133,18 @@ def route(
             from shipgnc.routing.obstacles import load_geojson
 
             polys = load_geojson(obstacles, units)
-        res = solve_route(fld, speed * vel, a, b, method=method, obstacles=polys, radius=radius * length,
-                          t0=depart_value * tscale, horizon=None if horizon is None else horizon * tscale,
-                          grid_spacing=None if grid is None else grid * length)
+        from shipgnc.routing.memory import route_memory_estimate
+        from shipgnc.routing.router import _validate
+
+        t_h = None if horizon is None else horizon * tscale
+        spacing = None if grid is None else grid * length
+        _validate(fld, speed * vel, a, b, depart_value * tscale, radius * length)  # the router's own errors
+        _check_memory(route_memory_estimate(fld, speed * vel, a, b, method=method, grid_spacing=spacing,
+                                            horizon=t_h, obstacles=polys, t0=depart_value * tscale,
+                                            radius=radius * length), limit)
+        with _progress() as progress:
+            res = solve_route(fld, speed * vel, a, b, method=method, obstacles=polys, radius=radius * length,
+                              t0=depart_value * tscale, horizon=t_h, grid_spacing=spacing, progress=progress)
         payload = res.to_json()
         text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
         if out is not None:  # atomic: a temporary directory moved into place when complete
@@ -153,8 +174,52 @@ def _number(text: str, name: str, rule: str) -> float:
     return value
 
 
+def _check_memory(need, limit: float | None) -> None:
+    """A ConfigError (exit 2, one line) when the estimate ``need``
+    (:class:`~shipgnc.routing.memory.RouteMemory`) exceeds ``limit`` bytes (default: the memory
+    available now, as ``shipgnc sweep`` measures it)."""
+    from shipgnc.routing.memory import format_bytes
+    from shipgnc.study.execute import available_memory
+
+    have = available_memory() if limit is None else limit
+    if need.total <= have:
+        return
+    what = f"{format_bytes(have)} is available" if limit is None else f"--max-memory is {format_bytes(have)}"
+    hint = {"level set": "use a coarser --grid, a shorter --horizon or --method pmp",
+            "graph": "use a coarser --grid or another --method",
+            "sweep": "use --method levelset"}.get(need.largest(), "")
+    raise ConfigError(f"route: needs about {format_bytes(need.total)} ({need.describe()}) but {what}; "
+                      f"{hint + ', or ' if hint else ''}raise --max-memory")
+
+
+@contextmanager
+def _progress():
+    """A ``progress(stage, fraction)`` callback drawing a rich progress display on stderr, one bar per
+    stage (the sweep's polish, the level set's advance), cleared when done; None when stderr is not a
+    terminal (pipes and tests see nothing, and the router does no extra work)."""
+    from shipgnc.cli import stderr
+
+    if not stderr.is_terminal:
+        yield None
+        return
+    from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeElapsedColumn
+
+    labels = {"extremals": "extremals: polishing candidates", "level set": "level set: share of the horizon"}
+    with Progress(TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(), TimeElapsedColumn(),
+                  console=stderr, transient=True) as bar:
+        tasks: dict = {}
+
+        def update(stage: str, fraction: float) -> None:
+            if stage not in tasks:
+                tasks[stage] = bar.add_task(labels.get(stage, stage), total=1.0)
+            bar.update(tasks[stage], completed=fraction)
+
+        yield update
+
+
 def _geo_route(start, target, speed, field, method, obstacles, units, json_, out, horizon, radius, depart,
-               grid, land, depth, draft, ukc, xte_m, length, tscale, sail=False, sail_vessel="auto") -> None:
+               grid, land, depth, draft, ukc, xte_m, length, tscale, sail=False, sail_vessel="auto",
+               limit=None) -> None:
     """``route --geo`` (docs/routing_geo.md)."""
     from shipgnc.cli import stderr, stdout
     from shipgnc.errors import require
@@ -185,7 +250,19 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     if iso_depart is None and problem.current.times is None and offset:
         raise ConfigError(f"--depart = {depart!r}: the current has no time axis; give an ISO 8601 UTC time")
     t_dep = problem.departure(iso_depart, offset)
-    res = problem.solve(t_dep, method=method, horizon=None if horizon is None else horizon * tscale)
+    from shipgnc.routing.memory import levelset_memory, route_memory_estimate
+
+    t_h = None if horizon is None else horizon * tscale
+    fld = problem.field_from(t_dep)
+    if problem.router_obstacles or (problem.current.grid is not None and method in ("auto", "levelset")):
+        need = levelset_memory(fld, speed, problem.A, problem.B, problem.box, problem.h, horizon=t_h,
+                               r0=1.2 * problem.h, n_rays=360, ray_steps=20)  # routing.geo.frontier
+    else:
+        need = route_memory_estimate(fld, speed, problem.A, problem.B, method=method, grid_spacing=problem.h,
+                                     domain=problem.box, horizon=t_h)
+    _check_memory(need, limit)
+    with _progress() as progress:
+        res = problem.solve(t_dep, method=method, horizon=t_h, progress=progress)
     payload = res.to_json()
     if sail and res.reachable:
         from shipgnc.routing.geo.sail import sail_check

@@ -326,7 +326,7 @@ def _initial_radius(spacing, dist, start, obstacles):
 
 def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizon=None, obstacles=None,
                  cfl=0.5, store_every=None, recover=True, compiled=True, band=6, r0=None, n_rays=720,
-                 ray_steps=60) -> LevelSetResult:
+                 ray_steps=60, progress=None) -> LevelSetResult:
     """Propagate the reachability front from ``start`` until it covers ``target`` (note 002-2.9.2).
 
     ``domain`` = ((north_min, north_max), (east_min, east_max)) [m]; ``spacing`` h [m]; ``obstacles`` a
@@ -338,7 +338,8 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     time-varying field (:class:`~shipgnc.routing.fields.GriddedCurrent`) is interpolated onto the grid one
     time slice at a time (:class:`_GridSlices`, equal results). Returns a :class:`LevelSetResult`.
     ``compiled=False`` uses the numpy reference of the right-hand side (:func:`front_rate`) instead of its
-    numba twin.
+    numba twin. ``progress(fraction)``, if given, is called after every step with the fraction of the
+    horizon's steps done (rising, 1.0 when the loop ends: at the arrival or the horizon).
     """
     from shipgnc.routing import pmp
 
@@ -446,6 +447,8 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
             steps += 1
             history_t.append(t)
             history_phi.append(float(phi[ib, jb]))
+            if progress is not None:
+                progress(steps / max_steps)
             if steps % store_every == 0:
                 snaps_t.append(t)
                 snaps.append(phi.astype(np.float32))
@@ -454,6 +457,8 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
                 snaps_t.append(t)
                 snaps.append(phi.astype(np.float32))
                 break
+    if progress is not None:
+        progress(1.0)
     require(bool(np.all(np.isfinite(phi))), "level set", "non-finite φ",
             "the front diverged; use a finer grid")
     closest = 0.0

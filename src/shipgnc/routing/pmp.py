@@ -449,12 +449,14 @@ class SweepResult:
 
 
 def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n_steps=None,
-          radius=0.0, max_candidates=24, conjugate=True) -> SweepResult:
+          radius=0.0, max_candidates=24, conjugate=True, progress=None) -> SweepResult:
     """Every extremal from ``start`` through ``target`` below ``horizon`` (notes 002-2.9.4, 002-F2).
 
     N costate angles are integrated together with RK4; the 2-D local minima (over angle and time) of
     the distance to B are polished with :func:`shoot`; duplicates are merged; each survivor is checked for
     a conjugate point (F3). Inadmissible initial directions (V + eᵀv(A) ≤ 0, steady fields) are skipped (F5).
+    ``progress(fraction)``, if given, is called with the share of the candidates examined or of the
+    ``max_candidates`` polishes begun, whichever is larger (rising, 1.0 at the end).
     """
     start = np.asarray(start, float)
     target = np.asarray(target, float)
@@ -502,7 +504,9 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
     seeds: list[tuple[int, int]] = []
     effort = Effort()
     dth = TWO_PI / n_angles
-    for k, i in candidates:
+    for n_done, (k, i) in enumerate(candidates):
+        if progress is not None:
+            progress(max(n_done / len(candidates), len(seeds) / max_candidates))
         if len(seeds) >= max_candidates:
             break
         # one polish per basin: skip seeds next to an earlier seed or to a polished extremal
@@ -531,6 +535,8 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
                           "optimal")
         else:
             ext.status = "global optimum" if j == 0 else "local minimum, no conjugate point"
+    if progress is not None:
+        progress(1.0)
     return SweepResult(extremals, closest, closest_t, n_angles, float(horizon), n_left,
                        int(np.sum(~admissible)), effort)
 

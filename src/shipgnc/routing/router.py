@@ -109,14 +109,16 @@ def _from_extremal(res: RouteResult, ext, method="pmp"):
 def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0.0, method: str = "auto",
                 horizon: float | None = None, radius: float = 0.0, obstacles=None, n_angles: int = 1440,
                 n_steps: int | None = None, grid_spacing: float | None = None, directions: int = 80,
-                global_check: bool | None = None, domain=None) -> RouteResult:
+                global_check: bool | None = None, domain=None, progress=None) -> RouteResult:
     """Time-optimal route from ``start`` to ``target`` (north, east) [m] at ``speed`` [m/s] through ``fld``.
 
     Returns a :class:`~shipgnc.routing.result.RouteResult`; an unreachable target gives ``reachable=False``
     with a worded ``reason`` (F1) rather than an exception. Bad input raises
     :class:`~shipgnc.errors.ConfigError` naming the field (F10, Z-22). ``horizon`` [s] bounds the search
     (default 4·|AB|/V); ``radius`` > 0 makes the target a disc (Z12); ``obstacles`` is a list of polygons
-    (sequences of (north, east) vertices in m, or shapely polygons) (2.9.3).
+    (sequences of (north, east) vertices in m, or shapely polygons) (2.9.3). ``progress(stage, fraction)``,
+    if given, is called as the sweep polishes its candidates (stage ``"extremals"``) and as the level set
+    advances (``"level set"``), each stage's fraction rising to 1.0; None (the default) costs nothing.
     """
     require(method in METHODS, "method", method, f"allowed: {', '.join(METHODS)}")
     start = np.asarray(start, dtype=float)
@@ -148,27 +150,27 @@ def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0
 
             route_around(res, polys, horizon=horizon, n_angles=n_angles)
         else:
-            _pmp(res, horizon, n_angles, n_steps, horizon_given)
+            _pmp(res, horizon, n_angles, n_steps, horizon_given, progress)
         if method == "auto" and (global_check is None or global_check) and res.reachable:
-            _levelset_check(res, polys, grid_spacing, horizon, domain)
+            _levelset_check(res, polys, grid_spacing, horizon, domain, progress)
         elif global_check and res.reachable:
-            _levelset_check(res, polys, grid_spacing, horizon, domain)
+            _levelset_check(res, polys, grid_spacing, horizon, domain, progress)
         if not res.reachable and method == "auto" and polys:
             # a detour past several vertices: the obstacle-aware graph search decides (2.9.3, F7)
             res.notes.append("no collision-free extremal or one-vertex chain: graph search around the "
                              "obstacles")
             _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles)
         elif not res.reachable and method == "auto" and not isinstance(fld, UniformCurrent):
-            _levelset_check(res, polys, grid_spacing, horizon, domain)
+            _levelset_check(res, polys, grid_spacing, horizon, domain, progress)
         return res
     if method == "levelset":
-        _levelset_primary(res, polys, grid_spacing, horizon, domain)
+        _levelset_primary(res, polys, grid_spacing, horizon, domain, progress)
         return res
     _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles)
     return res
 
 
-def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = True):
+def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = True, progress=None):
     from shipgnc.routing import pmp
     from shipgnc.routing.closed_form import uniform_solution
 
@@ -205,7 +207,7 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = Tru
                              f"t = {sol.exit_time:.1f} s; a later arrival is infeasible")
         return res
     sw = pmp.sweep(fld, V, A, B, t0=res.t0, horizon=horizon, n_angles=n_angles, n_steps=n_steps,
-                   radius=res.radius)
+                   radius=res.radius, progress=None if progress is None else _stage(progress, "extremals"))
     res.method = "pmp"
     res.extremals = [_ext_dict(e, V) for e in sw.extremals]
     res.extremal_paths = list(sw.extremals)
@@ -266,7 +268,12 @@ def default_domain(fld, start, target, margin=None, obstacles=None):
     return (n0, n1), (e0, e1)
 
 
-def _levelset_run(res, polys, grid_spacing, horizon, domain):
+def _stage(progress, stage):
+    """``progress(stage, fraction)`` as a one-argument callback of a method."""
+    return lambda fraction: progress(stage, fraction)
+
+
+def _levelset_run(res, polys, grid_spacing, horizon, domain, progress=None):
     from shipgnc.routing.levelset import reachability
 
     dom = domain if domain is not None else default_domain(res.field, res.start, res.target,
@@ -275,14 +282,15 @@ def _levelset_run(res, polys, grid_spacing, horizon, domain):
         size = max(dom[0][1] - dom[0][0], dom[1][1] - dom[1][0])
         grid_spacing = size / 160.0
     return reachability(res.field, res.speed, res.start, res.target, dom, grid_spacing, t0=res.t0,
-                        horizon=horizon, obstacles=polys)
+                        horizon=horizon, obstacles=polys,
+                        progress=None if progress is None else _stage(progress, "level set"))
 
 
-def _levelset_check(res, polys, grid_spacing, horizon, domain):
+def _levelset_check(res, polys, grid_spacing, horizon, domain, progress=None):
     from shipgnc.routing.levelset import FrontOutOfGrid
 
     try:
-        ls = _levelset_run(res, polys, grid_spacing, horizon, domain)
+        ls = _levelset_run(res, polys, grid_spacing, horizon, domain, progress)
     except FrontOutOfGrid as exc:  # the check cannot run: said, the sweep's answer stands
         res.notes.append(f"global check skipped: {exc}")
         return
@@ -409,11 +417,11 @@ def _polish_from_seed(res, theta0, duration):
     return ext
 
 
-def _levelset_primary(res, polys, grid_spacing, horizon, domain):
+def _levelset_primary(res, polys, grid_spacing, horizon, domain, progress=None):
     from shipgnc.routing.levelset import FrontOutOfGrid
 
     try:
-        ls = _levelset_run(res, polys, grid_spacing, horizon, domain)
+        ls = _levelset_run(res, polys, grid_spacing, horizon, domain, progress)
     except FrontOutOfGrid as exc:  # no answer from this method: said as the reason (exit 3)
         res.reason = str(exc)
         return
