@@ -39,7 +39,6 @@ import math
 
 import numpy as np
 import scipy.linalg
-import scipy.signal
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.models.base import names
@@ -61,6 +60,8 @@ def van_loan(Ac: np.ndarray, Bc: np.ndarray, E: np.ndarray, Qc: np.ndarray, Ts: 
     """(A, B, Q) of the zero-order-hold discretisation of ẋ = A_c x + B_c u + E w, E[w wᵀ] = Q_c δ:
     A, B from ``scipy.signal.cont2discrete``, Q = ∫₀^Ts e^{A_c s} E Q_c Eᵀ e^{A_cᵀ s} ds by Van
     Loan's block exponential."""
+    import scipy.signal  # here: half a second to import, and only a linear model needs it
+
     n = Ac.shape[0]
     A, B, *_ = scipy.signal.cont2discrete((Ac, Bc, np.eye(n), np.zeros((n, Bc.shape[1]))), Ts,
                                           method="zoh")

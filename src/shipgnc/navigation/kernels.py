@@ -11,8 +11,8 @@ hold, latency, dropouts, the state the controller sees, the logged ``<state>_mea
 ``<sensor>_valid``), then the estimator's update, whose model evaluations are made there (the
 vessel model's kernel is a name of the generated loop module: a numba function passed as an
 argument would make the loop uncacheable), and whose arithmetic is here: :func:`observer_rhs`
-(Fossen & Strand 1999), :func:`correct_row` and :func:`nees` (the Kalman filters, Simon 2006 §5.1,
-§13.2).
+(Fossen & Strand 1999), :func:`correct_c` and :func:`nees` (the Kalman filters, Simon 2006 §5.1,
+§13.2; the EKF's scalar correction, at the model's size, is the template's ``ekf_correct``).
 
 Layouts (offsets are stored as floats in ``p``; ``int()`` in the kernels):
 
@@ -34,6 +34,9 @@ first, bias × k, pipe]`` with the pipe a ring of ``latency + 1`` entries ``[due
 from __future__ import annotations
 
 import numpy as np
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from shipgnc.kernels import kernel_function, wrap
 
@@ -47,6 +50,31 @@ HEADER = 7
 SENSOR_FIELDS = 12
 #: fields of a channel
 CHANNEL_FIELDS = 5
+
+
+@intrinsic
+def stack_empty(typingctx, size):
+    """``stack_empty(N)``: an uninitialised float64 array of ``N`` numbers (a constant when
+    compiled, e.g. a size of the generated loop module) on the stack of the compiled function
+    that calls it: no allocation, and memory the compiler knows no argument aliases, so it keeps
+    the entries of small matrices in registers. Valid while that function runs: never return it
+    or store it beyond the call."""
+    if not isinstance(size, types.IntegerLiteral):
+        return None
+    count = max(int(size.literal_value), 1)
+    array = types.Array(types.float64, 1, "C")
+
+    def codegen(context, builder, signature, args):
+        out = context.make_array(array)(context, builder)
+        data = cgutils.alloca_once(builder, context.get_data_type(types.float64), size=count)
+        intp = context.get_value_type(types.intp)
+        context.populate_array(out, data=data,
+                               shape=cgutils.pack_array(builder, [intp(size.literal_value)]),
+                               strides=cgutils.pack_array(builder, [intp(8)]),
+                               itemsize=intp(8), meminfo=None)
+        return out._getvalue()
+
+    return array(size), codegen
 
 
 @kernel_function
@@ -233,7 +261,7 @@ def no_jacobian(x, u, d, p, A):
 
 @kernel_function
 def apply_gain(zh, P, Pc, S, innov):
-    """The scalar Kalman update shared by both corrections: with Pc = P cᵀ and S = c P cᵀ + var,
+    """The scalar Kalman update of :func:`correct_c`: with Pc = P cᵀ and S = c P cᵀ + var,
     x̂ += Pc/S·innov, P −= Pc Pcᵀ/S (then symmetrised), P row-major flat n × n."""
     n = zh.shape[0]
     for a in range(n):
@@ -247,22 +275,6 @@ def apply_gain(zh, P, Pc, S, innov):
             m = 0.5 * (P[a * n + b] + P[b * n + a])
             P[a * n + b] = m
             P[b * n + a] = m
-
-
-@kernel_function
-def correct_row(zh, P, j, y, var, angle, Pc):
-    """:meth:`GaussianFilter.correct_row` for one ship and a row c = e_j (a measured state):
-    scalar update of the mean ``zh`` (n) and the covariance ``P`` (n × n, row-major flat)."""
-    n = zh.shape[0]
-    for a in range(n):
-        Pc[a] = P[a * n + j]
-    S = Pc[j] + var
-    if not S > 0.0:
-        return
-    innov = y - zh[j]
-    if angle:
-        innov = wrap(innov)
-    apply_gain(zh, P, Pc, S, innov)
 
 
 @kernel_function

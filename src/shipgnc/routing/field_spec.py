@@ -5,7 +5,7 @@
     rotation:omega=..,north=..,east=..       ω [rad/s | rad/h] about (north, east) [m | nm]
     lamb-oseen:gamma=..,rc=..,north=..,east=..   Γ [m²/s | nm²/h], r_c and centre [m | nm]
     rankine:gamma=..,rc=..,north=..,east=..
-      …,drift_north=..,drift_east=..         a vortex whose centre moves [m/s | kn]
+    lamb-oseen:…,drift_north=..,drift_east=..    a vortex whose centre moves [m/s | kn]
     gyre:speed=..,length=..,north=..,east=..  double gyre, U [m/s | kn], cell L and centre [m | nm]
     A+B                                      the sum
     path/to/file.nc[:cubic]                  gridded field (SI data)
