@@ -176,3 +176,11 @@ def test_observations_are_read_by_name():
     np.testing.assert_array_equal(by_name["u"], batch[:, envs.observation_names.index("u")])
     with pytest.raises(ValueError, match="names"):
         named(obs[:-1], env.observation_names)
+
+
+@pytest.mark.parametrize("action", [np.zeros(5), 1.0, np.zeros((3, 2))])
+def test_an_action_of_the_wrong_shape_is_refused_in_one_line(action):
+    env = ShipEnv("boat-autopilot")
+    env.reset(seed=0)
+    with pytest.raises(ConfigError, match="must hold one command per ship and input"):
+        env.step(action)

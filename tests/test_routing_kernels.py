@@ -179,3 +179,11 @@ def test_the_step_follows_the_field():
     assert grid.cell == pytest.approx(0.04)
     assert ek.compiled(F.UniformCurrent(0.1, 0.0)).steps(1.0, 1e6) == ek.MIN_STEPS
     assert ek.compiled(NumpyOnly(GYRE)) is None
+
+
+@pytest.mark.parametrize("text", ["shear:k=-0.5+", "+shear:k=-0.5", "shear:k=-0.5++uniform:north=1"])
+def test_an_empty_term_of_a_field_sum_is_refused(text):
+    from shipgnc.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="empty term in the sum"):
+        parse_field(text)

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from shipgnc.routing import extremal_kernels, levelset, pmp
+from shipgnc.routing import fields as F
 from shipgnc.routing.field_spec import parse_field
 from shipgnc.routing.memory import levelset_memory, route_memory_estimate, sweep_memory
 from shipgnc.routing.router import default_domain, solve_route
@@ -126,3 +127,21 @@ def test_progress_rises_to_one_per_stage_and_leaves_the_route_alone(shear):
         assert fractions[-1] == 1.0
     assert with_bar.time_s == plain.time_s and with_bar.global_check == plain.global_check
     assert with_bar.time_s == pytest.approx(T_F, abs=0.5e-3 * 3600)
+
+
+def test_a_long_horizon_keeps_the_stored_fronts_bounded():
+    # a horizon 10⁴ times the route: the level set thins its fronts beyond MAX_SNAPSHOTS, and the estimate
+    # counts that bound (the route 0,0 → 0,1000 m at 1 m/s in a weak shear is answered, not refused)
+    from shipgnc.routing.levelset import MAX_SNAPSHOTS, reachability
+
+    fld = F.shear(-1e-4)
+    res = reachability(fld, 1.0, np.array([0.0, 0.0]), np.array([0.0, 1000.0]),
+                       ((-100.0, 100.0), (-50.0, 1050.0)), 25.0, horizon=60.0 * 1000.0, recover=False)
+    assert res.arrival is not None and res.snapshots.shape[0] <= MAX_SNAPSHOTS + 2
+    est = route_memory_estimate(fld, 1.0, (0.0, 0.0), (0.0, 1000.0), method="auto", horizon=1e7)
+    assert est.snapshots <= MAX_SNAPSHOTS + 1
+    # against a current twice the ship's speed the target is never reached: 9 000 steps to the horizon
+    far = reachability(F.UniformCurrent(0.0, -2.0), 1.0, np.array([0.0, 0.0]), np.array([0.0, 1000.0]),
+                       ((-100.0, 100.0), (-50.0, 1050.0)), 25.0, horizon=30000.0, recover=False)
+    assert far.arrival is None and far.steps > 3 * MAX_SNAPSHOTS
+    assert far.snapshots.shape[0] <= MAX_SNAPSHOTS + 1

@@ -192,6 +192,12 @@ def test_grid_numbers_in_exponent_notation_are_numbers():
     assert parse_grid("vessel.preset='1e5'") == ("vessel.preset", ("1e5",))  # quoted: a name
 
 
+@pytest.mark.parametrize("text", ["simulation.dt=0.05,", "simulation.dt=0.05,,0.1", "simulation.dt=,0.1"])
+def test_an_empty_grid_value_is_refused(text):
+    with pytest.raises(ConfigError, match="empty value between commas"):
+        parse_grid(text)
+
+
 def test_products_on_the_path_do_not_depend_on_the_batch():
     """The wave filter's Φx + Ln (note 000-A11) and the LQR's K·x (document 000 eq. 13) for one
     member are the same bits alone and in a batch of 300 (a BLAS product is not: its summation

@@ -74,7 +74,7 @@ class ShipEnv(gym.Env):
     def step(self, action):
         if self.episode.done[0]:
             raise RuntimeError("step() after the episode ended: call reset()")
-        obs, reward, terminated, truncated = self.episode.step(np.asarray(action)[None, :])
+        obs, reward, terminated, truncated = self.episode.step(np.asarray(action)[None, ...])
         return obs[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), self._info()
 
     def _info(self) -> dict:

@@ -180,7 +180,11 @@ class BatchedEpisode:
     def step(self, action: np.ndarray):
         """Hold ``action`` (shape ``(batch, n_inputs)``) over one control period; returns
         (observation, reward, terminated, truncated). Members already done stay frozen (reward 0)."""
-        action = np.asarray(action, dtype=float).reshape(self.batch, self.actuator.n)
+        action = np.asarray(action, dtype=float)
+        if action.size != self.batch * self.actuator.n:
+            raise ConfigError(f"action of shape {action.shape}: must hold one command per ship and input, "
+                              f"shape ({self.batch}, {self.actuator.n})")
+        action = action.reshape(self.batch, self.actuator.n)
         if not np.all(np.isfinite(action)):
             raise ConfigError(f"action {action.tolist()}: must be finite")
         self.command = np.where(self.done[:, None], self.command, action)

@@ -78,7 +78,11 @@ def parse_field(text: str, units: str = "si"):
     """A current field from a FIELD string (module docstring); terms joined by '+' are summed."""
     require(units in UNITS, "--units", units, f"allowed: {', '.join(UNITS)}")
     require(isinstance(text, str) and text.strip() != "", "--field", text, "must name a field")
-    terms = [_term(t, units) for t in text.split("+")]
+    parts = text.split("+")
+    if any(not t.strip() for t in parts):
+        raise ConfigError(f"--field = {text!r}: an empty term in the sum (a leading, trailing or doubled "
+                          "'+'); give FIELD+FIELD")
+    terms = [_term(t, units) for t in parts]
     if len(terms) == 1:
         return terms[0]
     from shipgnc.routing.fields import SumField

@@ -44,6 +44,9 @@ import numpy as np
 from shipgnc.errors import ConfigError, require
 
 TWO_PI = 2.0 * math.pi
+#: the most fronts :func:`reachability` stores (about 100 per |AB|/V; beyond this bound, on a horizon far
+#: longer than the route, it keeps every other one and stores half as often): memory stays bounded
+MAX_SNAPSHOTS = 1000
 
 
 def _weno(v1, v2, v3, v4, v5):
@@ -137,46 +140,6 @@ def _front_rate_kernel(g, h, speed, vn, ve, out):
             grad = np.sqrt(max(nm, 0.0) ** 2 + min(np_, 0.0) ** 2 + max(em, 0.0) ** 2 + min(ep, 0.0) ** 2)
             a = vn[i, j] * (nm if vn[i, j] > 0 else np_) + ve[i, j] * (em if ve[i, j] > 0 else ep)
             out[i, j] = -(speed[i, j] * grad + a)
-
-
-@numba.njit(cache=True, error_model="numpy", fastmath=True)
-def _pad3_kernel(phi, g):
-    """:func:`_pad3` into ``g`` (shape + 6): φ with three cells of linear extrapolation on every side."""
-    n, m = phi.shape
-    for i in range(n):
-        for j in range(m):
-            g[i + 3, j + 3] = phi[i, j]
-    for j in range(m):
-        for k in range(1, 4):
-            g[3 - k, j + 3] = phi[0, j] - (phi[1, j] - phi[0, j]) * k
-            g[n + 2 + k, j + 3] = phi[n - 1, j] + (phi[n - 1, j] - phi[n - 2, j]) * k
-    for i in range(n + 6):
-        for k in range(1, 4):
-            g[i, 3 - k] = g[i, 3] - (g[i, 4] - g[i, 3]) * k
-            g[i, m + 2 + k] = g[i, m + 2] + (g[i, m + 2] - g[i, m + 1]) * k
-
-
-@numba.njit(cache=True, error_model="numpy", fastmath=True)
-def _tvd_rk3_kernel(phi, dt, h, speed, vn, ve, cap, g, r, p1, p2):
-    """One TVD-RK3 step of the front in a steady field, in place (the loop of :func:`reachability`,
-    compiled whole): p₁ = φ + Δt R(φ), p₂ = ¾φ + ¼(p₁ + Δt R(p₁)), φ ← φ/3 + ⅔(p₂ + Δt R(p₂)), then
-    the narrow band φ ← min(φ, cap) (cap = inf: none)."""
-    n, m = phi.shape
-    _pad3_kernel(phi, g)
-    _front_rate_kernel(g, h, speed, vn, ve, r)
-    for i in range(n):
-        for j in range(m):
-            p1[i, j] = phi[i, j] + dt * r[i, j]
-    _pad3_kernel(p1, g)
-    _front_rate_kernel(g, h, speed, vn, ve, r)
-    for i in range(n):
-        for j in range(m):
-            p2[i, j] = 0.75 * phi[i, j] + 0.25 * (p1[i, j] + dt * r[i, j])
-    _pad3_kernel(p2, g)
-    _front_rate_kernel(g, h, speed, vn, ve, r)
-    for i in range(n):
-        for j in range(m):
-            phi[i, j] = min(phi[i, j] / 3 + 2 / 3 * (p2[i, j] + dt * r[i, j]), cap)
 
 
 @dataclass
@@ -424,25 +387,14 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     notes: list[str] = []
     steps = 0
     max_steps = math.ceil((horizon - t_init) / dt) + 1
-    fused = kernel is not None and steady  # the whole step compiled (no numpy temporaries)
-    if fused:
-        vn_c = np.ascontiguousarray(np.where(frozen, 0.0, v_grid[..., 0]) if any_frozen else v_grid[..., 0])
-        ve_c = np.ascontiguousarray(np.where(frozen, 0.0, v_grid[..., 1]) if any_frozen else v_grid[..., 1])
-        phi = np.ascontiguousarray(phi, dtype=float)
-        scratch = (np.empty((phi.shape[0] + 6, phi.shape[1] + 6)), np.empty_like(phi), np.empty_like(phi),
-                   np.empty_like(phi))
     with np.errstate(all="ignore"):
         while steps < max_steps:
             tt = t0 + t
-            if fused:
-                _tvd_rk3_kernel(phi, dt, spacing, speed_grid, vn_c, ve_c, math.inf if cap is None else cap,
-                                *scratch)
-            else:
-                p1 = phi + dt * rate(tt, phi)
-                p2 = 0.75 * phi + 0.25 * (p1 + dt * rate(tt + dt, p1))
-                phi = phi / 3 + 2 / 3 * (p2 + dt * rate(tt + dt / 2, p2))
-                if cap is not None:
-                    phi = np.minimum(phi, cap)  # the narrow band: nothing ahead of it moves
+            p1 = phi + dt * rate(tt, phi)
+            p2 = 0.75 * phi + 0.25 * (p1 + dt * rate(tt + dt, p1))
+            phi = phi / 3 + 2 / 3 * (p2 + dt * rate(tt + dt / 2, p2))
+            if cap is not None:
+                phi = np.minimum(phi, cap)  # the narrow band: nothing ahead of it moves
             t += dt
             steps += 1
             history_t.append(t)
@@ -452,6 +404,8 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
             if steps % store_every == 0:
                 snaps_t.append(t)
                 snaps.append(phi.astype(np.float32))
+                if len(snaps) > MAX_SNAPSHOTS:  # a long horizon: every other front kept, half as often
+                    snaps_t, snaps, store_every = snaps_t[::2], snaps[::2], 2 * store_every
             if history_phi[-1] <= 0 and history_phi[-2] > 0:
                 arrival = _cubic_crossing(np.array(history_t[-4:]), np.array(history_phi[-4:]))
                 snaps_t.append(t)

@@ -99,8 +99,9 @@ def levelset_memory(fld, speed, start, target, domain, spacing, *, t0=0.0, horiz
                     out: RouteMemory | None = None) -> RouteMemory:
     """The level set's arrays (module docstring) for :func:`~shipgnc.routing.levelset.reachability`'s
     arguments; the snapshot count follows its loop: Δt = cfl·h/(V + √2·v_max), ``store_every`` =
-    max(1, round(0.01·|AB|/V/Δt)), ⌈(T − r₀/V)/Δt⌉ + 1 steps, plus the first and the arrival front."""
-    from shipgnc.routing.levelset import _initial_radius
+    max(1, round(0.01·|AB|/V/Δt)), ⌈(T − r₀/V)/Δt⌉ + 1 steps, plus the first and the arrival front, at
+    most ``levelset.MAX_SNAPSHOTS`` (it thins beyond)."""
+    from shipgnc.routing.levelset import MAX_SNAPSHOTS, _initial_radius
 
     out = RouteMemory() if out is None else out
     start, target = np.asarray(start, float), np.asarray(target, float)
@@ -123,7 +124,7 @@ def levelset_memory(fld, speed, start, target, domain, spacing, *, t0=0.0, horiz
     dt = cfl * spacing / (speed + math.sqrt(2) * vmax)
     store_every = max(1, round(0.01 * dist / speed / dt))
     max_steps = max(0, math.ceil((horizon - r0 / speed) / dt) + 1)
-    snaps = 1 + max_steps // store_every + 1
+    snaps = min(1 + max_steps // store_every, MAX_SNAPSHOTS) + 1  # thinned beyond MAX_SNAPSHOTS
     out.grid, out.snapshots = (n_n, n_e), snaps
     unsteady = 0 if fld.steady else 2 * 16 * cells  # v(t) on the grid and its blend, per step
     items = {

@@ -122,7 +122,11 @@ def parse_grid(text: str) -> tuple[str, tuple]:
     if not sep or not key:
         raise ConfigError(f"--grid {text!r}: expected KEY=V1,V2,... with a dotted scenario key, "
                           f"e.g. controller.omega=0.5,1.0")
-    items = [v.strip() for v in values.split(",") if v.strip()]
+    items = [v.strip() for v in values.split(",")]
+    if items != [""] and "" in items:
+        raise ConfigError(f"--grid {text!r}: an empty value between commas (a trailing or doubled comma); "
+                          "give KEY=V1,V2,... without empty entries")
+    items = [v for v in items if v]
     if not items:
         raise ConfigError(f"--grid {text!r}: the grid of {key!r} is empty; give at least one value")
     parsed = tuple(parse_override(f"{key}={v}")[1] for v in items)
