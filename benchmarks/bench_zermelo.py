@@ -38,26 +38,6 @@ from bench_boat import machine_info, write_report
 NM, H, KN = 1852.0, 3600.0, 1852.0 / 3600.0
 
 
-class NumpyOnly:
-    """Built lazily (importing shipgnc): the field without a compiled form."""
-
-    @staticmethod
-    def wrap(field):
-        from shipgnc.routing.fields import CurrentField
-
-        class _Wrapped(CurrentField):
-            def __init__(self, inner):
-                self.inner, self.steady, self.bounds = inner, inner.steady, inner.bounds
-
-            def velocity(self, t, north, east):
-                return self.inner._velocity(t, north, east)
-
-            def jacobian(self, t, north, east):
-                return self.inner._jacobian(t, north, east)
-
-        return _Wrapped(field)
-
-
 def problems():
     from shipgnc.routing import closed_form as cf
     from shipgnc.routing import fields as F
@@ -97,6 +77,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--full", action="store_true", help="the numpy reference on every row (minutes)")
     args = parser.parse_args(argv)
     from shipgnc.routing import solve_route
+    from shipgnc.routing.fields import NumpyReference
 
     repeats = 1 if args.quick else 2
     start = time.perf_counter()
@@ -116,7 +97,7 @@ def main(argv=None) -> dict:
         t_auto, ra = _timed(lambda: route("auto"), repeats)
         numpy_s = None
         if not args.quick and (fast_row or args.full):
-            numpy_s, rn = _timed(lambda f=field, s=speed, a=a, b=b: solve_route(NumpyOnly.wrap(f), s, a, b,
+            numpy_s, rn = _timed(lambda f=field, s=speed, a=a, b=b: solve_route(NumpyReference(f), s, a, b,
                                                                               method="pmp"), 1)
             assert rn.time_s is not None and abs(rn.time_s / r.time_s - 1) < 1e-8, (rn.time_s, r.time_s)
         ls = (ra.global_check or {}).get("time_s")

@@ -29,17 +29,7 @@ GYRE = F.DoubleGyre(1.0, 1.0, (0.5, 0.5))
 MOVING = F.LambOseenVortex(2.0, 0.5, (0.1, 0.2), (0.01, -0.02))
 
 
-class NumpyOnly(F.CurrentField):
-    """The same field without a compiled form: the router integrates it with numpy and solve_ivp."""
-
-    def __init__(self, field):
-        self.field, self.steady, self.bounds = field, field.steady, field.bounds
-
-    def velocity(self, t, north, east):
-        return self.field._velocity(t, north, east)
-
-    def jacobian(self, t, north, east):
-        return self.field._jacobian(t, north, east)
+NumpyOnly = F.NumpyReference  # the same field without a compiled form: numpy family, solve_ivp polish
 
 
 FIELDS = {

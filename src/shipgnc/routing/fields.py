@@ -41,6 +41,7 @@ __all__ = [
     "GriddedCurrent",
     "LambOseenVortex",
     "Modulated",
+    "NumpyReference",
     "RankineVortex",
     "RigidRotation",
     "SumField",
@@ -453,6 +454,25 @@ class SumField(CurrentField):
 
     def grid_cell(self):
         return min(f.grid_cell() for f in self.fields)
+
+
+class NumpyReference(CurrentField):
+    """``field`` without its compiled form: the router integrates it on the numpy reference path (the
+    numpy family and the ``solve_ivp`` polish of :mod:`~shipgnc.routing.pmp`) — to hold the compiled
+    path equal to it, or to time the two side by side."""
+
+    def __init__(self, field: CurrentField):
+        require(isinstance(field, CurrentField), "field", field, "must be a CurrentField")
+        self.field, self.steady, self.bounds = field, field.steady, field.bounds
+
+    def velocity(self, t, north, east):
+        return self.field._velocity(t, north, east)
+
+    def jacobian(self, t, north, east):
+        return self.field._jacobian(t, north, east)
+
+    def describe(self):
+        return f"{self.field.describe()} (numpy reference path)"
 
 
 class Modulated(CurrentField):
