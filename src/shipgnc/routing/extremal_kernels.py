@@ -19,7 +19,7 @@ costate, (2.5)). The step is
     h = min( TURN_PER_STEP / ‖J‖_max ,  cell / (CELL_STEPS·(V + |v|_max)) ),  at least MIN_STEPS steps,
 
 where ``‖J‖_max`` is the field's :meth:`~shipgnc.routing.fields.CurrentField.rate_bound` and ``cell`` its
-smallest grid spacing (analytic fields: no cell limit). With λh ≤ 2·10⁻³ the error is ≈ 10⁻¹³·λT, below
+smallest grid spacing (analytic fields: no cell limit). With λh ≤ 4·10⁻³ the error is ≈ 2·10⁻¹²·λT, below
 the polish's miss tolerance (10⁻⁴ |AB|) by many orders for any λT the effort bound admits; across a cell
 edge RK4 drops to second order locally, O(h²) per edge, which the ≥ 4 steps per cell keep below the
 bilinear interpolant's own error. The step count is deterministic, so the effort bound is too: a
@@ -68,6 +68,8 @@ class CompiledField:
         if math.isfinite(self.cell):
             limits.append(self.cell / (CELL_STEPS * (speed + self.vmax)))
         h = min(limits)
+        if not math.isfinite(duration):  # no finite integration: past any effort bound
+            return 2**62
         n = math.ceil(abs(duration) / h) if math.isfinite(h) else 0
         return max(MIN_STEPS, n)
 
@@ -75,8 +77,31 @@ class CompiledField:
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
+def _speed_bound(field) -> float:
+    """The largest |v| [m/s] on a gridded field's extent over its time: sampled at t = 0, at every time
+    slice of its grids and over one period of each tidal factor."""
+    from shipgnc.routing.fields import GriddedCurrent, Modulated, SumField
+
+    times = {0.0}
+
+    def walk(f):
+        if isinstance(f, GriddedCurrent):
+            times.update(float(t) for t in f.times)
+        elif isinstance(f, Modulated):
+            times.update(float(t) for t in np.linspace(0.0, f.period, 33))
+            walk(f.field)
+        elif isinstance(f, SumField):
+            for part in f.fields:
+                walk(part)
+
+    walk(field)
+    return max(field.max_speed(field.bounds, t) for t in sorted(times))
+
+
 def compiled(field) -> CompiledField | None:
-    """The field's :class:`CompiledField` (built once per field object), or None without a compiled form."""
+    """The field's :class:`CompiledField` (built once per field object), or None without a compiled form.
+    Developers: ``field_state`` and the stages are inlined into these kernels, whose numba cache is keyed
+    on this file only — after editing ``fields.field_state``, delete the ``__pycache__/*.nbi`` files."""
     try:
         return _CACHE[field]
     except (KeyError, TypeError):
@@ -84,7 +109,7 @@ def compiled(field) -> CompiledField | None:
     try:
         _, params = field.current_kernel(0.0, grids=True)
         rate = float(field.rate_bound())
-    except (NotCompiled, AttributeError, TypeError):
+    except NotCompiled:
         return None
     cell = float(field.grid_cell())
     box = np.full(4, np.nan)
@@ -92,7 +117,7 @@ def compiled(field) -> CompiledField | None:
     if field.bounds is not None:
         (n0, n1), (e0, e1) = field.bounds
         box = np.array([n0, n1, e0, e1], float)
-        vmax = field.max_speed(field.bounds)
+        vmax = _speed_bound(field)
     out = CompiledField(params, rate, cell, vmax, box)
     try:
         _CACHE[field] = out
@@ -220,7 +245,6 @@ class NodeSolution:
 
         m = nodes.shape[0]
         self._spline = CubicHermiteSpline(times, nodes.reshape(m, -1), slopes.reshape(m, -1), axis=0)
-        self.t_min, self.t_max = float(times[0]), float(times[-1])
 
     def __call__(self, t):
         return np.moveaxis(self._spline(np.asarray(t, float)), -1, 0)
@@ -234,7 +258,6 @@ class Integrated:
     y: np.ndarray
     success: bool
     sol: NodeSolution | None
-    steps: int
 
 
 def integrate(cf: CompiledField, speed, y0, t0, duration, dense=False, n_steps=None) -> Integrated:
@@ -251,7 +274,7 @@ def integrate(cf: CompiledField, speed, y0, t0, duration, dense=False, n_steps=N
         times = t0 + np.arange(n + 1) * (duration / n)
         times[-1] = t0 + duration
         sol = NodeSolution(times, nodes, slopes)
-    return Integrated(end.reshape(-1)[:, None], ok, sol, n)
+    return Integrated(end.reshape(-1)[:, None], ok, sol)
 
 
 def family(cf: CompiledField, speed, y0, t0, duration, n_steps, target, radius, pos_dtype=np.float64):

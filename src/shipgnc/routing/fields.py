@@ -459,16 +459,24 @@ class SumField(CurrentField):
 class NumpyReference(CurrentField):
     """``field`` without its compiled form: the router integrates it on the numpy reference path (the
     numpy family and the ``solve_ivp`` polish of :mod:`~shipgnc.routing.pmp`) — to hold the compiled
-    path equal to it, or to time the two side by side."""
+    integrations equal to it, or to time the two side by side. The sweep's seed refinement and the
+    polish's coarse first phase belong to the compiled path only, so two sweeps may polish different
+    seeds and find different local extremals (the optimum agrees)."""
 
     def __init__(self, field: CurrentField):
         require(isinstance(field, CurrentField), "field", field, "must be a CurrentField")
         self.field, self.steady, self.bounds = field, field.steady, field.bounds
 
     def velocity(self, t, north, east):
-        return self.field._velocity(t, north, east)
+        return self.field.velocity(t, north, east)
 
     def jacobian(self, t, north, east):
+        return self.field.jacobian(t, north, east)
+
+    def _velocity(self, t, north, east):
+        return self.field._velocity(t, north, east)
+
+    def _jacobian(self, t, north, east):
         return self.field._jacobian(t, north, east)
 
     def describe(self):

@@ -171,7 +171,7 @@ class Extremal:
 MAX_EVALS_PER_SOLVE = 50_000
 MAX_EVALS_PER_SWEEP = 2_000_000
 #: the same bound for the compiled fixed-step integration (:mod:`~shipgnc.routing.extremal_kernels`),
-#: counted in RK4 steps of one integration (a few thousand for a regular route: ‖J‖·T / 2·10⁻³) and of
+#: counted in RK4 steps of one integration (a few thousand for a regular route: ‖J‖·T / 4·10⁻³) and of
 #: all the polishes of one sweep; a compiled step costs ≈ 1/500 of a numpy right-hand side
 MAX_STEPS_PER_SOLVE = 250_000
 MAX_STEPS_PER_SWEEP = 25_000_000
@@ -194,14 +194,17 @@ class Effort:
     steps: int = 0
     stopped: int = 0
 
+    compiled: bool = False  #: the polishes ran on the compiled integration (bounds in RK4 steps)
+
     def charge_steps(self, n: int) -> None:
         """Count a compiled integration of ``n`` RK4 steps before it runs; raise past the bounds."""
+        self.compiled = True
         if n > self.steps_per_solve or self.steps + n > self.steps_total:
             raise EffortExceeded
         self.steps += n
 
     def describe(self) -> str:
-        if self.steps:
+        if self.compiled:
             bound = (f"{self.steps_per_solve:,} RK4 steps per integration, {self.steps_total:,} per "
                      f"sweep; {self.steps:,} spent")
         else:
@@ -518,7 +521,7 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
         seeds.append((k, i))
         seed = (th[i], k * dt)
         if cf is not None:
-            seed = _refine_seed(cf, field, speed, start, target, th, i, k, dt, t0, radius)
+            seed = _refine_seed(cf, field, speed, start, target, th, i, k, dt, t0, radius, dth)
         ext = shoot(field, speed, start, target, *seed, t0=t0, radius=radius, effort=effort)
         if ext is None or ext.duration > horizon * (1 + 1e-9):
             continue
@@ -545,15 +548,12 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
 REFINE_ANGLES = 64
 
 
-def _refine_seed(cf, field, speed, start, target, th, i, k, dt, t0, radius):
-    """A sweep candidate (θ_i, k·dt) refined on REFINE_ANGLES sub-angles between θ_{i−1} and θ_{i+1}
-    (the compiled family, same step): the closest approach of the finer fan. Where the extremals fan out
-    fast (a gyre's folds, a grid's kinks) the coarse fan's nearest approach can sit far from the
-    extremal through B, and Levenberg–Marquardt then fails from it."""
-    n = th.size
-    lo, hi = th[(i - 1) % n], th[(i + 1) % n]
-    sub = th[i] + np.linspace(math.remainder(lo - th[i], TWO_PI), math.remainder(hi - th[i], TWO_PI),
-                              REFINE_ANGLES + 1)
+def _refine_seed(cf, field, speed, start, target, th, i, k, dt, t0, radius, dth):
+    """A sweep candidate (θ_i, k·dt) refined on REFINE_ANGLES sub-angles over θ_i ± dth, the sweep's
+    angular step (the compiled family, same time step): the closest approach of the finer fan. Where the
+    extremals fan out fast (a gyre's folds, a grid's kinks) the coarse fan's nearest approach can sit far
+    from the extremal through B, and Levenberg–Marquardt then fails from it."""
+    sub = th[i] + np.linspace(-dth, dth, REFINE_ANGLES + 1)
     steps = k + 3
     y0, _ = initial_state(field, speed, start, sub, t0)
     _, dist, _ = extremal_kernels.family(cf, speed, y0, t0, steps * dt, steps, target, radius)

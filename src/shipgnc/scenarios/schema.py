@@ -949,9 +949,7 @@ class Scenario(Strict):
         if self.current is None or self.vessel.model != "mariner" or self.route is not None:
             return self
         d = self.disturbance
-        if d is None or d.type != "mariner":
-            return self
-        if d.d_y_nm_min != 0.0:
+        if d is not None and d.type == "mariner" and d.d_y_nm_min != 0.0:
             raise ValueError(f"disturbance.d_y_nm_min = {d.d_y_nm_min!r} with a current section: "
                              f"give the current once — set d_y_nm_min: 0 (document 000's cross "
                              f"current) or leave the current section out")
