@@ -174,12 +174,9 @@ def family_kernel(speed, p, y0, t0, dt, n_steps, box, target, radius, pos, dist,
     ``pos`` (n + 1, N, 2), the distance to ``target`` (minus ``radius`` for a disc) ``dist`` (n + 1, N)
     (inf once frozen) and ``alive`` (N,)."""
     has_box = not math.isnan(box[0])
+    z, k1 = np.empty(4), np.empty(4)  # the step's result and first slope (scratch)
     for i in range(y0.shape[0]):
-        y = np.empty(4)
-        z = np.empty(4)
-        k1 = np.empty(4)
-        for c in range(4):
-            y[c] = y0[i, c]
+        y = y0[i].copy()
         live = True
         pos[0, i, 0] = y[0]
         pos[0, i, 1] = y[1]
@@ -211,12 +208,9 @@ def trajectory_kernel(speed, p, y0, t0, duration, n_steps, nodes, slopes, store)
     states and slopes at the n + 1 nodes go to ``nodes`` and ``slopes`` (n + 1, K, 4)."""
     dt = duration / n_steps
     out = np.empty((y0.shape[0], 4))
+    z, k1 = np.empty(4), np.empty(4)
     for i in range(y0.shape[0]):
-        y = np.empty(4)
-        z = np.empty(4)
-        k1 = np.empty(4)
-        for c in range(4):
-            y[c] = y0[i, c]
+        y = y0[i].copy()
         for k in range(n_steps):
             _rk4(t0 + k * dt, y, dt, speed, p, k1, z)
             if store:
