@@ -122,7 +122,7 @@ def _errno(exc: BaseException) -> int | None:
 def output_error(out: Path, exc: BaseException, option: str = "--out") -> ShipGNCError:
     """The one-line error of a failed write into ``out``."""
     code = _errno(exc)
-    reason = os.strerror(code) if code is not None else _reason(exc) if isinstance(exc, OSError) else str(exc)
+    reason = _reason(exc) if isinstance(exc, OSError) else os.strerror(code) if code is not None else str(exc)
     if code in UNWRITABLE:
         return ConfigError(f"{option} {str(out)!r}: cannot write ({reason}); nothing was written")
     if code in FULL:
@@ -191,7 +191,8 @@ def _replace(tmp: Path, out: Path) -> None:
 
 @contextmanager
 def _sigint_deferred():
-    """Hold a Ctrl-C that arrives while the directories are swapped until the swap is done."""
+    """Hold a Ctrl-C that arrives inside the block (the directories' swap, h5py's encoding) until
+    the block is done, then raise it."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -203,6 +204,37 @@ def _sigint_deferred():
         signal.signal(signal.SIGINT, previous)
     if caught:
         raise KeyboardInterrupt
+
+
+#: a NetCDF file up to this size is encoded in memory and written with plain file I/O
+IN_MEMORY_MAX_BYTES = 512 * 1024**2
+
+
+def write_netcdf(ds, path: Path) -> Path:
+    """Write the Dataset ``ds`` as NetCDF-4 (h5netcdf engine) so that a write that fails midway
+    is one plain :class:`OSError` (which :func:`atomic_dir` turns into one line).
+
+    HDF5 does not survive a write that fails: on a full disk h5py prints a traceback for every
+    open object and the process segfaults at exit. So the file is encoded in memory and written
+    by ordinary file I/O; a file larger than :data:`IN_MEMORY_MAX_BYTES` is left to HDF5 only
+    after the free space has been checked against its size (data + 5 % + 4 MiB). A Ctrl-C that
+    arrives while h5py works is held until it is done, then raised: delivered inside one of
+    h5py's deallocation callbacks it would be printed and ignored, and the run would go on."""
+    path = Path(path)
+    if ds.nbytes <= IN_MEMORY_MAX_BYTES:
+        with _sigint_deferred():
+            encoded = ds.to_netcdf(engine="h5netcdf")
+        with open(path, "wb") as handle:
+            handle.write(encoded)
+        return path
+    need = int(ds.nbytes * 1.05) + 4 * 1024**2
+    free = shutil.disk_usage(path.parent).free
+    if free < need:
+        raise OSError(errno.ENOSPC, f"No space left on device: {path.name} needs about "
+                      f"{need / 1024**2:.0f} MiB, {free / 1024**2:.0f} MiB are free", str(path))
+    with _sigint_deferred():
+        ds.to_netcdf(path, engine="h5netcdf")
+    return path
 
 
 def moved(paths: list[Path], tmp: Path, out: Path) -> list[Path]:

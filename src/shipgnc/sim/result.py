@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from shipgnc.errors import ConfigError
+from shipgnc.outputs import write_netcdf
 
 
 def build_dataset(log, batch_shape: tuple[int, ...], batch_dims: tuple[str, ...] | None,
@@ -57,10 +58,9 @@ def _netcdf_attr(value):
 
 
 def save(result: xr.Dataset, path: str | Path) -> Path:
-    """Write ``result`` as NetCDF (h5netcdf engine)."""
-    path = Path(path)
-    result.to_netcdf(path, engine="h5netcdf")
-    return path
+    """Write ``result`` as NetCDF (h5netcdf engine; a failed write is one OSError, see
+    :func:`shipgnc.outputs.write_netcdf`)."""
+    return write_netcdf(result, Path(path))
 
 
 def load(path: str | Path) -> xr.Dataset:

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from shipgnc.errors import ConfigError
+from shipgnc.outputs import write_netcdf
 
 #: a Dataset above this size goes to Zarr (when the ``[dist]`` extra brings zarr), else NetCDF
 ZARR_MIN_BYTES = 2 * 1024**3
@@ -72,8 +73,7 @@ def save_dataset(ds, out: Path) -> Path:
     for name in encoded.coords:  # the grid keys may hold strings: NetCDF wants them as str
         if encoded[name].dtype == object:
             encoded[name] = encoded[name].astype(str)
-    encoded.to_netcdf(path, engine="h5netcdf")
-    return path
+    return write_netcdf(encoded, path)
 
 
 def load_dataset(path: str | Path):
