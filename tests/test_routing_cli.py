@@ -81,6 +81,54 @@ def test_bad_input_exit_2(args, words):
     assert words in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize("args, words", [
+    (("--radius", "-1"), "--radius = -1.0: must be a finite radius >= 0 nm"),
+    (("--grid", "-1"), "--grid = -1.0: must be a finite spacing > 0 nm"),
+    (("--grid", "nan"), "--grid = nan"),
+    (("--horizon", "-5"), "--horizon = -5.0: must be a finite time > 0 h"),
+])
+def test_nautical_input_errors_speak_nautical_units(args, words):
+    """A user of --units nautical typed nm and h: the error quotes what was typed, in those units
+    (it quoted the internal grid_spacing = -1852.0 m)."""
+    r = invoke("--start", "0,0", "--target", "10,10", "--speed", "5", "--field", "uniform:north=0.1",
+               "--units", "nautical", *args)
+    assert r.exit_code == 2 and words in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
+
+
+def test_a_nautical_unreachable_reason_speaks_hours_and_knots():
+    """The straight route in a 0.1 kn current at 5 kn takes |AB|/(c·ê + √(V² − (c×ê)²)) ≈ 2.79 h:
+    beyond a 1 h horizon, said in hours; a 1 kn current against a 0.5 kn ship, said in knots."""
+    import math
+
+    along = across = 0.1 / math.sqrt(2)  # the current's parts along and across the 45° track
+    hours = math.hypot(10, 10) / (along + math.sqrt(5**2 - across**2))
+    base = ["--start", "0,0", "--target", "10,10", "--units", "nautical"]
+    r = invoke(*base, "--speed", "5", "--field", "uniform:north=0.1", "--horizon", "1")
+    assert r.exit_code == 3 and "T_max = 1 h" in r.stderr, r.stderr
+    import re
+
+    assert float(re.search(r"takes ([\d.]+) h", r.stderr).group(1)) == pytest.approx(hours, rel=1e-5)
+    r = invoke(*base, "--speed", "0.5", "--field", "uniform:north=1")
+    assert r.exit_code == 3 and "current 0.9999 kn exceeds ship speed 0.5 kn" in r.stderr, r.stderr
+
+
+def test_nautical_text_converts_each_si_quantity_and_range():
+    from shipgnc.units import nautical_text
+
+    assert nautical_text("within T_max = 3600 s; 1852 m off; 2.5722 m/s") == (
+        "within T_max = 1 h; 1 nm off; 5 kn")
+    assert nautical_text("north -3704…1852 m, k = 2.7778e-4 1/s") == "north -2…1 nm, k = 1 1/h"
+    # words and units inside words are left alone
+    assert nautical_text("5 steps, 3 more, 10 ms") == "5 steps, 3 more, 10 ms"
+
+
+def test_an_absurd_current_is_one_line_not_an_overflow():
+    r = invoke("--start", "0,0", "--target", "10,10", "--speed", "5", "--field", "shear:k=1e300",
+               "--units", "nautical")
+    assert r.exit_code == 2 and "no finite bound" in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
 def test_field_strings_and_nautical_units():
     f = parse_field("rotation:omega=0.1,north=1,east=2+lamb-oseen:gamma=2,rc=0.5", "nautical")
     assert isinstance(f, SumField)

@@ -35,6 +35,31 @@ def test_a_target_a_billion_miles_away_is_answered_in_seconds():
     assert "global check skipped" in proc.stdout + proc.stderr
 
 
+def test_a_current_a_hundred_times_the_ship_gets_its_closed_form_and_no_false_warning():
+    """Row 6 of the reliability issue: 100 nm × 100 nm at 0.5 kn in a shear of 0.5 /h (a current
+    of 50 kn at the target's latitude). The optimum (the shear's closed form, (2.6)–(2.8)) heads
+    south, rides the current 5 099 nm east and comes back: 485.49 h. The level set's box (|AB|/2
+    around A and B) cannot hold it, and its ghost cells, where the current flows in, made it
+    "arrive" 34 % early — a false WARNING after a minute. The check is skipped and said."""
+    from shipgnc.routing.closed_form import shear_closed_form
+
+    # one extremal: u₀ on the arcsine's second branch (the closed form took the shorter branch only
+    # and found none), u₀ and u_f in one half-plane (sin u keeps its sign along (2.6))
+    (exact,) = shear_closed_form(0.5 * KN, -0.5 / 3600, (0.0, 0.0), (100 * NM, 100 * NM))
+    assert np.sin(exact.heading_start) * np.sin(exact.heading_end) > 0
+    cmd = [sys.executable, "-m", "shipgnc", "route", "--start", "0,0", "--target", "100,100",
+           "--speed", "0.5", "--field", "shear:k=-0.5", "--units", "nautical", "--json"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    import json
+
+    js = json.loads(proc.stdout)
+    assert js["time_s"] == pytest.approx(exact.duration, rel=1e-6)
+    assert js["global_check"] is None
+    assert not any("WARNING" in n for n in js["notes"])
+    assert any("global check skipped: the route runs far outside" in n for n in js["notes"])
+
+
 def test_the_polish_stops_at_its_effort_bound_and_says_so(monkeypatch):
     monkeypatch.setattr(pmp, "MAX_EVALS_PER_SOLVE", 20)  # solve_ivp's bound (a field without a kernel)
     monkeypatch.setattr(pmp, "MAX_STEPS_PER_SOLVE", 20)  # the compiled integration's

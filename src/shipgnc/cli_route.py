@@ -34,8 +34,8 @@ from typing import Annotated
 
 import typer
 
-from shipgnc.errors import ConfigError
-from shipgnc.units import KNOT, NAUTICAL_MILE
+from shipgnc.errors import ConfigError, ShipGNCError
+from shipgnc.units import KNOT, NAUTICAL_MILE, nautical_text
 
 
 def _pair(text: str, name: str, scale: float):
@@ -92,12 +92,11 @@ def route(
                              "available now); a larger estimate is refused before any work.")] = None,
 ) -> None:
     """Time-optimal route through a current field (Zermelo's problem)."""
-    from shipgnc.cli import friendly_errors, stderr, stdout
+    from shipgnc.cli import friendly_errors
 
     with friendly_errors():
         from shipgnc.errors import require
-        from shipgnc.routing.field_spec import parse_field
-        from shipgnc.routing.router import METHODS, solve_route
+        from shipgnc.routing.router import METHODS
 
         if out is not None:
             from shipgnc.outputs import check_out
@@ -112,6 +111,15 @@ def route(
         length = NAUTICAL_MILE if nautical else 1.0
         vel = KNOT if nautical else 1.0
         tscale = 3600.0 if nautical else 1.0
+        u_len, u_time = ("nm", "h") if nautical else ("m", "s")
+        require(math.isfinite(speed) and speed > 0, "--speed", speed,
+                f"must be a finite speed > 0 {'kn' if nautical else 'm/s'}")
+        require(math.isfinite(radius) and radius >= 0, "--radius", radius,
+                f"must be a finite radius >= 0 {u_len}")
+        require(grid is None or (math.isfinite(grid) and grid > 0), "--grid", grid,
+                f"must be a finite spacing > 0 {u_len}")
+        require(horizon is None or (math.isfinite(horizon) and horizon > 0), "--horizon", horizon,
+                f"must be a finite time > 0 {u_time}")
         if geo:
             _geo_route(start, target, speed * vel, field, method, obstacles, units, json_, out, horizon,
                        radius, depart, grid, land, depth, draft, ukc, xte_m, length, tscale, sail,
@@ -125,43 +133,67 @@ def route(
         require(not geo_only, geo_only[0] if geo_only else "", "given", "needs --geo")
         a = _pair(start, "--start", length)
         b = _pair(target, "--target", length)
-        require(math.isfinite(speed) and speed > 0, "--speed", speed,
-                f"must be a finite speed > 0 {'kn' if nautical else 'm/s'}")
-        fld = parse_field(field, units)
-        polys = None
-        if obstacles is not None:
-            from shipgnc.routing.obstacles import load_geojson
+        with _in_units(nautical):
+            _plane_route(a, b, speed * vel, field, units, method, obstacles, json_, out, horizon, radius,
+                         depart_value, grid, length, tscale, nautical, limit)
 
-            polys = load_geojson(obstacles, units)
-        from shipgnc.routing.memory import route_memory_estimate
-        from shipgnc.routing.router import _validate
 
-        t_h = None if horizon is None else horizon * tscale
-        spacing = None if grid is None else grid * length
-        _validate(fld, speed * vel, a, b, depart_value * tscale, radius * length)  # the router's own errors
-        _check_memory(route_memory_estimate(fld, speed * vel, a, b, method=method, grid_spacing=spacing,
-                                            horizon=t_h, obstacles=polys, t0=depart_value * tscale,
-                                            radius=radius * length), limit)
-        with _progress() as progress:
-            res = solve_route(fld, speed * vel, a, b, method=method, obstacles=polys, radius=radius * length,
-                              t0=depart_value * tscale, horizon=t_h, grid_spacing=spacing, progress=progress)
-        payload = res.to_json()
-        text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
-        if out is not None:  # atomic: a temporary directory moved into place when complete
-            from shipgnc.outputs import atomic_dir
-            from shipgnc.routing.figures import route_figure
+def _plane_route(a, b, speed, field, units, method, obstacles, json_, out, horizon, radius, depart_value,
+                 grid, length, tscale, nautical, limit) -> None:
+    """``route`` on the plane (N, E), after the command's own checks; SI from here on."""
+    from shipgnc.cli import stderr, stdout
+    from shipgnc.routing.field_spec import parse_field
+    from shipgnc.routing.router import solve_route
 
-            with atomic_dir(out, command="route") as tmp:
-                (tmp / "route.json").write_text(text + "\n", encoding="utf-8")
-                route_figure(res, tmp / "route.png", nautical=nautical)
-            stderr.print(f"wrote route.json, route.png to {out}", soft_wrap=True)
-        if json_:
-            sys.stdout.write(text + "\n")
-        else:
-            _print(stdout, res, nautical)
-        if not res.reachable:
-            stderr.print(f"[bold red]unreachable:[/] {' '.join(str(res.reason).split())}", soft_wrap=True)
-            raise typer.Exit(3)
+    fld = parse_field(field, units)
+    polys = None
+    if obstacles is not None:
+        from shipgnc.routing.obstacles import load_geojson
+
+        polys = load_geojson(obstacles, units)
+    from shipgnc.routing.memory import route_memory_estimate
+    from shipgnc.routing.router import _validate
+
+    t0 = depart_value * tscale
+    t_h = None if horizon is None else horizon * tscale
+    spacing = None if grid is None else grid * length
+    _validate(fld, speed, a, b, t0, radius * length)  # the router's own errors, before the estimate
+    _check_memory(route_memory_estimate(fld, speed, a, b, method=method, grid_spacing=spacing, horizon=t_h,
+                                        obstacles=polys, t0=t0, radius=radius * length), limit)
+    with _progress() as progress:
+        res = solve_route(fld, speed, a, b, method=method, obstacles=polys, radius=radius * length, t0=t0,
+                          horizon=t_h, grid_spacing=spacing, progress=progress)
+    payload = res.to_json()
+    text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
+    if out is not None:  # atomic: a temporary directory moved into place when complete
+        from shipgnc.outputs import atomic_dir
+        from shipgnc.routing.figures import route_figure
+
+        with atomic_dir(out, command="route") as tmp:
+            (tmp / "route.json").write_text(text + "\n", encoding="utf-8")
+            route_figure(res, tmp / "route.png", nautical=nautical)
+        stderr.print(f"wrote route.json, route.png to {out}", soft_wrap=True)
+    if json_:
+        sys.stdout.write(text + "\n")
+    else:
+        _print(stdout, res, nautical)
+    if not res.reachable:
+        reason = " ".join(str(res.reason).split())
+        stderr.print(f"[bold red]unreachable:[/] {nautical_text(reason) if nautical else reason}",
+                     soft_wrap=True)
+        raise typer.Exit(3)
+
+
+@contextmanager
+def _in_units(nautical: bool):
+    """With ``--units nautical``, an error from the SI code below speaks nm, h and kn
+    (:func:`~shipgnc.units.nautical_text`): the units the user typed."""
+    try:
+        yield
+    except ShipGNCError as exc:
+        if nautical:
+            exc.args = (nautical_text(str(exc)),)
+        raise
 
 
 def _number(text: str, name: str, rule: str) -> float:
@@ -416,4 +448,4 @@ def _print(console, res, nautical: bool) -> None:
         row(f"global check by {name}: time to target", val)
     console.print(table)
     for note in js["notes"]:
-        console.print(f"note: {note}", soft_wrap=True)
+        console.print(f"note: {nautical_text(note) if nautical else note}", soft_wrap=True)

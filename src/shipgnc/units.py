@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 KNOT = 1852.0 / 3600.0  #: m/s per knot
 NAUTICAL_MILE = 1852.0  #: m per nautical mile
@@ -18,3 +19,29 @@ def deg(x):
 def to_deg(x):
     """Radians → degrees (works on floats and arrays)."""
     return x * (180.0 / math.pi)
+
+
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+#: an SI quantity (or a range ``a…b``) in a message: numbers, an optional space and a unit below
+_SI_QUANTITY = re.compile(rf"(?<![\w.])({_NUMBER})(?:…({_NUMBER}))? ?(m²/s|m/s|1/s|m|s)(?![\w/²])")
+#: SI unit → (nautical unit, factor from SI)
+_TO_NAUTICAL = {"m": ("nm", 1 / NAUTICAL_MILE), "s": ("h", 1 / 3600.0), "m/s": ("kn", 1 / KNOT),
+                "1/s": ("1/h", 3600.0), "m²/s": ("nm²/h", 3600.0 / NAUTICAL_MILE**2)}
+
+
+def nautical_text(text: str) -> str:
+    """A message with its SI quantities (``1852 m``, ``3600 s``, ``2.5 m/s``, ``k = 1e-4 1/s``,
+    ``Γ = 1e5 m²/s``) restated in the nautical units a user of ``--units nautical`` typed (nm, h,
+    kn, 1/h, nm²/h), so that an error speaks the units of its input."""
+    def convert(match: re.Match) -> str:
+        unit, factor = _TO_NAUTICAL[match.group(3)]
+        values = [f"{float(v) * factor:.{_significant(v)}g}" for v in match.groups()[:2] if v is not None]
+        return f"{'…'.join(values)} {unit}"
+
+    return _SI_QUANTITY.sub(convert, text)
+
+
+def _significant(number: str) -> int:
+    """The significant digits a number was printed with (at least 3): its conversion keeps them."""
+    mantissa = number.lstrip("+-").lower().split("e")[0].replace(".", "").lstrip("0")
+    return max(3, len(mantissa))

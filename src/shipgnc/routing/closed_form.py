@@ -53,49 +53,51 @@ def shear_closed_form(speed, k, start, target, s=0.0, n_scan=7200) -> list[Shear
     """All solutions of (2.7)–(2.8) through ``start`` (fastest first) for the shear v = (0, k (x_N − s)).
 
     From the first equation of (2.8): 1/sin u₀ = 1/sin u_f − k (A₁ − B₁)/V; u₀ lies in the half-plane of
-    u_f with t_f > 0 in (2.7); the second equation of (2.8) is then a scalar equation in u_f, solved by a
-    scan and Brent's method. Singular for sin u_f = 0 (due north or south): there use the numerical PMP.
+    u_f with t_f > 0 in (2.7), on either branch of the arcsine (the second equation decides which, not the
+    shorter t_f); the second equation of (2.8) is then a scalar equation in u_f, solved by a scan and
+    Brent's method on each branch. Singular for sin u_f = 0 (due north or south): there use the numerical PMP.
     """
     from scipy.optimize import brentq
 
     require(k != 0, "shear.k", k, "the closed form needs k ≠ 0 (still water: straight line)")
     a1, a2 = start
 
-    def u0_of(u_f):
+    def u0_of(u_f, branch):
+        """u₀ on ``branch`` (0: asin, 1: π − asin) of the first equation of (2.8), if t_f > 0."""
         inv = 1 / math.sin(u_f) - k * (a1 - target[0]) / speed
         if abs(inv) < 1.0:
             return None
-        base = math.asin(1 / inv)  # in the half-plane of sin(u_f) (inv has the sign of sin u0)
-        options = [np.mod(base, TWO_PI), np.mod(math.pi - base, TWO_PI)]
-        good = [u for u in options if shear_time(u, u_f, k) > 0]
-        return min(good, key=lambda u: shear_time(u, u_f, k)) if good else None
+        base = math.asin(1 / inv)  # inv has the sign of sin u₀
+        u0 = np.mod(base if branch == 0 else math.pi - base, TWO_PI)
+        # (2.6) keeps the heading in the half-plane of u_f: sin u never changes sign along an extremal
+        same_side = math.sin(u0) * math.sin(u_f) > 0
+        return u0 if same_side and shear_time(u0, u_f, k) > 0 else None
 
-    def resid(u_f):
-        u0 = u0_of(u_f)
+    def resid(u_f, branch):
+        u0 = u0_of(u_f, branch)
         if u0 is None:
             return math.nan
         return float(shear_path(u0, u_f, speed, k, target, s)[1]) - a2
 
     grid = np.linspace(0, TWO_PI, n_scan, endpoint=False)[1:]
     grid = grid[np.abs(np.sin(grid)) > 1e-6]
-    vals = np.array([resid(u) for u in grid])
     out = []
-    for i in range(grid.size - 1):
-        r0, r1 = vals[i], vals[i + 1]
-        if not (np.isfinite(r0) and np.isfinite(r1)) or r0 * r1 > 0:
-            continue
-        if np.sign(np.sin(grid[i])) != np.sign(np.sin(grid[i + 1])):
-            continue
-        if abs(r0 - r1) > 0.5 * (abs(r0) + abs(r1)) + 1e3 and min(abs(r0), abs(r1)) > 1e3:
-            continue  # a pole, not a root
-        try:
-            u_f = brentq(resid, grid[i], grid[i + 1], xtol=1e-15, rtol=1e-15)
-        except ValueError:
-            continue
-        u0 = u0_of(u_f)
-        if u0 is None or abs(resid(u_f)) > 1e-3:
-            continue
-        out.append(ShearSolution(shear_time(u0, u_f, k), float(u0), float(np.mod(u_f, TWO_PI))))
+    for branch in (0, 1):  # both: the east equation picks the branch, not the shorter t_f
+        vals = np.array([resid(u, branch) for u in grid])
+        for i in range(grid.size - 1):
+            r0, r1 = vals[i], vals[i + 1]
+            if not (np.isfinite(r0) and np.isfinite(r1)) or r0 * r1 > 0:
+                continue
+            if np.sign(np.sin(grid[i])) != np.sign(np.sin(grid[i + 1])):
+                continue
+            try:
+                u_f = brentq(resid, grid[i], grid[i + 1], args=(branch,), xtol=1e-15, rtol=1e-15)
+            except ValueError:
+                continue
+            u0 = u0_of(u_f, branch)
+            if u0 is None or abs(resid(u_f, branch)) > 1e-3:  # a pole (a sign change through ±∞)
+                continue
+            out.append(ShearSolution(shear_time(u0, u_f, k), float(u0), float(np.mod(u_f, TWO_PI))))
     return sorted(out, key=lambda z: z.duration)
 
 

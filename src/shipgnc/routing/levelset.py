@@ -377,7 +377,7 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
             return out
         return front_rate(ph, spacing, speed_grid, vn, ve)
 
-    dt = cfl * spacing / (speed + math.sqrt(2) * vmax)
+    dt = time_step(cfl, spacing, speed, vmax, field)
     if store_every is None:
         store_every = max(1, round(0.01 * dist / speed / dt))  # ~ 100 snapshots per |AB|/V
     t = t_init
@@ -430,6 +430,17 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
             notes.append(f"the recovered route passes {margin:.0f} m from the level-set domain's edge: "
                          "enlarge the domain")
     return res
+
+
+def time_step(cfl, spacing, speed, vmax, field) -> float:
+    """The CFL step Δt = cfl·h/(V + √2·v_max) [s]; a current without a finite bound over the grid
+    (or one so fast that Δt vanishes against the route's time) is refused in one line."""
+    dt = cfl * spacing / (speed + math.sqrt(2) * vmax) if math.isfinite(vmax) else 0.0
+    if not (dt > 0 and spacing / speed / dt < 1e12):
+        reach = f"reaches {vmax:.3g} m/s" if math.isfinite(vmax) else "has no finite bound"
+        raise ConfigError(f"field {field.describe()}: the current {reach} over the level set's grid, "
+                          f"beyond any time step (ship speed {speed:.3g} m/s)")
+    return dt
 
 
 def _cubic_crossing(t, f):

@@ -101,7 +101,7 @@ def levelset_memory(fld, speed, start, target, domain, spacing, *, t0=0.0, horiz
     arguments; the snapshot count follows its loop: Δt = cfl·h/(V + √2·v_max), ``store_every`` =
     max(1, round(0.01·|AB|/V/Δt)), ⌈(T − r₀/V)/Δt⌉ + 1 steps, plus the first and the arrival front, at
     most ``levelset.MAX_SNAPSHOTS`` (it thins beyond)."""
-    from shipgnc.routing.levelset import MAX_SNAPSHOTS, _initial_radius
+    from shipgnc.routing.levelset import MAX_SNAPSHOTS, _initial_radius, time_step
 
     out = RouteMemory() if out is None else out
     start, target = np.asarray(start, float), np.asarray(target, float)
@@ -121,7 +121,7 @@ def levelset_memory(fld, speed, start, target, domain, spacing, *, t0=0.0, horiz
     if r0 is None:
         r0 = _initial_radius(spacing, dist, start, obstacles)
     vmax = fld.max_speed(((lo_n, hi_n), (lo_e, hi_e)), t0)
-    dt = cfl * spacing / (speed + math.sqrt(2) * vmax)
+    dt = time_step(cfl, spacing, speed, vmax, fld)
     store_every = max(1, round(0.01 * dist / speed / dt))
     max_steps = max(0, math.ceil((horizon - r0 / speed) / dt) + 1)
     snaps = min(1 + max_steps // store_every, MAX_SNAPSHOTS) + 1  # thinned beyond MAX_SNAPSHOTS
