@@ -76,7 +76,8 @@ def _generator(path: str):
 
 
 def main(names: list[str]) -> None:
-    from shipgnc.scenarios.runner import run_scenario, write_outputs
+    from shipgnc.scenarios.runner import run_scenario
+    from shipgnc.scenarios.write import write_outputs
 
     known = [*JOBS, *SETS]
     wanted = names or known

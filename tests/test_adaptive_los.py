@@ -13,8 +13,8 @@ from shipgnc.control.heading_speed import HeadingSpeedAutopilot
 from shipgnc.environment.current_field import CurrentDisturbance, parse_current
 from shipgnc.errors import ConfigError
 from shipgnc.guidance.los import LOSGuidance
-from shipgnc.guidance.path import WaypointPath
 from shipgnc.models.fossen3dof import VectoredThrustBoat
+from shipgnc.paths import WaypointPath
 from shipgnc.scenarios.runner import load_scenario, run_scenario
 from shipgnc.sim.simulator import simulate
 

@@ -18,9 +18,9 @@ from shipgnc.control.open_loop import OpenLoopSchedule
 from shipgnc.environment.disturbance import ConstantDisturbance
 from shipgnc.errors import DivergenceError
 from shipgnc.guidance.los import LOSGuidance
-from shipgnc.guidance.path import WaypointPath
 from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.fossen3dof import VectoredThrustBoat
+from shipgnc.paths import WaypointPath
 from shipgnc.sim.simulator import _validate, simulate
 
 RTOL, ATOL = 1e-9, 1e-12

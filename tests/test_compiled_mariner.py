@@ -21,8 +21,8 @@ from shipgnc.environment.current import CrossCurrent
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
 from shipgnc.environment.filtered_noise import SecondOrderNoise
 from shipgnc.errors import DivergenceError
-from shipgnc.guidance.path import WaypointPath
 from shipgnc.models.mariner import DOC_B_R, DOC_D_Y, MarinerDisturbance, MarinerWitOppe, rudder
+from shipgnc.paths import WaypointPath
 from shipgnc.sim import compose, simulator
 from shipgnc.sim.simulator import _validate, simulate
 from shipgnc.units import NAUTICAL_MILE as NM

@@ -15,10 +15,10 @@ from shipgnc.control.open_loop import OpenLoopSchedule
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
 from shipgnc.errors import ConfigError
 from shipgnc.guidance.los import LOSGuidance
-from shipgnc.guidance.path import WaypointPath
 from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.base import Signal
 from shipgnc.models.fossen3dof import VectoredThrustBoat
+from shipgnc.paths import WaypointPath
 from shipgnc.sim import compose
 from shipgnc.sim.simulator import simulate
 

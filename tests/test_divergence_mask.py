@@ -20,7 +20,7 @@ from shipgnc.errors import ConfigError
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build
 from shipgnc.sim.simulator import simulate
-from shipgnc.sim.streams import MemberStreams, member_seeds
+from shipgnc.streams import MemberStreams, member_seeds
 
 RUNAWAY_SHIP = 1
 

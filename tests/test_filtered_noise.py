@@ -11,7 +11,7 @@ import scipy.signal
 from shipgnc.environment.current import CrossCurrent
 from shipgnc.environment.filtered_noise import SecondOrderNoise
 from shipgnc.errors import ConfigError
-from shipgnc.guidance.path import WaypointPath
+from shipgnc.paths import WaypointPath
 
 
 def realisation(noise, h, n, ships=1, seed=1):

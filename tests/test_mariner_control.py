@@ -37,7 +37,7 @@ from shipgnc.control.lqr import (
 )
 from shipgnc.errors import ConfigError
 from shipgnc.frames import wrap_angle
-from shipgnc.guidance.path import LegTracker, WaypointPath
+from shipgnc.paths import LegTracker, WaypointPath
 from shipgnc.sim.integrators import rk4_step
 from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
 

@@ -18,7 +18,6 @@ from shipgnc.control.heading_speed import HeadingSpeedAutopilot
 from shipgnc.environment.disturbance import GaussianForceNoise
 from shipgnc.errors import ConfigError
 from shipgnc.guidance.los import LOSGuidance
-from shipgnc.guidance.path import WaypointPath
 from shipgnc.models.cybership2 import CyberShip2
 from shipgnc.models.fossen3dof import VectoredThrustBoat
 from shipgnc.models.mariner import MarinerWitOppe
@@ -35,8 +34,9 @@ from shipgnc.navigation import (
     force_psd_to_state_psd,
     heading_wave_kf,
 )
+from shipgnc.paths import WaypointPath
 from shipgnc.sim.simulator import simulate
-from shipgnc.sim.streams import MemberStreams, member_seeds
+from shipgnc.streams import MemberStreams, member_seeds
 
 BOAT = VectoredThrustBoat.from_preset("otter")
 
@@ -166,7 +166,7 @@ def test_ekf_nees_in_chi2_band_and_dead_reckoning_through_dropout():
 
 def test_member_streams_make_a_ship_independent_of_its_batch():
     """With one stream per ship (MemberStreams), ship 1's sensor noise and estimate are the same in
-    a batch of 2 and of 3 (the convention of shipgnc.sim.streams)."""
+    a batch of 2 and of 3 (the convention of shipgnc.streams)."""
     def run(n):
         nav = Navigation([GNSS(1.5, rate_hz=1.0), Compass(math.radians(1.0))],
                          ExtendedKalmanFilter(requires=("north", "east", "psi")))

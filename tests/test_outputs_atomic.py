@@ -262,7 +262,8 @@ def test_a_real_failing_hdf5_write_is_one_line_not_a_crash(tmp_path):
 
 def test_write_outputs_api_is_atomic_too(tmp_path, monkeypatch):
     from shipgnc.errors import ShipGNCError
-    from shipgnc.scenarios.runner import run_scenario, write_outputs
+    from shipgnc.scenarios.runner import run_scenario
+    from shipgnc.scenarios.write import write_outputs
 
     run = run_scenario("boat-stern-kick", overrides=["simulation.t_end=2"])
     written = write_outputs(run, tmp_path / "api", figures=False)
@@ -325,3 +326,19 @@ def test_route_out_is_atomic(tmp_path):
     result = invoke("route", "--start", "0,0", "--target", "0,1000", "--speed", "1",
                     "--field", "uniform:north=0,east=0", "--out", out)
     assert result.exit_code == 2 and "not a shipgnc run" in one_line(result)
+
+
+def test_a_netcdf_write_works_with_a_dask_cluster_open(tmp_path):
+    """With a ``distributed.Client`` open in the session (a notebook's), xarray locks a write with
+    a cluster-wide lock named after the target; the in-memory encoding's target is no name
+    ("Semaphore or Lock <BytesIO> not known"). The write takes a thread lock and succeeds."""
+    import distributed
+
+    from shipgnc.outputs import write_netcdf
+
+    ds = xr.Dataset({"a": ("t", np.arange(5.0))})
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster):
+        write_netcdf(ds, tmp_path / "r.nc")
+    with xr.open_dataset(tmp_path / "r.nc", engine="h5netcdf") as back:
+        xr.testing.assert_identical(back.load(), ds)

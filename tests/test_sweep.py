@@ -206,7 +206,7 @@ def test_products_on_the_path_do_not_depend_on_the_batch():
     from shipgnc.environment.filtered_noise import SecondOrderNoise
     from shipgnc.scenarios.registry import load_scenario
     from shipgnc.scenarios.runner import build
-    from shipgnc.sim.streams import MemberStreams, member_seeds
+    from shipgnc.streams import MemberStreams, member_seeds
 
     seeds = member_seeds(3, 300)
     noise = SecondOrderNoise(sigma=0.5, period=8.0, zeta=0.1)

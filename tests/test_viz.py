@@ -17,9 +17,9 @@ from shipgnc.control.heading_speed import HeadingSpeedAutopilot
 from shipgnc.control.open_loop import OpenLoopSchedule
 from shipgnc.errors import ConfigError
 from shipgnc.guidance.los import LOSGuidance
-from shipgnc.guidance.path import WaypointPath
 from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.fossen3dof import VectoredThrustBoat
+from shipgnc.paths import WaypointPath
 from shipgnc.sim.simulator import StopSimulation, simulate
 from shipgnc.viz import style
 from shipgnc.viz.dashboard import dashboard, save_figure, stern_kick_closeup

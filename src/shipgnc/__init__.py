@@ -36,7 +36,7 @@ _LAZY = {
     "OpenLoopSchedule": "shipgnc.control.open_loop",
     "LOSGuidance": "shipgnc.guidance.los",
     "ReferenceSchedule": "shipgnc.guidance.schedule",
-    "WaypointPath": "shipgnc.guidance.path",
+    "WaypointPath": "shipgnc.paths",
     "load_scenario": "shipgnc.scenarios.registry",
     "run_scenario": "shipgnc.scenarios.runner",
     "ShipGNCError": "shipgnc.errors",

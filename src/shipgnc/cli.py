@@ -136,7 +136,8 @@ def run_command(
         from shipgnc.errors import ConfigError
         from shipgnc.outputs import check_out
         from shipgnc.scenarios.registry import load_scenario
-        from shipgnc.scenarios.runner import divergence_message, metrics_json, run_scenario, write_outputs
+        from shipgnc.scenarios.runner import divergence_message, metrics_json, run_scenario
+        from shipgnc.scenarios.write import write_outputs
 
         if realtime is not None and not (realtime > 0 and realtime < float("inf")):
             raise ConfigError(f"--realtime = {realtime}: must be a number > 0 (1.0 = real time)")

@@ -219,10 +219,11 @@ def write_netcdf(ds, path: Path) -> Path:
     by ordinary file I/O; a file larger than :data:`IN_MEMORY_MAX_BYTES` is left to HDF5 only
     after the free space has been checked against its size (data + 5 % + 4 MiB). A Ctrl-C that
     arrives while h5py works is held until it is done, then raised: delivered inside one of
-    h5py's deallocation callbacks it would be printed and ignored, and the run would go on."""
+    h5py's deallocation callbacks it would be printed and ignored, and the run would go on.
+    The write takes a thread lock, whatever dask scheduler the session has (:func:`_local_write_lock`)."""
     path = Path(path)
     if ds.nbytes <= IN_MEMORY_MAX_BYTES:
-        with _sigint_deferred():
+        with _sigint_deferred(), _local_write_lock():
             encoded = ds.to_netcdf(engine="h5netcdf")
         with open(path, "wb") as handle:
             handle.write(encoded)
@@ -232,9 +233,21 @@ def write_netcdf(ds, path: Path) -> Path:
     if free < need:
         raise OSError(errno.ENOSPC, f"No space left on device: {path.name} needs about "
                       f"{need / 1024**2:.0f} MiB, {free / 1024**2:.0f} MiB are free", str(path))
-    with _sigint_deferred():
+    with _sigint_deferred(), _local_write_lock():
         ds.to_netcdf(path, engine="h5netcdf")
     return path
+
+
+@contextmanager
+def _local_write_lock():
+    """xarray locks a NetCDF write with the lock of dask's current scheduler: with a
+    ``distributed.Client`` open in the session (a notebook's, a sweep's) that is a cluster-wide
+    lock named after the target, which an in-memory target cannot be ("Semaphore or Lock
+    <BytesIO> not known"). The data written here is in memory already: a thread lock will do."""
+    import dask
+
+    with dask.config.set(scheduler="synchronous"):
+        yield
 
 
 def moved(paths: list[Path], tmp: Path, out: Path) -> list[Path]:

@@ -7,7 +7,7 @@ Design model (14): a Norrbin yaw equation with the path-frame kinematics, x = [y
 
 Three controllers, each with the conventions of :mod:`shipgnc.control` (``Ts``, ``signals``,
 ``reset(batch_shape)``, ``step`` → ``(..., 1)``, batched) and the path geometry of
-:class:`~shipgnc.control.lqr.PathLQR` (their own :class:`~shipgnc.guidance.path.LegTracker`, leg
+:class:`~shipgnc.control.lqr.PathLQR` (their own :class:`~shipgnc.paths.LegTracker`, leg
 switching A6, ``reference_names = ()``):
 
 * :class:`OutputFL` with ``lookahead = 0`` — ``fl_paper``, the literal design (19)–(23) on
@@ -68,7 +68,9 @@ from shipgnc.control.lqr import (
 from shipgnc.environment.current import CURRENT_FRAMES
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
-from shipgnc.guidance.path import (
+from shipgnc.kernels import Kernel, clip, flat, kernel_function, wrap
+from shipgnc.models.base import Signal
+from shipgnc.paths import (
     LEG_ANGLE,
     LEG_COS,
     LEG_SIN,
@@ -78,8 +80,6 @@ from shipgnc.guidance.path import (
     leg_value,
     track_leg,
 )
-from shipgnc.kernels import Kernel, clip, flat, kernel_function, wrap
-from shipgnc.models.base import Signal
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 
 #: gains of (23) printed in the document [1/min², 1/min]

@@ -22,7 +22,7 @@ The printed gain :data:`PAPER_LQR_GAIN` = [3.4, 3.2, 1, 0.45] is reproduced with
 **Controller.** :class:`PathLQR` does its own path geometry (``reference_names = ()``): the LQR
 state *is* the path-frame error (y_r, ψ_r) of the active leg plus an integrator whose bookkeeping
 is tied to the leg (it is not reset at a switch, A7), so it takes the
-:class:`~shipgnc.guidance.path.WaypointPath` directly instead of a heading reference from a
+:class:`~shipgnc.paths.WaypointPath` directly instead of a heading reference from a
 guidance object (the simulator's references are set-points for one state each, which y_r, ψ_r
 and e_I are not). Leg switching (A6, :class:`LegTracker`): leg i+1 becomes active once the
 along-track distance x_r on leg i reaches its length; the last leg is a half-line.
@@ -39,7 +39,10 @@ import numpy as np
 from shipgnc.batchmath import row_dot
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
-from shipgnc.guidance.path import (
+from shipgnc.kernels import Kernel, clip, flat, kernel_function, sign, wrap
+from shipgnc.models.base import Signal
+from shipgnc.models.mariner import tracking_model  # the design model (8)/(9): the ship's, not the law's
+from shipgnc.paths import (
     LEG_ANGLE,
     LegTracker,
     WaypointPath,
@@ -47,8 +50,6 @@ from shipgnc.guidance.path import (
     leg_value,
     track_leg,
 )
-from shipgnc.kernels import Kernel, clip, flat, kernel_function, sign, wrap
-from shipgnc.models.base import Signal
 from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
 
 #: K = [k_y, k_ψ, k_r, k_e] printed in the document (min / nm / rad, state order [y_r, ψ_r, r, e_I])
@@ -87,20 +88,6 @@ def _gain_vector(K, field: str) -> np.ndarray:
     require(K.shape == (4,) and bool(np.all(np.isfinite(K))), f"controller.{field}", K.tolist(),
             "need four finite gains [k_y, k_psi, k_r, k_e]")
     return K
-
-
-def tracking_model(a: float, c: float, U: float) -> tuple[np.ndarray, np.ndarray]:
-    """(A, B) of the design model (8)/(9), state [y_r, ψ_r, r, e_I], in the units of a, c, U."""
-    for name, value in (("a", a), ("c", c), ("U", U)):
-        require(isinstance(value, (int, float, np.floating)) and np.isfinite(value),
-                f"controller.{name}", value, "must be a finite number")
-    require(c != 0, "controller.c", c, "the rudder must act on the yaw rate (c != 0)")
-    A = np.array([[0.0, U, 0.0, 0.0],
-                  [0.0, 0.0, 1.0, 0.0],
-                  [0.0, 0.0, -a, 0.0],
-                  [1.0, 0.0, 0.0, 0.0]])
-    B = np.array([[0.0], [0.0], [c], [0.0]])
-    return A, B
 
 
 def lqr_tracking_gain(a: float, c: float, U: float, Q=PAPER_Q, R: float = PAPER_R

@@ -3,7 +3,7 @@
 Document 000's cross current d_y acts "along OY_r", perpendicular to the active leg (note 000-A10): in NED
 it is R(ψ_r0)·[0, d_y]ᵀ = d_y·[−sin ψ_r0, cos ψ_r0] with ψ_r0 the active leg's
 angle (eq. (2)); the ``global`` option fixes it along global y (east). The active leg follows the
-switching rule of note 000-A6 (:class:`~shipgnc.guidance.path.LegTracker`), tracked from the
+switching rule of note 000-A6 (:class:`~shipgnc.paths.LegTracker`), tracked from the
 ship's position at each step's start; the current is held over the step.
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from shipgnc.errors import require
-from shipgnc.guidance.path import LegTracker, WaypointPath
+from shipgnc.paths import LegTracker, WaypointPath
 
 CURRENT_FRAMES = ("path", "global")
 

@@ -48,7 +48,7 @@ import numpy as np
 from shipgnc.errors import require
 from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
 from shipgnc.routing.fields import CurrentField, SumField, field_velocity
-from shipgnc.sim.streams import MemberStreams
+from shipgnc.streams import MemberStreams
 
 
 def _finite(value, field: str) -> float:

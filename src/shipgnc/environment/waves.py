@@ -44,7 +44,7 @@ from scipy import integrate
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.kernels import Kernel, flat
-from shipgnc.sim.streams import is_generator
+from shipgnc.streams import is_generator
 from shipgnc.units import G
 
 __all__ = [

@@ -41,9 +41,9 @@ import numpy as np
 
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
-from shipgnc.guidance.path import WaypointPath
 from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal, state_index
+from shipgnc.paths import WaypointPath
 
 
 class LOSGuidance:

@@ -59,10 +59,10 @@ import numpy as np
 from shipgnc.actuators import Actuator
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
-from shipgnc.guidance.path import leg_table, track_leg
 from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
 from shipgnc.models.base import Signal
 from shipgnc.params import Params
+from shipgnc.paths import leg_table, track_leg
 from shipgnc.routing.fields import field_velocity
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 
@@ -324,6 +324,21 @@ def rudder(params: MarinerParams, *, rate_limit: bool = True, rate_mode: str = "
                     names=tuple(s.name for s in INPUTS), rate_mode=rate_mode)
 
 
+def tracking_model(a: float, c: float, U: float) -> tuple[np.ndarray, np.ndarray]:
+    """(A, B) of the design model (8)/(9), state [y_r, ψ_r, r, e_I], in the units of a, c, U
+    (the LQR of :mod:`shipgnc.control.lqr` is designed on it)."""
+    for name, value in (("a", a), ("c", c), ("U", U)):
+        require(isinstance(value, (int, float, np.floating)) and np.isfinite(value),
+                f"controller.{name}", value, "must be a finite number")
+    require(c != 0, "controller.c", c, "the rudder must act on the yaw rate (c != 0)")
+    A = np.array([[0.0, U, 0.0, 0.0],
+                  [0.0, 0.0, 1.0, 0.0],
+                  [0.0, 0.0, -a, 0.0],
+                  [1.0, 0.0, 0.0, 0.0]])
+    B = np.array([[0.0], [0.0], [c], [0.0]])
+    return A, B
+
+
 def linear_tracking_model(params: MarinerParams, *,
                           paper_units: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """(A, B) of the linear design model (8) for the state [y_r, ψ_r, r, e_I] and input δ::
@@ -334,8 +349,6 @@ def linear_tracking_model(params: MarinerParams, *,
     ``paper_units=True`` in the document's nm, rad, rad/min, nm·min (min), the units the printed
     LQR gain refers to (note 000-0.4). B has shape (4, 1).
     """
-    from shipgnc.control.lqr import tracking_model
-
     values = params.to_paper_units() if paper_units else params.as_dict()
     return tracking_model(values["a"], values["c"], values["S"] / values["f"])
 

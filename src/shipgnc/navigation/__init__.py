@@ -17,7 +17,7 @@ The interface the simulation loop calls (:func:`shipgnc.sim.simulator.simulate`,
   found by name in ``model.states``) and the control period ``Ts`` (every sensor period a whole
   multiple of it), draws the initial error states. Random numbers come from child streams
   ``rng.spawn(...)`` of the run's generator (one per sensor and one for the estimator; per ship
-  when ``rng`` is a :class:`~shipgnc.sim.streams.MemberStreams`): the run's disturbance draws are
+  when ``rng`` is a :class:`~shipgnc.streams.MemberStreams`): the run's disturbance draws are
   the same with or without navigation, and the same seed gives the same run.
 * ``observe(t, x, u) -> x_seen`` — at every control sample, with the TRUE state ``x``
   (*batch, n_states) and the input ``u`` (*batch, n_inputs) applied over the last sample. Returns

@@ -14,7 +14,7 @@ from shipgnc.kernels import Kernel
 from shipgnc.models.base import Signal, names
 from shipgnc.navigation.estimator import Estimator
 from shipgnc.navigation.sensors import Sensor
-from shipgnc.sim.streams import MemberStreams
+from shipgnc.streams import MemberStreams
 
 
 def spawn_streams(rng, n: int) -> list:

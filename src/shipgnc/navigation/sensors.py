@@ -27,7 +27,7 @@ Error models (per ship, independent draws; w ~ N(0, 1) white):
 Random numbers come from the generator the navigation system hands to :meth:`Sensor.reset`: a
 ``numpy.random.Generator`` (draws of shape ``(*batch, k)``, the convention of
 :class:`~shipgnc.environment.disturbance.GaussianForceNoise`) or a
-:class:`~shipgnc.sim.streams.MemberStreams` (one stream per ship: a ship's noise does not depend on
+:class:`~shipgnc.streams.MemberStreams` (one stream per ship: a ship's noise does not depend on
 the batch it shares).
 """
 
@@ -202,8 +202,8 @@ class Sensor:
         ``[bias step, noise]`` each, taken from the sensor's stream in the order :meth:`_measure`
         takes them (zeros where it takes none), in one call per kind of stream: ``count``
         successive draws of shape ``(*batch, k)`` are one draw of ``(count, *batch, k)`` (per
-        member for :class:`~shipgnc.sim.streams.MemberStreams`)."""
-        from shipgnc.sim.streams import MemberStreams
+        member for :class:`~shipgnc.streams.MemberStreams`)."""
+        from shipgnc.streams import MemberStreams
 
         k = len(self.measures)
         out = np.zeros((count, n_ships, 2 * k))

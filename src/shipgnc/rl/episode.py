@@ -23,7 +23,7 @@ period (the final sample t_end included in the last step):
   to the states, the reference ω* and r − ω*. The agent takes the finite-state law's place: the
   action is the model's input δ̇ [rad/s], held over the law's ``Ts`` (continuous: one step dt).
 
-Each member of the batch has its own random stream (:class:`~shipgnc.sim.streams.MemberStreams`):
+Each member of the batch has its own random stream (:class:`~shipgnc.streams.MemberStreams`):
 its initial-state offsets (``perturb``) are drawn first, then its disturbance.
 """
 
@@ -35,7 +35,7 @@ from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import names
 from shipgnc.sim.simulator import _validate, advance_plant
-from shipgnc.sim.streams import MemberStreams
+from shipgnc.streams import MemberStreams
 from shipgnc.study.chunk import check_perturbable
 from shipgnc.study.spec import PERTURBABLE, Perturbation
 

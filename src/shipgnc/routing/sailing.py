@@ -201,8 +201,8 @@ def boat_sail(route, field, mode: str, *, preset: str = "otter", dt: float = 0.0
     from shipgnc.actuators import Actuator
     from shipgnc.control.heading_speed import HeadingSpeedAutopilot
     from shipgnc.guidance.los import LOSGuidance
-    from shipgnc.guidance.path import WaypointPath
     from shipgnc.guidance.schedule import ReferenceSchedule
+    from shipgnc.paths import WaypointPath
     from shipgnc.sim.simulator import simulate
 
     boat = VectoredThrustBoat.from_preset(preset)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from shipgnc.guidance.path import WaypointPath
+from shipgnc.paths import WaypointPath
 from shipgnc.scenarios.schema import Scenario
 from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
 

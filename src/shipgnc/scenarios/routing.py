@@ -193,25 +193,6 @@ def run(scenario: Scenario, *, seed: int):
                        else None, sailed=sailed)
 
 
-def write_figures(run, out) -> list:
-    """``route.png`` (the route over the current, isochrones when the level set ran) and, for a
-    sailed route, ``sail.png`` (the ship's tracks over the route)."""
-    from shipgnc.routing.figures import route_figure
-
-    nautical = run.scenario.route.units == "nautical"
-    document = run.scenario.document_figures.get("route", {})
-    text = None
-    if document:  # the document's numbers beside ours, on the figure
-        rows = [f"{key:<18} {value:>10.4g} {run.metrics.get(key) or float('nan'):>12.6g}"
-                for key, value in document.items()]
-        text = "\n".join([f"{'':<18} {'document':>10} {'shipgnc':>12}", *rows])
-    written = [route_figure(run.route, out / "route.png", nautical=nautical, extra_text=text,
-                            title=run.scenario.name)]
-    if run.sailed:
-        written.append(_sail_figure(run, out / "sail.png", nautical))
-    return [p for p in written if p is not None]
-
-
 #: the metric prefix of each sailed run's label (see :func:`run`)
 def _prefix(label: str) -> str:
     return "path" if label.startswith("LOS") else "legs" if "legs" in label else "sail"
@@ -224,38 +205,3 @@ def sail_summary(metrics: dict, prefix: str) -> str:
         return (f"time to target {metrics[f'{prefix}_arrival_s']:.1f} s "
                 f"({metrics[f'{prefix}_arrival_ratio']:.3f}× optimum)")
     return f"not arrived, miss {metrics[f'{prefix}_miss_m']:.3g} m"
-
-
-def _sail_figure(run, path, nautical: bool):
-    from matplotlib.figure import Figure
-    from matplotlib.patches import Circle
-
-    from shipgnc.viz import style
-    from shipgnc.viz.dashboard import save_figure
-
-    m = run.metrics
-    scale = NAUTICAL_MILE if nautical else 1.0
-    unit = "nm" if nautical else "m"
-    fig = Figure(figsize=(7.5, 7.0))
-    ax = fig.subplots()
-    _, north, east, _ = run.route.sample(400)
-    ax.plot(east / scale, north / scale, color=style.COLORS["path"], linestyle="--", linewidth=2.0,
-            label=f"optimal route ({run.route.time_s:.1f} s)")
-    for i, (label, ds) in enumerate(run.sailed.items()):
-        ax.plot(ds["east"].values / scale, ds["north"].values / scale, color=f"C{i}", linewidth=1.3,
-                label=f"{label}: {sail_summary(m, _prefix(label))}")
-    target = run.route.target
-    radius = m["acceptance_radius_m"]
-    ax.add_patch(Circle((target[1] / scale, target[0] / scale), radius / scale, fill=False,
-                        linestyle=":", color="k", label=f"acceptance radius {radius:.3g} m"))
-    ax.plot(target[1] / scale, target[0] / scale, "*", markersize=12,
-            color=style.COLORS["waypoint"], label="target")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel(f"east [{unit}]", fontsize=style.LABEL_SIZE)
-    ax.set_ylabel(f"north [{unit}]", fontsize=style.LABEL_SIZE)
-    ax.grid(True, linewidth=0.4, alpha=0.5)
-    ax.legend(loc="best", **{**style.LEGEND, "fontsize": 7})
-    vessel = {"mariner": "the Mariner", "vectored-thrust-boat": "the Otter-class boat"}[m["vessel"]]
-    ax.set_title(f"{run.scenario.name}: {len(run.sailed)} runs of {vessel} at "
-                 f"{run.route.speed:.3g} m/s through the water", fontsize=style.LABEL_SIZE)
-    return save_figure(fig, path)

@@ -1,8 +1,8 @@
 """Turn a validated :class:`~shipgnc.scenarios.schema.Scenario` into objects, run it, score it.
 
 ``build`` makes the model, actuator, controller, guidance and disturbance; ``run_scenario`` calls
-the one simulation loop and computes the scenario's metrics; ``write_outputs`` saves
-``result.nc``, ``metrics.json`` and the PNG figures.
+the one simulation loop and computes the scenario's metrics; :func:`shipgnc.scenarios.write.write_outputs`
+saves ``result.nc``, ``metrics.json`` and the PNG figures.
 """
 
 from __future__ import annotations
@@ -21,9 +21,9 @@ from shipgnc.control.open_loop import OpenLoopSchedule
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
 from shipgnc.errors import ConfigError, Interrupted
 from shipgnc.guidance.los import LOSGuidance
-from shipgnc.guidance.path import WaypointPath
 from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.fossen3dof import VectoredThrustBoat
+from shipgnc.paths import WaypointPath
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.schema import CATALOGUE_VESSELS, Scenario
 from shipgnc.units import NAUTICAL_MILE, deg
@@ -544,17 +544,6 @@ def _vessel_attrs(model, scenario: Scenario) -> dict:
     return attrs
 
 
-def figure_title(run: ScenarioRun) -> str:
-    """Scenario name, preset and the key metrics, for the dashboard's title."""
-    shown = []
-    for key, value in run.metrics.items():
-        if isinstance(value, (int, float)) and not isinstance(value, bool) and len(shown) < 4:
-            shown.append(f"{key} = {value:.4g}")
-    preset = getattr(run.scenario.vessel, "preset", None)
-    label = f"{run.scenario.name} (preset {preset})" if preset else run.scenario.name
-    return f"{label}: " + ", ".join(shown) if shown else label
-
-
 def divergence_message(run: ScenarioRun) -> str:
     """The divergence of a run said once: the first diverged run's message, and for a comparison
     the other controllers that diverged too."""
@@ -575,118 +564,6 @@ def run_status(run: ScenarioRun) -> str:
     if run.result is not None and run.result.attrs.get("diverged", 0):
         return "diverged"
     return "complete"
-
-
-def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True,
-                  figure_process=None, overwrite: bool = False) -> list[Path]:
-    """Write ``result.nc``, ``metrics.json`` and the figures into ``out_dir``; return the paths.
-
-    Atomic (:func:`shipgnc.outputs.atomic_dir`): the files are written into a temporary directory
-    beside ``out_dir`` and moved into place together, replacing an earlier shipgnc run whole; a
-    non-empty directory that is not a shipgnc run is refused unless ``overwrite``. A failed write
-    (a full disk, a read-only target) is one error and leaves ``out_dir`` as it was.
-
-    ``figure_process`` (a :class:`shipgnc.viz.background.FigureProcess`) draws the figures in a
-    worker process while this one writes the data files.
-    """
-    from shipgnc.outputs import atomic_dir, moved
-
-    out = Path(out_dir)
-    with atomic_dir(out, overwrite=overwrite, command="run", status=run_status(run)) as tmp:
-        written = _write_files(run, tmp, figures=figures, figure_process=figure_process)
-    return moved(written, tmp, out)
-
-
-def _write_files(run: ScenarioRun, out: Path, *, figures: bool, figure_process) -> list[Path]:
-    from shipgnc.sim.result import save
-    from shipgnc.viz.figures import render_figures
-
-    if run.route is not None:
-        from shipgnc.scenarios import routing
-
-        written = [] if run.result is None else [save(run.result, out / "result.nc")]
-        (out / "metrics.json").write_text(metrics_json(run.metrics) + "\n", encoding="utf-8")
-        written.append(out / "metrics.json")
-        return written + (routing.write_figures(run, out) if figures else [])
-    pending = None
-    job = figure_job(run, out) if figures else None
-    figures = job is not None
-    if figures and figure_process is not None:
-        pending = figure_process.submit(render_figures, job)
-    try:
-        written = [save(run.result, out / "result.nc")]
-        metrics_path = out / "metrics.json"
-        metrics_path.write_text(metrics_json(run.metrics) + "\n", encoding="utf-8")
-        written.append(metrics_path)
-        if run.setups is not None:
-            written.extend(write_table(comparison_table(run), out))
-    except BaseException:
-        if pending is not None:
-            pending.cancel()
-        raise
-    if pending is not None:
-        written.extend(pending.result())
-    elif figures:
-        written.extend(render_figures(job))
-    return written
-
-
-def figure_job(run: ScenarioRun, out: Path):
-    """The :class:`~shipgnc.viz.figures.FigureJob` of a run's figures (by vessel: the boat's
-    telemetry dashboard, document 003's course figure with one column per controller, or
-    document 000's path-tracking figures (Fig. 3–5) or Monte Carlo spread)."""
-    from shipgnc.viz.figures import FigureJob
-
-    model, g = run.setup.model, run.scenario.guidance
-    lower, upper = model.input_limits()
-    limits = {s.name: (float(lower[i]), float(upper[i])) for i, s in enumerate(model.inputs)}
-    names = list(run.setups) if run.setups is not None else list(run.scenario.variants)
-    if run.scenario.vessel.model == "catamaran":
-        if "controller" in run.result.dims:
-            runs = {n: run.result.sel(controller=n).dropna("time", how="all") for n in names}
-        else:
-            runs = {run.scenario.name: run.result}
-        from shipgnc.analysis.catamaran_metrics import model_fields
-        from shipgnc.viz.catamaran import batch_bands  # a batch: its quantiles, not every ship
-
-        runs = {k: batch_bands(ds) if "ship" in ds.dims else ds for k, ds in runs.items()}
-        target = getattr(run.setup.controller, "omega_ref", None)
-        omega = getattr(target, "omega", None)
-        options = {"builder": run.scenario.case.builder, "preset": run.scenario.vessel.preset,
-                   "heading_target": float(getattr(target, "psi_target", 0.0) or 0.0),
-                   "omega": float(omega) if omega is not None and np.ndim(omega) == 0 else None,
-                   "model_note": model_fields(run.setup.model, run.scenario.vessel.preset)["model_note"]}
-        return FigureJob(result=runs, out=out, title=run.scenario.name, kind="catamaran",
-                         options=options)
-    if run.setup.path is not None:
-        from shipgnc.viz import path_tracking as pt
-
-        waypoints = run.setup.path.waypoints.tolist()
-        if run.scenario.montecarlo is not None:
-            return FigureJob(result={n: pt.montecarlo_series(run.result, n) for n in names}, out=out,
-                             title=run.scenario.name, kind="montecarlo", waypoints=waypoints)
-        if run.setups is None:  # one controller: label it with the scenario's name
-            series = {run.scenario.name: pt.path_series(run.result, None)}
-        else:
-            series = {n: pt.path_series(run.result, n) for n in names}
-        return FigureJob(result=series,
-                         out=out, title=run.scenario.name, kind="path-tracking",
-                         waypoints=waypoints, limits=limits)
-    if not isinstance(model, VectoredThrustBoat):
-        from shipgnc.viz.comparison import course_series
-
-        return FigureJob(result={name: course_series(run.result, name) for name in names},
-                         out=out, title=run.scenario.name, kind="course-comparison",
-                         limits=limits)
-    from shipgnc.viz.series import result_series
-
-    series = result_series(run.result)
-    closeup = (run.scenario.metrics == "stern-kick" and series["time"].size > 1
-               and bool(np.any(series.get("alpha_cmd", np.zeros(1)) != 0)))
-    return FigureJob(result=series, out=out, title=figure_title(run),
-                     waypoints=list(g.waypoints) if g is not None and g.type == "los" else None,
-                     limits=limits, outline=(model.length, model.beam), lever_arm=model.params.L_m,
-                     closeup=closeup)
 
 
 def comparison_table(run: ScenarioRun) -> list[dict]:

@@ -28,7 +28,7 @@ from shipgnc.errors import ConfigError, DivergenceError, Interrupted, require
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import Signal, names
 from shipgnc.sim.integrators import rk4_step, solve_ivp_step
-from shipgnc.sim.streams import MemberStreams, is_generator
+from shipgnc.streams import MemberStreams, is_generator
 
 INTEGRATORS = ("rk4", "solve_ivp")
 BACKENDS = ("auto", "numpy", "compiled", "compiled-or-numpy")

@@ -17,7 +17,7 @@ import numpy as np
 from shipgnc.errors import ConfigError
 from shipgnc.models.base import names
 from shipgnc.models.per_ship import PerShipModel
-from shipgnc.sim.streams import MemberStreams
+from shipgnc.streams import MemberStreams
 from shipgnc.study.plant import check_plant, member_params, member_plant, param_variables
 from shipgnc.study.spec import PERTURB_UNITS, PERTURBABLE, Study
 

@@ -4,7 +4,7 @@ A study is the product of its grids (each grid key is a scenario field, as in ``
 ``members`` Monte Carlo members. Member *i* has its own random streams,
 ``SeedSequence(seed).spawn(members)[i]``, split in three children: one draws the member's initial
 state offsets (:class:`Perturbation` of a state field), one feeds the scenario's random
-disturbances (:class:`~shipgnc.sim.streams.MemberStreams`), one draws the member's plant
+disturbances (:class:`~shipgnc.streams.MemberStreams`), one draws the member's plant
 parameters (:class:`Perturbation` of ``vessel.params.NAME``). So a member's result depends on
 ``seed`` and *i* only, never on how the study is chunked or where a chunk runs; and member *i*
 meets the same sea, the same offsets and the same plant at every grid point (common random

@@ -133,8 +133,8 @@ def sail_check(route, *, vessel: str = "auto", preset: str = "otter", dt: float 
         name = f"vectored-thrust boat ({preset}, {length:g} m), LOS through the waypoints"
     else:
         from shipgnc.control.feedback_linearization import LOS_DELTA, LOSFL
-        from shipgnc.guidance.path import WaypointPath
         from shipgnc.models.mariner import MarinerWitOppe
+        from shipgnc.paths import WaypointPath
         from shipgnc.routing.sailing import mariner_sail, route_waypoints
 
         model = MarinerWitOppe()

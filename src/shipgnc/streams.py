@@ -1,0 +1,66 @@
+"""One random stream per ship of a batch, behind the ``numpy.random.Generator`` calls the
+disturbances use.
+
+A batched run normally draws every ship's noise from one generator, so ship *i*'s noise depends on
+how many ships share the batch. A study that splits its members into chunks (``shipgnc sweep``) needs
+each member's result to be the same whatever the chunking: :class:`MemberStreams` holds one
+generator per member (children of one :class:`numpy.random.SeedSequence`, see :func:`member_seeds`)
+and answers ``standard_normal``, ``random`` and ``uniform`` for shapes whose leading axis is the
+member axis by stacking each member's own draw.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from shipgnc.errors import require
+
+
+def member_seeds(seed: int, n_members: int) -> list[np.random.SeedSequence]:
+    """The independent streams of members ``0 .. n_members-1`` of a study seeded by ``seed``
+    (``SeedSequence(seed).spawn(n_members)``: member *i*'s stream does not depend on the others)."""
+    require(isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and seed >= 0,
+            "seed", seed, "must be a non-negative integer")
+    return np.random.SeedSequence(int(seed)).spawn(int(n_members))
+
+
+class MemberStreams:
+    """A batch of generators, one per member; draws have the member axis first.
+
+    ``streams[i]`` is member *i*'s :class:`numpy.random.Generator` (from a seed, a ``SeedSequence``
+    or a generator, used as it is). ``standard_normal(shape)`` with
+    ``shape = (n_members, *rest)`` returns member *i*'s ``standard_normal(rest)`` in row *i*; same for
+    ``random`` and ``uniform``. A shape without the member axis first is refused (it would mix the
+    streams).
+    """
+
+    def __init__(self, seeds):
+        self.streams = [np.random.default_rng(s) for s in seeds]
+        require(len(self.streams) >= 1, "streams", len(self.streams), "need at least one member")
+
+    def __len__(self) -> int:
+        return len(self.streams)
+
+    def _rest(self, shape) -> tuple[int, ...]:
+        shape = (shape,) if np.ndim(shape) == 0 else tuple(int(s) for s in shape)
+        require(len(shape) >= 1 and shape[0] == len(self.streams), "draw shape", shape,
+                f"must start with the member axis ({len(self.streams)} members)")
+        return shape[1:]
+
+    def standard_normal(self, size) -> np.ndarray:
+        rest = self._rest(size)
+        return np.stack([g.standard_normal(rest) for g in self.streams])
+
+    def random(self, size) -> np.ndarray:
+        rest = self._rest(size)
+        return np.stack([g.random(rest) for g in self.streams])
+
+    def uniform(self, low=0.0, high=1.0, size=None) -> np.ndarray:
+        require(size is not None, "uniform size", size, "must give the shape (member axis first)")
+        rest = self._rest(size)
+        return np.stack([g.uniform(low, high, rest) for g in self.streams])
+
+
+def is_generator(rng) -> bool:
+    """True for a ``numpy.random.Generator`` or a :class:`MemberStreams`."""
+    return isinstance(rng, (np.random.Generator, MemberStreams))
