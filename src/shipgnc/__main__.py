@@ -12,6 +12,9 @@ EXIT_INTERRUPTED = 130
 
 
 def main() -> None:
+    from shipgnc.interrupts import install
+
+    install()  # from the first moment: a Ctrl-C swallowed while importing still ends the command
     try:
         from shipgnc.cli import main as cli_main
     except KeyboardInterrupt:

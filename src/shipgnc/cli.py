@@ -35,9 +35,12 @@ stderr = Console(stderr=True, highlight=False)
 
 @contextmanager
 def friendly_errors():
-    """Turn errors into one line on stderr and an exit code."""
+    """Turn errors into one line on stderr and an exit code (Ctrl-C latched: :mod:`shipgnc.interrupts`)."""
+    from shipgnc.interrupts import latching
+
     try:
-        yield
+        with latching():
+            yield
     except typer.Exit:
         raise
     except ShipGNCError as exc:

@@ -32,6 +32,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from shipgnc.errors import ConfigError, ShipGNCError
+from shipgnc.interrupts import latched
 
 #: the marker file written with every run's outputs
 MARKER = ".shipgnc-run"
@@ -147,6 +148,8 @@ def atomic_dir(out: Path, *, overwrite: bool = False, command: str = "run", stat
         raise output_error(out, exc, option) from None
     try:
         yield tmp
+        if status == "complete" and latched():  # a Ctrl-C a callback swallowed: not complete
+            raise KeyboardInterrupt
         marker = {"tool": "shipgnc", "version": _version(), "command": command, "status": status,
                   "files": sorted(p.name for p in tmp.iterdir())}
         (tmp / MARKER).write_text(json.dumps(marker, indent=2) + "\n", encoding="utf-8")

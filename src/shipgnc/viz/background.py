@@ -66,9 +66,15 @@ class FigureProcess:
         nothing more is written; the command does not wait for the drawing to end."""
         if self._pool is None:
             return
-        for process in list(getattr(self._pool, "_processes", {}).values()):
+        processes = list(getattr(self._pool, "_processes", {}).values())
+        for process in processes:
             process.terminate()
-        self._pool.shutdown(wait=False, cancel_futures=True)
+        for process in processes:  # dead within milliseconds of SIGTERM
+            process.join(timeout=2.0)
+        # join the pool's manager thread too: left running (shutdown(wait=False)), the interpreter's
+        # exit handler wakes it through a pipe the broken pool has closed, and prints "Exception
+        # ignored ... Bad file descriptor" after the command's one line
+        self._pool.shutdown(wait=True, cancel_futures=True)
         self._pool = None
 
     def __enter__(self) -> FigureProcess:
