@@ -26,13 +26,38 @@ NM = 1852.0
 KN = NM / 3600.0
 
 
-def test_a_target_a_billion_miles_away_is_answered_in_seconds():
+def test_a_target_a_billion_miles_away_is_undecided_not_called_unreachable():
+    """The target is reachable: due south for t₁ (the current, k·x_N, sets the ship east), then due
+    north, reaches (L, L) nm in 2t₁ + 2L h with t₁ = √((L + L²/2)/0.25) h (0.5 kn, k = 0.5 /h):
+    4.83·10⁹ h < T_max = 4|AB|/V = 1.13·10¹⁰ h. At this scale the current carries the extremals
+    ~10¹⁶ nm between two of the sweep's samples, so the sweep cannot see the target: the answer is
+    "undecided", exit 3 — it said "not reachable, closest approach at t = 0"."""
+    L = 1e9
+    t1 = np.sqrt((L + L**2 / 2) / 0.25)
+    assert 2 * t1 + 2 * L < 4 * np.hypot(L, L) / 0.5  # reachable within the default horizon
     cmd = [sys.executable, "-m", "shipgnc", "route", "--start", "0,0", "--target", "1e9,1e9",
            "--speed", "0.5", "--field", "shear:k=-0.5", "--units", "nautical"]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 3, proc.stderr
-    assert "unreachable" in proc.stderr and "Traceback" not in proc.stderr
+    assert proc.stderr.startswith("undecided: no route found and none ruled out"), proc.stderr
+    assert "not reachable" not in proc.stderr and "Traceback" not in proc.stderr
     assert "global check skipped" in proc.stdout + proc.stderr
+
+
+def test_the_level_set_does_not_start_beyond_its_effort_bound():
+    """1 000 nm in the same shear: the current reaches ≈ 855 kn over the level set's box, its CFL
+    step is 22.5 s and the horizon 4.07·10⁷ s: ≈ 4.7·10¹⁰ cell updates on 162 × 162 cells (the route
+    command ran for over 15 minutes). It refuses before the first step, naming the bound."""
+    from shipgnc.routing.levelset import MAX_CELL_STEPS, EffortBound, reachability
+    from shipgnc.routing.router import default_domain
+
+    field = parse_field("shear:k=-0.5", "nautical")
+    a, b = (0.0, 0.0), (1000 * NM, 1000 * NM)
+    dom = default_domain(field, a, b)
+    spacing = max(dom[0][1] - dom[0][0], dom[1][1] - dom[1][0]) / 160
+    with pytest.raises(EffortBound, match="effort bound") as info:
+        reachability(field, 0.5 * KN, a, b, dom, spacing, horizon=4 * np.hypot(*b) / (0.5 * KN))
+    assert f"{MAX_CELL_STEPS:.0e}" in str(info.value)
 
 
 def test_a_current_a_hundred_times_the_ship_gets_its_closed_form_and_no_false_warning():

@@ -177,9 +177,11 @@ def _plane_route(a, b, speed, field, units, method, obstacles, json_, out, horiz
         sys.stdout.write(text + "\n")
     else:
         _print(stdout, res, nautical)
-    if not res.reachable:
+    if not res.reachable:  # exit 3: unreachable, or undecided (the methods cannot resolve the scale)
         reason = " ".join(str(res.reason).split())
-        stderr.print(f"[bold red]unreachable:[/] {nautical_text(reason) if nautical else reason}",
+        label, reason = (("undecided", reason.removeprefix("undecided: ")) if reason.startswith("undecided")
+                         else ("unreachable", reason))
+        stderr.print(f"[bold red]{label}:[/] {nautical_text(reason) if nautical else reason}",
                      soft_wrap=True)
         raise typer.Exit(3)
 

@@ -213,6 +213,16 @@ class FrontOutOfGrid(ConfigError):
     orders of magnitude at this scale)."""
 
 
+class EffortBound(FrontOutOfGrid):
+    """The level set would take more than :data:`MAX_CELL_STEPS` cell updates to its horizon (a
+    current that outruns the ship forces a CFL step far below the route's time): it does not start."""
+
+
+#: the level set's effort bound in cell updates (steps to the horizon × grid cells): ≈ 40 s of the
+#: compiled scheme on 2 cores; document 002's cases need at most ≈ 4·10⁷
+MAX_CELL_STEPS = 1_000_000_000
+
+
 def _signed_distance(poly, nn, ee, h):
     """Signed distance to a closed polygon (negative inside): exact near the polygon, a k-d tree of its
     densified outline elsewhere (error below h/8 there, where it does not move the front)."""
@@ -387,6 +397,12 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     notes: list[str] = []
     steps = 0
     max_steps = math.ceil((horizon - t_init) / dt) + 1
+    if max_steps * nn.size > MAX_CELL_STEPS:
+        raise EffortBound(
+            f"level set: {max_steps:.3g} steps of Δt = {dt:.3g} s to the horizon on its {north.size}×"
+            f"{east.size} grid ({max_steps * nn.size:.3g} cell-steps) exceed its effort bound of "
+            f"{MAX_CELL_STEPS:.0e}: the current (up to {vmax:.3g} m/s against V = {speed:.3g} m/s) "
+            "forces small steps; a shorter horizon or a coarser grid lowers the count")
     with np.errstate(all="ignore"):
         while steps < max_steps:
             tt = t0 + t

@@ -449,6 +449,15 @@ class SweepResult:
     n_left_domain: int = 0
     n_inadmissible: int = 0
     effort: Effort | None = None  #: the polishes' effort (``effort.stopped``: cut short by its bound)
+    max_sample_step: float = 0.0  #: the farthest an extremal moves between two of the sweep's samples [m]
+    sample_dt: float = 0.0  #: the time between two samples [s]
+
+    def unresolved(self, dist: float) -> bool:
+        """Whether the sweep's samples are too coarse to see the target: an extremal moves more than
+        half the start–target distance between two samples (where the current outruns the ship by
+        hundreds of times over the horizon), so a pass through the target falls between samples and
+        "no extremal came close" proves nothing."""
+        return self.max_sample_step > 0.5 * dist
 
 
 def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n_steps=None,
@@ -497,6 +506,9 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
     elif th.size:
         integrate_family(field, speed, start, th, t0, horizon, n_steps, record=record)
     n_left = int(np.sum(~alive_tab))
+    with np.errstate(invalid="ignore", over="ignore"):
+        moves = np.hypot(*np.diff(pos, axis=0).transpose(2, 0, 1)) if th.size else np.zeros(1)
+    max_sample_step = float(np.max(moves, initial=0.0, where=np.isfinite(moves)))
     finite = np.isfinite(dist_tab)
     masked = np.where(finite, dist_tab, np.inf)
     best = np.unravel_index(np.argmin(masked), dist_tab.shape) if th.size else (0, 0)
@@ -541,7 +553,7 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
     if progress is not None:
         progress(1.0)
     return SweepResult(extremals, closest, closest_t, n_angles, float(horizon), n_left,
-                       int(np.sum(~admissible)), effort)
+                       int(np.sum(~admissible)), effort, max_sample_step, dt)
 
 
 #: sub-angles between a candidate's neighbours in :func:`_refine_seed`

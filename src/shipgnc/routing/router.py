@@ -222,6 +222,13 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = Tru
     stopped = sw.effort is not None and sw.effort.stopped > 0
     if stopped:
         res.notes.append(sw.effort.describe())
+    if not optimal and sw.unresolved(float(np.hypot(*(np.asarray(B) - np.asarray(A))))):
+        res.reason = (f"undecided: no route found and none ruled out within T_max = {horizon:.6g} s in "
+                      f"{fld.describe()} at ship speed {V:.4g} m/s: the current carries the extremals up "
+                      f"to {sw.max_sample_step:.3g} m between two of the sweep's samples "
+                      f"({sw.sample_dt:.3g} s apart), more than half the distance to the target, so a "
+                      "pass through it goes unseen")
+        return res
     if not optimal:
         res.closest_approach_m, res.closest_time_s = sw.closest_approach, sw.closest_time
         extra = ""
@@ -229,7 +236,7 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = Tru
             extra = f"; {sw.n_left_domain} extremals left the gridded field's domain {_extent(fld)}"
         if stopped:
             extra += f"; {sw.effort.describe()}"
-        res.reason = (f"target not reachable within T_max = {horizon:.0f} s ({horizon / 3600:.2f} h) in "
+        res.reason = (f"target not reachable within T_max = {horizon:.0f} s in "
                       f"{fld.describe()} at ship speed {V:.4f} m/s: closest approach "
                       f"{sw.closest_approach:.1f} m at t = {sw.closest_time:.0f} s{extra}")
         return res
