@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from shipgnc.analysis import identification as idn
-from shipgnc.analysis.nomoto import PRINTED_EQ18, davidson_schiff
+from shipgnc.cases.cybership import PRINTED_EQ18
 from shipgnc.control.course import CoursePD
 from shipgnc.environment.waves import FroudeKrylovWaveLoads, WaveSpectrum
 from shipgnc.guidance.schedule import CourseSchedule
@@ -27,6 +27,7 @@ from shipgnc.models.cybership2 import (
     steering_machine,
     surge_equilibrium,
 )
+from shipgnc.models.nomoto_reduction import davidson_schiff
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build
 from shipgnc.sim.simulator import simulate

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from shipgnc.analysis import catamaran_metrics as M
-from shipgnc.analysis.steady_turn import steady_state_at_angle, steady_turn
 from shipgnc.cases import catamaran as C
 from shipgnc.models.catamaran import Catamaran
+from shipgnc.models.steady_turn import steady_state_at_angle, steady_turn
 
 
 @pytest.fixture(scope="module")

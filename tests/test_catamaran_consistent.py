@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from shipgnc.analysis.catamaran_metrics import ALIASES, catamaran_metrics, comparison_metrics
-from shipgnc.analysis.steady_turn import steady_turn
 from shipgnc.cases import catamaran as C
 from shipgnc.control.catamaran_baselines import (
     designed_pi_gains,
@@ -20,6 +19,7 @@ from shipgnc.control.catamaran_baselines import (
     place_rate_gain,
 )
 from shipgnc.models.catamaran import Catamaran, model_note, preset, straight_running_eigenvalues
+from shipgnc.models.steady_turn import steady_turn
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import run_scenario
 

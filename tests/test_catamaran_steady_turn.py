@@ -7,14 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from shipgnc.analysis.steady_turn import (
+from shipgnc.errors import ConfigError
+from shipgnc.models.catamaran import Catamaran, preset
+from shipgnc.models.steady_turn import (
     omega_max,
     steady_state_at_angle,
     steady_turn,
     turning_characteristic,
 )
-from shipgnc.errors import ConfigError
-from shipgnc.models.catamaran import Catamaran, preset
 
 
 def test_check4_steady_turn_at_0_08():

@@ -12,7 +12,8 @@ import math
 import numpy as np
 import pytest
 
-from shipgnc.control.course import CoursePD, SlidingModeCourse, smc_paper, smc_tuned
+from shipgnc.cases.cybership import smc_paper, smc_tuned
+from shipgnc.control.course import CoursePD, SlidingModeCourse
 from shipgnc.environment import wave_kernel
 from shipgnc.environment.waves import FroudeKrylovWaveLoads, WaveSpectrum
 from shipgnc.guidance.schedule import CourseSchedule

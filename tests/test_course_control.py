@@ -8,21 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from shipgnc.analysis.nomoto import (
-    PRINTED_EQ17,
-    PRINTED_EQ18,
-    davidson_schiff,
-    first_order_reduction,
-    nomoto_second_order,
-)
-from shipgnc.control.course import (
-    PAPER_LAMBDAS,
-    CoursePD,
-    SlidingModeCourse,
-    course_controller,
-    design_smc,
-    smc_tuned,
-)
+from shipgnc.cases.cybership import PAPER_LAMBDAS, PRINTED_EQ17, PRINTED_EQ18, course_controller, smc_tuned
+from shipgnc.control.course import CoursePD, SlidingModeCourse, design_smc
 from shipgnc.errors import ConfigError
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import Signal
@@ -33,6 +20,7 @@ from shipgnc.models.cybership2 import (
     steering_machine,
     surge_equilibrium,
 )
+from shipgnc.models.nomoto_reduction import davidson_schiff, first_order_reduction, nomoto_second_order
 from shipgnc.sim.simulator import simulate
 
 LAM1, LAM2 = PAPER_LAMBDAS
@@ -338,7 +326,7 @@ def test_smc_identified_is_designed_on_the_identified_model_by_the_documents_rul
     instantaneous gain (M⁻¹b)_r = −0.0918 s⁻² (note 003-3.3) stays below 1 (the paper's gains
     on the same model: far above 2)."""
     from shipgnc.analysis.identification import identify_cybership2
-    from shipgnc.control.course import course_controller, smc_paper
+    from shipgnc.cases.cybership import course_controller, smc_paper
 
     ctrl = course_controller("smc_identified")
     g = ctrl.design

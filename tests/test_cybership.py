@@ -14,14 +14,7 @@ import pytest
 from scipy import signal
 
 from shipgnc.actuators import Actuator
-from shipgnc.analysis.nomoto import (
-    PRINTED_EQ17,
-    PRINTED_EQ18,
-    NomotoII,
-    davidson_schiff,
-    first_order_reduction,
-    nomoto_second_order,
-)
+from shipgnc.cases.cybership import PRINTED_EQ17, PRINTED_EQ18
 from shipgnc.errors import ConfigError
 from shipgnc.models.base import Model
 from shipgnc.models.cybership2 import (
@@ -31,6 +24,12 @@ from shipgnc.models.cybership2 import (
     rudder_gains,
     steering_machine,
     surge_equilibrium,
+)
+from shipgnc.models.nomoto_reduction import (
+    NomotoII,
+    davidson_schiff,
+    first_order_reduction,
+    nomoto_second_order,
 )
 
 P = CyberShip2Params()

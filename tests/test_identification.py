@@ -9,9 +9,10 @@ import pytest
 
 from shipgnc.actuators import Actuator
 from shipgnc.analysis import identification as idn
-from shipgnc.analysis.nomoto import PRINTED_EQ18, davidson_schiff, nomoto_second_order
+from shipgnc.cases.cybership import PRINTED_EQ18
 from shipgnc.models.cybership2 import CyberShip2Params
 from shipgnc.models.nomoto import NomotoModel
+from shipgnc.models.nomoto_reduction import davidson_schiff, nomoto_second_order
 
 
 @pytest.mark.parametrize(("K", "T"), [(0.08, 12.0), (-0.2, 5.0), (0.05, 40.0)])

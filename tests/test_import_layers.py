@@ -2,7 +2,8 @@
 level and inside functions alike (an import moved into a function to dodge a cycle is still a
 dependency). The layers, lowest first::
 
-    core       errors, units, frames, paths, timeseries, streams, batchmath, params, kernels, outputs
+    core       errors, units, frames, paths, timeseries, streams, batchmath, params, kernels, outputs,
+               interrupts
     physics    models, actuators, environment, routing.fields, routing.field_spec
     gnc        guidance, control, navigation
     sim        sim
@@ -25,7 +26,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "shipgnc"
 
 LAYERS = [
     ("core", ("errors", "units", "frames", "paths", "timeseries", "streams", "batchmath", "params",
-              "kernels", "outputs", "")),
+              "kernels", "outputs", "interrupts", "")),
     ("physics", ("models", "actuators", "environment", "routing.fields", "routing.field_spec")),
     ("gnc", ("guidance", "control", "navigation")),
     ("sim", ("sim",)),
@@ -38,13 +39,6 @@ LAYERS = [
 
 #: dependencies that still point up: (importer, imported) module prefixes → what removes it
 KNOWN: dict[tuple[str, str], str] = {
-    ("control.course", "analysis.nomoto"):
-        "document 003's printed design models (PRINTED_EQ17/18) move to its scenario, the Nomoto "
-        "reduction beside the models; the factories take the design model as an argument",
-    ("control.course", "analysis.identification"):
-        "smc_identified's design model identified by the scenario builder, passed to the law",
-    ("control.finite_state", "analysis.steady_turn"):
-        "the steady-turn solver (a model's analysis, models only) moves beside the catamaran model",
     ("vessels.files", "scenarios.schema"):
         "the catalogue's vessel section (CatalogueVesselConfig) moves to the catalogue, the scenario "
         "schema imports it",

@@ -545,8 +545,8 @@ def test_wave_load_calibration_heading_rms_is_the_linear_response_estimate():
     the linear sway–yaw model (16) driven by the same loads (a RAO estimate), within 15 %; the
     heading RMS is a few tenths of a degree (first-order Froude–Krylov only), and a yaw gain of
     2 doubles the yaw response of the linear estimate."""
-    from shipgnc.analysis.nomoto import davidson_schiff
     from shipgnc.models.cybership2 import CyberShip2Params
+    from shipgnc.models.nomoto_reduction import davidson_schiff
 
     ds, loads, psi0 = _heading_hold_in_waves(2024)
     keep = ds["time"].values >= 20.0

@@ -167,7 +167,7 @@ def fixed_angle(preset_name: str = DEFAULT_PRESET, t_end: float = T_END, delta: 
     ``delta`` [rad]: the document's 0.6 rad for the printed-sign presets; on a hull with the
     consistent sign (no steady turn at 0.6 rad) the angle of the steady turn at r = 0.036434 rad/s,
     the 0.6 rad run's rate in ``si``."""
-    from shipgnc.analysis.steady_turn import steady_state_at_angle, steady_turn
+    from shipgnc.models.steady_turn import steady_state_at_angle, steady_turn
 
     model = Catamaran.from_preset(preset_name, **(vessel or {}))
     if delta is None:

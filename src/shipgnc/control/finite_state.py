@@ -473,7 +473,7 @@ class YawRateFSM:
         self.delta_max, self.gain_freeze = delta_max, gain_freeze
         self.omega_max = None
         if check_feasibility and model.params.coriolis == "printed":
-            from shipgnc.analysis.steady_turn import omega_max
+            from shipgnc.models.steady_turn import omega_max
 
             self.omega_max = omega_max(self.model)
         self.signals = (Signal("omega_ref", "rad/s", "yaw-rate reference used by the law"),

@@ -1062,7 +1062,7 @@ class FroudeKrylovWaveLoads:
         ship at ω_e,i = ωᵢ − kᵢU cos βᵢ (:func:`encounter_frequency`) with the sway force and yaw
         moment phasors Yᵢ = −j·g_Y aᵢcYᵢ, Nᵢ = g_N aᵢcNᵢ (Y ∝ sin θᵢ, N ∝ cos θᵢ). The linear
         sway–yaw model ``mass`` M ν̇ + ``damping`` N ν = [Y, N] (ν = [v, r], e.g. eq. (16) from
-        :func:`shipgnc.analysis.nomoto.davidson_schiff`) answers with
+        :func:`shipgnc.models.nomoto_reduction.davidson_schiff`) answers with
         νᵢ = (jω_e,i M + N)⁻¹[Yᵢ, Nᵢ] and ψᵢ = rᵢ/(jω_e,i) (negative ω_e: the conjugate phasor at
         |ω_e|). With random phases the variances are Σ|·ᵢ|²/2. Open loop: an autopilot acting
         well below ω_e (course control ≲ 0.5 rad/s vs ω_e ≈ 10 rad/s here) leaves it unchanged.

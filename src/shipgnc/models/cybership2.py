@@ -27,7 +27,7 @@ x_R = −0.549 m:
 **Rudder sign:** δ > 0 pushes the stern to starboard, so the bow turns to **port** (r < 0):
 b₂ < 0, the opposite of document 000's Mariner. The document's laws (3) and (14) are written for this
 sign. Linearised at (u₀, 0, 0) the sway–yaw equations are eq. (16) term by term
-(:func:`shipgnc.analysis.nomoto.davidson_schiff`).
+(:func:`shipgnc.models.nomoto_reduction.davidson_schiff`).
 
 State ``[north, east, psi, u, v, r]`` (NED, ψ clockwise from north), input ``[n, delta]``,
 disturbance ``[X_env, Y_env, N_env, current_north, current_east]``: forces in body axes (N, N,

@@ -2,7 +2,8 @@
 
 * :func:`davidson_schiff` — the linear Davidson–Schiff model (16) of CyberShip II at speed u₀,
   M ν̇ + N(u₀) ν = b δ with ν = [v, r], derived from the model's parameters;
-* :data:`PRINTED_EQ17`, :data:`PRINTED_EQ18` — the document's printed (17) and (18);
+* the document's printed (17) and (18) are :data:`shipgnc.cases.cybership.PRINTED_EQ17` and
+  :data:`~shipgnc.cases.cybership.PRINTED_EQ18` (document constants live with its scenario);
 * :func:`nomoto_second_order` — any (M, N, b) to Nomoto's second-order model
   r/δ = K(1 + T₃s)/((1 + T₁s)(1 + T₂s)) (a python-control transfer function);
 * :func:`first_order_reduction` — T = T₁ + T₂ − T₃, K unchanged: ṙ = a₂₂ r + b₂ δ with
@@ -40,22 +41,6 @@ class SwayYawModel(NamedTuple):
     M: np.ndarray
     N: np.ndarray
     b: np.ndarray
-
-
-def _frozen(values) -> np.ndarray:
-    arr = np.array(values, dtype=float)
-    arr.setflags(write=False)
-    return arr
-
-
-#: eq. (17) as printed: M, N(0.3) with the erroneous N₂₂ = 2.9948 (B2), b
-PRINTED_EQ17 = SwayYawModel(M=_frozen([[33.8, 1.0948], [1.0948, 2.76]]),
-                            N=_frozen([[0.8897, 14.99], [2.3687, 2.9948]]),
-                            b=_frozen([0.4304, -0.2363]))
-#: eq. (18) as printed: (a₂₂, b₂) of the first-order design model, rounded by the document
-PRINTED_EQ18 = (0.1057, -0.0040)
-#: the linearisation speed of (17) [m/s]
-U0_EQ17 = 0.3
 
 
 def davidson_schiff(params, u0: float, *, n: float | None = None,

@@ -143,6 +143,7 @@ def _controller(cfg, model, scenario: Scenario):
 
 def _course_controller(cfg, params, propeller_rps: float):
     """Document 003's PD or sliding-mode autopilot with the scenario's gains (note 003-3.2)."""
+    from shipgnc.cases import cybership as document
     from shipgnc.control import course
 
     gains = cfg.gains()
@@ -150,12 +151,13 @@ def _course_controller(cfg, params, propeller_rps: float):
     if cfg.variant == "pd":
         return course.CoursePD(**gains, **common)
     if cfg.variant == "smc_identified":
-        return course.smc_identified(params, **common, **gains)
-    design_model = course.design_model_of(params, gains.pop("design_model", "eq18"),
-                                          propeller_rps=propeller_rps)
+        return document.smc_identified(params, **common, **gains)
+    design_model = document.design_model_of(params, gains.pop("design_model", "eq18"),
+                                            propeller_rps=propeller_rps)
     if cfg.variant == "smc_tuned":
-        return course.smc_tuned(design_model, **common, **gains)
-    lam1, lam2 = gains.pop("lam1", course.PAPER_LAMBDAS[0]), gains.pop("lam2", course.PAPER_LAMBDAS[1])
+        return document.smc_tuned(design_model, **common, **gains)
+    lam1 = gains.pop("lam1", document.PAPER_LAMBDAS[0])
+    lam2 = gains.pop("lam2", document.PAPER_LAMBDAS[1])
     form = "consistent" if cfg.variant == "smc_consistent" else "printed"
     return course.SlidingModeCourse(course.design_smc(*design_model, lam1, lam2), form=form,
                                     **common, **gains)

@@ -204,7 +204,7 @@ def fig_heading(ds, heading_target: float):
 
 def fig_turning_characteristic(vessels: dict):
     """Steady r, diameter and drift angle against δ for each vessel (``{"paper": params, ...}``)."""
-    from shipgnc.analysis.steady_turn import omega_max, turning_characteristic
+    from shipgnc.models.steady_turn import omega_max, turning_characteristic
 
     fig, axes = _figure(1, 3, size=(13.0, 4.2))
     a0, a1, a2 = axes[0]
