@@ -135,6 +135,7 @@ def test_a_ctrl_c_a_callback_swallows_still_ends_the_command(capsys):
             time.sleep(0.01)  # the block goes on: the interrupt was swallowed
     assert "Exception ignored" not in capsys.readouterr().err
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    assert not interrupts.latched()  # a later command or library call starts clear
 
 
 @given(st.floats(min_value=0.3, max_value=2.5))
@@ -154,3 +155,19 @@ def test_ctrl_c_with_the_figure_worker_is_one_line_and_leaves_no_process(tmp_pat
     assert proc.returncode in (0, 130, -signal.SIGINT), (proc.returncode, err[-1500:])
     assert "Traceback" not in err and "Exception ignored" not in err, err[-1500:]
     assert len(err.strip().splitlines()) <= 1, err[-1500:]
+
+
+@pytest.mark.parametrize("args, words", [
+    (["route", "--start", "0,0", "--target", "1,1", "--speed", "1", "--field", "uniform:north=0",
+      "--grid", "1,"], "Invalid value for '--grid'"),
+    (["run"], "Missing argument"),
+    (["run", "boat-autopilot", "--bogus"], "No such option: --bogus"),
+    (["bogus"], "No such command"),
+])
+def test_a_usage_error_is_one_line_and_exit_2(args, words):
+    """The parser's errors (a value that does not parse, a missing argument, an unknown option or
+    command) answer like every other bad input: one line naming the problem, exit 2."""
+    result = _cli(args, timeout=60)
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0] and "--help" in lines[0], result.stderr

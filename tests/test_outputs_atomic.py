@@ -342,3 +342,16 @@ def test_a_netcdf_write_works_with_a_dask_cluster_open(tmp_path):
         write_netcdf(ds, tmp_path / "r.nc")
     with xr.open_dataset(tmp_path / "r.nc", engine="h5netcdf") as back:
         xr.testing.assert_identical(back.load(), ds)
+
+
+def test_a_netcdf_write_needs_no_dask(tmp_path, monkeypatch):
+    """dask is optional (the ``dist`` extra): the README's plain install writes result.nc too."""
+    import sys
+
+    from shipgnc.outputs import write_netcdf
+
+    monkeypatch.setitem(sys.modules, "dask", None)  # `import dask` raises ImportError
+    ds = xr.Dataset({"a": ("t", np.arange(5.0))})
+    write_netcdf(ds, tmp_path / "r.nc")
+    with xr.open_dataset(tmp_path / "r.nc", engine="h5netcdf") as back:
+        xr.testing.assert_identical(back.load(), ds)

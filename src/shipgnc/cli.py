@@ -307,8 +307,23 @@ app.command("vessels")(_vessels)
 
 
 def main() -> None:
-    """Console-script entry point."""
-    app()
+    """Console-script entry point. A usage error (an unknown option or command, a value that does
+    not parse, a missing argument) is one line and exit 2 like every other bad input, not the
+    parser's boxed usage text."""
+    try:
+        code = app(standalone_mode=False)
+    except typer.Abort:
+        stderr.print("interrupted", soft_wrap=True)
+        raise SystemExit(130) from None
+    except Exception as exc:  # the parser's own errors (click's, as vendored by typer)
+        code = getattr(exc, "exit_code", None)
+        if not (callable(getattr(exc, "format_message", None)) and isinstance(code, int)):
+            raise
+        ctx = getattr(exc, "ctx", None)
+        hint = f" (see {ctx.command_path} --help)" if code == 2 and ctx is not None else ""
+        stderr.print(f"[bold red]error:[/] {_one_line(exc.format_message())}{hint}", soft_wrap=True)
+        raise SystemExit(code) from None
+    raise SystemExit(code if isinstance(code, int) else 0)
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 _latched = False
+_previous_hook = sys.__unraisablehook__
 
 
 def _handler(signum, frame) -> None:
@@ -33,7 +34,7 @@ def _unraisable(info) -> None:
     """A latched Ctrl-C that a callback could not raise is not printed (it is acted on later);
     anything else goes to Python's own hook."""
     if not (_latched and isinstance(info.exc_value, KeyboardInterrupt)):
-        sys.__unraisablehook__(info)
+        _previous_hook(info)
 
 
 def _main_thread() -> bool:
@@ -43,13 +44,15 @@ def _main_thread() -> bool:
 def install() -> None:
     """Latch Ctrl-C from now on (main thread only, and only in place of Python's default
     handler); installed afresh, the latch starts clear."""
-    global _latched
+    global _latched, _previous_hook
     if not _main_thread():
         return
     current = signal.getsignal(signal.SIGINT)
     if current is signal.default_int_handler:
         _latched = False
         signal.signal(signal.SIGINT, _handler)
+        if sys.unraisablehook is not _unraisable:
+            _previous_hook = sys.unraisablehook
         sys.unraisablehook = _unraisable
 
 
@@ -62,14 +65,18 @@ def latched() -> bool:
 def latching() -> Iterator[None]:
     """Ctrl-C latched inside the block, the previous handler restored after it; a block that ends
     normally after a Ctrl-C that something swallowed raises KeyboardInterrupt."""
+    global _latched
     previous = signal.getsignal(signal.SIGINT) if _main_thread() else None
     hook = sys.unraisablehook
     install()
+    caught = False
     try:
         yield
     finally:
-        if previous is not None:
+        caught = _latched
+        if previous is not None and previous is not _handler:  # this block installed the latch
             signal.signal(signal.SIGINT, previous)
             sys.unraisablehook = hook
-    if _latched:
+            _latched = False  # a later command, or library call, starts clear
+    if caught:
         raise KeyboardInterrupt

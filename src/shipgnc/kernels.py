@@ -59,7 +59,7 @@ def kernel_function(function):
     and defeated its disk cache.
 
     Developers: numba's cache of a kernel is keyed to its own file only, so after editing a helper
-    that kernels in *other* files call (``wrap``, ``guidance.path.track_leg``), delete the
+    that kernels in *other* files call (``wrap``, ``paths.track_leg``), delete the
     ``__pycache__/*.nbi`` files (the composed loops are keyed to every file of the package and
     regenerate by themselves). Without the per-kernel cache every new combination would compile
     twice as long; an installed package never meets the case."""

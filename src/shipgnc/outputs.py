@@ -226,11 +226,15 @@ def write_netcdf(ds, path: Path) -> Path:
     The write takes a thread lock, whatever dask scheduler the session has (:func:`_local_write_lock`)."""
     path = Path(path)
     if ds.nbytes <= IN_MEMORY_MAX_BYTES:
-        with _sigint_deferred(), _local_write_lock():
-            encoded = ds.to_netcdf(engine="h5netcdf")
-        with open(path, "wb") as handle:
-            handle.write(encoded)
-        return path
+        try:
+            with _sigint_deferred(), _local_write_lock():
+                encoded = ds.to_netcdf(engine="h5netcdf")
+        except ValueError:  # an xarray that encodes in memory with the scipy engine only
+            encoded = None
+        if encoded is not None:
+            with open(path, "wb") as handle:
+                handle.write(encoded)
+            return path
     need = int(ds.nbytes * 1.05) + 4 * 1024**2
     free = shutil.disk_usage(path.parent).free
     if free < need:
@@ -247,8 +251,11 @@ def _local_write_lock():
     ``distributed.Client`` open in the session (a notebook's, a sweep's) that is a cluster-wide
     lock named after the target, which an in-memory target cannot be ("Semaphore or Lock
     <BytesIO> not known"). The data written here is in memory already: a thread lock will do."""
-    import dask
-
+    try:
+        import dask
+    except ImportError:  # dask is optional (the dist extra): without it xarray locks by thread
+        yield
+        return
     with dask.config.set(scheduler="synchronous"):
         yield
 

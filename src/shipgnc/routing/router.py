@@ -335,7 +335,8 @@ def _levelset_check(res, polys, grid_spacing, horizon, domain, progress=None):
             res.notes.append(f"level set did not reach the target within {horizon:.0f} s")
             res.global_check = {"method": "levelset", "time_s": None, "rel_diff": None}
         else:
-            res.notes.append(f"level set confirms: not reached within {horizon:.0f} s; front's closest "
+            verb = "finds" if str(res.reason).startswith("undecided") else "confirms"
+            res.notes.append(f"level set {verb}: not reached within {horizon:.0f} s; front's closest "
                              f"approach {ls.closest_approach:.1f} m")
         return
     if polys and ls.route is not None and _leaks(ls.route, polys, ls.arrival, res.t0, ls.spacing):

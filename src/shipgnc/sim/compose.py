@@ -161,7 +161,7 @@ _DIGEST: list[bytes] = []
 
 def _sources_digest() -> bytes:
     """A hash of every source file of the package (once per process): a kernel's helper may live
-    in another file than the kernel (``guidance.path.track_leg`` in the Mariner's controllers), so
+    in another file than the kernel (``paths.track_leg`` in the Mariner's controllers), so
     any edit of the package gives every loop a new module."""
     if not _DIGEST:
         digest = hashlib.sha256()

@@ -69,8 +69,11 @@ class FigureProcess:
         processes = list(getattr(self._pool, "_processes", {}).values())
         for process in processes:
             process.terminate()
-        for process in processes:  # dead within milliseconds of SIGTERM
+        for process in processes:  # dead within milliseconds of SIGTERM; else SIGKILL
             process.join(timeout=2.0)
+            if process.is_alive():
+                process.kill()
+                process.join(timeout=2.0)
         # join the pool's manager thread too: left running (shutdown(wait=False)), the interpreter's
         # exit handler wakes it through a pipe the broken pool has closed, and prints "Exception
         # ignored ... Bad file descriptor" after the command's one line
