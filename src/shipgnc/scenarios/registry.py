@@ -10,6 +10,15 @@ import yaml
 
 from shipgnc.errors import ConfigError
 from shipgnc.scenarios.schema import Scenario, validate
+from shipgnc.yaml_files import (  # noqa: F401  (MAX_*: the bounds, quoted by the tests)
+    MAX_EXPANDED_NODES,
+    MAX_NESTING,
+    MAX_SCENARIO_BYTES,
+    DuplicateKey,
+    StrictLoader,
+)
+from shipgnc.yaml_files import read_text as _read_text
+from shipgnc.yaml_files import read_yaml as _read_yaml
 
 BUILTIN_PACKAGE = "shipgnc.scenarios.builtin"
 #: a decimal number, exponent allowed (YAML 1.1 leaves ``1e-1`` a string)
@@ -30,123 +39,6 @@ def builtin_names() -> list[str]:
 def list_scenarios() -> list[Scenario]:
     """Every built-in scenario, validated."""
     return [load_scenario(name) for name in builtin_names()]
-
-
-#: bounds on a scenario file, checked before it is parsed: its size, the nesting of its sections
-#: and the number of nodes once YAML aliases are expanded (a few hundred bytes of nested aliases
-#: can stand for billions of nodes)
-MAX_SCENARIO_BYTES = 1 << 20
-MAX_NESTING = 64
-MAX_EXPANDED_NODES = 200_000
-
-
-class _StrictLoader(yaml.SafeLoader):
-    """YAML's safe loader that refuses a key given twice in one mapping (the last would win)."""
-
-    def construct_mapping(self, node, deep=False):
-        seen: dict[object, int] = {}
-        for key_node, _ in node.value:
-            if key_node.tag == "tag:yaml.org,2002:merge":  # ``<<: *base``: merged, may be overridden
-                continue
-            key = self.construct_object(key_node, deep=deep)
-            if isinstance(key, (str, int, float, bool)) and key in seen:
-                raise _DuplicateKey(key, seen[key], key_node.start_mark.line + 1)
-            if isinstance(key, (str, int, float, bool)):
-                seen[key] = key_node.start_mark.line + 1
-        return super().construct_mapping(node, deep=deep)
-
-
-class _DuplicateKey(Exception):
-    def __init__(self, key: object, first: int, again: int):
-        super().__init__(key, first, again)
-        self.key, self.first, self.again = key, first, again
-
-
-def _excerpt(text: object, limit: int = 60) -> str:
-    """``repr`` of a value cut to ``limit`` characters, for messages about hostile input."""
-    shown = repr(text)
-    return shown if len(shown) <= limit else shown[: limit - 3] + "..."
-
-
-def _check_shape(text: str, source: str) -> None:
-    """Refuse nesting deeper than ``MAX_NESTING`` and alias expansion beyond
-    ``MAX_EXPANDED_NODES`` before anything is built (one pass over the parser's events, then
-    one pass over the composed node graph counting each shared node once per reference)."""
-    depth = 0
-    for event in yaml.parse(text, Loader=yaml.SafeLoader):
-        if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
-            depth += 1
-            if depth > MAX_NESTING:
-                line = event.start_mark.line + 1
-                raise ConfigError(f"scenario {source}: nested more than {MAX_NESTING} levels deep "
-                                  f"(at line {line}); a scenario needs a handful")
-        elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
-            depth -= 1
-    root = yaml.compose(text, Loader=yaml.SafeLoader)
-    if root is None:
-        return
-    expanded: dict[int, int] = {}
-    order, stack = [], [root]
-    while stack:  # post-order without recursion: a node's size after its children's
-        node = stack.pop()
-        if id(node) in expanded:
-            continue
-        expanded[id(node)] = -1
-        order.append(node)
-        for child in _children(node):
-            if id(child) not in expanded:
-                stack.append(child)
-    for node in reversed(order):
-        expanded[id(node)] = 1 + sum(expanded[id(c)] for c in _children(node)
-                                     if expanded[id(c)] > 0)
-        if expanded[id(node)] > MAX_EXPANDED_NODES:
-            raise ConfigError(f"scenario {source}: its aliases expand to more than "
-                              f"{MAX_EXPANDED_NODES:,} values; a scenario needs a few hundred")
-
-
-def _children(node) -> list:
-    if isinstance(node, yaml.MappingNode):
-        return [part for pair in node.value for part in pair]
-    if isinstance(node, yaml.SequenceNode):
-        return list(node.value)
-    return []
-
-
-def _read_yaml(text: str, source: str) -> object:
-    try:
-        _check_shape(text, source)
-        return yaml.load(text, Loader=_StrictLoader)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or "invalid YAML"
-        raise ConfigError(f"scenario {source}: not valid YAML{where}: {problem}") from None
-    except _DuplicateKey as dup:
-        raise ConfigError(f"scenario {source}: key {_excerpt(dup.key)} given twice (lines "
-                          f"{dup.first} and {dup.again}); give each field once") from None
-    except RecursionError:
-        raise ConfigError(f"scenario {source}: nested too deeply to read") from None
-
-
-def _read_text(path: Path, source: str) -> str:
-    """The file's text, refused when larger than ``MAX_SCENARIO_BYTES`` or not UTF-8."""
-    try:
-        size = path.stat().st_size
-        if size > MAX_SCENARIO_BYTES:
-            raise ConfigError(f"scenario {source}: {size:,} bytes; scenario files are limited "
-                              f"to {MAX_SCENARIO_BYTES:,} bytes")
-        with path.open("rb") as handle:  # a device or FIFO reports size 0: read at most the cap
-            data = handle.read(MAX_SCENARIO_BYTES + 1)
-    except OSError as exc:
-        raise ConfigError(f"scenario {source}: cannot read ({exc.strerror or exc})") from None
-    if len(data) > MAX_SCENARIO_BYTES:
-        raise ConfigError(f"scenario {source}: more than {MAX_SCENARIO_BYTES:,} bytes; "
-                          f"scenario files are limited to that")
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f"scenario {source}: not UTF-8 text (byte {exc.start} is "
-                          f"0x{data[exc.start]:02x}); save the file as UTF-8") from None
 
 
 def raw_scenario(name_or_path: str) -> tuple[dict, str]:
@@ -221,8 +113,8 @@ def parse_override(item: str) -> tuple[str, object]:
     if not text.strip():
         raise ConfigError(f"--set {item!r}: missing value after '='")
     try:
-        value = yaml.load(text, Loader=_StrictLoader)
-    except (yaml.YAMLError, _DuplicateKey, RecursionError):
+        value = yaml.load(text, Loader=StrictLoader)
+    except (yaml.YAMLError, DuplicateKey, RecursionError):
         value = text
     if isinstance(value, str) and NUMBER.fullmatch(text.strip()):
         value = float(value)  # YAML 1.1 reads 1e-1 (no dot) as a string; "1e-1" stays one

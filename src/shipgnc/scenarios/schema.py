@@ -12,8 +12,6 @@ import math
 from typing import Annotated, Literal
 
 from pydantic import (
-    BaseModel,
-    ConfigDict,
     Discriminator,
     Field,
     Tag,
@@ -22,19 +20,15 @@ from pydantic import (
     model_validator,
 )
 
+from shipgnc.config_types import Finite, Matrix3, Positive, Strict, format_validation_error  # noqa: F401
 from shipgnc.errors import ConfigError
+from shipgnc.vessels.config import CATALOGUE_VESSELS, CatalogueVesselConfig
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 OffsetNm = Annotated[float, Field(ge=-1000, le=1000, allow_inf_nan=False)]
 OffsetDeg = Annotated[float, Field(ge=-180, le=180, allow_inf_nan=False)]
 #: a commanded heading: up to ten turns either way (beyond that a float's degrees lose meaning)
 HeadingDeg = Annotated[float, Field(ge=-3600, le=3600, allow_inf_nan=False)]
-
-
-class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 # --------------------------------------------------------------------------- vessel, actuator
@@ -162,68 +156,6 @@ class CatamaranCaseConfig(Strict):
     builder: Literal["turn", "steps", "fixed-angle", "sine", "heading", "actuator", "montecarlo",
                      "compare"]
     options: dict[str, Finite | int | bool | str | None] = Field(default_factory=dict)
-
-
-#: the vessel catalogue's models (``shipgnc vessels``; :mod:`shipgnc.vessels`)
-CATALOGUE_VESSELS = ("mariner-cst", "frigate", "kvlcc2", "kvlcc2-l7", "linear-3dof", "nomoto",
-                     "nomoto2")
-Matrix3 = Annotated[list[Annotated[list[Finite], Field(min_length=3, max_length=3)]],
-                    Field(min_length=3, max_length=3)]
-
-
-class CatalogueVesselConfig(Strict):
-    """``vessel`` from the catalogue (``shipgnc vessels``; :mod:`shipgnc.vessels`), SI: the model
-    at ``speed_mps`` (default: its design speed) with the entry's parameters, e.g. ``K``, ``T``
-    for ``nomoto``, ``M``, ``N``, ``B`` (or ``L``, ``B``, ``T``, ``Cb``, ...) for ``linear-3dof``;
-    the steering machine ``rudder_max_deg``, ``rudder_rate_deg_s``, ``rudder_time_constant_s``.
-    The vessel starts in its steady straight run at that speed (``initial_state`` sets position,
-    heading and yaw rate)."""
-
-    model: Literal["mariner-cst", "frigate", "kvlcc2", "kvlcc2-l7", "linear-3dof", "nomoto",
-                   "nomoto2"]
-    speed_mps: Positive | None = None
-    K: Finite | None = None
-    T: Finite | None = None
-    T1: Finite | None = None
-    T2: Finite | None = None
-    T3: Finite | None = None
-    a0: Finite | None = None
-    a1: Finite | None = None
-    a2: Finite | None = None
-    a3: Finite | None = None
-    M: Matrix3 | None = None
-    N: Matrix3 | None = None
-    B: Finite | Annotated[list[Finite], Field(min_length=3, max_length=3)] | Annotated[
-        list[Annotated[list[Finite], Field(min_length=1, max_length=1)]],
-        Field(min_length=3, max_length=3)] | None = None
-    L: Finite | None = None
-    Cb: Finite | None = None
-    R66: Finite | None = None
-    xg: Finite | None = None
-    T_surge: Finite | None = None
-    T_n: Positive | None = None
-    rudder_max_deg: Annotated[float, Field(gt=0, le=90, allow_inf_nan=False)] | None = None
-    rudder_rate_deg_s: Positive | None = None
-    rudder_time_constant_s: Positive | None = None
-
-    def params(self) -> dict:
-        """The entry's parameters given (None left out)."""
-        return {k: v for k, v in self.model_dump(exclude={"model", "speed_mps"}).items()
-                if v is not None}
-
-    def build(self):
-        """The model (:meth:`shipgnc.vessels.VesselEntry.build`)."""
-        from shipgnc.vessels import get_vessel
-
-        return get_vessel(self.model).build(self.speed_mps, **self.params())
-
-    @model_validator(mode="after")
-    def _builds(self) -> CatalogueVesselConfig:
-        try:
-            self.build()
-        except ConfigError as exc:
-            raise ValueError(str(exc)) from None
-        return self
 
 
 def _vessel_tag(value) -> str:
@@ -527,8 +459,8 @@ class PathConfig(Strict):
 
     type: Literal["path"]
     reading: Literal["caption", "text", "literal"] = "caption"
-    points_nm: Annotated[list[tuple[Finite, Finite]], Field(min_length=2)] = [
-        (0.0, 0.0), (0.0, 10.0), (4.0, 12.0), (12.0, 18.0)]
+    points_nm: Annotated[list[tuple[Finite, Finite]], Field(min_length=2)] = Field(
+        default_factory=lambda: [(0.0, 0.0), (0.0, 10.0), (4.0, 12.0), (12.0, 18.0)])
 
     @model_validator(mode="after")
     def _enough_points(self) -> PathConfig:
@@ -1138,36 +1070,6 @@ def _check_times(times: list[float]) -> None:
     for a, b in itertools.pairwise(times):
         if not b > a:
             raise ValueError(f"times must increase strictly (t = {a!r} is followed by t = {b!r})")
-
-
-def format_validation_error(error: ValidationError, source: str) -> str:
-    """One line naming each bad field, its value and the rule, e.g.
-    ``scenario 'x.yaml': simulation.dt = -1: Input should be greater than 0``."""
-    parts = []
-    for item in error.errors():
-        loc = _location(item["loc"])
-        msg = item["msg"].removeprefix("Value error, ")
-        value = item.get("input")
-        if item["type"] == "extra_forbidden":
-            parts.append(f"{loc}: unknown field (check the spelling; see `shipgnc show`)")
-        elif item["type"] == "missing":
-            parts.append(f"{loc}: required field is missing")
-        elif isinstance(value, (dict, list)) and len(repr(value)) > 60:
-            parts.append(f"{loc or 'scenario'}: {msg}")
-        else:
-            parts.append(f"{loc or 'scenario'} = {value!r}: {msg}")
-    return f"scenario {source}: " + "; ".join(parts)
-
-
-def _location(loc: tuple) -> str:
-    """Dotted field path without pydantic's union tags (``controller.open-loop.schedule`` →
-    ``controller.schedule``; ``controllers.pd.course.Ts`` → ``controllers.pd.Ts``)."""
-    parts = [str(p) for p in loc]
-    if len(parts) > 1 and parts[0] in ("controller", "guidance", "disturbance", "vessel"):
-        del parts[1]
-    elif len(parts) > 2 and parts[0] == "controllers":
-        del parts[2]
-    return ".".join(parts)
 
 
 def validate(data: object, source: str) -> Scenario:

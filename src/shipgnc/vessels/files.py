@@ -1,5 +1,5 @@
 """A vessel section read from a file or a mapping, validated once (the scenario schema's
-:class:`~shipgnc.scenarios.schema.CatalogueVesselConfig`), for ``shipgnc trial --vessel FILE``,
+:class:`~shipgnc.vessels.config.CatalogueVesselConfig`), for ``shipgnc trial --vessel FILE``,
 the YAML ``shipgnc identify`` writes, and a scenario's ``vessel:`` section alike."""
 
 from __future__ import annotations
@@ -11,11 +11,12 @@ from shipgnc.errors import ConfigError
 
 def vessel_config(data: object, source: str):
     """``{model: NAME, speed_mps: …, params…}`` (or ``{vessel: {…}}``) as a validated
-    :class:`~shipgnc.scenarios.schema.CatalogueVesselConfig`; a one-line :class:`ConfigError`
+    :class:`~shipgnc.vessels.config.CatalogueVesselConfig`; a one-line :class:`ConfigError`
     naming the field, the value and the rule otherwise."""
     from pydantic import ValidationError
 
-    from shipgnc.scenarios.schema import CatalogueVesselConfig, format_validation_error
+    from shipgnc.config_types import format_validation_error
+    from shipgnc.vessels.config import CatalogueVesselConfig
 
     if isinstance(data, dict) and isinstance(data.get("vessel"), dict):
         data = data["vessel"]
@@ -30,8 +31,7 @@ def vessel_config(data: object, source: str):
 
 def load_vessel_file(path: str | Path, source: str | None = None):
     """The vessel section of a YAML file (size-bounded, strict YAML as for scenarios)."""
-    from shipgnc.scenarios.registry import _read_text, _read_yaml
+    from shipgnc.yaml_files import read_text, read_yaml
 
     source = source or repr(str(path))
-    text = _read_text(Path(path), source)
-    return vessel_config(_read_yaml(text, source), source)
+    return vessel_config(read_yaml(read_text(Path(path), source), source), source)
