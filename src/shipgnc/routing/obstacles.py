@@ -63,14 +63,9 @@ MAX_GEOJSON_BYTES = 64 << 20
 def read_geojson(path, where: str) -> object:
     """The parsed JSON of a GeoJSON file, read up to ``MAX_GEOJSON_BYTES`` (a device or FIFO reports
     size 0, so the cap is on what is read); one-line ConfigErrors starting with ``where``."""
-    try:
-        with open(path, "rb") as handle:
-            raw = handle.read(MAX_GEOJSON_BYTES + 1)
-    except OSError as exc:
-        raise ConfigError(f"{where}: cannot read ({exc.strerror or exc})") from None
-    if len(raw) > MAX_GEOJSON_BYTES:
-        raise ConfigError(f"{where}: more than {MAX_GEOJSON_BYTES >> 20} MiB; polygon files are "
-                          f"limited to that")
+    from shipgnc.user_files import read_capped
+
+    raw = read_capped(path, MAX_GEOJSON_BYTES, where, "polygon files")
     try:
         return json.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, ValueError, RecursionError) as exc:

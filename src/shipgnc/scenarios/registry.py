@@ -10,15 +10,15 @@ import yaml
 
 from shipgnc.errors import ConfigError
 from shipgnc.scenarios.schema import Scenario, validate
-from shipgnc.yaml_files import (  # noqa: F401  (MAX_*: the bounds, quoted by the tests)
+from shipgnc.user_files import (  # noqa: F401  (MAX_*: the bounds, quoted by the tests)
     MAX_EXPANDED_NODES,
     MAX_NESTING,
     MAX_SCENARIO_BYTES,
     DuplicateKey,
     StrictLoader,
 )
-from shipgnc.yaml_files import read_text as _read_text
-from shipgnc.yaml_files import read_yaml as _read_yaml
+from shipgnc.user_files import read_text as _read_text
+from shipgnc.user_files import read_yaml as _read_yaml
 
 BUILTIN_PACKAGE = "shipgnc.scenarios.builtin"
 #: a decimal number, exponent allowed (YAML 1.1 leaves ``1e-1`` a string)

@@ -31,7 +31,7 @@ def vessel_config(data: object, source: str):
 
 def load_vessel_file(path: str | Path, source: str | None = None):
     """The vessel section of a YAML file (size-bounded, strict YAML as for scenarios)."""
-    from shipgnc.yaml_files import read_text, read_yaml
+    from shipgnc.user_files import read_text, read_yaml
 
     source = source or repr(str(path))
     return vessel_config(read_yaml(read_text(Path(path), source), source), source)

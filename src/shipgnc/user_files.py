@@ -1,8 +1,9 @@
-"""A user's YAML file read within bounds, for scenario files and vessel files alike: its size, the
-nesting of its sections and the values its aliases expand to are checked before anything is built
-(a few hundred bytes of nested aliases can stand for billions of nodes), a key given twice is an
-error (YAML would keep the last), and every refusal is one :class:`~shipgnc.errors.ConfigError`
-naming the file."""
+"""A user's file read within bounds (scenario and vessel YAML, GeoJSON polygons): at most a cap of
+bytes (:func:`read_capped`: a device or a FIFO reports size 0, so the cap is on what is read). For
+YAML, the nesting of its sections and the values its aliases expand to are checked before anything
+is built (a few hundred bytes of nested aliases can stand for billions of nodes) and a key given
+twice is an error (YAML would keep the last). Every refusal is one
+:class:`~shipgnc.errors.ConfigError` naming the file."""
 
 from __future__ import annotations
 
@@ -109,20 +110,23 @@ def read_yaml(text: str, source: str) -> object:
         raise ConfigError(f"scenario {source}: nested too deeply to read") from None
 
 
+def read_capped(path, limit: int, where: str, kind: str) -> bytes:
+    """At most ``limit`` bytes of ``path``; a ConfigError starting with ``where`` if it cannot be
+    read or holds more (``kind`` names the files limited, e.g. "scenario files")."""
+    try:
+        with open(path, "rb") as handle:
+            data = handle.read(limit + 1)
+    except OSError as exc:
+        raise ConfigError(f"{where}: cannot read ({exc.strerror or exc})") from None
+    if len(data) > limit:
+        raise ConfigError(f"{where}: more than {limit:,} bytes ({limit / 2**20:g} MiB); {kind} are "
+                          "limited to that")
+    return data
+
+
 def read_text(path: Path, source: str) -> str:
     """The file's text, refused when larger than ``MAX_SCENARIO_BYTES`` or not UTF-8."""
-    try:
-        size = path.stat().st_size
-        if size > MAX_SCENARIO_BYTES:
-            raise ConfigError(f"scenario {source}: {size:,} bytes; scenario files are limited "
-                              f"to {MAX_SCENARIO_BYTES:,} bytes")
-        with path.open("rb") as handle:  # a device or FIFO reports size 0: read at most the cap
-            data = handle.read(MAX_SCENARIO_BYTES + 1)
-    except OSError as exc:
-        raise ConfigError(f"scenario {source}: cannot read ({exc.strerror or exc})") from None
-    if len(data) > MAX_SCENARIO_BYTES:
-        raise ConfigError(f"scenario {source}: more than {MAX_SCENARIO_BYTES:,} bytes; "
-                          f"scenario files are limited to that")
+    data = read_capped(path, MAX_SCENARIO_BYTES, f"scenario {source}", "scenario files")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
