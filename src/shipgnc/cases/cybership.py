@@ -44,6 +44,17 @@ PRINTED_EQ17 = SwayYawModel(M=_frozen([[33.8, 1.0948], [1.0948, 2.76]]),
 PRINTED_EQ18 = (0.1057, -0.0040)
 #: the linearisation speed of (17) [m/s]
 U0_EQ17 = 0.3
+def _gains(name: str, defaults: dict, changes: dict) -> dict:
+    """``defaults`` updated by ``changes`` (known keys only), the switching gain checked."""
+    unknown = set(changes) - set(defaults)
+    if unknown:
+        raise ConfigError(f"{name}: unknown option(s) {', '.join(sorted(unknown))}; "
+                          f"allowed: {', '.join(defaults)}")
+    gains = {**defaults, **changes}
+    _check_positive("eta_rudder", gains["eta_rudder"])
+    return gains
+
+
 #: eigenvalues of the document (§3 of seed 003) [1/s]
 PAPER_LAMBDAS = (-0.0005, -7.8128)
 CONTROLLER_NAMES = ("pd", "smc_printed", "smc_consistent", "smc_tuned", "smc_identified")
@@ -105,12 +116,7 @@ def smc_tuned(design_model: tuple[float, float] | None = None, *, Ts: float = 0.
     faster λ₂ or larger η_δ/φ_h track ψ_z more closely but push g·|(M⁻¹b)_r|·Ts past 1, and a
     faster λ₁ raised J.
     """
-    unknown = set(changes) - set(TUNED)
-    if unknown:
-        raise ConfigError(f"smc_tuned: unknown option(s) {', '.join(sorted(unknown))}; "
-                          f"allowed: {', '.join(TUNED)}")
-    gains = {**TUNED, **changes}
-    _check_positive("eta_rudder", gains["eta_rudder"])
+    gains = _gains("smc_tuned", TUNED, changes)
     a22, b2 = PRINTED_EQ18 if design_model is None else design_model
     design = design_smc(a22, b2, gains["lam1"], gains["lam2"])
     return SlidingModeCourse(design, form="consistent", eta=gains["eta_rudder"] * abs(design.hB),
@@ -152,12 +158,7 @@ def smc_identified(params=None, *, Ts: float = 0.1, propeller_rps: float = CRUIS
     cost; λ₂ ≥ −0.3 lets the course-unstable ship lag its reference (the identified a₂₂ < 0 is an
     average over the zig-zag's large yaw rates; at small r the plant is unstable).
     """
-    unknown = set(changes) - set(IDENTIFIED)
-    if unknown:
-        raise ConfigError(f"smc_identified: unknown option(s) {', '.join(sorted(unknown))}; "
-                          f"allowed: {', '.join(IDENTIFIED)}")
-    gains = {**IDENTIFIED, **changes}
-    _check_positive("eta_rudder", gains["eta_rudder"])
+    gains = _gains("smc_identified", IDENTIFIED, changes)
     if design_model is None:
         design_model = identify_cybership2(params, propeller_rps=propeller_rps).design_model
     a22, b2 = design_model
