@@ -254,6 +254,8 @@ def _local_write_lock():
     try:
         import dask
     except ImportError:  # dask is optional (the dist extra): without it xarray locks by thread
+        dask = None
+    if dask is None:
         yield
         return
     with dask.config.set(scheduler="synchronous"):
