@@ -60,7 +60,8 @@ def _gnss_compass_ekf(dropouts=(), **ekf):
 def test_kalman_steady_state_gain_equals_dlqe():
     """The running filter's a-priori covariance and gain converge to python-control's dlqe
     (L = A K, P⁻ = dlqe's P) for the Nomoto + wave + rudder-bias model with compass and gyro."""
-    control = pytest.importorskip("control")
+    import control  # python-control: a hard dependency (a missing one fails, never skips)
+
     Ts = 0.1
     kf = heading_wave_kf(K=-0.05, T=10.0, omega0=7.85, lambda_w=0.1, gyro=True, Ts=Ts,
                          sigma_wave=math.radians(2.0), q_r=1e-6, q_b=1e-5)
