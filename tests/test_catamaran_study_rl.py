@@ -191,3 +191,17 @@ def test_ship_v0_takes_a_yaw_rate_case_and_refuses_the_others():
     for name in ("catamaran-steps", "catamaran-montecarlo", "catamaran-actuator"):
         with pytest.raises(ConfigError, match="has no per-sample reward; catamaran environments take"):
             ShipVectorEnv(num_envs=2, scenario=name)
+
+
+def test_an_episode_in_waves_or_current_reads_the_catamarans_pose_by_name():
+    """The catamaran keeps north, east, ψ at 3, 4, 5 ([u, v, r, north, east, ψ, δ]): an episode's
+    disturbance reads them there (bound to the model at reset, as in a simulated run), so a shear
+    current east = k·north is zero on the start line north = 0 whatever the surge speed."""
+    from shipgnc.rl.episode import BatchedEpisode
+
+    episode = BatchedEpisode(load_scenario("catamaran-turn", ["current=shear:k=0.01"]), batch=1)
+    episode.reset([1])
+    assert episode.disturbance.position_index == (3, 4)
+    x = episode.x.copy()
+    assert x[0, 0] > 1.0 and x[0, 3] == 0.0  # under way, on north = 0
+    np.testing.assert_array_equal(episode.disturbance(0.0, x)[0, 3:], [0.0, 0.0])

@@ -51,7 +51,8 @@ def test_current_section_on_catamaran_and_mariner():
     assert cat.current.field == UNIFORM
     for case in SC.cases(cat).values():  # every run of the case, each with its own object
         assert isinstance(case.disturbance, CurrentDisturbance)
-        assert case.disturbance.position_index == (3, 4)
+        case.disturbance.bind_model(case.model)  # as the simulator does at the run's start
+        assert case.disturbance.position_index == (3, 4)  # the catamaran's north, east by name
     setup = build(cat)
     assert setup.disturbance is not None
     np.testing.assert_array_equal(setup.disturbance(0.0, setup.x0), [0, 0, 0, VN, VE])

@@ -28,7 +28,8 @@ def tables():
 @pytest.mark.parametrize("page", [
     "000_mariner_tracking.md", "001_vectored_thrust_boat.md", "002_zermelo_routing.md",
     "003_cybership_autopilot.md",
-    # catamaran-compare: 13 single-ship runs in the numpy loop (no compiled twin), ≈ 40 s
+    # catamaran-compare: 13 single-ship runs, ≈ 40 s in the numpy loop or at their loops' first
+    # compile, ≈ 4 s once they are cached
     pytest.param("004_catamaran_fsm.md", marks=pytest.mark.slow),
 ])
 def test_documented_tables_match_their_runs(tables, page):

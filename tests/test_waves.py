@@ -566,3 +566,26 @@ def test_wave_load_calibration_heading_rms_is_the_linear_response_estimate():
     one = yaw_only.linear_response(psi0, speed, linear.M, linear.N)["psi_rms"]
     two = double.linear_response(psi0, speed, linear.M, linear.N)["psi_rms"]
     assert float(two) == pytest.approx(2.0 * float(one), rel=1e-12)
+
+
+def test_the_loads_read_the_pose_where_the_model_keeps_it():
+    """The loads on a ship whose state puts north, east and ψ elsewhere (the catamaran's
+    [u, v, r, north, east, ψ, δ]) are the loads on the same pose in the 3-DOF layout: the simulator
+    binds the disturbance to the model, which finds the indices by name."""
+    from shipgnc.models.catamaran import Catamaran
+    from shipgnc.models.cybership2 import CyberShip2
+
+    pose = np.array([3.0, -2.0, 0.7])
+    rng_seed = 11
+    loads_3dof, loads_cat = make_loads(), make_loads()
+    loads_3dof.bind_model(CyberShip2())
+    loads_cat.bind_model(Catamaran())
+    assert loads_cat.state_index == (3, 4, 5)
+    loads_3dof.reset((), np.random.default_rng(rng_seed))
+    loads_cat.reset((), np.random.default_rng(rng_seed))
+    x_3dof = np.concatenate([pose, [0.3, 0.0, 0.0]])
+    x_cat = np.concatenate([[0.3, 0.0, 0.0], pose, [0.0]])
+    np.testing.assert_array_equal(loads_cat(12.5, x_cat), loads_3dof(12.5, x_3dof))
+    given = FroudeKrylovWaveLoads(WaveSpectrum.jonswap(HS, T0), state_index=(0, 1, 2))
+    given.bind_model(Catamaran())  # an explicit state_index stays
+    assert given.state_index == (0, 1, 2)

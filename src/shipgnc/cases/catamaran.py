@@ -36,6 +36,7 @@ from shipgnc.control.finite_state import (
     default_gains,
 )
 from shipgnc.errors import require
+from shipgnc.models.base import state_index
 from shipgnc.models.catamaran import DEFAULT_PRESET, Catamaran
 
 DT = 0.0625
@@ -101,7 +102,8 @@ def with_current(case: CatamaranCase, current, force=None) -> CatamaranCase:
 
     if isinstance(current, str):
         current = parse_current(current)
-    case.disturbance = CurrentDisturbance(current, force, n_force=3, position_index=(3, 4))
+    north, east = (state_index(case.model, name) for name in ("north", "east"))
+    case.disturbance = CurrentDisturbance(current, force, n_force=3, position_index=(north, east))
     return case
 
 

@@ -40,8 +40,8 @@ from shipgnc.batchmath import row_dot
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.kernels import Kernel, clip, flat, kernel_function, sign, wrap
-from shipgnc.models.base import Signal
-from shipgnc.models.mariner import tracking_model  # the design model (8)/(9): the ship's, not the law's
+from shipgnc.models.base import Signal, state_index
+from shipgnc.models.mariner import MarinerWitOppe, tracking_model  # the design model (8)/(9)
 from shipgnc.paths import (
     LEG_ANGLE,
     LegTracker,
@@ -65,8 +65,10 @@ PAPER_STATE_UNITS = np.array([NAUTICAL_MILE, 1.0, 1.0 / MINUTE, NAUTICAL_MILE * 
 #: rudder limit of the Mariner (35°) [rad]
 DELTA_MAX = deg(35.0)
 
-#: indices of the Mariner state [north, east, psi, u, r] (document 000 eq. (25))
-I_NORTH, I_EAST, I_PSI, I_U, I_R = range(5)
+#: indices of the Mariner's states north, east, psi, u, r (document 000 eq. (25)), found by name
+#: in the model's state list (constants of the compiled laws)
+I_NORTH, I_EAST, I_PSI, I_U, I_R = (state_index(MarinerWitOppe, name)
+                                    for name in ("north", "east", "psi", "u", "r"))
 
 
 def gain_to_si(K_paper) -> np.ndarray:

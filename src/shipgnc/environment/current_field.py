@@ -47,6 +47,7 @@ import numpy as np
 
 from shipgnc.errors import require
 from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
+from shipgnc.models.base import state_index as index_of
 from shipgnc.routing.fields import CurrentField, SumField, field_velocity
 from shipgnc.streams import MemberStreams
 
@@ -184,18 +185,29 @@ class CurrentDisturbance:
     ``current``: a :class:`~shipgnc.routing.fields.CurrentField` (including
     :class:`GaussMarkovCurrent` and sums of both); ``force``: a disturbance of
     :mod:`shipgnc.environment.disturbance` or :mod:`shipgnc.environment.waves` writing ``n_force``
-    channels (3: X, Y, N); ``position_index``: where the model's state holds north and east
-    ((0, 1) for the boat and CyberShip II, (3, 4) for the catamaran).
+    channels (3: X, Y, N); ``position_index``: where the model's state holds north and east; by
+    default found by name in the simulated model's states (:meth:`bind_model`; (0, 1) before a run).
     """
 
     def __init__(self, current, force=None, *, n_force: int = 3,
-                 position_index: tuple[int, int] = (0, 1)):
+                 position_index: tuple[int, int] | None = None):
         require(isinstance(current, CurrentField), "current", type(current).__name__,
                 "must be a current field (shipgnc.routing.fields) or a GaussMarkovCurrent")
         self.current, self.force = current, force
         self.n_force = int(n_force)
-        self.position_index = tuple(int(i) for i in position_index)
+        self._given_index = None if position_index is None else tuple(int(i) for i in position_index)
+        self.position_index = self._given_index or (0, 1)
         self._field, self._markov = split_current(current)
+
+    def bind_model(self, model) -> None:
+        """Read north and east where ``model`` keeps them (found by name in its states; the
+        simulator calls this at the start of every run), unless ``position_index`` was given; the
+        force part is bound too."""
+        if self._given_index is None:
+            self.position_index = (index_of(model, "north"), index_of(model, "east"))
+        bind = getattr(self.force, "bind_model", None)
+        if callable(bind):
+            bind(model)
 
     @property
     def per_stage(self) -> bool:

@@ -44,6 +44,7 @@ from scipy import integrate
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.kernels import Kernel, flat
+from shipgnc.models.base import state_index as index_of
 from shipgnc.streams import is_generator
 from shipgnc.units import G
 
@@ -70,6 +71,8 @@ __all__ = [
     "torsethaugen_parameters",
 ]
 
+#: north, east, ψ in the toolkit's 3-DOF layout: where the wave loads read them before a run
+DEFAULT_STATE_INDEX = (0, 1, 2)
 #: Phillips' constant of the PM spectrum, α = 8.1e-3 (Pierson & Moskowitz 1964)
 PM_ALPHA = 8.1e-3
 #: PM's β = 0.74 in B = β (g/U₁₉.₅)⁴
@@ -966,8 +969,9 @@ class FroudeKrylovWaveLoads:
     large rudder activity. Short-crested (s = 1) head seas give ≈ 0.8 N·m RMS on course 0°.
 
     **Simulator protocol.** ``reset(batch_shape, rng)`` draws the sea (one independent sea per ship);
-    ``__call__(t, x)`` returns (*batch, 3), reading north, east and ψ from ``x`` at ``state_index``
-    (default (0, 1, 2), the toolkit's 3-DOF layout). ``per_stage = True``: the load depends on time within
+    ``__call__(t, x)`` returns (*batch, 3), reading north, east and ψ from ``x`` at ``state_index``:
+    by default found by name in the simulated model's states (:meth:`bind_model`; (0, 1, 2), the
+    toolkit's 3-DOF layout, before a run). ``per_stage = True``: the load depends on time within
     the step and on the state — at ω_e ≈ 9 rad/s a step of 0.1 s is a seventh of a period, and holding the
     step-start value would lag it by half a step (≈ 26°); evaluating at the RK stages keeps RK4's accuracy.
     """
@@ -977,7 +981,7 @@ class FroudeKrylovWaveLoads:
     def __init__(self, spectrum: WaveSpectrum, *, direction: float = math.pi, n_components: int = 200,
                  spreading: float | None = None, length: float = 1.255, beam: float = 0.29,
                  draft: float = 0.05, rho: float = 1014.0, gains=(1.0, 1.0, 1.0),
-                 state_index: tuple[int, int, int] = (0, 1, 2), backend: str = "auto"):
+                 state_index: tuple[int, int, int] | None = None, backend: str = "auto"):
         require(isinstance(spectrum, WaveSpectrum), "waves.spectrum", type(spectrum).__name__,
                 "must be a WaveSpectrum")
         require(backend in ("auto", "numpy"), "waves.backend", backend,
@@ -999,11 +1003,21 @@ class FroudeKrylovWaveLoads:
         require(gains_arr.shape == (3,) and bool(np.all(np.isfinite(gains_arr))), "waves.gains",
                 np.asarray(gains).tolist(), "must be three finite numbers (surge, sway, yaw)")
         self.gains = gains_arr
-        idx = tuple(state_index)
-        require(len(idx) == 3 and all(isinstance(i, (int, np.integer)) and i >= 0 for i in idx),
-                "waves.state_index", state_index, "must be three state indices (north, east, psi)")
-        self.state_index = tuple(int(i) for i in idx)
+        self._given_index = None
+        if state_index is not None:
+            idx = tuple(state_index)
+            require(len(idx) == 3 and all(isinstance(i, (int, np.integer)) and i >= 0 for i in idx),
+                    "waves.state_index", state_index, "must be three state indices (north, east, psi)")
+            self._given_index = tuple(int(i) for i in idx)
+        self.state_index = self._given_index or DEFAULT_STATE_INDEX
         self.realisation: WaveRealisation | None = None
+
+    def bind_model(self, model) -> None:
+        """Read north, east and ψ where ``model`` keeps them: their indices found by name in its
+        states (the simulator calls this at the start of every run), unless ``state_index`` was
+        given."""
+        if self._given_index is None:
+            self.state_index = tuple(index_of(model, name) for name in ("north", "east", "psi"))
 
     def reset(self, batch_shape, rng: np.random.Generator) -> None:
         """Draw an independent sea for every ship of ``batch_shape`` from ``rng``."""

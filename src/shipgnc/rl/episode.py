@@ -34,7 +34,7 @@ import numpy as np
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import names
-from shipgnc.sim.simulator import _validate, advance_plant
+from shipgnc.sim.simulator import _validate, advance_plant, reset_disturbance
 from shipgnc.streams import MemberStreams
 from shipgnc.study.chunk import check_perturbable
 from shipgnc.study.spec import PERTURBABLE, Perturbation
@@ -132,7 +132,7 @@ class BatchedEpisode:
         self.k = 0
         self.guidance.reset((self.batch,), self.model)
         if self.disturbance is not None:
-            self.disturbance.reset((self.batch,), streams)
+            reset_disturbance(self.disturbance, self.model, (self.batch,), streams)
         self.command = np.broadcast_to(self.sim.u0, (self.batch, self.actuator.n)).copy()
         self.applied = self.actuator.initial(self.command)
         self.lag = self.applied.copy() if self.actuator.has_lag else None

@@ -92,8 +92,7 @@ def disturbance(d, path: WaypointPath, current=None):
         require(d is None or d.d_y_nm_min == 0.0, "disturbance.d_y_nm_min", d and d.d_y_nm_min,
                 "must be 0 with a current section (give the current once)")
         field = current.build() if hasattr(current, "build") else current
-        return CurrentDisturbance(field, MarinerYawDisturbance(b_r, waves), n_force=1,
-                                  position_index=(0, 1))
+        return CurrentDisturbance(field, MarinerYawDisturbance(b_r, waves), n_force=1)
     if d is None:
         return None
     return MarinerDisturbance(b_r, current=CrossCurrent(d.d_y, path, frame=d.current_frame),

@@ -34,12 +34,13 @@ INTEGRATORS = ("rk4", "solve_ivp")
 BACKENDS = ("auto", "numpy", "compiled", "compiled-or-numpy")
 #: what a run does when a ship diverges (see :func:`simulate`)
 ON_DIVERGENCE = ("raise", "stop", "mask")
-#: ``backend="auto"`` uses a compiled twin from this batch size (compilation then pays off) ...
+#: ``backend="auto"`` uses the composed loop from this batch size (compilation then pays off) ...
 COMPILED_MIN_BATCH = 64
-#: ... or from this much work, ships × steps (a long run of a few ships: the numpy loop needs
-#: ≈ 0.4 ms a step, a cached kernel ≈ 1 s to load, a cold one ≈ 10 s to compile once); setups no
-#: twin covers run in the numpy loop
-COMPILED_MIN_WORK = 20_000
+#: ... or from this much work, ships × steps: a few ships' numpy loop needs ≈ 0.3 ms a step, a
+#: combination's first compile ≈ 10 s, paid once per machine (the loop is cached on disk and
+#: loaded in ≈ 0.1 s by every later process), so a run of more than half a second compiles it
+#: for every later run; setups no twin covers run in the numpy loop
+COMPILED_MIN_WORK = 2_000
 #: the compiled loops (modules of ``shipgnc.sim``), asked in this order, and the name each
 #: records in ``attrs["backend"]``: the composed loop of components with kernels
 COMPILED_TWINS = {"compose": "compiled"}
@@ -468,6 +469,15 @@ def advance_plant(setup: SimSetup, t0: float, x: np.ndarray, lag: np.ndarray | N
     return z[..., :n], (z[..., n:] if lag is not None else None)
 
 
+def reset_disturbance(disturbance, model, batch_shape, rng) -> None:
+    """A run's start for a disturbance: bound to the model first (``bind_model``: one that reads
+    the state finds north, east and ψ by name in ``model``'s states), then ``reset``."""
+    bind = getattr(disturbance, "bind_model", None)
+    if callable(bind):
+        bind(model)
+    disturbance.reset(batch_shape, rng)
+
+
 def reset_components(setup: SimSetup) -> None:
     """Reset the controller, guidance and disturbance for the run's batch (every loop starts so;
     the disturbance draws its initial state from the run's generator)."""
@@ -477,7 +487,7 @@ def reset_components(setup: SimSetup) -> None:
     if setup.guidance is not None:
         setup.guidance.reset(batch, setup.model)
     if setup.disturbance is not None:
-        setup.disturbance.reset(batch, setup.rng)
+        reset_disturbance(setup.disturbance, setup.model, batch, setup.rng)
     if setup.navigation is not None:  # draws from child streams of rng, not from rng itself
         setup.navigation.reset(batch, setup.rng, setup.model, setup.dt * setup.hold)
 
