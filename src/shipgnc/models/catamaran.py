@@ -497,12 +497,11 @@ def catamaran_rhs(x, u, d, p, xdot):
     X = X + two_T_v * cd + d[0]
     Y = Y - two_T_v * sd + d[1]
     N = N + L_T_v * sd + d[2]
-    xdot[0] = X / m_x
-    xdot[1] = Y / m_y
+    # ν̇_c = (r v_c, −r u_c, 0), zero in still water (u_c = v_c = 0); every element written once,
+    # unconditionally (a write in one branch keeps numba's reference counting in the RK stages)
+    xdot[0] = X / m_x + x[2] * vc
+    xdot[1] = Y / m_y - x[2] * uc
     xdot[2] = N / J
-    if in_current:  # ν̇_c = (r v_c, −r u_c, 0)
-        xdot[0] = xdot[0] + x[2] * vc
-        xdot[1] = xdot[1] - x[2] * uc
     xdot[3] = c * x[0] - s * x[1]
     xdot[4] = s * x[0] + c * x[1]
     xdot[5] = x[2]

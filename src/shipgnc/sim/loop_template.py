@@ -75,12 +75,20 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
                 if has_nav:  # Navigation.observe: the estimate (or measurements) from the truth
                     nav_observe(t, x, applied, zni, pn, Wn[k // hold - j0, i], seen, nsg, pm,
                                 nwk)
+                # the constant flags pick each call at compile time (an array chosen by a
+                # conditional expression would keep numba's reference counting in the loop)
                 if has_guid:
-                    if guid_fn(t, seen if has_nav else x, zgi, pg, ref, gout):
+                    if has_nav:
+                        finished = guid_fn(t, seen, zgi, pg, ref, gout)
+                    else:
+                        finished = guid_fn(t, x, zgi, pg, ref, gout)
+                    if finished:
                         done = 1.0
                 if has_ctrl:  # a continuous controller's law reads the truth (as run_numpy)
-                    ctrl_fn(t, seen if (has_nav and not continuous) else x, ref, zci, pc, cmd,
-                            sig)
+                    if has_nav and not continuous:
+                        ctrl_fn(t, seen, ref, zci, pc, cmd, sig)
+                    else:
+                        ctrl_fn(t, x, ref, zci, pc, cmd, sig)
                     bad = False
                     for j in range(nu):
                         if not math.isfinite(cmd[j]):
