@@ -109,7 +109,7 @@ def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> 
     pushed beyond the model's state range is a ConfigError naming the member and the field."""
     state_names = names(model.states)
     batch = np.tile(np.asarray(x0, dtype=float), (chunk.size, 1))
-    for row, member in enumerate(range(chunk.start, chunk.stop)):
+    for row, member in enumerate(range(chunk.start, chunk.stop) if study.offsets else ()):
         rng = np.random.default_rng(study.member_stream(member, 0))
         for p in study.offsets:
             state, scale = PERTURBABLE[p.field]
@@ -248,7 +248,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     drawn = member_params(study, setup.model, chunk.start, chunk.stop)  # the plant's parameters
     if drawn:  # each member's own plant; the controller keeps its nominal design
         setup = replace(setup, model=member_plant(study, setup.model, chunk.start, chunk.stop, drawn))
-    seeds = [study.member_stream(m, 1) for m in range(chunk.start, chunk.stop)]
+    seeds = study.member_seeds(chunk.start, chunk.stop, 1)  # made when a disturbance draws
     route = ends_early(setup)
     result, done_at = _run_batch(setup, scenario, x0, seeds, backend, route, "mask")
     diverged = np.isfinite(result["diverged_at"].values)
@@ -269,7 +269,9 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
         rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
         keys = list(dict.fromkeys(k for row in rows for k in row))
         arrays = {k: np.array([row.get(k, math.nan) for row in rows]) for k in keys}
-    data = {k: ("member", np.asarray(v, dtype=float)) for k, v in arrays.items()}
+    # copies: a metric that is a view of the log (a final value) would keep the chunk's whole
+    # log alive until the study ends (≈ 190 MB per 1 000 boats of boat-autopilot)
+    data = {k: ("member", np.array(v, dtype=float)) for k, v in arrays.items()}
     data.update(param_variables(study, drawn))
     out = xr.Dataset(data, coords={"member": np.arange(chunk.start, chunk.stop)},
                      attrs={"backend": ", ".join(sorted(str(b) for b in ran_on))})
