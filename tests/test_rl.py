@@ -184,3 +184,71 @@ def test_an_action_of_the_wrong_shape_is_refused_in_one_line(action):
     env.reset(seed=0)
     with pytest.raises(ConfigError, match="must hold one command per ship and input"):
         env.step(action)
+
+
+def _roll(scenario, backend, actions, perturb=(), seed=3):
+    from shipgnc.rl.episode import BatchedEpisode
+
+    episode = BatchedEpisode(scenario, batch=actions.shape[1], perturb=perturb, backend=backend)
+    assert episode.backend == backend
+    seeds = [np.random.SeedSequence(seed, spawn_key=(i,)) for i in range(actions.shape[1])]
+    rows = [(episode.reset(seeds), np.zeros(actions.shape[1]), None, None)]
+    for action in actions:
+        rows.append(episode.step(action))
+        if np.all(episode.done):
+            break
+    return rows, episode
+
+
+@pytest.mark.parametrize("scenario,perturb,steps", [
+    ("boat-autopilot", ("psi_deg=uniform:-30,30",), 120),  # heading-steps reward
+    ("boat-los", (), 200),                                   # waypoints: guidance outputs
+    ("cybership-waves", (), 40),                             # course-quality, per-stage wave loads
+    ("catamaran-turn", (), 150),                             # continuous law's place: hold = 1
+])
+def test_the_compiled_episode_is_the_numpy_episode(scenario, perturb, steps):
+    """The agent's plant advances in the composed loop (the one ``simulate`` runs) and gives the
+    numpy loop's episode: observations and rewards within 1e-9 relative (``simulate``'s promise),
+    flags equal, over random actions."""
+    from shipgnc.rl.episode import BatchedEpisode
+
+    probe = BatchedEpisode(scenario, batch=1)
+    rng = np.random.default_rng(1)
+    low = np.nan_to_num(probe.action_low, neginf=-0.02)  # an unbounded δ̇: ±0.02 rad/s
+    high = np.nan_to_num(probe.action_high, posinf=0.02)
+    actions = rng.uniform(low, high, (steps, 3, probe.actuator.n))
+    ref, _ = _roll(scenario, "numpy", actions, perturb)
+    got, _ = _roll(scenario, "compiled", actions, perturb)
+    assert len(got) == len(ref)
+    for (o_r, r_r, *flags_r), (o_g, r_g, *flags_g) in zip(ref, got, strict=True):
+        np.testing.assert_allclose(o_g, o_r, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(r_g, r_r, rtol=1e-9, atol=1e-12)
+        for a, b in zip(flags_r, flags_g, strict=True):
+            if a is not None:
+                np.testing.assert_array_equal(a, b)
+
+
+def test_a_member_that_diverges_in_the_compiled_loop_stops_alone(monkeypatch):
+    """A member pushed past the model's runaway limit (here a surge limit of 1.6 m/s, which full
+    thrust passes) is flagged, frozen at its last good state and rewarded up to its divergence,
+    as in the numpy loop; the other members run on."""
+    from shipgnc.models.fossen3dof import VectoredThrustBoat
+
+    monkeypatch.setattr(VectoredThrustBoat, "state_limits", (1e7, 1e7, 1e5, 1.6, 50.0, 50.0))
+    actions = np.zeros((400, 3, 2))
+    actions[:, 0, 0] = 1000.0  # member 0: full thrust; the others coast
+    ref, numpy_episode = _roll("boat-autopilot", "numpy", actions)
+    got, compiled_episode = _roll("boat-autopilot", "compiled", actions)
+    assert numpy_episode.diverged.tolist() == compiled_episode.diverged.tolist() == [True, False, False]
+    assert len(got) == len(ref)
+    for (o_r, r_r, *_), (o_g, r_g, *_) in zip(ref, got, strict=True):
+        np.testing.assert_allclose(o_g, o_r, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(r_g, r_r, rtol=1e-9, atol=1e-12)
+    assert abs(compiled_episode.x[0, 3]) <= 1.6  # its last good surge speed
+
+
+def test_an_episode_backend_without_kernels_is_named():
+    from shipgnc.rl.episode import BatchedEpisode
+
+    with pytest.raises(ConfigError, match="backend"):
+        BatchedEpisode("boat-autopilot", backend="fast")

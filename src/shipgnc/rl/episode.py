@@ -25,6 +25,15 @@ period (the final sample t_end included in the last step):
 
 Each member of the batch has its own random stream (:class:`~shipgnc.streams.MemberStreams`):
 its initial-state offsets (``perturb``) are drawn first, then its disturbance.
+
+**The loop** — the plant, the actuator and the disturbance of a control period advance in the
+composed compiled loop of :func:`~shipgnc.sim.simulator.simulate` (a
+:class:`~shipgnc.sim.compose.Composition` without controller and guidance, the agent's command
+held in its rows) when every component has a kernel (``backend="auto"``, or ``"compiled"``,
+which names the component that has none), else in the numpy loop's
+:func:`~shipgnc.sim.simulator.advance_plant` (``backend="numpy"``); both give the same episode to
+round-off. The guidance's references and the rewards are evaluated in numpy at the samples the loop
+logs.
 """
 
 from __future__ import annotations
@@ -40,6 +49,9 @@ from shipgnc.study.chunk import check_perturbable
 from shipgnc.study.spec import PERTURBABLE, Perturbation
 
 REWARDS = ("heading-steps", "course-quality", "waypoints")
+BACKENDS = ("auto", "numpy", "compiled")
+#: an event that makes the compiled loop skip a member (one already done stays frozen)
+_SKIP = np.iinfo(np.int64).max
 #: document 004's case builders an environment takes, with the kind of their per-sample reward
 #: (one plant and one reference for every run of the builder: the agent replaces the law)
 CATAMARAN_REWARDS = {"turn": "yaw-rate", "sine": "yaw-rate", "heading": "heading"}
@@ -48,7 +60,7 @@ CATAMARAN_REWARDS = {"turn": "yaw-rate", "sine": "yaw-rate", "heading": "heading
 class BatchedEpisode:
     """``batch`` episodes of ``scenario`` stepped together (the batch axis is the member axis)."""
 
-    def __init__(self, scenario, batch: int = 1, perturb=()):
+    def __init__(self, scenario, batch: int = 1, perturb=(), backend: str = "auto"):
         from shipgnc.scenarios.registry import load_scenario
         from shipgnc.scenarios.runner import build
 
@@ -91,6 +103,16 @@ class BatchedEpisode:
                              atol=sim.atol, seed=None, on_divergence="stop", observer=None,
                              progress=None, log_every=1)
         self.actuator = self.sim.actuator
+        require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
+        from shipgnc.sim.compose import unsupported_reason
+
+        reason = None if backend == "numpy" else unsupported_reason(self.sim)
+        if backend == "compiled" and reason:
+            raise ConfigError(f"backend = 'compiled': no compiled loop covers this episode ({reason}); "
+                              "use backend='numpy'")
+        #: the loop that steps the plant: ``compiled`` or ``numpy``
+        self.backend = "numpy" if backend == "numpy" or reason else "compiled"
+        self._comp = None
         self.hold = max(1, round(float(getattr(ctrl, "Ts", None) or sim.dt) / sim.dt))
         self.dt = sim.dt
         self.n_steps = self.sim.n_steps
@@ -139,6 +161,11 @@ class BatchedEpisode:
         self.ref = self.guidance.reference(0.0, self.x)
         self.done = np.zeros(self.batch, dtype=bool)
         self.diverged = np.zeros(self.batch, dtype=bool)
+        if self.backend == "compiled":
+            from shipgnc.sim.compose import Composition
+
+            self._comp = Composition(self.sim)  # the disturbance's kernel after its reset
+            self._comp.S[:, :x.shape[-1]] = self.x
         return self.observation()
 
     def observation(self) -> np.ndarray:
@@ -188,8 +215,16 @@ class BatchedEpisode:
         if not np.all(np.isfinite(action)):
             raise ConfigError(f"action {action.tolist()}: must be finite")
         self.command = np.where(self.done[:, None], self.command, action)
-        reward = np.zeros(self.batch)
         live = ~self.done
+        if self._comp is not None:
+            reward, live = self._advance_compiled(live)
+        else:
+            reward, live = self._advance_numpy(live)
+        return self._end_of_period(reward, live)
+
+    def _advance_numpy(self, live: np.ndarray):
+        """One control period of the plant in the numpy loop; (reward, live)."""
+        reward = np.zeros(self.batch)
         for _ in range(self.hold):
             plan = self.actuator.begin_step(self.applied, self.command, self.dt)
             self.applied_now = self.actuator.input_at(plan, 0.0, self.lag)
@@ -210,6 +245,44 @@ class BatchedEpisode:
             self.t = self.k * self.dt
             if self.k >= self.n_steps:
                 break
+        return reward, live
+
+    def _advance_compiled(self, live: np.ndarray):
+        """One control period of the plant in the composed loop (the command held in the rows of
+        the members that run; the others skipped); the rewards from the states and inputs it
+        logged at each step's start, up to a member's divergence; (reward, live)."""
+        comp = self._comp
+        lay, S, out = comp.layout, comp.S, comp.out
+        nx, nu = self.x.shape[-1], self.actuator.n
+        k0, k1 = self.k, min(self.k + self.hold, self.n_steps)
+        S[:, lay["cmd"]:lay["cmd"] + nu] = self.command
+        comp.event[:] = np.where(live, -1, _SKIP)
+        comp.prepare(k0, k1)
+        comp.call(k0, k1, self.n_steps)
+        bad = live & (comp.event >= 0)
+        k_bad = np.where(bad, comp.event // 2, self.n_steps)  # a bad state after step k_bad
+        x_log = out[:nx, k0:k1].transpose(1, 2, 0)  # (step, member, state) at each step's start
+        applied_log = out[comp.columns["applied"]:comp.columns["applied"] + nu, k0:k1].transpose(1, 2, 0)
+        reward = np.zeros(self.batch)
+        with np.errstate(all="ignore"):  # a member's log is not written after its divergence
+            for j, k in enumerate(range(k0, k1)):
+                self.x, self.applied_now = x_log[j], applied_log[j]
+                reward -= np.where(live & (k <= k_bad), self.sample_cost(), 0.0)
+        for i in np.flatnonzero(bad):  # frozen at its last good state (the numpy loop's keep)
+            S[i, :nx] = x_log[k_bad[i] - k0, i]
+            S[i, lay["applied"]:lay["applied"] + nu] = applied_log[k_bad[i] - k0, i]
+        self.x = S[:, :nx].copy()
+        self.applied = S[:, lay["applied"]:lay["applied"] + nu].copy()
+        if self.lag is not None:
+            self.lag = S[:, lay["lag"]:lay["lag"] + nu].copy()
+        self.diverged |= bad
+        self.k = k1
+        self.t = self.k * self.dt
+        return reward, live & ~bad
+
+    def _end_of_period(self, reward: np.ndarray, live: np.ndarray):
+        """The period's end: the guidance's next reference at a control instant, the final
+        sample's reward, the members' termination; the step's return value."""
         truncated = self.k >= self.n_steps
         if self.k % self.hold == 0:  # a control instant: the guidance's next reference
             self.ref = self.guidance.reference(self.t, self.x)

@@ -240,108 +240,150 @@ def unsupported_reason(setup) -> str | None:
     return None
 
 
-def run(setup):
-    """Run ``setup`` in its composed loop; returns the same ``Log`` as ``run_numpy(setup)``."""
-    from shipgnc.sim.compiled import drive, log_length, make_log
-    from shipgnc.sim.simulator import log_signals, reset_components
+class Composition:
+    """A setup's composed loop with its carried state: each ship's row of ``S`` (state, lag,
+    applied input, command, references, components' states; :func:`row_layout`), the log
+    ``out`` (column, sample, ship) in the order of :func:`~shipgnc.sim.simulator.log_signals`,
+    each ship's divergence ``event`` (2k: a bad command at sample k, 2k + 1: a bad state after
+    step k; −1: none; a ship with an event is skipped) and ``done_at``. Built after the
+    components' reset (:func:`~shipgnc.sim.simulator.reset_components`); :meth:`call` runs steps
+    ``k0 … k1 − 1`` of every ship. :func:`run` drives it over a whole run; an agent's episode
+    (:class:`~shipgnc.rl.episode.BatchedEpisode`) a control period at a time."""
 
-    reason = unsupported_reason(setup)
-    if reason:
-        raise ConfigError(f"compiled loop: {reason}")
-    model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller, setup.guidance,
-                                  setup.disturbance)
-    batch = setup.batch_shape
-    n = math.prod(batch)
-    reset_components(setup)  # the same side effects on the components as the numpy loop
-    try:
-        km = model.kernel()
-        kc = ctrl.kernel(batch) if ctrl is not None else None
-        kg = gd.kernel(batch) if gd is not None else None
-        kd = dist.kernel(batch, dt=setup.dt) if dist is not None else None
-        # a disturbance with a current part (environment.current_field.CurrentDisturbance)
-        cur = getattr(dist, "kernel_current", None)
-        ku = cur(batch, dt=setup.dt) if callable(cur) else None
-        nav = setup.navigation
-        kn = nav.kernel(batch, dt=setup.dt, x0=setup.x0) if nav is not None else None
-    except NotCompiled as exc:  # a setting only known after reset: the caller falls back
-        raise ConfigError(f"compiled loop: {exc}") from None
-    empty = Kernel(_no_controller)
-    kc_, kg_, kd_ = kc or empty, kg or empty, kd or empty
+    def __init__(self, setup):
+        from shipgnc.sim.compiled import log_length
+        from shipgnc.sim.simulator import log_signals
 
-    nx, nu = len(model.states), act.n
-    nd = len(model.disturbances)
-    refs = tuple(gd.references) if gd is not None else ()
-    nout = len(gd.outputs) if gd is not None else 0
-    nsig = len(getattr(ctrl, "signals", ())) if ctrl is not None else 0
-    state_names = [s.name for s in model.states]
-    err = np.array([(state_names.index(s.tracks), j, int(s.angle)) for j, s in enumerate(refs)
-                    if s.tracks], dtype=np.int64).reshape(-1, 3)
-    zc0, zg0, zd0 = kc_.state_for(n), kg_.state_for(n), kd_.state_for(n)
-    zn0 = kn.state_for(n) if kn else np.zeros((n, 0))
-    nnsig = kn.n_signals if kn else 0
-    continuous = bool(getattr(ctrl, "continuous", False))
-    loop = loop_for(km.function, kc.function if kc else _no_controller,
-                    kg.function if kg else _no_guidance, kd.function if kd else _no_disturbance,
-                    nx=nx, nu=nu, nd=nd, nref=len(refs), nout=nout, nsig=nsig, nerr=err.shape[0],
-                    nzc=zc0.shape[1], nzg=zg0.shape[1], nzd=zd0.shape[1], has_ctrl=ctrl is not None,
-                    continuous=continuous, has_guid=gd is not None, has_dist=dist is not None,
-                    per_stage=bool(getattr(dist, "per_stage", False)), has_lag=act.has_lag,
-                    rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold",
-                    cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None,
-                    est_kind=kn.estimator if kn else -1, nzn=zn0.shape[1], nnsig=nnsig)
-    lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd, zc0.shape[1],
-                     zg0.shape[1], zd0.shape[1], zn0.shape[1], nnsig)
+        model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller,
+                                      setup.guidance, setup.disturbance)
+        self.setup = setup
+        batch = setup.batch_shape
+        n = math.prod(batch)
+        try:
+            km = model.kernel()
+            kc = ctrl.kernel(batch) if ctrl is not None else None
+            kg = gd.kernel(batch) if gd is not None else None
+            kd = dist.kernel(batch, dt=setup.dt) if dist is not None else None
+            # a disturbance with a current part (environment.current_field.CurrentDisturbance)
+            cur = getattr(dist, "kernel_current", None)
+            ku = cur(batch, dt=setup.dt) if callable(cur) else None
+            nav = setup.navigation
+            kn = nav.kernel(batch, dt=setup.dt, x0=setup.x0) if nav is not None else None
+        except NotCompiled as exc:  # a setting only known after reset: the caller falls back
+            raise ConfigError(f"compiled loop: {exc}") from None
+        empty = Kernel(_no_controller)
+        kc_, kg_, kd_ = kc or empty, kg or empty, kd or empty
+        self._stateful = ((kc, "zc"), (kg, "zg"), (kd, "zd"))
 
-    S = np.zeros((n, lay["row"]))
-    S[:, :nx] = setup.x0.reshape(n, nx)
-    command = np.broadcast_to(setup.u0, (*batch, nu)).reshape(n, nu)
-    applied = act.initial(command)
-    if act.has_lag:
-        S[:, lay["lag"]:lay["lag"] + nu] = applied
-    S[:, lay["applied"]:lay["applied"] + nu] = applied
-    S[:, lay["cmd"]:lay["cmd"] + nu] = command
-    S[:, lay["zc"]:lay["zc"] + zc0.shape[1]] = zc0
-    S[:, lay["zg"]:lay["zg"] + zg0.shape[1]] = zg0
-    S[:, lay["zd"]:lay["zd"] + zd0.shape[1]] = zd0
-    S[:, lay["zn"]:lay["zn"] + zn0.shape[1]] = zn0
+        nx, nu = len(model.states), act.n
+        nd = len(model.disturbances)
+        refs = tuple(gd.references) if gd is not None else ()
+        nout = len(gd.outputs) if gd is not None else 0
+        nsig = len(getattr(ctrl, "signals", ())) if ctrl is not None else 0
+        state_names = [s.name for s in model.states]
+        err = np.array([(state_names.index(s.tracks), j, int(s.angle)) for j, s in enumerate(refs)
+                        if s.tracks], dtype=np.int64).reshape(-1, 3)
+        zc0, zg0, zd0 = kc_.state_for(n), kg_.state_for(n), kd_.state_for(n)
+        zn0 = kn.state_for(n) if kn else np.zeros((n, 0))
+        nnsig = kn.n_signals if kn else 0
+        continuous = bool(getattr(ctrl, "continuous", False))
+        self.loop = loop_for(
+            km.function, kc.function if kc else _no_controller,
+            kg.function if kg else _no_guidance, kd.function if kd else _no_disturbance,
+            nx=nx, nu=nu, nd=nd, nref=len(refs), nout=nout, nsig=nsig, nerr=err.shape[0],
+            nzc=zc0.shape[1], nzg=zg0.shape[1], nzd=zd0.shape[1], has_ctrl=ctrl is not None,
+            continuous=continuous, has_guid=gd is not None, has_dist=dist is not None,
+            per_stage=bool(getattr(dist, "per_stage", False)), has_lag=act.has_lag,
+            rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold",
+            cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None,
+            est_kind=kn.estimator if kn else -1, nzn=zn0.shape[1], nnsig=nnsig)
+        lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd,
+                         zc0.shape[1], zg0.shape[1], zd0.shape[1], zn0.shape[1], nnsig)
+        self.layout = lay
+        self.widths = {"zc": zc0.shape[1], "zg": zg0.shape[1], "zd": zd0.shape[1]}
 
-    signals = log_signals(setup)
-    n_columns = nx + 2 * nu + len(refs) + err.shape[0] + nout + nsig + nnsig
-    if n_columns != len(signals):  # the loop's column layout must match the numpy loop's log
-        raise RuntimeError(f"compiled loop: {n_columns} log columns for {list(signals)}")
-    out = np.empty((n_columns, log_length(setup), n))
-    event_at = np.full(n, -1, dtype=np.int64)
-    # only guidance that can finish (a route's last waypoint) ends a run early
-    can_finish = gd is not None and gd.finished() is not None
-    done_at = np.full(n, -1, dtype=np.int64) if can_finish else None
-    params = [_param_rows(k, n) for k in (km, kc_, kg_, kd_)]
-    pa = act.kernel_params()
-    limits = np.asarray(model.state_limits, dtype=np.float64)
-    table = {"W": np.zeros((1, n, 0)), "Wu": np.zeros((1, n, 0)), "Wn": np.zeros((1, n, 0))}
-    pu = _param_rows(ku or empty, n)
-    pn = _param_rows(kn or empty, n)
+        S = np.zeros((n, lay["row"]))
+        S[:, :nx] = setup.x0.reshape(n, nx)
+        command = np.broadcast_to(setup.u0, (*batch, nu)).reshape(n, nu)
+        applied = act.initial(command)
+        if act.has_lag:
+            S[:, lay["lag"]:lay["lag"] + nu] = applied
+        S[:, lay["applied"]:lay["applied"] + nu] = applied
+        S[:, lay["cmd"]:lay["cmd"] + nu] = command
+        S[:, lay["zc"]:lay["zc"] + zc0.shape[1]] = zc0
+        S[:, lay["zg"]:lay["zg"] + zg0.shape[1]] = zg0
+        S[:, lay["zd"]:lay["zd"] + zd0.shape[1]] = zd0
+        S[:, lay["zn"]:lay["zn"] + zn0.shape[1]] = zn0
+        self.S = S
 
-    def prepare(k0: int, k1: int) -> None:
-        for name, k in (("W", kd), ("Wu", ku), ("Wn", kn)):
+        self.signals = log_signals(setup)
+        n_columns = nx + 2 * nu + len(refs) + err.shape[0] + nout + nsig + nnsig
+        if n_columns != len(self.signals):  # the loop's column layout must match the numpy log
+            raise RuntimeError(f"compiled loop: {n_columns} log columns for {list(self.signals)}")
+        #: log columns of the state and of the applied input
+        self.columns = {"x": 0, "cmd": nx, "applied": nx + nu}
+        self.out = np.empty((n_columns, log_length(setup), n))
+        self.event = np.full(n, -1, dtype=np.int64)
+        # only guidance that can finish (a route's last waypoint) ends a run early
+        can_finish = gd is not None and gd.finished() is not None
+        self.done_at = np.full(n, -1, dtype=np.int64) if can_finish else None
+        self._no_done = np.zeros(n, dtype=np.int64)
+        self._params = [_param_rows(k, n) for k in (km, kc_, kg_, kd_)]
+        self._pa = act.kernel_params()
+        self._limits = np.asarray(model.state_limits, dtype=np.float64)
+        self._err = err
+        self._table = {"W": np.zeros((1, n, 0)), "Wu": np.zeros((1, n, 0)), "Wn": np.zeros((1, n, 0))}
+        self._tabled = (("W", kd), ("Wu", ku), ("Wn", kn))
+        self._kn = kn
+        self._pu = _param_rows(ku or empty, n)
+        self._pn = _param_rows(kn or empty, n)
+
+    def prepare(self, k0: int, k1: int) -> None:
+        """The input tables of steps ``k0 … k1 − 1`` (a noise's draws, the sensors' draws)."""
+        n = self.S.shape[0]
+        table = self._table
+        for name, k in self._tabled:
             if k is not None and k.table is not None:
                 table[name] = np.ascontiguousarray(k.table(k0, k1), dtype=np.float64)
             else:
                 table[name] = np.zeros((k1 - k0, n, 0))
-        if kn is not None and table["Wn"].shape[0] == 0:  # a chunk without a control sample
-            table["Wn"] = np.zeros((1, n, kn.n_table))
+        if self._kn is not None and table["Wn"].shape[0] == 0:  # a chunk without a control sample
+            table["Wn"] = np.zeros((1, n, self._kn.n_table))
 
-    def call(k0: int, k1: int, k_last: int) -> None:
-        loop(k0, k1, k_last, int(setup.hold), int(setup.log_every), float(setup.dt), S, table["W"],
-             params[0], pa, params[1], params[2], params[3], limits, err, out, event_at,
-             done_at if done_at is not None else np.zeros(n, dtype=np.int64), table["Wu"], pu,
-             table["Wn"], pn)
+    def call(self, k0: int, k1: int, k_last: int) -> None:
+        """Steps ``k0 <= k < k1`` of every ship without an event (``k_last``: the step logged
+        whatever ``log_every`` that ends the run); :meth:`prepare` first."""
+        setup, table, params = self.setup, self._table, self._params
+        self.loop(k0, k1, k_last, int(setup.hold), int(setup.log_every), float(setup.dt), self.S,
+                  table["W"], params[0], self._pa, params[1], params[2], params[3], self._limits,
+                  self._err, self.out, self.event,
+                  self.done_at if self.done_at is not None else self._no_done, table["Wu"],
+                  self._pu, table["Wn"], self._pn)
 
-    stop = drive(setup, call, S, event_at, prepare=prepare, done_at=done_at)
-    for k, key, width in ((kc, "zc", zc0.shape[1]), (kg, "zg", zg0.shape[1]), (kd, "zd", zd0.shape[1])):
-        if k is not None and k.restore is not None:
-            k.restore(S[:, lay[key]:lay[key] + width].copy())
-    return make_log(setup, signals, out, S, stop.event, state_slot=0, cmd_slot=lay["cmd"],
-                    k_end=stop.k_end, interrupted=stop.interrupted, events=event_at)
+    def restore(self) -> None:
+        """Leave the components as the numpy loop would (their carried states)."""
+        lay, S = self.layout, self.S
+        for k, key in self._stateful:
+            if k is not None and k.restore is not None:
+                width = self.widths[key]
+                k.restore(S[:, lay[key]:lay[key] + width].copy())
+
+
+def run(setup):
+    """Run ``setup`` in its composed loop; returns the same ``Log`` as ``run_numpy(setup)``."""
+    from shipgnc.sim.compiled import drive, make_log
+    from shipgnc.sim.simulator import reset_components
+
+    reason = unsupported_reason(setup)
+    if reason:
+        raise ConfigError(f"compiled loop: {reason}")
+    reset_components(setup)  # the same side effects on the components as the numpy loop
+    comp = Composition(setup)
+    stop = drive(setup, comp.call, comp.S, comp.event, prepare=comp.prepare, done_at=comp.done_at)
+    comp.restore()
+    return make_log(setup, comp.signals, comp.out, comp.S, stop.event, state_slot=0,
+                    cmd_slot=comp.layout["cmd"], k_end=stop.k_end, interrupted=stop.interrupted,
+                    events=comp.event)
 
 
 def _param_rows(kernel: Kernel, n_ships: int) -> np.ndarray:
