@@ -7,7 +7,8 @@ normal 0.2 m/s; 1000 members per chunk), timed
 
 (a) ``workers="local"``: the chunks one after another in this process;
 (b) on a ``LocalCluster`` with one single-threaded worker process per core (cluster start-up
-    excluded, reported apart; each worker's first chunk loads the compiled kernel).
+    and the workers' warm-up — imports and the compiled loop's load, the same two-member study
+    that warms (a) up, run on the cluster — excluded, reported apart).
 
 Both results are checked identical to the bit. Reports members/s for both and the ratio (b)/(a).
 Writes ``benchmarks/results/bench_sweep.json`` (``..._quick.json`` with ``--quick``: 2 000 members).
@@ -50,6 +51,10 @@ def main(argv=None) -> dict:
                       dashboard_address=None) as cluster, Client(cluster) as client:
         startup_s = time.perf_counter() - start
         start = time.perf_counter()
+        warm = Study("boat-autopilot", members=workers)  # a chunk per worker: imports, kernel cache
+        run_study(warm, chunk_size=1, client=client)
+        warmup_s = time.perf_counter() - start
+        start = time.perf_counter()
         on_dask = run_study(study, chunk_size=1000, client=client).dataset
         dask_s = time.perf_counter() - start
     xr.testing.assert_identical(local, on_dask)
@@ -57,7 +62,8 @@ def main(argv=None) -> dict:
     results = {
         "members": members, "chunk_size": 1000, "dask_workers": workers,
         "local": {"seconds": local_s, "members_per_s": members / local_s},
-        "dask": {"seconds": dask_s, "members_per_s": members / dask_s, "cluster_startup_s": startup_s},
+        "dask": {"seconds": dask_s, "members_per_s": members / dask_s, "cluster_startup_s": startup_s,
+                 "workers_warmup_s": warmup_s},
         "speedup_dask_over_local": local_s / dask_s,
         "identical": True,
         "heading_rmse_deg_median": float(local["heading_rmse_deg"].median()),
@@ -65,7 +71,7 @@ def main(argv=None) -> dict:
     print(f"{members} members of boat-autopilot (70 s, dt 0.05 s), chunks of 1000")
     print(f"  (a) local          {local_s:7.2f} s  {members / local_s:9.0f} members/s")
     print(f"  (b) LocalCluster×{workers} {dask_s:7.2f} s  {members / dask_s:9.0f} members/s "
-          f"(+ {startup_s:.1f} s start-up)")
+          f"(+ {startup_s:.1f} s start-up, {warmup_s:.1f} s workers' warm-up)")
     print(f"  ratio (b)/(a) {local_s / dask_s:.2f}×; results identical to the bit")
     write_report("bench_sweep", {"machine": machine_info(), "results": results}, args.quick)
     return results
