@@ -189,6 +189,9 @@ def test_an_action_of_the_wrong_shape_is_refused_in_one_line(action):
 def _roll(scenario, backend, actions, perturb=(), seed=3):
     from shipgnc.rl.episode import BatchedEpisode
 
+    if isinstance(scenario, tuple):  # (name, overrides)
+        scenario = load_scenario(scenario[0], list(scenario[1]))
+
     episode = BatchedEpisode(scenario, batch=actions.shape[1], perturb=perturb, backend=backend)
     assert episode.backend == backend
     seeds = [np.random.SeedSequence(seed, spawn_key=(i,)) for i in range(actions.shape[1])]
@@ -205,6 +208,11 @@ def _roll(scenario, backend, actions, perturb=(), seed=3):
     ("boat-los", (), 200),                                   # waypoints: guidance outputs
     ("cybership-waves", (), 40),                             # course-quality, per-stage wave loads
     ("catamaran-turn", (), 150),                             # continuous law's place: hold = 1
+    # a control period of 3 steps (1 400 steps: a short last one), thrust and angle lags, a rate
+    # limit and a random force noise drawn per step
+    (("boat-autopilot", ("controller.Ts=0.15", "actuator.thrust_time_constant=0.5",
+                         "actuator.angle_time_constant=0.3", "actuator.angle_rate_deg_s=30",
+                         "disturbance={type: gaussian, psd: [1.0, 1.0, 0.1]}")), (), 480),
 ])
 def test_the_compiled_episode_is_the_numpy_episode(scenario, perturb, steps):
     """The agent's plant advances in the composed loop (the one ``simulate`` runs) and gives the
@@ -212,7 +220,8 @@ def test_the_compiled_episode_is_the_numpy_episode(scenario, perturb, steps):
     flags equal, over random actions."""
     from shipgnc.rl.episode import BatchedEpisode
 
-    probe = BatchedEpisode(scenario, batch=1)
+    probe = BatchedEpisode(load_scenario(scenario[0], list(scenario[1]))
+                           if isinstance(scenario, tuple) else scenario, batch=1)
     rng = np.random.default_rng(1)
     low = np.nan_to_num(probe.action_low, neginf=-0.02)  # an unbounded δ̇: ±0.02 rad/s
     high = np.nan_to_num(probe.action_high, posinf=0.02)
@@ -245,6 +254,26 @@ def test_a_member_that_diverges_in_the_compiled_loop_stops_alone(monkeypatch):
         np.testing.assert_allclose(o_g, o_r, rtol=1e-9, atol=1e-12)
         np.testing.assert_allclose(r_g, r_r, rtol=1e-9, atol=1e-12)
     assert abs(compiled_episode.x[0, 3]) <= 1.6  # its last good surge speed
+    np.testing.assert_allclose(compiled_episode.applied, numpy_episode.applied, rtol=1e-9)
+
+
+@pytest.mark.parametrize("backend", ["numpy", "compiled"])
+def test_a_step_after_the_end_moves_nothing_and_earns_nothing(backend):
+    """Stepping a batch whose episodes ended (truncated at t_end), with a noise that draws per
+    step: reward 0, the same observation, still truncated, in either loop."""
+    from shipgnc.rl.episode import BatchedEpisode
+
+    scenario = load_scenario("boat-autopilot", ["simulation.t_end=1.0",
+                                                "disturbance={type: gaussian, psd: [1.0, 1.0, 0.1]}"])
+    episode = BatchedEpisode(scenario, batch=2, backend=backend)
+    episode.reset([1, 2])
+    action = np.array([[100.0, 0.0], [50.0, 0.1]])
+    while not np.all(episode.done):
+        obs, *_ = episode.step(action)
+    again, reward, _, truncated = episode.step(action)
+    np.testing.assert_array_equal(again, obs)
+    assert reward.tolist() == [0.0, 0.0] and episode.t == pytest.approx(1.0)
+    assert truncated.tolist() == [False, False] and episode.done.all()  # ended before, not again
 
 
 def test_an_episode_backend_without_kernels_is_named():

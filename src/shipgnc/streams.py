@@ -35,7 +35,8 @@ class MemberStreams:
     """
 
     def __init__(self, seeds):
-        self._seeds = seeds if hasattr(seeds, "__len__") else list(seeds)
+        # a list is copied (a caller may change it); a lazy sequence (a study's seeds) is kept
+        self._seeds = tuple(seeds) if isinstance(seeds, list) or not hasattr(seeds, "__len__") else seeds
         self._streams: list | None = None
         require(len(self._seeds) >= 1, "streams", len(self._seeds), "need at least one member")
 
@@ -52,8 +53,8 @@ class MemberStreams:
 
     def _rest(self, shape) -> tuple[int, ...]:
         shape = (shape,) if np.ndim(shape) == 0 else tuple(int(s) for s in shape)
-        require(len(shape) >= 1 and shape[0] == len(self.streams), "draw shape", shape,
-                f"must start with the member axis ({len(self.streams)} members)")
+        require(len(shape) >= 1 and shape[0] == len(self), "draw shape", shape,
+                f"must start with the member axis ({len(self)} members)")
         return shape[1:]
 
     def standard_normal(self, size) -> np.ndarray:
@@ -73,4 +74,3 @@ class MemberStreams:
 def is_generator(rng) -> bool:
     """True for a ``numpy.random.Generator`` or a :class:`MemberStreams`."""
     return isinstance(rng, (np.random.Generator, MemberStreams))
-

@@ -164,7 +164,8 @@ class BatchedEpisode:
         if self.backend == "compiled":
             from shipgnc.sim.compose import Composition
 
-            self._comp = Composition(self.sim)  # the disturbance's kernel after its reset
+            # the disturbance's kernel after its reset; a log of one control period
+            self._comp = Composition(self.sim, log_samples=self.hold)
             self._comp.S[:, :x.shape[-1]] = self.x
         return self.observation()
 
@@ -216,7 +217,9 @@ class BatchedEpisode:
             raise ConfigError(f"action {action.tolist()}: must be finite")
         self.command = np.where(self.done[:, None], self.command, action)
         live = ~self.done
-        if self._comp is not None:
+        if self.k >= self.n_steps:  # after the episode's end: nothing moves, nothing is earned
+            reward, live = np.zeros(self.batch), live & False
+        elif self._comp is not None:
             reward, live = self._advance_compiled(live)
         else:
             reward, live = self._advance_numpy(live)
@@ -256,21 +259,25 @@ class BatchedEpisode:
         nx, nu = self.x.shape[-1], self.actuator.n
         k0, k1 = self.k, min(self.k + self.hold, self.n_steps)
         S[:, lay["cmd"]:lay["cmd"] + nu] = self.command
+        start = S.copy()
         comp.event[:] = np.where(live, -1, _SKIP)
+        comp.s_base = k0  # the log holds this period's steps
         comp.prepare(k0, k1)
         comp.call(k0, k1, self.n_steps)
         bad = live & (comp.event >= 0)
         k_bad = np.where(bad, comp.event // 2, self.n_steps)  # a bad state after step k_bad
-        x_log = out[:nx, k0:k1].transpose(1, 2, 0)  # (step, member, state) at each step's start
-        applied_log = out[comp.columns["applied"]:comp.columns["applied"] + nu, k0:k1].transpose(1, 2, 0)
+        x_log = out[:nx, :k1 - k0].transpose(1, 2, 0)  # (step, member, state) at each step's start
+        applied_log = out[comp.columns["applied"]:comp.columns["applied"] + nu, :k1 - k0].transpose(1, 2, 0)
         reward = np.zeros(self.batch)
         with np.errstate(all="ignore"):  # a member's log is not written after its divergence
             for j, k in enumerate(range(k0, k1)):
                 self.x, self.applied_now = x_log[j], applied_log[j]
                 reward -= np.where(live & (k <= k_bad), self.sample_cost(), 0.0)
-        for i in np.flatnonzero(bad):  # frozen at its last good state (the numpy loop's keep)
-            S[i, :nx] = x_log[k_bad[i] - k0, i]
-            S[i, lay["applied"]:lay["applied"] + nu] = applied_log[k_bad[i] - k0, i]
+        for i in np.flatnonzero(bad):  # frozen before its bad step (the numpy loop's keep): its
+            S[i] = start[i]           # row replayed up to that step, the same table's draws
+            comp.event[:] = _SKIP
+            comp.event[i] = -1
+            comp.call(k0, int(k_bad[i]), self.n_steps)
         self.x = S[:, :nx].copy()
         self.applied = S[:, lay["applied"]:lay["applied"] + nu].copy()
         if self.lag is not None:

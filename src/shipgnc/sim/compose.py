@@ -248,9 +248,11 @@ class Composition:
     step k; −1: none; a ship with an event is skipped) and ``done_at``. Built after the
     components' reset (:func:`~shipgnc.sim.simulator.reset_components`); :meth:`call` runs steps
     ``k0 … k1 − 1`` of every ship. :func:`run` drives it over a whole run; an agent's episode
-    (:class:`~shipgnc.rl.episode.BatchedEpisode`) a control period at a time."""
+    (:class:`~shipgnc.rl.episode.BatchedEpisode`) a control period at a time, with a log of
+    ``log_samples`` samples from sample :attr:`s_base` (set before each call) instead of the whole
+    run's."""
 
-    def __init__(self, setup):
+    def __init__(self, setup, log_samples: int | None = None):
         from shipgnc.sim.compiled import log_length
         from shipgnc.sim.simulator import log_signals
 
@@ -322,7 +324,9 @@ class Composition:
             raise RuntimeError(f"compiled loop: {n_columns} log columns for {list(self.signals)}")
         #: log columns of the state and of the applied input
         self.columns = {"x": 0, "cmd": nx, "applied": nx + nu}
-        self.out = np.empty((n_columns, log_length(setup), n))
+        self.out = np.empty((n_columns, log_length(setup) if log_samples is None else log_samples, n))
+        #: the run's sample that ``out[:, 0]`` holds
+        self.s_base = 0
         self.event = np.full(n, -1, dtype=np.int64)
         # only guidance that can finish (a route's last waypoint) ends a run early
         can_finish = gd is not None and gd.finished() is not None
@@ -358,7 +362,7 @@ class Composition:
                   table["W"], params[0], self._pa, params[1], params[2], params[3], self._limits,
                   self._err, self.out, self.event,
                   self.done_at if self.done_at is not None else self._no_done, table["Wu"],
-                  self._pu, table["Wn"], self._pn)
+                  self._pu, table["Wn"], self._pn, self.s_base)
 
     def restore(self) -> None:
         """Leave the components as the numpy loop would (their carried states)."""

@@ -20,7 +20,7 @@ from shipgnc.kernels import JIT_OPTIONS, clip, wrap  # noqa: F401  (JIT_OPTIONS:
 
 
 def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, pd_rows, limits,
-         err, out, event, done_at, Wu, pu_rows, Wn, pn_rows):
+         err, out, event, done_at, Wu, pu_rows, Wn, pn_rows, s_base):
     n_ships = S.shape[0]
     for i in numba.prange(n_ships):
         if event[i] >= 0:  # stopped by its divergence (on_divergence="mask"): skipped
@@ -68,7 +68,7 @@ def loop(k0, k1, k_last, hold, every, dt, S, W, pm_rows, pa, pc_rows, pg_rows, p
         al = np.empty(nl)
         ic = k0 % hold
         il = k0 % every
-        s = (k0 + every - 1) // every
+        s = (k0 + every - 1) // every - s_base  # the log's sample (``out`` from sample s_base)
         for k in range(k0, k1):
             t = k * dt
             if ic == 0:
