@@ -210,3 +210,34 @@ def test_a_component_without_kernel_falls_back_and_is_named():
     assert result.attrs["backend"] == "numpy"
     with pytest.raises(ConfigError, match="model _Toy has no kernel"):
         simulate(_Toy(), np.zeros(3), t_end=1.0, dt=0.1, backend="compiled")
+
+
+def test_loops_of_an_older_release_are_pruned_once_stale(tmp_path, monkeypatch):
+    """The cache of composed loops does not pile up across edits and upgrades: a new loop's write
+    deletes other releases' modules (and their compiled files) last written over a week ago; this
+    release's loops and a recent one of another release stay."""
+    import os
+
+    monkeypatch.setattr(compose, "_PRUNED", [])
+    cache = tmp_path / "__pycache__"
+    cache.mkdir()
+    now = 1.0e9
+    old = now - compose.STALE_AFTER - 60.0
+
+    def loop_file(stem, when):
+        files = [tmp_path / f"{stem}.py", cache / f"{stem}.loop-410.py311.nbi",
+                 cache / f"{stem}.loop-410.py311.1.nbc"]
+        for f in files:
+            f.write_text("x")
+            os.utime(f, (when, when))
+        return files
+
+    stale = loop_file("shipgnc_loop_aaaaaaaa_0123456789abcdef", old)
+    legacy = loop_file("shipgnc_loop_0123456789abcdef01234567", old)  # named before releases
+    recent = loop_file("shipgnc_loop_bbbbbbbb_0123456789abcdef", now - 3600.0)
+    current = loop_file("shipgnc_loop_cccccccc_0123456789abcdef", old)
+    deleted = compose.prune_stale_loops(tmp_path, "cccccccc", now=now)
+    assert sorted(deleted) == sorted([stale[0], legacy[0]])
+    assert not any(f.exists() for f in stale + legacy)
+    assert all(f.exists() for f in recent + current)
+    assert compose.prune_stale_loops(tmp_path, "cccccccc", now=now) == []  # once per process

@@ -142,16 +142,64 @@ def _cache_file(source: str, functions) -> Path | None:
     for name in sorted(f for f in files if f and not f.startswith(str(PACKAGE))):
         digest.update(Path(name).read_bytes())  # a user's kernels outside the package
     digest.update(numba.__version__.encode())
-    path = cache_dir() / f"shipgnc_loop_{digest.hexdigest()[:24]}.py"
+    release = _release_tag()
+    path = cache_dir() / f"shipgnc_loop_{release}_{digest.hexdigest()[:16]}.py"
     try:
         if not path.exists():
             path.parent.mkdir(parents=True, exist_ok=True)
+            prune_stale_loops(path.parent, release)
             tmp = path.with_suffix(f".{os.getpid()}.tmp")
             tmp.write_text(source)
             os.replace(tmp, path)
     except OSError:
         return None
     return path
+
+
+#: a loop module of another release of the package (other sources or numba) unused this long is
+#: deleted with its compiled files when a new loop is written [s]
+STALE_AFTER = 7 * 24 * 3600.0
+_PRUNED: list[bool] = []
+
+
+def _release_tag() -> str:
+    """8 hex digits naming the package's sources and numba's version (a loop's file name starts
+    with them, so that the loops of an older release are known)."""
+    digest = hashlib.sha256(_sources_digest())
+    digest.update(numba.__version__.encode())
+    return digest.hexdigest()[:8]
+
+
+def prune_stale_loops(folder: Path, release: str, *, now: float | None = None) -> list[Path]:
+    """Delete the loop modules of other releases (an edited or upgraded package) written and
+    compiled more than :data:`STALE_AFTER` seconds ago, and their numba cache files
+    (``__pycache__/<name>.*.nbi|nbc``); once per process, when a new loop is written. Loops of this
+    release, and recent ones of another (a second environment sharing the cache: a loop it still
+    uses but compiled over a week ago is compiled again there once), stay. Returns the modules
+    deleted."""
+    if _PRUNED:
+        return []
+    _PRUNED.append(True)
+    import time
+
+    now = time.time() if now is None else now
+    deleted = []
+    for module in folder.glob("shipgnc_loop_*.py"):
+        try:
+            stem = module.stem
+            if stem.startswith(f"shipgnc_loop_{release}_"):
+                continue
+            compiled = list((folder / "__pycache__").glob(f"{stem}.*.nb[ic]"))
+            last_use = max([module.stat().st_mtime] + [f.stat().st_mtime for f in compiled])
+            if now - last_use < STALE_AFTER:
+                continue
+            for f in compiled:
+                f.unlink(missing_ok=True)
+            module.unlink(missing_ok=True)
+            deleted.append(module)
+        except OSError:  # another process pruned it first, or a read-only cache
+            continue
+    return deleted
 
 
 #: the package's source folder: the composed loops are keyed on every file in it
