@@ -87,7 +87,7 @@ def test_current_refused_where_it_does_not_apply():
     from shipgnc.scenarios.registry import raw_scenario, validate
 
     data, source = raw_scenario("mariner-cst-heading")  # a catalogue vessel: no current section
-    with pytest.raises(ConfigError, match=r"catamaran, mariner.*not to vessel model 'mariner-cst'"):
+    with pytest.raises(ConfigError, match=r"vessel models .*catamaran.*not to vessel model 'mariner-cst'"):
         validate({**data, "current": "uniform:north=0,east=0.5"}, source)
 
 

@@ -70,7 +70,7 @@ class BatchedEpisode:
             raise ConfigError(f"scenario {sc.name!r}: an environment needs a vessel stepped by the generic "
                               "loop with guidance (the vectored-thrust boat, CyberShip II or document "
                               "004's catamaran)")
-        catamaran = sc.vessel.model == "catamaran"
+        catamaran = sc.kind.shape == "case"
         self.reward_kind = CATAMARAN_REWARDS.get(sc.case.builder) if catamaran else sc.metrics
         if catamaran and self.reward_kind is None:
             raise ConfigError(f"scenario {sc.name!r}: case builder {sc.case.builder!r} has no per-sample "

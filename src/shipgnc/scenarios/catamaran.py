@@ -175,6 +175,23 @@ def setup(scenario: Scenario, variant: str | None = None):
                  case.disturbance, case=case)
 
 
+def setup_of(scenario: Scenario, variant: str | None, seed: int):
+    """:func:`setup` as the component registry calls it (``seed``: unused, a case sets its own
+    initial state)."""
+    return setup(scenario, variant)
+
+
+def vessel_parts(scenario: Scenario):
+    """(model, actuator, u0) of the scenario's first run."""
+    first = setup(scenario)
+    return first.model, first.actuator, first.u0
+
+
+def initial_state(scenario: Scenario, seed: int) -> np.ndarray:
+    """x0 of the scenario's first run (document 004's cases set their own initial state)."""
+    return np.array(next(iter(cases(scenario).values())).x0, dtype=float)
+
+
 def run_keys(scenario: Scenario) -> list[str]:
     """The scenario's run keys (the ``controller`` coordinate of a scenario with several runs)."""
     return list(cases(scenario))

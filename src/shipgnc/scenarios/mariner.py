@@ -97,3 +97,54 @@ def disturbance(d, path: WaypointPath, current=None):
         return None
     return MarinerDisturbance(b_r, current=CrossCurrent(d.d_y, path, frame=d.current_frame),
                               waves=waves)
+
+
+def check(scenario: Scenario) -> None:
+    """The Mariner's own scenario rules (its registry entry's ``check``): the sway is algebraic
+    (initial v = 0); with a ``current`` section one current only (d_y = 0) and no oracle
+    controller (it knows b_r and d_y, not the current)."""
+    if scenario.simulation.initial_state.v != 0:
+        raise ValueError("simulation.initial_state.v: the Mariner's sway is algebraic "
+                         "(v = r1 r + r2 r^3); leave v at 0")
+    if scenario.current is None:
+        return
+    d = scenario.disturbance
+    if d is not None and d.type == "mariner" and d.d_y_nm_min != 0.0:
+        raise ValueError(f"disturbance.d_y_nm_min = {d.d_y_nm_min!r} with a current section: "
+                         f"give the current once — set d_y_nm_min: 0 (document 000's cross "
+                         f"current) or leave the current section out")
+    for name, ctrl in scenario.variants.items():
+        if getattr(ctrl, "knows_disturbance", False):
+            raise ValueError(f"{scenario.where(name)}.knows_disturbance = true with a current "
+                             f"section: the document's oracle law knows b_r and d_y only, not the "
+                             f"current; set knows_disturbance: false (integral LOS for los-fl)")
+
+
+def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
+    """x0 = (north, east, ψ, u, r): one state, or ``montecarlo.runs`` states with random offsets
+    (drawn from a stream of their own, so the waves of the same seed are not shifted)."""
+    init = scenario.simulation.initial_state
+    x0 = np.array([init.north, init.east, deg(init.psi_deg), init.u, deg(init.r_deg_s)])
+    mc = scenario.montecarlo
+    if mc is None:
+        return x0
+    rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(1)[0])
+    batch = np.tile(x0, (mc.runs, 1))
+    batch[:, 1] += rng.uniform(*mc.east_offset_nm, size=mc.runs) * NAUTICAL_MILE
+    batch[:, 2] += deg(rng.uniform(*mc.heading_offset_deg, size=mc.runs))
+    return batch
+
+
+def setup(scenario: Scenario, name: str, seed: int):
+    """The :class:`~shipgnc.scenarios.runner.Setup` of controller ``name``: the path-frame
+    controllers track the path themselves (no guidance object); the disturbance needs the path."""
+    from shipgnc.scenarios.runner import Setup, navigation, sampled
+
+    model, actuator, _ = vessel(scenario)
+    cfg = scenario.variants[name]
+    path = mariner_path(scenario.guidance)
+    d, current = scenario.disturbance, scenario.current
+    dist = None if d is None and current is None else disturbance(d, path, current)
+    return Setup(model, initial_states(scenario, seed), actuator,
+                 controller(sampled(cfg, scenario), model, path, scenario), None, dist, path=path,
+                 navigation=navigation(scenario, cfg))

@@ -24,9 +24,10 @@ from shipgnc.guidance.los import LOSGuidance
 from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.fossen3dof import VectoredThrustBoat
 from shipgnc.paths import WaypointPath
+from shipgnc.scenarios import components as C
 from shipgnc.scenarios.registry import load_scenario
-from shipgnc.scenarios.schema import CATALOGUE_VESSELS, Scenario
-from shipgnc.units import NAUTICAL_MILE, deg
+from shipgnc.scenarios.schema import Scenario
+from shipgnc.units import deg
 
 
 @dataclass
@@ -65,7 +66,8 @@ class ScenarioRun:
     interrupted: str = ""
 
 
-def _boat(scenario: Scenario):
+def boat_parts(scenario: Scenario):
+    """Document 001's boat: its preset with overrides and the thruster dynamics of ``actuator``."""
     params = dict(scenario.vessel.params)
     if "alpha_max_deg" in params:
         params["alpha_max"] = deg(params.pop("alpha_max_deg"))
@@ -79,7 +81,8 @@ def _boat(scenario: Scenario):
     return model, actuator, None
 
 
-def _cybership(scenario: Scenario):
+def cybership_parts(scenario: Scenario):
+    """Document 003's CyberShip II, its steering machine and the held propeller revolutions."""
     from shipgnc.models.cybership2 import CyberShip2, CyberShip2Params, steering_machine
 
     v = scenario.vessel
@@ -91,30 +94,20 @@ def _cybership(scenario: Scenario):
             np.array([v.propeller_rps, 0.0]))
 
 
+def vessel_parts(scenario: Scenario):
+    """(model, actuator, u0) of the scenario's vessel, by its registry entry's builder."""
+    return C.resolve(scenario.kind.build)(scenario)
+
+
 def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
-    """x0 of the scenario's vessel: one state, or ``montecarlo.runs`` states with random offsets
-    (drawn from a stream of their own, so the waves of the same seed are not shifted); for the
-    catamaran, its first run's x0 (document 004's cases set their own initial state)."""
-    if scenario.vessel.model == "catamaran":
-        from shipgnc.scenarios import catamaran
-
-        return np.array(next(iter(catamaran.cases(scenario).values())).x0, dtype=float)
-    if scenario.vessel.model in CATALOGUE_VESSELS:
-        from shipgnc.vessels import scenario as catalogue
-
-        return catalogue.initial_state(scenario)
+    """x0 of the scenario's vessel: the registry entry's own (the Mariner's Monte Carlo batch,
+    a catalogue vessel's steady run, a catamaran case's first run), else
+    (north, east, ψ, u, v, r) from ``simulation.initial_state``."""
+    kind = scenario.kind
+    if kind.initial_state is not None:
+        return C.resolve(kind.initial_state)(scenario, seed)
     init = scenario.simulation.initial_state
-    if scenario.vessel.model != "mariner":
-        return np.array([init.north, init.east, deg(init.psi_deg), init.u, init.v, deg(init.r_deg_s)])
-    x0 = np.array([init.north, init.east, deg(init.psi_deg), init.u, deg(init.r_deg_s)])
-    mc = scenario.montecarlo
-    if mc is None:
-        return x0
-    rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(1)[0])
-    batch = np.tile(x0, (mc.runs, 1))
-    batch[:, 1] += rng.uniform(*mc.east_offset_nm, size=mc.runs) * NAUTICAL_MILE
-    batch[:, 2] += deg(rng.uniform(*mc.heading_offset_deg, size=mc.runs))
-    return batch
+    return np.array([init.north, init.east, deg(init.psi_deg), init.u, init.v, deg(init.r_deg_s)])
 
 
 def sampled(cfg, scenario: Scenario):
@@ -125,27 +118,33 @@ def sampled(cfg, scenario: Scenario):
     return cfg
 
 
-def _controller(cfg, model, scenario: Scenario):
-    if cfg.type == "open-loop":
-        entries = cfg.schedule
-        return OpenLoopSchedule([e.t for e in entries], [[e.T, deg(e.alpha_deg)] for e in entries],
-                                labels=[e.label for e in entries])
-    if cfg.type == "heading-speed":
-        return HeadingSpeedAutopilot(model.params, Ts=cfg.Ts, omega_ref=cfg.omega_ref,
-                                     omega=cfg.omega, omega_u=cfg.omega_u,
-                                     yaw_feedforward=cfg.yaw_feedforward)
-    if scenario.vessel.model in CATALOGUE_VESSELS:
-        from shipgnc.vessels import scenario as catalogue
-
-        return catalogue.controller(cfg, model)
-    return _course_controller(cfg, model.params, scenario.vessel.propeller_rps)
+def controller_of(cfg, model, scenario: Scenario):
+    """The controller of section ``cfg``: the vessel entry's own builder, else the controller
+    entry's."""
+    own = scenario.kind.controller
+    return C.resolve(own or C.CONTROLLERS[cfg.type].build)(cfg, model, scenario)
 
 
-def _course_controller(cfg, params, propeller_rps: float):
+def open_loop_controller(cfg, model, scenario: Scenario):
+    """Document 001's hand-written (T, α) schedule."""
+    entries = cfg.schedule
+    return OpenLoopSchedule([e.t for e in entries], [[e.T, deg(e.alpha_deg)] for e in entries],
+                            labels=[e.label for e in entries])
+
+
+def heading_speed_controller(cfg, model, scenario: Scenario):
+    """The boat's heading and speed autopilot (note 001-1.10)."""
+    return HeadingSpeedAutopilot(model.params, Ts=cfg.Ts, omega_ref=cfg.omega_ref,
+                                 omega=cfg.omega, omega_u=cfg.omega_u,
+                                 yaw_feedforward=cfg.yaw_feedforward)
+
+
+def course_controller(cfg, model, scenario: Scenario):
     """Document 003's PD or sliding-mode autopilot with the scenario's gains (note 003-3.2)."""
     from shipgnc.cases import cybership as document
     from shipgnc.control import course
 
+    params, propeller_rps = model.params, scenario.vessel.propeller_rps
     gains = cfg.gains()
     common = {"Ts": cfg.Ts, "propeller_rps": propeller_rps}
     if cfg.variant == "pd":
@@ -163,25 +162,45 @@ def _course_controller(cfg, params, propeller_rps: float):
                                     **common, **gains)
 
 
-def _guidance(g):
-    if g is None:
-        return None
-    if g.type == "schedule":
-        return ReferenceSchedule([e.t for e in g.schedule], [deg(e.psi_deg) for e in g.schedule],
-                                 [e.u for e in g.schedule])
-    if g.type == "los":
-        return LOSGuidance(WaypointPath(g.waypoints), lookahead=g.lookahead, speed=g.speed,
-                           switch_radius=g.switch_radius, integral_gain=g.integral_gain,
-                           adaptive_gain=g.adaptive_gain)
+def reference_schedule(g):
+    """Heading and speed set-points from time t on."""
+    return ReferenceSchedule([e.t for e in g.schedule], [deg(e.psi_deg) for e in g.schedule],
+                             [e.u for e in g.schedule])
+
+
+def los_guidance(g):
+    """Lookahead (integral, adaptive) LOS along the waypoints."""
+    return LOSGuidance(WaypointPath(g.waypoints), lookahead=g.lookahead, speed=g.speed,
+                       switch_radius=g.switch_radius, integral_gain=g.integral_gain,
+                       adaptive_gain=g.adaptive_gain)
+
+
+def course_schedule(g):
+    """Course set-points from time t on (document 003)."""
     from shipgnc.guidance.schedule import CourseSchedule
 
     return CourseSchedule([e.t for e in g.schedule], [deg(e.psi_deg) for e in g.schedule])
 
 
-def _disturbance(d, scenario: Scenario):
+def guidance_of(g):
+    """The guidance object of section ``g`` (None: none), by its registry entry."""
+    if g is None:
+        return None
+    build = C.GUIDANCE[g.type].build
+    if build is None:
+        raise ConfigError(f"guidance type {g.type!r}: read by its vessel's set-up, not built alone")
+    return C.resolve(build)(g)
+
+
+def disturbance_of(d, scenario: Scenario):
     """The force disturbance ``d`` and the scenario's ``current`` composed once
     (:class:`~shipgnc.environment.current_field.CurrentDisturbance`), or the force alone."""
-    force = _force_disturbance(d, scenario)
+    force = None
+    if d is not None and not (d.type == "waves" and d.hs == 0):  # hs: 0 is calm water: no load
+        build = C.DISTURBANCES[d.type].build
+        if build is None:
+            raise ConfigError(f"disturbance type {d.type!r}: built by its vessel's set-up")
+        force = C.resolve(build)(d, scenario)
     current = getattr(scenario, "current", None)
     if current is None:
         return force
@@ -190,17 +209,22 @@ def _disturbance(d, scenario: Scenario):
     return CurrentDisturbance(current.build(), force)
 
 
-def _force_disturbance(d, scenario: Scenario):
-    if d is None or (d.type == "waves" and d.hs == 0):  # hs: 0 is calm water: no wave load at all
-        return None
-    if d.type == "constant":
-        return ConstantDisturbance(d.values)
-    if d.type == "gaussian":
-        if d.psd is not None:  # white noise of spectral density S: σ = √(S/dt) per step
-            return GaussianForceNoise(psd=d.psd, dt=scenario.simulation.dt, mean=d.mean)
-        if d.stationary_std is not None:
-            return GaussianForceNoise(d.stationary_std, d.mean, time_constant=d.time_constant)
-        return GaussianForceNoise(d.per_step_std, d.mean)
+def constant_force(d, scenario: Scenario):
+    """A constant body-frame force and moment."""
+    return ConstantDisturbance(d.values)
+
+
+def gaussian_force(d, scenario: Scenario):
+    """Seeded Gaussian force noise in the form the section gives."""
+    if d.psd is not None:  # white noise of spectral density S: σ = √(S/dt) per step
+        return GaussianForceNoise(psd=d.psd, dt=scenario.simulation.dt, mean=d.mean)
+    if d.stationary_std is not None:
+        return GaussianForceNoise(d.stationary_std, d.mean, time_constant=d.time_constant)
+    return GaussianForceNoise(d.per_step_std, d.mean)
+
+
+def wave_loads(d, scenario: Scenario):
+    """Froude–Krylov loads of irregular waves from the section's spectrum (note 003-3.6)."""
     from shipgnc.environment.waves import FroudeKrylovWaveLoads, WaveSpectrum
 
     if d.spectrum == "modified-pm":
@@ -213,33 +237,10 @@ def _force_disturbance(d, scenario: Scenario):
                                  gains=d.gains)
 
 
-def _mariner(scenario: Scenario):
-    from shipgnc.scenarios import mariner
-
-    return mariner.vessel(scenario)
-
-
-def _catamaran(scenario: Scenario):
-    from shipgnc.scenarios import catamaran
-
-    first = catamaran.setup(scenario)
-    return first.model, first.actuator, first.u0
-
-
-def _catalogue(scenario: Scenario):
-    from shipgnc.vessels import scenario as catalogue
-
-    return catalogue.vessel(scenario)
-
-
-VESSELS = {"vectored-thrust-boat": _boat, "cybership2": _cybership, "mariner": _mariner,
-           "catamaran": _catamaran, **dict.fromkeys(CATALOGUE_VESSELS, _catalogue)}
-
-
 def variant_names(scenario: Scenario) -> list[str] | None:
     """The names of a ``controller`` dimension: a comparison's controllers, or the run keys of a
     catamaran scenario with several runs (e.g. laws 20 and 21); None for one run."""
-    if scenario.vessel.model == "catamaran":
+    if scenario.kind.shape == "case":
         from shipgnc.scenarios import catamaran
 
         keys = catamaran.run_keys(scenario)
@@ -252,31 +253,24 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
 
     ``seed`` draws a Monte Carlo batch's initial offsets (default: ``simulation.seed`` or 0).
     A catamaran scenario's ``variant`` is a run key of its case builder (see
-    :func:`shipgnc.scenarios.catamaran.setup`)."""
-    if scenario.vessel.model == "catamaran":
-        from shipgnc.scenarios import catamaran
-
-        return catamaran.setup(scenario, variant)
-    model, actuator, u0 = VESSELS[scenario.vessel.model](scenario)
+    :func:`shipgnc.scenarios.catamaran.setup`); a vessel whose registry entry has a ``setup`` of
+    its own (the Mariner's path-frame controllers) is set up by it."""
+    kind = scenario.kind
+    seed = seed if seed is not None else (scenario.simulation.seed or 0)
+    if kind.shape == "case":
+        return C.resolve(kind.setup)(scenario, variant, seed)
     variants = scenario.variants
     name = variant if variant is not None else next(iter(variants))
     if name not in variants:
         raise ConfigError(f"controller {name!r}: not in this scenario; have {', '.join(variants)}")
-    seed = seed if seed is not None else (scenario.simulation.seed or 0)
-    x0 = initial_states(scenario, seed)
-    if scenario.vessel.model == "mariner":
-        from shipgnc.scenarios import mariner
-
-        path = mariner.mariner_path(scenario.guidance)
-        d, current = scenario.disturbance, scenario.current
-        dist = None if d is None and current is None else mariner.disturbance(d, path, current)
-        return Setup(model, x0, actuator,
-                     mariner.controller(sampled(variants[name], scenario), model, path, scenario),
-                     None, dist, path=path,
-                     navigation=navigation(scenario, variants[name]))
-    return Setup(model, x0, actuator, _controller(sampled(variants[name], scenario), model, scenario),
-                 _guidance(scenario.guidance), _disturbance(scenario.disturbance, scenario), u0,
-                 navigation=navigation(scenario, variants[name]))
+    if kind.setup is not None:
+        return C.resolve(kind.setup)(scenario, name, seed)
+    model, actuator, u0 = vessel_parts(scenario)
+    cfg = variants[name]
+    return Setup(model, initial_states(scenario, seed), actuator,
+                 controller_of(sampled(cfg, scenario), model, scenario),
+                 guidance_of(scenario.guidance), disturbance_of(scenario.disturbance, scenario), u0,
+                 navigation=navigation(scenario, cfg))
 
 
 def navigation(scenario: Scenario, controller=None):
@@ -451,11 +445,10 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         from shipgnc.scenarios import routing
 
         return routing.run(scenario, seed=seed)
-    if scenario.vessel.model == "catamaran":
-        from shipgnc.scenarios import catamaran
-
-        return catamaran.run(scenario, seed=seed, progress=progress, on_divergence=on_divergence,
-                             keep_interrupted=keep_interrupted)
+    if scenario.kind.run is not None:  # a vessel whose runs are its own (document 004's cases)
+        return C.resolve(scenario.kind.run)(scenario, seed=seed, progress=progress,
+                                            on_divergence=on_divergence,
+                                            keep_interrupted=keep_interrupted)
     results, all_metrics, setups = {}, {}, {}
     for name in scenario.variants:
         setup = build(scenario, name, seed=seed)

@@ -75,7 +75,7 @@ def figure_job(run: ScenarioRun, out: Path):
     lower, upper = model.input_limits()
     limits = {s.name: (float(lower[i]), float(upper[i])) for i, s in enumerate(model.inputs)}
     names = list(run.setups) if run.setups is not None else list(run.scenario.variants)
-    if run.scenario.vessel.model == "catamaran":
+    if run.scenario.kind.shape == "case":
         if "controller" in run.result.dims:
             runs = {n: run.result.sel(controller=n).dropna("time", how="all") for n in names}
         else:

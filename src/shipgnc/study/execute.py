@@ -48,13 +48,13 @@ def variants_of(study: Study) -> list[str] | None:
     catamaran scenario with several runs, else None; every grid point is loaded here, so a bad
     grid key or value, an unsweepable scenario or a ``--perturb`` field the vessel does not have
     fails before any work starts."""
-    from shipgnc.scenarios.runner import VESSELS, initial_states, variant_names
+    from shipgnc.scenarios.runner import initial_states, variant_names, vessel_parts
 
     variants = None
     for point in study.points:
         scenario = study.scenario_at(point)
         check_sweepable(scenario)
-        check_perturbable(study.perturb, VESSELS[scenario.vessel.model](scenario)[0],
+        check_perturbable(study.perturb, vessel_parts(scenario)[0],
                           initial_states(scenario, study.seed))
         names = variant_names(scenario)
         if names is not None:
@@ -236,11 +236,11 @@ def estimate_memory(study: Study, variants: list[str] | None, chunk_size: int) -
     metrics, with ``--series`` every member's thinned series) and ``chunk`` (one chunk's
     every-step record that the metrics are computed from, about twice for the arrays derived
     from it). The measure of a series is :func:`shipgnc.sim.simulator.logged_numbers`."""
-    from shipgnc.scenarios.runner import VESSELS
+    from shipgnc.scenarios.runner import vessel_parts
     from shipgnc.sim.simulator import logged_numbers
 
     scenario = study.scenario_at(study.points[0])
-    model = VESSELS[scenario.vessel.model](scenario)[0]
+    model = vessel_parts(scenario)[0]
     sim = scenario.simulation
     n_steps = round(sim.t_end / sim.dt)
     cells = len(study.points) * len(variants or [None])

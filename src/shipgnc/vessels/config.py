@@ -56,6 +56,10 @@ class CatalogueVesselConfig(Strict):
         return {k: v for k, v in self.model_dump(exclude={"model", "speed_mps"}).items()
                 if v is not None}
 
+    def surge_equilibrium(self) -> float:
+        """The steady straight run's surge speed [m/s] (``initial_state.u: null``)."""
+        return float(self.build().straight_state()[3])
+
     def build(self):
         """The model (:meth:`shipgnc.vessels.VesselEntry.build`)."""
         from shipgnc.vessels.catalogue import get_vessel

@@ -41,8 +41,9 @@ def straight_inputs(model) -> np.ndarray:
     return np.array(out, dtype=float)
 
 
-def initial_state(scenario) -> np.ndarray:
-    """x0: the steady straight run, placed and turned by ``simulation.initial_state``."""
+def initial_state(scenario, seed: int | None = None) -> np.ndarray:
+    """x0: the steady straight run, placed and turned by ``simulation.initial_state`` (``seed``:
+    unused, no random offsets)."""
     model = scenario.vessel.build()
     init = scenario.simulation.initial_state
     x0 = model.straight_state()
@@ -56,8 +57,9 @@ def initial_state(scenario) -> np.ndarray:
     return x0
 
 
-def controller(cfg, model):
-    """The heading autopilot of a ``course`` controller config (variant ``pd`` only)."""
+def controller(cfg, model, scenario=None):
+    """The heading autopilot of a ``course`` controller config (variant ``pd`` only; ``scenario``
+    unused: the gains are the config's)."""
     from shipgnc.vessels.autopilot import HeadingAutopilot
 
     if cfg.type != "course" or cfg.variant != "pd":

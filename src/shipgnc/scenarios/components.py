@@ -1,0 +1,189 @@
+"""The component registry: every vessel, controller, guidance, disturbance and metric set a scenario
+may name, with its configuration section, its builder and what it fits.
+
+The scenario schema derives from these tables its unions (which ``vessel.model``, ``controller.type``,
+``guidance.type``, ``disturbance.type`` are allowed), its compatibility checks (a controller that
+does not fit the vessel, the guidance a controller needs, the sections a vessel reads) and the
+runner its dispatch (which function builds the vessel, the controller, the guidance). Adding a
+component is its module, its configuration section (:mod:`shipgnc.scenarios.sections`) and one
+entry here; no check or dispatch elsewhere names it (``docs/extending.md``).
+
+Builders are named ``"module:function"`` and imported when first used, so that reading a scenario
+file does not import every model and controller.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from typing import Literal
+
+from shipgnc.errors import ConfigError
+from shipgnc.scenarios import sections as S
+from shipgnc.vessels.config import CATALOGUE_VESSELS, CatalogueVesselConfig
+
+
+def resolve(target: str):
+    """The function named ``"module:function"``."""
+    module, _, name = target.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+@dataclass(frozen=True)
+class VesselKind:
+    """A ``vessel.model``.
+
+    ``build(scenario) -> (model, actuator, u0)``; ``controllers``, ``disturbances``: the types of
+    those sections that fit it; ``navigation``: takes ``sensors`` and ``estimator``; ``current``:
+    takes a ``current`` section; ``sections``: other top-level sections it reads (e.g. the boat's
+    ``actuator``); ``comparisons``: takes a ``controllers`` mapping. Optional hooks, each
+    ``"module:function"``: ``setup(scenario, variant, seed) -> Setup`` (a vessel whose whole set-up
+    is its own, e.g. document 000's path-frame controllers), ``run(scenario, seed=, progress=,
+    on_divergence=, keep_interrupted=) -> ScenarioRun`` (a vessel whose runs are its own),
+    ``controller(cfg, model, scenario)`` (its own controller builder), ``initial_state(scenario,
+    seed) -> x0``, ``check(scenario)`` (rules of its own, raising ValueError). ``shape``:
+    ``controlled`` (vessel, controller(s), guidance, disturbance) or ``case`` (document 004's case
+    builders)."""
+
+    model: str
+    config: type
+    build: str
+    controllers: tuple[str, ...] = ()
+    disturbances: tuple[str, ...] = ()
+    navigation: bool = False
+    current: bool = False
+    sections: tuple[str, ...] = ()
+    comparisons: bool = True
+    shape: Literal["controlled", "case"] = "controlled"
+    setup: str | None = None
+    run: str | None = None
+    controller: str | None = None
+    initial_state: str | None = None
+    check: str | None = None
+
+
+@dataclass(frozen=True)
+class ControllerKind:
+    """A ``controller.type``: its section, the guidance types it needs (one of them; empty: none)
+    and its builder ``(cfg, model, scenario)`` (None: the vessel's own, :attr:`VesselKind.controller`
+    or :attr:`VesselKind.setup`)."""
+
+    type: str
+    config: type
+    guidance: tuple[str, ...] = ()
+    build: str | None = None
+
+
+@dataclass(frozen=True)
+class GuidanceKind:
+    """A ``guidance.type``: its section, its builder ``(cfg) -> guidance`` (None: the vessel's
+    set-up reads it, e.g. document 000's path) and the vessel models it serves (None: any)."""
+
+    type: str
+    config: type
+    build: str | None = None
+    vessels: tuple[str, ...] | None = None
+
+
+@dataclass(frozen=True)
+class DisturbanceKind:
+    """A ``disturbance.type``: its section and its builder ``(cfg, scenario)`` (None: the vessel's
+    set-up builds it)."""
+
+    type: str
+    config: type
+    build: str | None = None
+
+
+@dataclass(frozen=True)
+class MetricKind:
+    """A ``metrics`` set: the guidance type it scores against (None: any), the controller types it
+    needs (None: any) and the sections it reads."""
+
+    name: str
+    guidance: str | None = None
+    controllers: tuple[str, ...] | None = None
+    sections: tuple[str, ...] = ()
+
+
+RUNNER = "shipgnc.scenarios.runner"
+
+CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
+    ControllerKind("open-loop", S.OpenLoopConfig, build=f"{RUNNER}:open_loop_controller"),
+    ControllerKind("heading-speed", S.HeadingSpeedConfig, guidance=("schedule", "los"),
+                   build=f"{RUNNER}:heading_speed_controller"),
+    ControllerKind("course", S.CourseControllerConfig, guidance=("course-schedule",),
+                   build=f"{RUNNER}:course_controller"),
+    ControllerKind("lqr", S.PathLQRConfig, guidance=("path",)),
+    ControllerKind("fl", S.OutputFLConfig, guidance=("path",)),
+    ControllerKind("los-fl", S.LOSFLConfig, guidance=("path",)),
+)}
+
+GUIDANCE: dict[str, GuidanceKind] = {k.type: k for k in (
+    GuidanceKind("schedule", S.ScheduleGuidanceConfig, build=f"{RUNNER}:reference_schedule"),
+    GuidanceKind("los", S.LOSConfig, build=f"{RUNNER}:los_guidance"),
+    GuidanceKind("course-schedule", S.CourseScheduleConfig, build=f"{RUNNER}:course_schedule"),
+    GuidanceKind("path", S.PathConfig, vessels=("mariner",)),
+)}
+
+DISTURBANCES: dict[str, DisturbanceKind] = {k.type: k for k in (
+    DisturbanceKind("constant", S.ConstantForceConfig, build=f"{RUNNER}:constant_force"),
+    DisturbanceKind("gaussian", S.GaussianForceConfig, build=f"{RUNNER}:gaussian_force"),
+    DisturbanceKind("waves", S.WavesConfig, build=f"{RUNNER}:wave_loads"),
+    DisturbanceKind("mariner", S.MarinerDisturbanceConfig),
+)}
+
+METRICS: dict[str, MetricKind] = {k.name: k for k in (
+    MetricKind("stern-kick", controllers=("open-loop",)),
+    MetricKind("heading-steps", guidance="schedule"),
+    MetricKind("waypoints", guidance="los"),
+    MetricKind("course-quality", guidance="course-schedule", sections=("quality",)),
+    MetricKind("path-tracking", guidance="path"),
+    MetricKind("catamaran"),
+    MetricKind("route"),
+    MetricKind("none"),
+)}
+
+VESSEL_KINDS: dict[str, VesselKind] = {k.model: k for k in (
+    VesselKind("vectored-thrust-boat", S.VesselConfig, f"{RUNNER}:boat_parts",
+               controllers=("open-loop", "heading-speed"), disturbances=("constant", "gaussian"),
+               navigation=True, current=True, sections=("actuator",), comparisons=False),
+    VesselKind("cybership2", S.CyberShipVesselConfig, f"{RUNNER}:cybership_parts",
+               controllers=("course",), disturbances=("constant", "gaussian", "waves"),
+               navigation=True, current=True),
+    VesselKind("mariner", S.MarinerVesselConfig, "shipgnc.scenarios.mariner:vessel",
+               controllers=("lqr", "fl", "los-fl"), disturbances=("mariner",),
+               navigation=True, current=True, sections=("montecarlo",),
+               setup="shipgnc.scenarios.mariner:setup",
+               initial_state="shipgnc.scenarios.mariner:initial_states",
+               check="shipgnc.scenarios.mariner:check"),
+    VesselKind("catamaran", S.CatamaranVesselConfig, "shipgnc.scenarios.catamaran:vessel_parts",
+               current=True, sections=("case",), shape="case",
+               setup="shipgnc.scenarios.catamaran:setup_of", run="shipgnc.scenarios.catamaran:run",
+               initial_state="shipgnc.scenarios.catamaran:initial_state"),
+    *(VesselKind(name, CatalogueVesselConfig, "shipgnc.vessels.scenario:vessel",
+                 controllers=("course",), controller="shipgnc.vessels.scenario:controller",
+                 initial_state="shipgnc.vessels.scenario:initial_state")
+      for name in CATALOGUE_VESSELS),
+)}
+
+
+def of_vessel(model: str) -> VesselKind:
+    """The registry entry of vessel model ``model`` (ConfigError naming the allowed ones)."""
+    try:
+        return VESSEL_KINDS[model]
+    except KeyError:
+        raise ConfigError(f"vessel.model = {model!r}: unknown vessel model; allowed: "
+                          f"{', '.join(VESSEL_KINDS)}") from None
+
+
+def having(flag: str) -> tuple[str, ...]:
+    """The vessel models whose entry sets ``flag`` (``navigation``, ``current``) or reads the
+    section named ``flag``."""
+    return tuple(name for name, kind in VESSEL_KINDS.items()
+                 if getattr(kind, flag, False) is True or flag in kind.sections)
+
+
+def config_classes(table: dict) -> tuple[type, ...]:
+    """The distinct configuration classes of a table's entries, in entry order."""
+    return tuple(dict.fromkeys(kind.config for kind in table.values()))

@@ -1,0 +1,123 @@
+"""The component registry is the one place that says which components exist and what fits what:
+the schema's unions, its compatibility checks and the runner's dispatch follow its tables."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+
+from shipgnc.errors import ConfigError
+from shipgnc.scenarios import components as C
+from shipgnc.scenarios import schema
+from shipgnc.scenarios.registry import raw_scenario, validate
+
+#: a built-in scenario of each controlled vessel kind (validated, then changed one field at a time)
+BY_VESSEL = {"vectored-thrust-boat": "boat-los", "cybership2": "cybership-calm",
+             "mariner": "mariner-lqr", "mariner-cst": "mariner-cst-heading"}
+
+
+def _hooks():
+    for table in (C.VESSEL_KINDS, C.CONTROLLERS, C.GUIDANCE, C.DISTURBANCES):
+        for key, kind in table.items():
+            for hook in ("build", "setup", "run", "controller", "initial_state", "check"):
+                target = getattr(kind, hook, None)
+                if target is not None:
+                    yield f"{key}.{hook}", target
+
+
+@pytest.mark.parametrize(("where", "target"), list(_hooks()))
+def test_every_hook_names_a_function(where, target):
+    assert callable(C.resolve(target)), where
+
+
+def test_every_fit_names_a_registered_component():
+    for kind in C.VESSEL_KINDS.values():
+        assert set(kind.controllers) <= set(C.CONTROLLERS), kind.model
+        assert set(kind.disturbances) <= set(C.DISTURBANCES), kind.model
+    for kind in C.CONTROLLERS.values():
+        assert set(kind.guidance) <= set(C.GUIDANCE), kind.type
+    for kind in C.METRICS.values():
+        assert kind.guidance is None or kind.guidance in C.GUIDANCE
+    for kind in C.GUIDANCE.values():
+        assert kind.vessels is None or set(kind.vessels) <= set(C.VESSEL_KINDS)
+
+
+def test_capability_lists_are_the_registry_s():
+    assert set(schema.CURRENT_VESSELS) == {n for n, k in C.VESSEL_KINDS.items() if k.current}
+    assert set(schema.NAVIGATION_VESSELS) == {n for n, k in C.VESSEL_KINDS.items() if k.navigation}
+
+
+def test_unknown_vessel_model_lists_every_registered_one():
+    data, source = raw_scenario("boat-los")
+    data["vessel"] = {"model": "hovercraft"}
+    with pytest.raises(ConfigError) as err:
+        validate(data, source)
+    for name in C.VESSEL_KINDS:
+        assert name in str(err.value)
+
+
+@pytest.mark.parametrize("vessel", list(BY_VESSEL))
+def test_a_controller_that_does_not_fit_is_refused_with_the_registry_s_list(vessel):
+    data, source = raw_scenario(BY_VESSEL[vessel])
+    validate(data, source)  # the scenario as built in
+    kind = C.VESSEL_KINDS[vessel]
+    foreign = next(t for t in C.CONTROLLERS if t not in kind.controllers)
+    changed = copy.deepcopy(data)
+    changed.pop("controllers", None)
+    minimal = {"open-loop": {"schedule": [{"t": 0, "T": 0, "alpha_deg": 0}]},
+               "course": {"variant": "pd"}}.get(foreign, {})
+    changed["controller"] = {"type": foreign, **minimal}
+    with pytest.raises(ConfigError, match=rf"type '{foreign}' does not fit vessel model '{vessel}' "
+                                          rf"\(allowed: {', '.join(kind.controllers)}\)"):
+        validate(changed, source)
+
+
+@pytest.mark.parametrize("vessel", list(BY_VESSEL))
+def test_a_disturbance_that_does_not_fit_is_refused(vessel):
+    data, source = raw_scenario(BY_VESSEL[vessel])
+    kind = C.VESSEL_KINDS[vessel]
+    foreign = next(t for t in ("waves", "mariner", "constant") if t not in kind.disturbances)
+    values = {"waves": {}, "mariner": {}, "constant": {"values": [0, 0, 0]}}[foreign]
+    data["disturbance"] = {"type": foreign, **values}
+    with pytest.raises(ConfigError, match=rf"disturbance type '{foreign}' does not fit vessel "
+                                          rf"model '{vessel}'"):
+        validate(data, source)
+
+
+def test_a_controller_without_the_guidance_it_needs_is_refused():
+    data, source = raw_scenario("cybership-calm")
+    data["guidance"] = {"type": "schedule", "schedule": [{"t": 0, "psi_deg": 0, "u": 0.3}]}
+    needs = C.CONTROLLERS["course"].guidance
+    with pytest.raises(ConfigError, match=rf"needs a guidance section of type {' or '.join(needs)}"):
+        validate(data, source)
+
+
+def test_a_section_the_vessel_does_not_read_is_refused():
+    data, source = raw_scenario("cybership-calm")
+    data["montecarlo"] = {"runs": 4}
+    with pytest.raises(ConfigError, match=r"montecarlo: applies to vessel model mariner"):
+        validate(data, source)
+    data, source = raw_scenario("mariner-lqr")
+    data["actuator"] = {"thrust_time_constant": 1.0}
+    with pytest.raises(ConfigError, match=r"actuator: applies to vessel model vectored-thrust-boat"):
+        validate(data, source)
+
+
+def test_a_metric_set_of_another_shape_is_refused():
+    data, source = raw_scenario("boat-los")
+    data["metrics"] = "catamaran"
+    with pytest.raises(ConfigError, match=r"metrics = 'catamaran': scores document 004's cases"):
+        validate(data, source)
+
+
+def test_the_runner_dispatches_by_the_registry():
+    from shipgnc.guidance.los import LOSGuidance
+    from shipgnc.scenarios.registry import load_scenario
+    from shipgnc.scenarios.runner import build
+    from shipgnc.vessels.autopilot import HeadingAutopilot
+
+    assert C.GUIDANCE["los"].build.endswith(":los_guidance")
+    assert isinstance(build(load_scenario("boat-los")).guidance, LOSGuidance)
+    # a catalogue vessel's ``course`` controller is its entry's own hook, not document 003's law
+    assert isinstance(build(load_scenario("mariner-cst-heading")).controller, HeadingAutopilot)
