@@ -68,8 +68,8 @@ def s4_paper():
 def test_check8_small_step(s4_paper):
     _case, ds = s4_paper[20]
     one = ds.isel(ship=0)
-    phi3 = Catamaran.from_preset("paper").yaw_acceleration(np.stack([one[s].values for s in
-                                                                       ("u", "v", "r", "north", "east", "psi", "delta")], -1))
+    phi3 = Catamaran.from_preset("paper").yaw_acceleration(np.stack([one[s.name].values for s in
+                                                                       Catamaran.states], -1))
     t = one.time.values
     assert 0.005 <= np.max(np.abs(phi3[t <= 5])) <= 0.1
     assert np.max(np.abs(phi3[t >= 20])) < 1e-4
@@ -98,7 +98,7 @@ def test_check9_small_reference_and_fixed_angle(s4_paper):
     for name, low, high in (("paper", 10.0, np.inf), ("si", 0.0, 0.05)):
         case = C.fixed_angle(name, t_end=60.0)["fixed"]
         d = case.run()
-        x = np.stack([d[s].values for s in ("u", "v", "r", "north", "east", "psi", "delta")], -1)
+        x = np.stack([d[s.name].values for s in Catamaran.states], -1)
         peak = np.max(np.abs(case.model.yaw_acceleration(x)))
         assert low <= peak < high
 

@@ -22,14 +22,14 @@ from shipgnc.control.finite_state import (
     w37,
 )
 from shipgnc.errors import ConfigError
-from shipgnc.models.catamaran import Catamaran
+from shipgnc.models.catamaran import DELTA, PSI, Catamaran, R
 from shipgnc.sim.simulator import simulate
 
-X0 = np.array([4.0, 0, 0, 0, 0, 0, 0])
+X0 = np.array([0, 0, 0, 4.0, 0, 0, 0])  # north, east, psi, u, v, r, delta
 
 
 def yaw_criterion(z):
-    return z[..., 2:3]
+    return z[..., R:R + 1]
 
 
 def test_w37_and_initial_thruster_rate_both_presets():
@@ -48,12 +48,12 @@ def test_generic_fsm_equals_law20_pointwise():
     for name in ("paper", "si"):
         model = Catamaran.from_preset(name)
         T_u, h = default_gains(name)
-        x = np.column_stack([rng.uniform(3, 4.5, 200), rng.uniform(-0.5, 0.5, 200), rng.uniform(-0.1, 0.1, 200),
-                             np.zeros(200), np.zeros(200), rng.uniform(-3, 3, 200), rng.uniform(-1.4, 1.4, 200)])
+        x = np.column_stack([np.zeros(200), np.zeros(200), rng.uniform(-3, 3, 200), rng.uniform(3, 4.5, 200),
+                             rng.uniform(-0.5, 0.5, 200), rng.uniform(-0.1, 0.1, 200), rng.uniform(-1.4, 1.4, 200)])
         target = rng.uniform(-0.08, 0.08, 200)
         phi = lambda z, model=model: model.derivatives(z, np.zeros((*z.shape[:-1], 1)))  # noqa: E731
         B = np.zeros((7, 1))
-        B[6, 0] = 1.0
+        B[DELTA, 0] = 1.0
         generic = fsm_control(phi, x, B, yaw_criterion, target[:, None], T_u, h)[:, 0]
         closed = law20(model, x, target, T_u, h)
         np.testing.assert_allclose(generic, closed, rtol=1e-6, atol=1e-9)
@@ -91,7 +91,7 @@ def test_heading_capture_switch_time_sign_and_wrap():
     cap = HeadingCapture(-3.0, 0.01)
     cap.reset((2,))
     xs = np.zeros((2, 7))
-    xs[:, 5] = [3.0, 3.0 + 2 * math.pi]
+    xs[:, PSI] = [3.0, 3.0 + 2 * math.pi]
     np.testing.assert_allclose(cap.value(0.0, xs), [0.01, 0.01])
     np.testing.assert_allclose(cap.switch_time(), (2 * math.pi - 6.0) / 0.01)
     # the ramp keeps the area
@@ -144,9 +144,9 @@ def test_clamp_and_frozen_gain():
     ctrl = YawRateFSM(model, 21, T_u=2.5, h=2.5, omega_ref=0.08, delta_max=math.radians(85), gain_freeze=math.radians(80))
     ctrl.reset(())
     x = X0.copy()
-    x[6] = math.radians(85.0)
+    x[DELTA] = math.radians(85.0)
     assert float(ctrl.law(1.0, x, np.zeros(0))[0]) == 0.0
     assert ctrl.events[0]["kind"] == "delta_clamped" and ctrl.events[0]["time_s"] == 1.0
-    x[6] = math.radians(83.0)
+    x[DELTA] = math.radians(83.0)
     u = float(ctrl.law(2.0, x, np.zeros(0))[0])
-    assert u == pytest.approx(float(law21(model, np.where(np.arange(7) == 6, math.radians(80), x), 0.08, 2.5, 2.5)))
+    assert u == pytest.approx(float(law21(model, np.where(np.arange(7) == DELTA, math.radians(80), x), 0.08, 2.5, 2.5)))

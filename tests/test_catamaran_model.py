@@ -9,15 +9,24 @@ import pytest
 
 from shipgnc.errors import ConfigError
 from shipgnc.models.catamaran import (
+    DELTA,
     V_MIN_FIT,
     Catamaran,
     CatamaranParams,
+    R,
+    U,
+    V,
     document_derivatives,
     from_document,
     preset,
     straight_running_eigenvalues,
     to_document,
 )
+
+
+def state(u=0.0, v=0.0, r=0.0, delta=0.0):
+    """A catamaran state at the origin, heading north ([north, east, psi, u, v, r, delta])."""
+    return np.array([0.0, 0.0, 0.0, u, v, r, delta])
 
 
 def test_check1_parameters():
@@ -40,17 +49,19 @@ def test_check2_ned_form_equals_document_form():
     for name in ("paper", "si"):
         for coriolis in ("printed", "consistent"):
             model = Catamaran.from_preset(name, coriolis=coriolis)
-            x = np.column_stack([rng.uniform(-1, 6, n), rng.uniform(-3, 3, n), rng.uniform(-0.3, 0.3, n),
-                                 rng.uniform(-1e3, 1e3, n), rng.uniform(-1e3, 1e3, n),
-                                 rng.uniform(-7, 7, n), rng.uniform(-2, 2, n)])
+            x = np.column_stack([rng.uniform(-1e3, 1e3, n), rng.uniform(-1e3, 1e3, n),
+                                 rng.uniform(-7, 7, n), rng.uniform(-1, 6, n), rng.uniform(-3, 3, n),
+                                 rng.uniform(-0.3, 0.3, n), rng.uniform(-2, 2, n)])
             ud = rng.uniform(-0.2, 0.2, (n, 1))
             ned = model.derivatives(x, ud)
             doc = document_derivatives(model.params, to_document(x), ud[:, 0])
             mapped = from_document(doc)
             scale = np.maximum(1.0, np.abs(ned))
             assert np.max(np.abs(mapped - ned) / scale) < 1e-12
-    # the mapping is an involution: v = −V_y, everything else unchanged
+    # the document's z = [V_x, V_y, ω, x₁, x₂, K, δ] = [u, −v, r, north, east, ψ, δ], and back
     x = rng.normal(size=(5, 7))
+    np.testing.assert_array_equal(to_document(x), np.column_stack(
+        [x[:, U], -x[:, V], x[:, R], x[:, 0], x[:, 1], x[:, 2], x[:, DELTA]]))
     assert np.array_equal(from_document(to_document(x)), x)
 
 
@@ -61,16 +72,17 @@ def test_check3_top_speed():
         assert V == pytest.approx(4.42306, abs=1e-5)
         assert p.resistance(V) == pytest.approx(2 * p.T_v, rel=1e-12)
         model = Catamaran(p)
-        xdot = model.derivatives(np.array([V, 0, 0, 0, 0, 0, 0.0]), np.zeros(1))
-        assert np.max(np.abs(xdot[[0, 1, 2, 4, 5, 6]])) < 1e-12
+        xdot = model.derivatives(state(u=V), np.zeros(1))
+        assert xdot[0] == pytest.approx(V, rel=1e-12)  # north at the top speed, nothing else moves
+        assert np.max(np.abs(xdot[1:])) < 1e-12
 
 
 def test_s1_straight_run_acceleration():
     model = Catamaran.from_preset("si")
-    xdot = model.derivatives(np.array([4.0, 0, 0, 0, 0, 0, 0.0]), np.zeros(1))
+    xdot = model.derivatives(state(u=4.0), np.zeros(1))
     p = model.params
-    assert xdot[0] == pytest.approx((2 * p.T_v - 2000 * (8.1 - 8.436 * 4 + 2.536 * 16)) / p.m_x)
-    assert xdot[0] == pytest.approx(0.0672, abs=1e-4)
+    assert xdot[U] == pytest.approx((2 * p.T_v - 2000 * (8.1 - 8.436 * 4 + 2.536 * 16)) / p.m_x)
+    assert xdot[U] == pytest.approx(0.0672, abs=1e-4)
 
 
 def test_check15_eigenvalues_and_counter_steer_sign():
@@ -97,28 +109,28 @@ def test_resistance_continuation():
     model = Catamaran(p)
     xdot = model.derivatives(np.zeros(7), np.zeros(1))
     assert np.all(np.isfinite(xdot))
-    astern = model.derivatives(np.array([-2.0, 0, 0, 0, 0, 0, math.pi / 2]), np.zeros(1))
-    assert astern[0] > 0
+    astern = model.derivatives(state(u=-2.0, delta=math.pi / 2), np.zeros(1))
+    assert astern[U] > 0
 
 
 def test_thruster_sign_and_rows():
     model = Catamaran.from_preset("si")
-    x = np.array([4.0, 0, 0, 0, 0, 0, 0.3])
+    x = state(u=4.0, delta=0.3)
     xdot = model.derivatives(x, np.array([0.1]))
-    assert xdot[2] > 0 and xdot[1] < 0  # δ > 0: bow to starboard, stern pushed to port
-    assert xdot[6] == pytest.approx(0.1)
+    assert xdot[R] > 0 and xdot[V] < 0  # δ > 0: bow to starboard, stern pushed to port
+    assert xdot[DELTA] == pytest.approx(0.1)
     lag = Catamaran.from_preset("si", delta_row="lag", T_t=2.0, k_t=0.8)
     assert lag.inputs[0].name == "v_a"
-    assert lag.derivatives(x, np.array([0.5]))[6] == pytest.approx((-0.3 + 0.8 * 0.5) / 2.0)
+    assert lag.derivatives(x, np.array([0.5]))[DELTA] == pytest.approx((-0.3 + 0.8 * 0.5) / 2.0)
 
 
 def test_batched_params():
     factors = np.array([0.7, 1.0, 1.3])
     model = Catamaran(preset("si", J_factor=factors))
-    x = np.tile([4.0, 0.1, 0.01, 0, 0, 0, 0.2], (3, 1))
+    x = np.tile(state(u=4.0, v=0.1, r=0.01, delta=0.2), (3, 1))
     xdot = model.derivatives(x, np.zeros((3, 1)))
     single = Catamaran(preset("si")).derivatives(x[0], np.zeros(1))
-    np.testing.assert_allclose(xdot[:, 2] * factors, single[2], rtol=1e-12)
+    np.testing.assert_allclose(xdot[:, R] * factors, single[R], rtol=1e-12)
 
 
 @pytest.mark.parametrize("kwargs, field", [

@@ -78,8 +78,9 @@ def test_a_single_run_scenario_has_no_controller_dimension():
 
 
 def test_every_perturbable_field_is_a_catamaran_state_and_ranges_are_checked():
-    """The catamaran's states are [u, v, r, north, east, psi, delta] (another order than the other
-    vessels'): offsets go by name, and one beyond the model's range names the field and unit."""
+    """The catamaran's states are [north, east, psi, u, v, r, delta] (every vessel's pose and body
+    velocity, then its thruster angle): offsets go by name, and one beyond the model's range
+    names the field and unit."""
     setup = build(load_scenario("catamaran-turn"))
     check_perturbable(_perturb(*(f"{f}=normal:1" for f in PERTURBABLE)), setup.model, setup.x0)
     with pytest.raises(ConfigError, match=r"u = 104 m/s, beyond the model's range \|u\| <= 50 m/s"):
@@ -120,11 +121,11 @@ def test_check_env_passes(env_id):
 
 def test_spaces_are_the_catamaran_states_references_and_input():
     env = gym.make("shipgnc/CatamaranHeading-v0").unwrapped
-    assert env.observation_names == ["u", "v", "r", "north", "east", "psi", "delta", "r_ref",
+    assert env.observation_names == ["north", "east", "psi", "u", "v", "r", "delta", "r_ref",
                                      "r_error", "psi_target", "psi_error"]
     assert env.action_space.shape == (1,)  # δ̇ [rad/s], no limit in document 004
     obs, _ = env.reset(seed=0)
-    assert obs[9] == 0.8 and obs[10] == pytest.approx(wrap_angle(obs[5] - 0.8), abs=1e-15)
+    assert obs[9] == 0.8 and obs[10] == pytest.approx(wrap_angle(obs[2] - 0.8), abs=1e-15)
     turn = ShipEnv("catamaran-turn")
     assert turn.observation_names[-2:] == ["r_ref", "r_error"]
 
@@ -174,7 +175,7 @@ def test_catamaran_vector_env_equals_single_envs():
     obs_v, _ = vec.reset(seed=seed)
     obs_s = np.stack([env.reset(seed=seed + i)[0] for i, env in enumerate(singles)])
     np.testing.assert_array_equal(obs_v, obs_s)
-    assert len(np.unique(obs_v[:, 5])) == n  # each its own initial heading
+    assert len(np.unique(obs_v[:, 2])) == n  # each its own initial heading
     rng = np.random.default_rng(0)
     for _ in range(40):
         actions = rng.normal(0.0, 0.01, (n, 1))
@@ -194,14 +195,15 @@ def test_ship_v0_takes_a_yaw_rate_case_and_refuses_the_others():
 
 
 def test_an_episode_in_waves_or_current_reads_the_catamarans_pose_by_name():
-    """The catamaran keeps north, east, ψ at 3, 4, 5 ([u, v, r, north, east, ψ, δ]): an episode's
-    disturbance reads them there (bound to the model at reset, as in a simulated run), so a shear
-    current east = k·north is zero on the start line north = 0 whatever the surge speed."""
+    """An episode's disturbance finds north and east by name in the catamaran's states (bound to
+    the model at reset, as in a simulated run), so a shear current east = k·north is zero on the
+    start line north = 0 whatever the surge speed."""
     from shipgnc.rl.episode import BatchedEpisode
 
     episode = BatchedEpisode(load_scenario("catamaran-turn", ["current=shear:k=0.01"]), batch=1)
     episode.reset([1])
-    assert episode.disturbance.position_index == (3, 4)
+    names = [s.name for s in episode.model.states]
+    assert episode.disturbance.position_index == (names.index("north"), names.index("east"))
     x = episode.x.copy()
-    assert x[0, 0] > 1.0 and x[0, 3] == 0.0  # under way, on north = 0
+    assert x[0, names.index("u")] > 1.0 and x[0, names.index("north")] == 0.0  # under way, on north = 0
     np.testing.assert_array_equal(episode.disturbance(0.0, x)[0, 3:], [0.0, 0.0])

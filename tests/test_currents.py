@@ -55,7 +55,7 @@ def _vessels():
     x_cat = straight_running_state(cat.params)
     return [("boat", boat, np.array([0, 0, 0, U_boat, 0, 0.0]), np.array([100.0, 0.0]), 3, U_boat),
             ("cybership2", cs2, np.array([0, 0, 0, U_cs2, 0, 0.0]), np.array([8.13, 0.0]), 3, U_cs2),
-            ("catamaran", cat, x_cat, np.array([0.0]), 0, x_cat[0])]
+            ("catamaran", cat, x_cat, np.array([0.0]), 3, x_cat[3])]
 
 
 @pytest.mark.parametrize("name,model,x_eq,u_in,i_u,U", _vessels(), ids=lambda v: str(v)[:12])
@@ -63,7 +63,7 @@ def test_current_along_the_heading_adds_to_the_ground_speed(name, model, x_eq, u
     """Heading north at the straight-running speed U through the water with a current V towards
     north: the same equilibrium moved by V, u = U + V over ground (ν̇ = 0, ground speed U + V)."""
     V = 0.4 * U
-    i_n, i_e, i_psi = (0, 1, 2) if name != "catamaran" else (3, 4, 5)
+    i_n, i_e, i_psi = 0, 1, 2  # every vessel's layout: north, east, psi, u, v, r, ...
     x = x_eq.copy()
     x[i_u] = U + V
     d = np.array([0.0, 0.0, 0.0, V, 0.0])

@@ -20,6 +20,7 @@ import yaml
 from shipgnc.cases import catamaran as C
 from shipgnc.environment.current_field import CurrentDisturbance, GaussMarkovCurrent
 from shipgnc.errors import ConfigError
+from shipgnc.models.catamaran import EAST, NORTH, U, V
 from shipgnc.models.mariner import MarinerParams, MarinerWitOppe, MarinerYawDisturbance
 from shipgnc.routing.fields import SumField, UniformCurrent
 from shipgnc.scenarios import catamaran as SC
@@ -52,7 +53,7 @@ def test_current_section_on_catamaran_and_mariner():
     for case in SC.cases(cat).values():  # every run of the case, each with its own object
         assert isinstance(case.disturbance, CurrentDisturbance)
         case.disturbance.bind_model(case.model)  # as the simulator does at the run's start
-        assert case.disturbance.position_index == (3, 4)  # the catamaran's north, east by name
+        assert case.disturbance.position_index == (NORTH, EAST)  # found by name
     setup = build(cat)
     assert setup.disturbance is not None
     np.testing.assert_array_equal(setup.disturbance(0.0, setup.x0), [0, 0, 0, VN, VE])
@@ -124,8 +125,8 @@ def _catamaran_pair(case_of, dt=None):
         assert case.controller is None and (case.disturbance is None) == (current is None)
         x0 = np.array(case.x0, dtype=float)
         if current is not None:
-            x0[0] += VN
-            x0[1] += VE
+            x0[U] += VN  # ψ(0) = 0: the body axes are north, east
+            x0[V] += VE
         kw = case.simulate_kwargs()
         if dt is not None:
             kw["dt"] = dt

@@ -569,23 +569,27 @@ def test_wave_load_calibration_heading_rms_is_the_linear_response_estimate():
 
 
 def test_the_loads_read_the_pose_where_the_model_keeps_it():
-    """The loads on a ship whose state puts north, east and ψ elsewhere (the catamaran's
-    [u, v, r, north, east, ψ, δ]) are the loads on the same pose in the 3-DOF layout: the simulator
-    binds the disturbance to the model, which finds the indices by name."""
-    from shipgnc.models.catamaran import Catamaran
+    """The loads on a ship whose state puts north, east and ψ elsewhere (a model of a user's,
+    here [u, v, r, north, east, ψ]) are the loads on the same pose in the 3-DOF layout: the
+    simulator binds the disturbance to the model, which finds the indices by name."""
+    from types import SimpleNamespace
+
+    from shipgnc.models.base import Signal
     from shipgnc.models.cybership2 import CyberShip2
 
+    reordered = SimpleNamespace(states=tuple(Signal(name, "", "") for name in
+                                             ("u", "v", "r", "north", "east", "psi")))
     pose = np.array([3.0, -2.0, 0.7])
     rng_seed = 11
-    loads_3dof, loads_cat = make_loads(), make_loads()
+    loads_3dof, loads_other = make_loads(), make_loads()
     loads_3dof.bind_model(CyberShip2())
-    loads_cat.bind_model(Catamaran())
-    assert loads_cat.state_index == (3, 4, 5)
+    loads_other.bind_model(reordered)
+    assert loads_3dof.state_index == (0, 1, 2) and loads_other.state_index == (3, 4, 5)
     loads_3dof.reset((), np.random.default_rng(rng_seed))
-    loads_cat.reset((), np.random.default_rng(rng_seed))
+    loads_other.reset((), np.random.default_rng(rng_seed))
     x_3dof = np.concatenate([pose, [0.3, 0.0, 0.0]])
-    x_cat = np.concatenate([[0.3, 0.0, 0.0], pose, [0.0]])
-    np.testing.assert_array_equal(loads_cat(12.5, x_cat), loads_3dof(12.5, x_3dof))
+    x_other = np.concatenate([[0.3, 0.0, 0.0], pose])
+    np.testing.assert_array_equal(loads_other(12.5, x_other), loads_3dof(12.5, x_3dof))
     given = FroudeKrylovWaveLoads(WaveSpectrum.jonswap(HS, T0), state_index=(0, 1, 2))
-    given.bind_model(Catamaran())  # an explicit state_index stays
+    given.bind_model(reordered)  # an explicit state_index stays
     assert given.state_index == (0, 1, 2)

@@ -108,7 +108,7 @@ def with_current(case: CatamaranCase, current, force=None) -> CatamaranCase:
 
 
 def initial_state(u0: float = U0, delta0: float = 0.0, batch: int | None = None) -> np.ndarray:
-    x0 = np.array([u0, 0.0, 0.0, 0.0, 0.0, 0.0, delta0])
+    x0 = np.array([0.0, 0.0, 0.0, u0, 0.0, 0.0, delta0])  # north, east, psi, u, v, r, delta
     return x0 if batch is None else np.tile(x0, (batch, 1))
 
 

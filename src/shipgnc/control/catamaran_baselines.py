@@ -55,6 +55,7 @@ from shipgnc.models.catamaran import (
     PSI,
     Catamaran,
     R,
+    U,
     V,
     _hull_forces,
     catamaran_yaw_acceleration,
@@ -362,7 +363,7 @@ def pole_placement_step(t, x, ref, z, p, cmd, sig):
     z[0] += 1.0
     w = rate_value(t, x, ref, p, PLACE_SOURCE, z, 2)
     o = PLACE_MODEL
-    _, Y, N = _hull_forces(x[0], x[1], x[2], p, o)
+    _, Y, N = _hull_forces(x[U], x[V], x[R], p, o)
     sd = math.sin(x[DELTA])
     v_dot = (Y - p[o + 7] * sd + 0.0) / p[o + 1]
     r_dot = (N + p[o + 8] * sd + 0.0) / p[o + 2]

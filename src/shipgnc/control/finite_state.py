@@ -62,6 +62,8 @@ from shipgnc.models.catamaran import (
     PSI,
     Catamaran,
     R,
+    U,
+    V,
     kernel_params,
     kernel_params_reason,
     yaw_acceleration_of,
@@ -631,7 +633,7 @@ def yaw_rate_fsm_step(t, x, ref, z, p, cmd, sig):
     # keeps numba's reference counting of every array argument in the RK stages' hot path
     z[0] += 1.0
     w = rate_value(t, x, ref, p, FSM_SOURCE, z, FSM_STATE - N_RATE_STATE)
-    su, sv, sr, delta = x[0], x[1], x[R], x[DELTA]
+    su, sv, sr, delta = x[U], x[V], x[R], x[DELTA]
     law20, T_u, h, hLT_v, J, check_max, omega_max = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
     if check_max != 0.0 and abs(w) > omega_max:
         _first(z, 0, t, abs(w))

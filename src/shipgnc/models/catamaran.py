@@ -14,7 +14,8 @@ with V = √(u² + v²), β = atan2(v, u) (= −β of the document), R(V) = 2000
 c_D = C_d (ρ/2) A_Ls L². The two thrusters are always at the same angle δ with equal thrust T_v;
 δ > 0 turns the bow to starboard (an azimuth angle from +x toward starboard α = −δ).
 
-State ``[u, v, r, north, east, psi, delta]`` (note 004-4.2), input ``[delta_rate]`` [rad/s] or
+State ``[north, east, psi, u, v, r, delta]`` (every vessel's layout; the document's order
+[V_x, V_y, ω, x₁, x₂, K, δ] is :func:`to_document`), input ``[delta_rate]`` [rad/s] or
 ``[v_a]`` [rad], disturbance ``[X_env, Y_env, N_env]`` (body-axis force [N] and moment [N m]).
 
 **δ is a state**, not the output of the foundation's actuator lag: the finite-state laws need δ in
@@ -282,13 +283,13 @@ def preset(name: str = DEFAULT_PRESET, **overrides) -> CatamaranParams:
     return CatamaranParams().with_(**{**PRESETS[name], **overrides})
 
 
-STATES = (
-    Signal("u", "m/s", "surge velocity"),
-    Signal("v", "m/s", "sway velocity (to starboard)"),
-    Signal("r", "rad/s", "yaw rate (bow to starboard)"),
+STATES = (  # the layout of every vessel: pose, body velocity, then states of its own
     Signal("north", "m", "north position (NED x)"),
     Signal("east", "m", "east position (NED y)"),
     Signal("psi", "rad", "heading, clockwise from north (unwrapped)", angle=True),
+    Signal("u", "m/s", "surge velocity"),
+    Signal("v", "m/s", "sway velocity (to starboard)"),
+    Signal("r", "rad/s", "yaw rate (bow to starboard)"),
     Signal("delta", "rad", "thruster angle, positive turns the bow to starboard", angle=True),
 )
 RATE_INPUTS = (Signal("delta_rate", "rad/s", "thruster turning rate"),)
@@ -298,7 +299,7 @@ DISTURBANCES = (
     Signal("Y_env", "N", "environmental sway force (to starboard)"),
     Signal("N_env", "N m", "environmental yaw moment"),
 )
-U, V, R, NORTH, EAST, PSI, DELTA = range(7)
+NORTH, EAST, PSI, U, V, R, DELTA = range(7)
 
 
 def relative_state(x, d):
@@ -333,7 +334,7 @@ class Catamaran:
 
     states = STATES
     disturbances = (*DISTURBANCES, *CURRENT)
-    state_limits = (50.0, 50.0, 50.0, 1e8, 1e8, 1e6, 1e4)
+    state_limits = (1e8, 1e8, 1e6, 50.0, 50.0, 50.0, 1e4)
 
     @classmethod
     def from_preset(cls, name: str = DEFAULT_PRESET, **overrides) -> Catamaran:
@@ -382,7 +383,7 @@ class Catamaran:
         u_dot, v_dot = X / p.m_x, Y / p.m_y
         if current is not None:  # ν̇ = ν̇_r + ν̇_c, ν̇_c = (r v_c, −r u_c, 0)
             u_dot, v_dot = u_dot + x[..., R] * current[1], v_dot - x[..., R] * current[0]
-        return np.stack([u_dot, v_dot, N / p.J, north_dot, east_dot, x[..., R], delta_dot],
+        return np.stack([north_dot, east_dot, x[..., R], u_dot, v_dot, N / p.J, delta_dot],
                         axis=-1)
 
     def yaw_acceleration(self, x, d=None):
@@ -481,34 +482,34 @@ def catamaran_rhs(x, u, d, p, xdot):
     forces ``d[0:3]``, earth-fixed current ``d[3:5]`` as relative velocity; a zero ``d`` is
     ``d=None``)."""
     m_x, m_y, J, two_T_v, L_T_v = p[0], p[1], p[2], p[7], p[8]
-    delta = x[6]
-    c, s = math.cos(x[5]), math.sin(x[5])
+    delta = x[DELTA]
+    c, s = math.cos(x[PSI]), math.sin(x[PSI])
     in_current = d.shape[0] > 4 and (d[3] != 0.0 or d[4] != 0.0)
     uc = 0.0
     vc = 0.0
-    su, sv = x[0], x[1]
+    su, sv = x[U], x[V]
     if in_current:  # the hull sees ν_r = ν − R(ψ)ᵀ[V_N, V_E]
         uc = c * d[3] + s * d[4]
         vc = -s * d[3] + c * d[4]
-        su = x[0] - uc
-        sv = x[1] - vc
-    X, Y, N = _hull_forces(su, sv, x[2], p, 0)
+        su = x[U] - uc
+        sv = x[V] - vc
+    X, Y, N = _hull_forces(su, sv, x[R], p, 0)
     cd, sd = math.cos(delta), math.sin(delta)
     X = X + two_T_v * cd + d[0]
     Y = Y - two_T_v * sd + d[1]
     N = N + L_T_v * sd + d[2]
     # ν̇_c = (r v_c, −r u_c, 0), zero in still water (u_c = v_c = 0); every element written once,
     # unconditionally (a write in one branch keeps numba's reference counting in the RK stages)
-    xdot[0] = X / m_x + x[2] * vc
-    xdot[1] = Y / m_y - x[2] * uc
-    xdot[2] = N / J
-    xdot[3] = c * x[0] - s * x[1]
-    xdot[4] = s * x[0] + c * x[1]
-    xdot[5] = x[2]
+    xdot[NORTH] = c * x[U] - s * x[V]
+    xdot[EAST] = s * x[U] + c * x[V]
+    xdot[PSI] = x[R]
+    xdot[U] = X / m_x + x[R] * vc
+    xdot[V] = Y / m_y - x[R] * uc
+    xdot[R] = N / J
     if p[12] != 0.0:
-        xdot[6] = (-delta + p[13] * u[0]) / p[14]
+        xdot[DELTA] = (-delta + p[13] * u[0]) / p[14]
     else:
-        xdot[6] = u[0]
+        xdot[DELTA] = u[0]
 
 
 @kernel_function
@@ -525,7 +526,7 @@ def yaw_acceleration_of(su, sv, sr, delta, p, o):
 def catamaran_yaw_acceleration(x, p, o):
     """Φ₃ = ṙ of eq. (3) at one ship's state without disturbance:
     :meth:`Catamaran.yaw_acceleration` (``p[o:]``: :func:`kernel_params`)."""
-    return yaw_acceleration_of(x[0], x[1], x[2], x[6], p, o)
+    return yaw_acceleration_of(x[U], x[V], x[R], x[DELTA], p, o)
 
 
 def slew_actuator(model: Catamaran, rate_deg_s: float) -> Actuator:
@@ -538,16 +539,25 @@ def slew_actuator(model: Catamaran, rate_deg_s: float) -> Actuator:
 
 
 # --- document frame (x forward, y to port, ω and K clockwise), note 004-4.2 ------------------
+#: where the document's z = [V_x, V_y, ω, x₁, x₂, K, δ] sits in the NED state
+DOCUMENT_ORDER = (U, V, R, NORTH, EAST, PSI, DELTA)
+
+
 def to_document(x):
-    """NED state [u, v, r, N, E, ψ, δ] → the document's z = [V_x, V_y, ω, x₁, x₂, K, δ]."""
-    z = np.array(x, dtype=float, copy=True)
+    """NED state [N, E, ψ, u, v, r, δ] → the document's z = [V_x, V_y, ω, x₁, x₂, K, δ]
+    = [u, −v, r, N, E, ψ, δ] (its y to port)."""
+    z = np.array(x, dtype=float)[..., DOCUMENT_ORDER]
     z[..., 1] = -z[..., 1]
     return z
 
 
 def from_document(z):
     """The document's z = [V_x, V_y, ω, x₁, x₂, K, δ] → NED state (inverse of :func:`to_document`)."""
-    return to_document(z)
+    z = np.asarray(z, dtype=float)
+    x = np.empty_like(z)
+    x[..., DOCUMENT_ORDER] = z
+    x[..., V] = -x[..., V]
+    return x
 
 
 def document_derivatives(params: CatamaranParams, z, u_delta):
@@ -595,5 +605,6 @@ def linearize(model: Catamaran, x0, *, step: float = 1e-6) -> tuple[np.ndarray, 
 def straight_running_eigenvalues(model: Catamaran, speed: float | None = None) -> np.ndarray:
     """Eigenvalues of the (u, v, r) subsystem at straight running (note 004-4.12 check 15), sorted."""
     A, _ = linearize(model, straight_running_state(model.params, speed))
-    eig = np.linalg.eigvals(A[:3, :3])
+    nu = [U, V, R]
+    eig = np.linalg.eigvals(A[np.ix_(nu, nu)])
     return eig[np.lexsort((eig.imag, eig.real))]

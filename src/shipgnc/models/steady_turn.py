@@ -47,8 +47,8 @@ class SteadyTurn:
         return 2.0 * self.speed / abs(self.r) if self.r != 0 else math.inf
 
     def state(self) -> np.ndarray:
-        """The model state [u, v, r, 0, 0, 0, δ] of this turn."""
-        return np.array([self.u, self.v, self.r, 0.0, 0.0, 0.0, self.delta])
+        """The model state [0, 0, 0, u, v, r, δ] (north, east, ψ at the origin) of this turn."""
+        return np.array([0.0, 0.0, 0.0, self.u, self.v, self.r, self.delta])
 
 
 def _params(vessel) -> CatamaranParams:
@@ -60,10 +60,10 @@ def _params(vessel) -> CatamaranParams:
 
 
 def _residual(model: Catamaran, u, v, r, delta) -> np.ndarray:
-    x = np.array([u, v, r, 0.0, 0.0, 0.0, delta])
+    x = np.array([0.0, 0.0, 0.0, u, v, r, delta])  # north, east, psi, u, v, r, delta
     p = model.params
     xdot = model.derivatives(x, np.zeros(1))
-    return xdot[:3] * np.array([p.m_x, p.m_y, p.J]) / (2.0 * p.T_v) / np.array([1.0, 1.0, p.L])
+    return xdot[3:6] * np.array([p.m_x, p.m_y, p.J]) / (2.0 * p.T_v) / np.array([1.0, 1.0, p.L])
 
 
 def _newton(fun, y0: np.ndarray, tol: float = 1e-14, max_iter: int = 50) -> np.ndarray | None:

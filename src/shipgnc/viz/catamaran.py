@@ -15,9 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
+from shipgnc.models.catamaran import STATES
 from shipgnc.viz.style import COLORS, DPI, LABEL_SIZE, LEGEND, REFERENCE, new_figure
 
-STATE_ORDER = ("u", "v", "r", "north", "east", "psi", "delta")
+STATE_ORDER = tuple(s.name for s in STATES)  # the model's state layout
 
 
 _figure = new_figure
