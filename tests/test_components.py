@@ -121,3 +121,26 @@ def test_the_runner_dispatches_by_the_registry():
     assert isinstance(build(load_scenario("boat-los")).guidance, LOSGuidance)
     # a catalogue vessel's ``course`` controller is its entry's own hook, not document 003's law
     assert isinstance(build(load_scenario("mariner-cst-heading")).controller, HeadingAutopilot)
+
+
+def test_show_of_a_catamaran_case_lists_what_a_set_can_change():
+    """``shipgnc show`` prints the fields that act on the run: every option of the case's builder
+    (with its default), not the initial state and integrator the case does not read; a ``--set``
+    into one of those is refused instead of being ignored."""
+    import inspect
+
+    import yaml
+
+    from shipgnc.cases import catamaran as cases
+    from shipgnc.scenarios.registry import load_scenario, scenario_yaml
+
+    shown = yaml.safe_load(scenario_yaml(load_scenario("catamaran-heading")))
+    assert "initial_state" not in shown["simulation"] and "integrator" not in shown["simulation"]
+    assert "sensors" not in shown and "actuator" not in shown
+    signature = inspect.signature(cases.heading).parameters
+    expected = {k for k in signature if k not in ("preset_name", "vessel", "t_end", "dt")}
+    assert set(shown["case"]["options"]) == expected
+    assert shown["case"]["options"]["psi_target"] == signature["psi_target"].default
+    for key in ("simulation.initial_state.u=3", "simulation.integrator=solve_ivp"):
+        with pytest.raises(ConfigError, match=r"does not read simulation\.\w+ .*would be ignored"):
+            load_scenario("catamaran-turn", [key])

@@ -36,7 +36,9 @@ class VesselKind:
     ``build(scenario) -> (model, actuator, u0)``; ``controllers``, ``disturbances``: the types of
     those sections that fit it; ``navigation``: takes ``sensors`` and ``estimator``; ``current``:
     takes a ``current`` section; ``sections``: other top-level sections it reads (e.g. the boat's
-    ``actuator``); ``comparisons``: takes a ``controllers`` mapping. Optional hooks, each
+    ``actuator``); ``ignores``: dotted fields of those sections it does not read (a ``--set`` into
+    one is refused, ``shipgnc show`` leaves it out); ``comparisons``: takes a ``controllers``
+    mapping. Optional hooks, each
     ``"module:function"``: ``setup(scenario, variant, seed) -> Setup`` (a vessel whose whole set-up
     is its own, e.g. document 000's path-frame controllers), ``run(scenario, seed=, progress=,
     on_divergence=, keep_interrupted=) -> ScenarioRun`` (a vessel whose runs are its own),
@@ -53,6 +55,7 @@ class VesselKind:
     navigation: bool = False
     current: bool = False
     sections: tuple[str, ...] = ()
+    ignores: tuple[str, ...] = ()
     comparisons: bool = True
     shape: Literal["controlled", "case"] = "controlled"
     setup: str | None = None
@@ -159,6 +162,9 @@ VESSEL_KINDS: dict[str, VesselKind] = {k.model: k for k in (
                check="shipgnc.scenarios.mariner:check"),
     VesselKind("catamaran", S.CatamaranVesselConfig, "shipgnc.scenarios.catamaran:vessel_parts",
                current=True, sections=("case",), shape="case",
+               # a case sets its own initial state and integrates with RK4 at its step
+               ignores=("simulation.initial_state", "simulation.integrator", "simulation.method",
+                        "simulation.rtol", "simulation.atol"),
                setup="shipgnc.scenarios.catamaran:setup_of", run="shipgnc.scenarios.catamaran:run",
                initial_state="shipgnc.scenarios.catamaran:initial_state"),
     *(VesselKind(name, CatalogueVesselConfig, "shipgnc.vessels.scenario:vessel",

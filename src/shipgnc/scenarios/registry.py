@@ -101,6 +101,11 @@ def refuse_unused(scenario: Scenario, keys) -> None:
             raise ConfigError(f"--set {key}: scenario {scenario.name!r} does not use the section "
                               f"{section!r}, so the setting would be ignored; its sections: "
                               f"{', '.join(reads)}")
+        for field in scenario.ignored_fields():
+            if key == field or key.startswith(field + "."):
+                raise ConfigError(f"--set {key}: vessel model {scenario.vessel.model!r} does not "
+                                  f"read {field} (the runs of scenario {scenario.name!r} set it "
+                                  f"themselves), so the setting would be ignored")
 
 
 def parse_override(item: str) -> tuple[str, object]:
@@ -148,13 +153,25 @@ def set_path(data: dict, key: str, value: object) -> None:
 
 def scenario_yaml(scenario: Scenario) -> str:
     """The scenario as YAML (what ``shipgnc show`` prints): every field that acts on this
-    scenario, with its value or default; sections that cannot change its run are left out
-    (``actuator`` beyond the boat, ``quality`` beyond document 003's index, ``vessel`` of a route)."""
+    scenario, with its value or default, so that each line is one a ``--set`` can change;
+    sections it does not read (:meth:`Scenario.used_sections`: ``actuator`` beyond the boat,
+    ``quality`` beyond document 003's index, ``vessel`` of a route) and fields its vessel
+    ignores (:meth:`Scenario.ignored_fields`) are left out. A catamaran case's ``options`` list
+    every option of its builder with its default (``t_end`` and ``dt`` come from ``simulation``)."""
     data = scenario.model_dump(mode="json", exclude_none=True)
-    if scenario.route is not None:
-        data.pop("vessel", None)
-    if scenario.route is not None or scenario.vessel.model != "vectored-thrust-boat":
-        data.pop("actuator", None)
-    if scenario.metrics != "course-quality":
-        data.pop("quality", None)
+    used = set(scenario.used_sections())
+    data = {key: value for key, value in data.items() if key in used}
+    for field in scenario.ignored_fields():
+        *parents, leaf = field.split(".")
+        node = data
+        for part in parents:
+            node = node.get(part, {}) if isinstance(node, dict) else {}
+        if isinstance(node, dict):
+            node.pop(leaf, None)
+    if scenario.route is None and scenario.kind.shape == "case":
+        from shipgnc.scenarios.catamaran import builder_options
+
+        defaults = {k: v for k, v in builder_options(scenario.case.builder).items()
+                    if k not in ("t_end", "dt")}
+        data["case"]["options"] = {**defaults, **data["case"].get("options", {})}
     return yaml.safe_dump(data, sort_keys=False)

@@ -146,6 +146,11 @@ class Scenario(Strict):
         used += C.METRICS[self.metrics].sections
         return tuple(used)
 
+    def ignored_fields(self) -> tuple[str, ...]:
+        """Dotted fields of the used sections that this scenario's vessel does not read (its
+        registry entry's ``ignores``: a catamaran case sets its own initial state)."""
+        return () if self.route is not None else self.kind.ignores
+
     @model_validator(mode="wrap")
     @classmethod
     def _equilibrium_surge(cls, data, handler) -> Scenario:
