@@ -34,9 +34,10 @@ def time_sum(values) -> np.ndarray:
     adds a single column pairwise but a wide array row by row) nor on zeros padding the end of a
     member's series (a route member that finished before its batch)."""
     values = np.asarray(values, dtype=float)
-    if values.shape[0] == 0:
-        return np.zeros(values.shape[1:])
-    return np.cumsum(values, axis=0)[-1]
+    total = np.zeros(values.shape[1:])
+    for row in values:  # a row at a time: the running sum's last value, without its whole array
+        total += row
+    return total
 
 
 def time_mean(values) -> np.ndarray:

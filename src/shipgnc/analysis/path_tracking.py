@@ -54,6 +54,11 @@ BOOL_KEYS = ("stable", "reversed")
 REVERSED_DEG = 90.0
 
 
+#: ships scored together: every figure is the ship's own, and a block's temporaries (a few
+#: arrays of time × block) stay small where a whole batch's would each be as large as the log
+SHIPS_PER_BLOCK = 64
+
+
 def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reached_end) -> dict:
     """The metrics for every ship at once: arrays ``(time, ship)`` in SI → dict of ``(ship,)``
     float arrays in the reported units (NaN where a figure does not exist; ``stable`` and
@@ -61,10 +66,21 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
     plus ``final_abs_crosstrack_nm``, the mean |y_r| over the last 10 min.
 
     ``reached_end``: bool per ship (or one bool), False when the run stopped early (divergence).
-    Samples after a run stopped (NaN padding) are ignored.
+    Samples after a run stopped (NaN padding) are ignored. The ships are scored in blocks of
+    :data:`SHIPS_PER_BLOCK` (each figure is a ship's own: the same numbers, less memory).
     """
     t = np.asarray(time, dtype=float)
     y, psi, lg, d = (np.asarray(a, dtype=float).reshape(t.size, -1) for a in (y_r, psi_r, leg, delta))
+    reached = np.broadcast_to(np.asarray(reached_end, dtype=bool), (y.shape[1],))
+    blocks = [_path_tracking_block(t, y[:, i:i + SHIPS_PER_BLOCK], psi[:, i:i + SHIPS_PER_BLOCK],
+                                   lg[:, i:i + SHIPS_PER_BLOCK], d[:, i:i + SHIPS_PER_BLOCK],
+                                   delta_max, reached[i:i + SHIPS_PER_BLOCK])
+              for i in range(0, max(y.shape[1], 1), SHIPS_PER_BLOCK)]
+    return {key: np.concatenate([b[key] for b in blocks]) for key in blocks[0]}
+
+
+def _path_tracking_block(t, y, psi, lg, d, delta_max: float, reached_end) -> dict:
+    """:func:`path_tracking_arrays` of one block of ships."""
     valid = np.isfinite(y) & np.isfinite(lg)
     n_t = y.shape[0]
     rows = np.arange(n_t)[:, None]
