@@ -14,7 +14,7 @@ import itertools
 import math
 from typing import Annotated, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import AfterValidator, Field, field_validator, model_validator
 
 from shipgnc.config_types import Finite, Positive, Strict
 from shipgnc.errors import ConfigError
@@ -24,6 +24,17 @@ OffsetNm = Annotated[float, Field(ge=-1000, le=1000, allow_inf_nan=False)]
 OffsetDeg = Annotated[float, Field(ge=-180, le=180, allow_inf_nan=False)]
 #: a commanded heading: up to ten turns either way (beyond that a float's degrees lose meaning)
 HeadingDeg = Annotated[float, Field(ge=-3600, le=3600, allow_inf_nan=False)]
+
+
+def _in_time_order(entries: list) -> list:
+    """A schedule's entries start at t = 0 and their times increase strictly."""
+    times = [e.t for e in entries]
+    if times[0] != 0:
+        raise ValueError(f"the first entry must start at t = 0 (got t = {times[0]!r})")
+    for a, b in itertools.pairwise(times):
+        if not b > a:
+            raise ValueError(f"times must increase strictly (t = {a!r} is followed by t = {b!r})")
+    return entries
 
 
 # --------------------------------------------------------------------------- vessel, actuator
@@ -238,13 +249,7 @@ class OpenLoopConfig(Strict):
     """Document 001's hand-written command sequence: piecewise-constant (T, α) from time t."""
 
     type: Literal["open-loop"]
-    schedule: Annotated[list[CommandEntry], Field(min_length=1)]
-
-    @field_validator("schedule")
-    @classmethod
-    def _ordered(cls, schedule: list[CommandEntry]) -> list[CommandEntry]:
-        _check_times([e.t for e in schedule])
-        return schedule
+    schedule: Annotated[list[CommandEntry], Field(min_length=1), AfterValidator(_in_time_order)]
 
 
 class HeadingSpeedConfig(Navigated):
@@ -383,13 +388,7 @@ class ScheduleGuidanceConfig(Strict):
     """Heading and speed set-points from time t on."""
 
     type: Literal["schedule"]
-    schedule: Annotated[list[ReferenceEntry], Field(min_length=1)]
-
-    @field_validator("schedule")
-    @classmethod
-    def _ordered(cls, schedule: list[ReferenceEntry]) -> list[ReferenceEntry]:
-        _check_times([e.t for e in schedule])
-        return schedule
+    schedule: Annotated[list[ReferenceEntry], Field(min_length=1), AfterValidator(_in_time_order)]
 
 
 class LOSConfig(Strict):
@@ -423,13 +422,7 @@ class CourseScheduleConfig(Strict):
     """Course set-points ψ_d from time t on (no speed reference: the propellers are held)."""
 
     type: Literal["course-schedule"]
-    schedule: Annotated[list[CourseEntry], Field(min_length=1)]
-
-    @field_validator("schedule")
-    @classmethod
-    def _ordered(cls, schedule: list[CourseEntry]) -> list[CourseEntry]:
-        _check_times([e.t for e in schedule])
-        return schedule
+    schedule: Annotated[list[CourseEntry], Field(min_length=1), AfterValidator(_in_time_order)]
 
 
 class PathConfig(Strict):
@@ -792,11 +785,3 @@ class PassiveObserverConfig(Strict):
 
 
 EstimatorConfig = Annotated[EKFConfig | PassiveObserverConfig, Field(discriminator="type")]
-
-
-def _check_times(times: list[float]) -> None:
-    if times[0] != 0:
-        raise ValueError(f"the first entry must start at t = 0 (got t = {times[0]!r})")
-    for a, b in itertools.pairwise(times):
-        if not b > a:
-            raise ValueError(f"times must increase strictly (t = {a!r} is followed by t = {b!r})")
