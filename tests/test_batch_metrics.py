@@ -58,6 +58,11 @@ def test_time_sum_ignores_batch_width_and_trailing_zeros():
     wide = time_sum(x)
     for j in range(5):
         assert time_sum(x[:, j:j + 1])[0] == wide[j] == time_sum(padded[:, j:j + 1])[0]
+    # in time order for each member: the running sum's last value, also across its blocks of rows
+    long = rng.normal(size=(3 * 512 + 7, 3))
+    np.testing.assert_array_equal(time_sum(long), np.cumsum(long, axis=0)[-1])
+    assert time_sum(long[:, 0]) == np.cumsum(long[:, 0])[-1] and np.ndim(time_sum(long[:, 0])) == 0
+    assert time_sum(np.zeros((0, 2))).shape == (2,)
 
 
 def test_a_schedule_without_turn_reports_what_is_defined_and_why_not_the_rest():

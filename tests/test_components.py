@@ -107,7 +107,32 @@ def test_a_section_the_vessel_does_not_read_is_refused():
 def test_a_metric_set_of_another_shape_is_refused():
     data, source = raw_scenario("boat-los")
     data["metrics"] = "catamaran"
-    with pytest.raises(ConfigError, match=r"metrics = 'catamaran': scores document 004's cases"):
+    with pytest.raises(ConfigError, match=r"metrics = 'catamaran': scores the cases of vessel model "
+                                          r"'catamaran'"):
+        validate(data, source)
+
+
+def test_a_catamaran_case_refuses_what_its_builder_sets_naming_where_it_goes():
+    for section, value, message in (
+            ("actuator", {"thrust_time_constant": 1.0}, r"actuator: the catamaran's thruster is set "
+                                                         r"in case\.options"),
+            ("montecarlo", {"runs": 3}, r"montecarlo: a catamaran scenario's runs come from its case "
+                                        r"builder; set them in case\.options")):
+        data, source = raw_scenario("catamaran-turn")
+        data[section] = value
+        with pytest.raises(ConfigError, match=message):
+            validate(data, source)
+    data, source = raw_scenario("catamaran-turn")  # in the file, or a --set of the whole section
+    data["simulation"]["initial_state"] = {"u": 5.0}
+    with pytest.raises(ConfigError, match=r"simulation\.initial_state: vessel model 'catamaran' does "
+                                          r"not read it"):
+        validate(data, source)
+
+
+def test_a_config_class_name_is_not_a_vessel_model():
+    data, source = raw_scenario("boat-los")
+    data["vessel"] = {"model": "MarinerVesselConfig"}
+    with pytest.raises(ConfigError, match="unknown vessel model; allowed: vectored-thrust-boat"):
         validate(data, source)
 
 

@@ -20,6 +20,7 @@ on a listed one that is gone (so the list only shrinks).
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "shipgnc"
@@ -66,9 +67,16 @@ def modules() -> dict[str, Path]:
 
 def imports(path: Path, known: set[str]) -> set[str]:
     """The shipgnc modules ``path`` imports (without ``shipgnc.``), anywhere in the file; ``from
-    package import module`` counts as the module."""
+    package import module`` counts as the module, and so does a ``"shipgnc.module:function"``
+    string (the component registry's builders, imported when first used)."""
     found = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and re.fullmatch(
+                r"shipgnc(\.\w+)+:\w+", node.value):
+            module = node.value.partition(":")[0].removeprefix("shipgnc.")
+            if module in known:
+                found.add(module)
+            continue
         if isinstance(node, ast.Import):
             names = [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:

@@ -28,16 +28,24 @@ def matvec(matrix, x) -> np.ndarray:
     return np.stack([row_dot(x, M[i]) for i in range(M.shape[0])], axis=-1)
 
 
+#: rows of :func:`time_sum`'s running sum held at once (its memory: this many rows, not the series)
+TIME_SUM_ROWS = 512
+
+
 def time_sum(values) -> np.ndarray:
     """Σ over the time axis of ``(time, member)`` values, added in time order for every member
     (a running sum): its bits depend neither on how many members share the array (numpy's ``sum``
     adds a single column pairwise but a wide array row by row) nor on zeros padding the end of a
     member's series (a route member that finished before its batch)."""
     values = np.asarray(values, dtype=float)
-    total = np.zeros(values.shape[1:])
-    for row in values:  # a row at a time: the running sum's last value, without its whole array
-        total += row
-    return total
+    if values.shape[0] == 0:
+        total = np.zeros(values.shape[1:])
+    else:  # the running sum's last value, a block of rows at a time (not the whole running sum)
+        total = values[0]
+        for start in range(1, values.shape[0], TIME_SUM_ROWS):
+            block = values[start:start + TIME_SUM_ROWS]
+            total = np.cumsum(np.concatenate([total[None], block]), axis=0)[-1]
+    return total[()] if values.ndim == 1 else np.array(total)
 
 
 def time_mean(values) -> np.ndarray:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from shipgnc.errors import ConfigError, require
-from shipgnc.models.catamaran import Catamaran, CatamaranParams
+from shipgnc.models.catamaran import Catamaran, CatamaranParams, R, U, V
 
 
 @dataclass(frozen=True)
@@ -63,7 +63,7 @@ def _residual(model: Catamaran, u, v, r, delta) -> np.ndarray:
     x = np.array([0.0, 0.0, 0.0, u, v, r, delta])  # north, east, psi, u, v, r, delta
     p = model.params
     xdot = model.derivatives(x, np.zeros(1))
-    return xdot[3:6] * np.array([p.m_x, p.m_y, p.J]) / (2.0 * p.T_v) / np.array([1.0, 1.0, p.L])
+    return xdot[[U, V, R]] * np.array([p.m_x, p.m_y, p.J]) / (2.0 * p.T_v) / np.array([1.0, 1.0, p.L])
 
 
 def _newton(fun, y0: np.ndarray, tol: float = 1e-14, max_iter: int = 50) -> np.ndarray | None:

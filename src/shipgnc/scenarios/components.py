@@ -6,7 +6,8 @@ The scenario schema derives from these tables its unions (which ``vessel.model``
 does not fit the vessel, the guidance a controller needs, the sections a vessel reads) and the
 runner its dispatch (which function builds the vessel, the controller, the guidance). Adding a
 component is its module, its configuration section (:mod:`shipgnc.scenarios.sections`) and one
-entry here; no check or dispatch elsewhere names it (``docs/extending.md``).
+entry here; neither the schema's checks nor the runner's dispatch names it
+(``docs/extending.md``; the RL environments and the live dashboard keep their own short lists).
 
 Builders are named ``"module:function"`` and imported when first used, so that reading a scenario
 file does not import every model and controller.
@@ -101,57 +102,57 @@ class DisturbanceKind:
 @dataclass(frozen=True)
 class MetricKind:
     """A ``metrics`` set: the guidance type it scores against (None: any), the controller types it
-    needs (None: any) and the sections it reads."""
+    needs (None: any), the sections it reads and the scenario shape it scores (``controlled``,
+    ``case``, ``route``; None: any)."""
 
     name: str
+    shape: Literal["controlled", "case", "route"] | None = None
     guidance: str | None = None
     controllers: tuple[str, ...] | None = None
     sections: tuple[str, ...] = ()
 
 
-RUNNER = "shipgnc.scenarios.runner"
-
 CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
-    ControllerKind("open-loop", S.OpenLoopConfig, build=f"{RUNNER}:open_loop_controller"),
+    ControllerKind("open-loop", S.OpenLoopConfig, build="shipgnc.scenarios.runner:open_loop_controller"),
     ControllerKind("heading-speed", S.HeadingSpeedConfig, guidance=("schedule", "los"),
-                   build=f"{RUNNER}:heading_speed_controller"),
+                   build="shipgnc.scenarios.runner:heading_speed_controller"),
     ControllerKind("course", S.CourseControllerConfig, guidance=("course-schedule",),
-                   build=f"{RUNNER}:course_controller"),
+                   build="shipgnc.scenarios.runner:course_controller"),
     ControllerKind("lqr", S.PathLQRConfig, guidance=("path",)),
     ControllerKind("fl", S.OutputFLConfig, guidance=("path",)),
     ControllerKind("los-fl", S.LOSFLConfig, guidance=("path",)),
 )}
 
 GUIDANCE: dict[str, GuidanceKind] = {k.type: k for k in (
-    GuidanceKind("schedule", S.ScheduleGuidanceConfig, build=f"{RUNNER}:reference_schedule"),
-    GuidanceKind("los", S.LOSConfig, build=f"{RUNNER}:los_guidance"),
-    GuidanceKind("course-schedule", S.CourseScheduleConfig, build=f"{RUNNER}:course_schedule"),
+    GuidanceKind("schedule", S.ScheduleGuidanceConfig, build="shipgnc.scenarios.runner:reference_schedule"),
+    GuidanceKind("los", S.LOSConfig, build="shipgnc.scenarios.runner:los_guidance"),
+    GuidanceKind("course-schedule", S.CourseScheduleConfig, build="shipgnc.scenarios.runner:course_schedule"),
     GuidanceKind("path", S.PathConfig, vessels=("mariner",)),
 )}
 
 DISTURBANCES: dict[str, DisturbanceKind] = {k.type: k for k in (
-    DisturbanceKind("constant", S.ConstantForceConfig, build=f"{RUNNER}:constant_force"),
-    DisturbanceKind("gaussian", S.GaussianForceConfig, build=f"{RUNNER}:gaussian_force"),
-    DisturbanceKind("waves", S.WavesConfig, build=f"{RUNNER}:wave_loads"),
+    DisturbanceKind("constant", S.ConstantForceConfig, build="shipgnc.scenarios.runner:constant_force"),
+    DisturbanceKind("gaussian", S.GaussianForceConfig, build="shipgnc.scenarios.runner:gaussian_force"),
+    DisturbanceKind("waves", S.WavesConfig, build="shipgnc.scenarios.runner:wave_loads"),
     DisturbanceKind("mariner", S.MarinerDisturbanceConfig),
 )}
 
 METRICS: dict[str, MetricKind] = {k.name: k for k in (
-    MetricKind("stern-kick", controllers=("open-loop",)),
-    MetricKind("heading-steps", guidance="schedule"),
-    MetricKind("waypoints", guidance="los"),
-    MetricKind("course-quality", guidance="course-schedule", sections=("quality",)),
-    MetricKind("path-tracking", guidance="path"),
-    MetricKind("catamaran"),
-    MetricKind("route"),
+    MetricKind("stern-kick", "controlled", controllers=("open-loop",)),
+    MetricKind("heading-steps", "controlled", guidance="schedule"),
+    MetricKind("waypoints", "controlled", guidance="los"),
+    MetricKind("course-quality", "controlled", guidance="course-schedule", sections=("quality",)),
+    MetricKind("path-tracking", "controlled", guidance="path"),
+    MetricKind("catamaran", "case"),
+    MetricKind("route", "route"),
     MetricKind("none"),
 )}
 
 VESSEL_KINDS: dict[str, VesselKind] = {k.model: k for k in (
-    VesselKind("vectored-thrust-boat", S.VesselConfig, f"{RUNNER}:boat_parts",
+    VesselKind("vectored-thrust-boat", S.VesselConfig, "shipgnc.scenarios.runner:boat_parts",
                controllers=("open-loop", "heading-speed"), disturbances=("constant", "gaussian"),
                navigation=True, current=True, sections=("actuator",), comparisons=False),
-    VesselKind("cybership2", S.CyberShipVesselConfig, f"{RUNNER}:cybership_parts",
+    VesselKind("cybership2", S.CyberShipVesselConfig, "shipgnc.scenarios.runner:cybership_parts",
                controllers=("course",), disturbances=("constant", "gaussian", "waves"),
                navigation=True, current=True),
     VesselKind("mariner", S.MarinerVesselConfig, "shipgnc.scenarios.mariner:vessel",
@@ -188,6 +189,11 @@ def having(flag: str) -> tuple[str, ...]:
     section named ``flag``."""
     return tuple(name for name, kind in VESSEL_KINDS.items()
                  if getattr(kind, flag, False) is True or flag in kind.sections)
+
+
+def having_shape(shape: str) -> tuple[str, ...]:
+    """The vessel models of scenario shape ``shape`` (``controlled`` or ``case``)."""
+    return tuple(name for name, kind in VESSEL_KINDS.items() if kind.shape == shape)
 
 
 def config_classes(table: dict) -> tuple[type, ...]:

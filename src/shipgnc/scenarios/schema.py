@@ -43,7 +43,7 @@ def _vessel_tag(value) -> str:
     model = (value.get("model", "vectored-thrust-boat") if isinstance(value, dict)
              else getattr(value, "model", "vectored-thrust-boat"))
     kind = C.VESSEL_KINDS.get(model) if isinstance(model, str) else None
-    return kind.config.__name__ if kind is not None else str(model)
+    return kind.config.__name__ if kind is not None else "unknown vessel model"
 
 
 def _union_by_type(table: dict):
@@ -158,7 +158,8 @@ class Scenario(Strict):
         from its section's ``surge_equilibrium()``."""
         scenario = handler(data)
         sim = scenario.simulation
-        if sim is None or sim.initial_state.u is not None:
+        if (sim is None or sim.initial_state.u is not None or scenario.route is not None
+                or "simulation.initial_state" in scenario.kind.ignores):  # refused in _consistent
             return scenario
         vessel = scenario.vessel
         if not hasattr(vessel, "surge_equilibrium"):
@@ -180,12 +181,12 @@ class Scenario(Strict):
             raise ValueError("simulation: required field is missing (dt, t_end, ...)")
         kind = self.kind
         if self.case is not None and kind.shape != "case":
-            case_vessels = [n for n, k in C.VESSEL_KINDS.items() if k.shape == "case"]
             raise ValueError(f"case: document 004's cases need vessel model "
-                             f"{' or '.join(map(repr, case_vessels))}, not {self.vessel.model!r}")
-        self._sections_fit(kind)
+                             f"{' or '.join(map(repr, C.having_shape('case')))}, not {self.vessel.model!r}")
         if kind.shape == "case":
             return self._consistent_case(kind)
+        self._ignored_unset(kind)
+        self._sections_fit(kind)
         self._controllers_fit(kind)
         self._guidance_fits(kind)
         dist = self.disturbance.type if self.disturbance is not None else None
@@ -216,9 +217,25 @@ class Scenario(Strict):
             if sees == "measurement" and not self.sensors:
                 raise ValueError(f"{self.where(name)}.sees = 'measurement': the scenario has no sensors")
 
+    def _ignored_unset(self, kind: C.VesselKind) -> None:
+        """A field the vessel does not read (its entry's ``ignores``) is refused when given, in
+        the file or by a ``--set`` of its whole section, rather than silently ignored."""
+        for field in kind.ignores:
+            *parents, leaf = field.split(".")
+            node = self
+            for part in parents:
+                node = getattr(node, part, None)
+            if node is not None and leaf in node.model_fields_set:
+                raise ValueError(f"{field}: vessel model {self.vessel.model!r} does not read it (its "
+                                 f"runs set it themselves); leave it out")
+
     def _sections_fit(self, kind: C.VesselKind) -> None:
-        """A section the vessel does not read is refused, with the vessels that read it."""
-        for section, default in (("actuator", ActuatorConfig()), ("montecarlo", None)):
+        """A section that only some vessels read (their entries' ``sections``) is refused on
+        another, with the vessels that read it."""
+        optional = dict.fromkeys(s for k in C.VESSEL_KINDS.values() if k.shape == kind.shape
+                                 for s in k.sections)
+        for section in optional:
+            default = type(self).model_fields[section].get_default(call_default_factory=True)
             if getattr(self, section) != default and section not in kind.sections:
                 readers = C.having(section)
                 raise ValueError(f"{section}: applies to vessel model {' and '.join(readers)} in "
@@ -263,10 +280,11 @@ class Scenario(Strict):
         if metric.controllers and any(c.type not in metric.controllers for c in self.variants.values()):
             raise ValueError(f"metrics = {self.metrics!r} needs controller type "
                              f"{' or '.join(map(repr, metric.controllers))}")
-        if self.metrics in ("route", "catamaran"):
+        if metric.shape not in (None, "controlled"):
             raise ValueError(f"metrics = {self.metrics!r}: scores "
-                             + ("a route scenario" if self.metrics == "route"
-                                else "document 004's cases (vessel model 'catamaran')"))
+                             + ("a route scenario" if metric.shape == "route"
+                                else f"the cases of vessel model "
+                                     f"{' or '.join(map(repr, C.having_shape(metric.shape)))}"))
 
     def _consistent_route(self) -> Scenario:
         if self.route is None:
@@ -283,11 +301,14 @@ class Scenario(Strict):
         if self.case is None:
             raise ValueError("case: a catamaran scenario names a case builder (allowed: "
                              f"{', '.join(CATAMARAN_BUILDERS)})")
-        for name in ("controller", "controllers", "guidance", "disturbance"):
+        for name in ("controller", "controllers", "guidance", "disturbance", "montecarlo"):
             if getattr(self, name) is not None:
                 raise ValueError(f"{name}: a catamaran scenario's runs come from its case builder; "
                                  "set them in case.options")
-        if self.metrics not in ("catamaran", "none"):
+        if self.actuator != ActuatorConfig():
+            raise ValueError("actuator: the catamaran's thruster is set in case.options")
+        self._ignored_unset(kind)
+        if C.METRICS[self.metrics].shape not in (None, "case"):
             raise ValueError(f"metrics = {self.metrics!r}: a catamaran scenario reports 'catamaran'")
         return self
 
