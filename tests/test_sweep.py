@@ -328,3 +328,27 @@ def test_a_foreign_output_directory_is_refused_not_mixed(tmp_path, local_result)
     write_study(local_result, out, figures=False, overwrite=True)
     assert not (out / "notes.txt").exists()
     assert (out / "summary.csv").exists() and (out / "summary.md").exists()
+
+
+def test_a_member_run_again_alone_draws_the_sensor_noise_of_its_batch_run():
+    """A member that diverges in its batch is run again by itself (``run_chunk``) with the seeds
+    the batch used: its sensors must draw the same noise. The seeds are made afresh at every read
+    (``Study.member_seeds``), so a second read spawns the same children as the first; a list of
+    ``SeedSequence`` objects read once would hand the re-run children the batch run had not drawn."""
+    import numpy as np
+
+    from shipgnc.scenarios.runner import build
+    from shipgnc.study.chunk import _alone, _run_batch
+
+    study = Study("boat-los-gnss", members=3, overrides=("simulation.t_end=20",))
+    scenario = study.scenario_at(study.points[0])
+    setup = build(scenario, seed=study.seed)
+    x0 = np.tile(setup.x0, (3, 1))
+    seeds = study.member_seeds(0, 3, 1)
+    batch = _run_batch(setup, scenario, x0, seeds, "numpy", False, "mask")[0]
+    alone = _run_batch(_alone(setup, 1), scenario, x0[1:2], seeds[1:2], "numpy", False)[0]
+    measured = [v for v in batch.data_vars if v.endswith("_meas")]
+    assert {"north_meas", "psi_meas"} <= set(measured)
+    for name in (*measured, "north", "psi"):
+        np.testing.assert_array_equal(alone[name].isel(member=0).values,
+                                      batch[name].isel(member=1).values, err_msg=name)
