@@ -169,3 +169,20 @@ def test_show_of_a_catamaran_case_lists_what_a_set_can_change():
     for key in ("simulation.initial_state.u=3", "simulation.integrator=solve_ivp"):
         with pytest.raises(ConfigError, match=r"does not read simulation\.\w+ .*would be ignored"):
             load_scenario("catamaran-turn", [key])
+
+
+def test_show_reads_back_as_the_same_scenario_for_every_built_in():
+    """What ``shipgnc show`` prints is a scenario file: validated again it is the same scenario
+    (a null that is not a field's default, e.g. a GNSS ``rate_hz: null``, is kept)."""
+    import yaml
+
+    from shipgnc.scenarios.registry import builtin_names, load_scenario, scenario_yaml
+
+    for name in builtin_names():
+        scenario = load_scenario(name)
+        text = scenario_yaml(scenario)
+        again = validate(yaml.safe_load(text), f"shown {name}")
+        assert again == scenario, name
+        assert scenario_yaml(again) == text, name
+    shown = yaml.safe_load(scenario_yaml(load_scenario("cybership-waves-observer")))
+    assert any(s["type"] == "gnss" and s["rate_hz"] is None for s in shown["sensors"])

@@ -151,6 +151,29 @@ def set_path(data: dict, key: str, value: object) -> None:
                               f"({node!r}), not a section")
 
 
+def _drop_default_nulls(model, data: dict) -> None:
+    """Remove from ``data`` (``model``'s dump) the ``null`` fields whose default is null: a null
+    that is not the default (a GNSS ``rate_hz: null``, every control sample, against 1 Hz) stays,
+    so that the printed scenario reads back as the same scenario."""
+    from pydantic import BaseModel
+
+    for name, field in type(model).model_fields.items():
+        value = getattr(model, name)
+        if value is None:
+            if field.get_default(call_default_factory=True) is None:
+                data.pop(name, None)
+        elif isinstance(value, BaseModel):
+            _drop_default_nulls(value, data[name])
+        elif isinstance(value, (list, tuple)):
+            for item, dumped in zip(value, data[name], strict=True):
+                if isinstance(item, BaseModel):
+                    _drop_default_nulls(item, dumped)
+        elif isinstance(value, dict):
+            for key, item in value.items():
+                if isinstance(item, BaseModel):
+                    _drop_default_nulls(item, data[name][key])
+
+
 def scenario_yaml(scenario: Scenario) -> str:
     """The scenario as YAML (what ``shipgnc show`` prints): every field that acts on this
     scenario, with its value or default, so that each line is one a ``--set`` can change;
@@ -158,7 +181,8 @@ def scenario_yaml(scenario: Scenario) -> str:
     ``quality`` beyond document 003's index, ``vessel`` of a route) and fields its vessel
     ignores (:meth:`Scenario.ignored_fields`) are left out. A catamaran case's ``options`` list
     every option of its builder with its default (``t_end`` and ``dt`` come from ``simulation``)."""
-    data = scenario.model_dump(mode="json", exclude_none=True)
+    data = scenario.model_dump(mode="json")
+    _drop_default_nulls(scenario, data)
     used = set(scenario.used_sections())
     data = {key: value for key, value in data.items() if key in used}
     for field in scenario.ignored_fields():
