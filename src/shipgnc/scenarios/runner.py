@@ -196,7 +196,7 @@ def disturbance_of(d, scenario: Scenario):
     """The force disturbance ``d`` and the scenario's ``current`` composed once
     (:class:`~shipgnc.environment.current_field.CurrentDisturbance`), or the force alone."""
     force = None
-    if d is not None and not (d.type == "waves" and d.hs == 0):  # hs: 0 is calm water: no load
+    if d is not None:
         build = C.DISTURBANCES[d.type].build
         if build is None:
             raise ConfigError(f"disturbance type {d.type!r}: built by its vessel's set-up")
@@ -224,9 +224,12 @@ def gaussian_force(d, scenario: Scenario):
 
 
 def wave_loads(d, scenario: Scenario):
-    """Froude–Krylov loads of irregular waves from the section's spectrum (note 003-3.6)."""
+    """Froude–Krylov loads of irregular waves from the section's spectrum (note 003-3.6); None for
+    ``hs: 0`` (calm water: no wave load at all)."""
     from shipgnc.environment.waves import FroudeKrylovWaveLoads, WaveSpectrum
 
+    if d.hs == 0:
+        return None
     if d.spectrum == "modified-pm":
         spectrum = WaveSpectrum.modified_pierson_moskowitz(d.hs, d.t0)
     elif d.spectrum == "jonswap":
