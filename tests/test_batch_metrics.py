@@ -58,10 +58,16 @@ def test_time_sum_ignores_batch_width_and_trailing_zeros():
     wide = time_sum(x)
     for j in range(5):
         assert time_sum(x[:, j:j + 1])[0] == wide[j] == time_sum(padded[:, j:j + 1])[0]
-    # in time order for each member: the running sum's last value, also across its blocks of rows
-    long = rng.normal(size=(3 * 512 + 7, 3))
+    # in time order for each member: the running sum's last value to the bit, for a batch wide
+    # enough to fill vector lanes, a strided view, a 1-D series, more than one member axis, NaN
+    long = rng.normal(size=(1543, 1001)) * np.exp(rng.normal(scale=8.0, size=(1543, 1001)))
     np.testing.assert_array_equal(time_sum(long), np.cumsum(long, axis=0)[-1])
+    np.testing.assert_array_equal(time_sum(long[::3, 1::7]), np.cumsum(long[::3, 1::7], axis=0)[-1])
     assert time_sum(long[:, 0]) == np.cumsum(long[:, 0])[-1] and np.ndim(time_sum(long[:, 0])) == 0
+    cube = long[:, :1000].reshape(1543, 10, 100)
+    np.testing.assert_array_equal(time_sum(cube), np.cumsum(cube, axis=0)[-1])
+    long[700, 5] = np.nan
+    assert np.isnan(time_sum(long)[5]) and np.isfinite(time_sum(long)[4])
     assert time_sum(np.zeros((0, 2))).shape == (2,)
 
 

@@ -12,6 +12,7 @@ from shipgnc.environment.current import CrossCurrent
 from shipgnc.environment.filtered_noise import SecondOrderNoise
 from shipgnc.errors import ConfigError
 from shipgnc.paths import WaypointPath
+from shipgnc.streams import MemberStreams
 
 
 def realisation(noise, h, n, ships=1, seed=1):
@@ -55,6 +56,37 @@ def test_same_seed_same_sea_and_call_equals_sequence():
     noise.reset((3,), np.random.default_rng(5))
     np.testing.assert_array_equal(np.stack([noise(0.3 * k) for k in range(100)]), a)
     assert not np.allclose(a[:, 0], a[:, 1])  # each ship its own realisation
+
+
+@pytest.mark.parametrize("streams", [False, True])
+@pytest.mark.parametrize("step", [None, 0.3])
+def test_a_run_of_calls_at_once_is_the_calls_to_the_bit(step, streams):
+    """``at_times`` (one draw, one compiled pass) returns what the calls return and leaves the
+    state as they leave it: continued in chunks (the compiled loop's table), after an irregular
+    call (a skipped step, a repeated time), with two batch axes, from one generator or from one
+    stream per member (a study's :class:`~shipgnc.streams.MemberStreams`)."""
+    def rng():
+        return MemberStreams([11, 12, 13, 14]) if streams else np.random.default_rng(11)
+
+    def pair():
+        a, b = (SecondOrderNoise(sigma=0.7, period=8.0, zeta=0.1, step=step) for _ in range(2))
+        a.reset((4, 3), rng())
+        b.reset((4, 3), rng())
+        return a, b
+
+    times = np.arange(0, 500) * 0.3
+    calls, chunks = pair()
+    expected = np.stack([calls(t) for t in times])
+    got = np.concatenate([chunks.at_times(times[k:k + 64]) for k in range(0, times.size, 64)])
+    np.testing.assert_array_equal(got, expected)
+    assert got.shape == (500, 4, 3)
+    # after the chunks the state is the calls' state: the next values agree too
+    np.testing.assert_array_equal(chunks.at_times(times[-1] + 0.3 * np.arange(1, 4)),
+                                  np.stack([calls(times[-1] + 0.3 * k) for k in range(1, 4)]))
+    irregular = np.concatenate([times[:10], times[9:10], times[12:40], [12.05], times[41:60]])
+    calls, at_once = pair()
+    np.testing.assert_array_equal(at_once.at_times(irregular), np.stack([calls(t) for t in irregular]))
+    assert at_once.at_times([]).shape == (0, 4, 3)
 
 
 @pytest.mark.parametrize(("kwargs", "field"), [

@@ -9,6 +9,7 @@ left-to-right order, elementwise over the batch.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 
@@ -28,23 +29,30 @@ def matvec(matrix, x) -> np.ndarray:
     return np.stack([row_dot(x, M[i]) for i in range(M.shape[0])], axis=-1)
 
 
-#: rows of :func:`time_sum`'s running sum held at once (its memory: this many rows, not the series)
-TIME_SUM_ROWS = 512
+@numba.njit(cache=True, error_model="numpy")  # no fastmath: the additions stay in time order
+def _running_total(values):
+    """The last row of ``np.cumsum(values, axis=0)`` for C-contiguous ``(time ≥ 1, member)``
+    values: each member's column added in time order (lanes side by side, one order per lane),
+    without the running-sum array."""
+    total = values[0].copy()
+    for k in range(1, values.shape[0]):
+        for m in range(values.shape[1]):
+            total[m] += values[k, m]
+    return total
 
 
 def time_sum(values) -> np.ndarray:
     """Σ over the time axis of ``(time, member)`` values, added in time order for every member
-    (a running sum): its bits depend neither on how many members share the array (numpy's ``sum``
-    adds a single column pairwise but a wide array row by row) nor on zeros padding the end of a
-    member's series (a route member that finished before its batch)."""
+    (the last value of the running sum ``np.cumsum(values, axis=0)``, to the bit): its bits depend
+    neither on how many members share the array (numpy's ``sum`` adds a single column pairwise but
+    a wide array row by row) nor on zeros padding the end of a member's series (a route member that
+    finished before its batch)."""
     values = np.asarray(values, dtype=float)
     if values.shape[0] == 0:
         total = np.zeros(values.shape[1:])
-    else:  # the running sum's last value, a block of rows at a time (not the whole running sum)
-        total = values[0]
-        for start in range(1, values.shape[0], TIME_SUM_ROWS):
-            block = values[start:start + TIME_SUM_ROWS]
-            total = np.cumsum(np.concatenate([total[None], block]), axis=0)[-1]
+    else:
+        flat_values = np.ascontiguousarray(values.reshape(values.shape[0], -1))
+        total = _running_total(flat_values).reshape(values.shape[1:])
     return total[()] if values.ndim == 1 else np.array(total)
 
 

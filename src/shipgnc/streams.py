@@ -61,6 +61,12 @@ class MemberStreams:
         rest = self._rest(size)
         return np.stack([g.standard_normal(rest) for g in self.streams])
 
+    def standard_normal_steps(self, steps: int, size) -> np.ndarray:
+        """``steps`` consecutive ``standard_normal(size)`` draws at once, shape (steps, *size):
+        each member's ``steps`` draws are one draw of its generator (the same stream)."""
+        rest = self._rest(size)
+        return np.stack([g.standard_normal((int(steps), *rest)) for g in self.streams], axis=1)
+
     def random(self, size) -> np.ndarray:
         rest = self._rest(size)
         return np.stack([g.random(rest) for g in self.streams])
@@ -69,6 +75,17 @@ class MemberStreams:
         require(size is not None, "uniform size", size, "must give the shape (member axis first)")
         rest = self._rest(size)
         return np.stack([g.uniform(low, high, rest) for g in self.streams])
+
+
+def normal_steps(rng, steps: int, size) -> np.ndarray:
+    """``np.stack([rng.standard_normal(size) for _ in range(steps)])`` in one draw per stream, to
+    the bit: a ``Generator`` fills its output in order, so ``steps`` consecutive draws are one draw
+    of shape (steps, *size); a :class:`MemberStreams` draws each member's steps from its own
+    generator."""
+    size = (size,) if np.ndim(size) == 0 else tuple(int(s) for s in size)
+    if isinstance(rng, MemberStreams):
+        return rng.standard_normal_steps(steps, size)
+    return rng.standard_normal((int(steps), *size))
 
 
 def is_generator(rng) -> bool:

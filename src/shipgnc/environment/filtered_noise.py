@@ -36,11 +36,13 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 import scipy.linalg
 
 from shipgnc.batchmath import matvec
 from shipgnc.errors import require
+from shipgnc.streams import normal_steps
 
 
 class SecondOrderNoise:
@@ -167,7 +169,67 @@ class SecondOrderNoise:
         """w at every time of ``times`` (ascending), shape (len(times), *batch_shape): the values
         ``__call__`` would return after ``reset(batch_shape, rng)``, with the same draws."""
         self.reset(batch_shape, rng)
-        return np.stack([self(float(t)) for t in np.asarray(times, dtype=float)])
+        return self.at_times(times)
+
+    def at_times(self, times) -> np.ndarray:
+        """``np.stack([self(t) for t in times])`` from the current state, to the bit, and the
+        state left as those calls leave it. After the first call, a regular sequence (each time
+        at the end of the step drawn before it: t_k = k·dt) is one draw of all its normals, the
+        same stream as one draw per call, and one compiled pass of the step recursion
+        (:func:`_averaged_steps`); anything else is the calls themselves."""
+        times = np.asarray(times, dtype=float)
+        out = []
+        k = 0
+        while k < min(2, times.size):  # the first call after a reset and the one after it may
+            # not be regular steps (a point value w(t0), then the step that reaches t1)
+            out.append(self(float(times[k])))
+            k += 1
+        rest = times[k:]
+        if rest.size == 0:
+            return np.stack(out) if out else np.empty((0, *self._x.shape[:-1]))
+        t_prev = np.concatenate([[self._t], rest[:-1]])
+        steps = rest - t_prev
+        ends = np.concatenate([[self._t_end], t_prev[1:] + steps[:-1]])  # t_end before each call
+        tol = 1e-9 * np.maximum(1.0, np.abs(rest))
+        if not (np.all(rest > t_prev) and np.all(np.abs(rest - ends) <= tol)):
+            out.extend(self(float(t)) for t in rest)
+            return np.stack(out)
+        keys = sorted({round(float(h), 12) for h in steps})
+        which = np.searchsorted(keys, np.round(steps, 12))
+        tables = [self.averaged_transition(h) for h in keys]
+        G = np.stack([g for g, _ in tables])[which]
+        L = np.stack([f for _, f in tables])[which]
+        batch = self._x.shape[:-1]
+        noise = normal_steps(self._rng, rest.size, (*batch, 3))
+        x = np.ascontiguousarray(self._x.reshape(-1, 2))
+        held, x_start = _averaged_steps(x, noise.reshape(rest.size, -1, 3), G, L, steps)
+        self._x_start = x_start.reshape(*batch, 2)
+        self._x = x.reshape(*batch, 2)
+        self._t, self._t_end = float(rest[-1]), float(rest[-1] + steps[-1])
+        values = held.reshape(rest.size, *batch)
+        self._held = values[-1]
+        return np.concatenate([np.stack(out), values]) if out else values
+
+
+@numba.njit(cache=True, error_model="numpy")  # no fastmath: :func:`matvec`'s products and sums, in order
+def _averaged_steps(x, noise, G, L, steps):
+    """The regular calls of :meth:`SecondOrderNoise.__call__` for ships ``x`` (ships, 2), updated
+    in place: per step k, z = G_k x + L_k n_k as :func:`~shipgnc.batchmath.matvec` forms each
+    row (left to right, the two products added), x ← z[:2], w̄_k = z[2]/h_k. Returns (w̄ (steps,
+    ships), x at the last step's start)."""
+    held = np.empty((steps.shape[0], x.shape[0]))
+    x_start = x.copy()
+    for k in range(steps.shape[0]):
+        for i in range(x.shape[0]):
+            x0, x1 = x[i, 0], x[i, 1]
+            x_start[i, 0], x_start[i, 1] = x0, x1
+            n0, n1, n2 = noise[k, i, 0], noise[k, i, 1], noise[k, i, 2]
+            z0 = (x0 * G[k, 0, 0] + x1 * G[k, 0, 1]) + ((n0 * L[k, 0, 0] + n1 * L[k, 0, 1]) + n2 * L[k, 0, 2])
+            z1 = (x0 * G[k, 1, 0] + x1 * G[k, 1, 1]) + ((n0 * L[k, 1, 0] + n1 * L[k, 1, 1]) + n2 * L[k, 1, 2])
+            z2 = (x0 * G[k, 2, 0] + x1 * G[k, 2, 1]) + ((n0 * L[k, 2, 0] + n1 * L[k, 2, 1]) + n2 * L[k, 2, 2])
+            x[i, 0], x[i, 1] = z0, z1
+            held[k, i] = z2 / steps[k]
+    return held, x_start
 
 
 #: Pierson–Moskowitz modal frequency ω₀ = 0.40·√(g/H_s) (Fossen 2021 §10.2.1) [-]

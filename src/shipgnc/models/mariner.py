@@ -442,7 +442,7 @@ class MarinerDisturbance:
                 raise NotCompiled("SecondOrderNoise waves need the run's step dt")
 
             def table(k0: int, k1: int) -> np.ndarray:  # the numpy loop's calls, t_k = k·dt
-                values = np.stack([waves(k * dt) for k in range(k0, k1)])
+                values = waves.at_times(np.arange(k0, k1) * dt)
                 return values.reshape(k1 - k0, -1, 1)
 
         if mode == 2:
