@@ -83,10 +83,26 @@ def test_a_run_of_calls_at_once_is_the_calls_to_the_bit(step, streams):
     # after the chunks the state is the calls' state: the next values agree too
     np.testing.assert_array_equal(chunks.at_times(times[-1] + 0.3 * np.arange(1, 4)),
                                   np.stack([calls(times[-1] + 0.3 * k) for k in range(1, 4)]))
+    # far from t = 0, t_k − t_{k−1} rounds to other cache keys than dt's (0.3 and 0.299999999999
+    # from t ≈ 4097 s): each key's transition is the one of the first step that has it
+    late = np.arange(13600, 13760) * 0.3
+    calls, at_once = pair()
+    np.testing.assert_array_equal(at_once.at_times(late), np.stack([calls(t) for t in late]))
+    assert len(calls._avg_cache) >= 2
+    for key, (G, L) in calls._avg_cache.items():
+        np.testing.assert_array_equal(at_once._avg_cache[key][0], G)
+        np.testing.assert_array_equal(at_once._avg_cache[key][1], L)
     irregular = np.concatenate([times[:10], times[9:10], times[12:40], [12.05], times[41:60]])
     calls, at_once = pair()
     np.testing.assert_array_equal(at_once.at_times(irregular), np.stack([calls(t) for t in irregular]))
     assert at_once.at_times([]).shape == (0, 4, 3)
+    # the compiled pass steps its own copy of the state, not the array a point value w(t0)
+    # handed out is a view of (a repeated first time, then regular steps)
+    tiny = np.array([0.0, 0.0, 1e-10, 2e-10, 3e-10, 4e-10])
+    calls, at_once = pair()
+    np.testing.assert_array_equal(at_once.at_times(tiny), np.stack([calls(t) for t in tiny]))
+    with pytest.raises(ConfigError, match="reset"):
+        SecondOrderNoise(sigma=0.7, period=8.0, zeta=0.1).at_times([])
 
 
 @pytest.mark.parametrize(("kwargs", "field"), [

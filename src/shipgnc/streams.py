@@ -6,7 +6,8 @@ how many ships share the batch. A study that splits its members into chunks (``s
 each member's result to be the same whatever the chunking: :class:`MemberStreams` holds one
 generator per member (children of one :class:`numpy.random.SeedSequence`, see :func:`member_seeds`)
 and answers ``standard_normal``, ``random`` and ``uniform`` for shapes whose leading axis is the
-member axis by stacking each member's own draw.
+member axis by stacking each member's own draw. :func:`normal_steps` draws a run of steps' normals
+at once, from either kind of generator, as the steps would draw them one by one.
 """
 
 from __future__ import annotations

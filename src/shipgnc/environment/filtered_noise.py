@@ -52,7 +52,8 @@ class SecondOrderNoise:
     ``period`` T₀ [s], ``zeta`` the filter's damping ratio, ``step`` the loop's step [s] when
     known (only the first call needs it; see the module notes). ``__call__(t, x)`` returns the
     exact average of w (...,) over the step starting at t (held over the step, ``per_stage =
-    False``); ``sequence(times, batch_shape, rng)`` the same values for a whole run at once.
+    False``); ``at_times(times)`` the values of a run of calls at once (one draw, one compiled
+    pass, the same bits); ``sequence(times, batch_shape, rng)`` those of a whole run from a reset.
     """
 
     per_stage = False
@@ -84,7 +85,7 @@ class SecondOrderNoise:
 
     def transition(self, h: float) -> tuple[np.ndarray, np.ndarray]:
         """(Φ, L) of one step of length ``h`` [s]: x ← Φ x + L n (exact in distribution)."""
-        key = round(h, 12)
+        key = _step_key(h)
         if key not in self._cache:
             phi = scipy.linalg.expm(self.A * h)
             Qd = self.P - phi @ self.P @ phi.T
@@ -95,7 +96,7 @@ class SecondOrderNoise:
         """(G, L) of one step of length ``h`` > 0 [s] with the step's integral of w:
         [x(t+h); ∫w] = G x(t) + L n, n ~ N(0, I₃) (exact in distribution; G is 3×2, L 3×3).
         Van Loan: exp([[−Aₐ, b bᵀ], [0, Aₐᵀ]] h) = [[·, Φₐ⁻¹ Q], [0, Φₐᵀ]], Q = Φₐ (Φₐ⁻¹ Q)."""
-        key = round(h, 12)
+        key = _step_key(h)
         if key not in self._avg_cache:
             Aa = np.zeros((3, 3))
             Aa[:2, :2] = self.A
@@ -147,7 +148,7 @@ class SecondOrderNoise:
             h = self.step
         else:
             # t_k − t_{k−1} added back to t_{k−1} may miss t_k by a rounding: that is the step end
-            tol = 1e-9 * max(1.0, abs(t))
+            tol = _same_time_tol(t)
             if t < self._t_end - tol:  # inside the step drawn last: restart from its start
                 self._x, self._t_end = self._x_start, self._t
             if t > self._t_end + tol:
@@ -177,38 +178,57 @@ class SecondOrderNoise:
         at the end of the step drawn before it: t_k = k·dt) is one draw of all its normals, the
         same stream as one draw per call, and one compiled pass of the step recursion
         (:func:`_averaged_steps`); anything else is the calls themselves."""
+        require(self._x is not None, "disturbance", "SecondOrderNoise", "call reset() first")
         times = np.asarray(times, dtype=float)
-        out = []
-        k = 0
-        while k < min(2, times.size):  # the first call after a reset and the one after it may
-            # not be regular steps (a point value w(t0), then the step that reaches t1)
-            out.append(self(float(times[k])))
-            k += 1
-        rest = times[k:]
+        # the first two calls of every run of times go through __call__: after a reset the first
+        # may hold the point value w(t0) and the second then steps from t0 to t1 in two draws
+        out = [self(float(t)) for t in times[:2]]
+        rest = times[2:]
         if rest.size == 0:
             return np.stack(out) if out else np.empty((0, *self._x.shape[:-1]))
         t_prev = np.concatenate([[self._t], rest[:-1]])
         steps = rest - t_prev
         ends = np.concatenate([[self._t_end], t_prev[1:] + steps[:-1]])  # t_end before each call
-        tol = 1e-9 * np.maximum(1.0, np.abs(rest))
-        if not (np.all(rest > t_prev) and np.all(np.abs(rest - ends) <= tol)):
+        regular = np.all(rest > t_prev) and all(  # __call__'s tests: neither a restart nor a gap
+            end - _same_time_tol(t) <= t <= end + _same_time_tol(t)
+            for t, end in zip(rest.tolist(), ends.tolist(), strict=True))
+        if not regular:
             out.extend(self(float(t)) for t in rest)
             return np.stack(out)
-        keys = sorted({round(float(h), 12) for h in steps})
-        which = np.searchsorted(keys, np.round(steps, 12))
-        tables = [self.averaged_transition(h) for h in keys]
-        G = np.stack([g for g, _ in tables])[which]
-        L = np.stack([f for _, f in tables])[which]
+        # each step's (G, L) as the calls get them: the cached pair of its key, or the pair of
+        # the first step with that key (the one whose call would fill the cache)
+        pairs, position = [], {}
+        which = np.empty(steps.size, dtype=np.int64)
+        for i, h in enumerate(steps.tolist()):
+            key = _step_key(h)
+            if key not in position:
+                position[key] = len(pairs)
+                pairs.append(self.averaged_transition(h))
+            which[i] = position[key]
+        G = np.stack([g for g, _ in pairs])[which]
+        L = np.stack([f for _, f in pairs])[which]
         batch = self._x.shape[:-1]
         noise = normal_steps(self._rng, rest.size, (*batch, 3))
-        x = np.ascontiguousarray(self._x.reshape(-1, 2))
+        x = self._x.reshape(-1, 2).copy()  # the kernel steps it in place: not the held values' array
         held, x_start = _averaged_steps(x, noise.reshape(rest.size, -1, 3), G, L, steps)
         self._x_start = x_start.reshape(*batch, 2)
         self._x = x.reshape(*batch, 2)
         self._t, self._t_end = float(rest[-1]), float(rest[-1] + steps[-1])
         values = held.reshape(rest.size, *batch)
         self._held = values[-1]
-        return np.concatenate([np.stack(out), values]) if out else values
+        return np.concatenate([np.stack(out), values])
+
+
+def _step_key(h: float) -> float:
+    """The cache key of a step length [s]: t_k − t_{k−1} of t_k = k·dt misses dt by a rounding,
+    and those steps share one transition (the first step with the key computes it)."""
+    return round(h, 12)
+
+
+def _same_time_tol(t: float) -> float:
+    """How far a call's time may miss the end of the step drawn before it and still be that end
+    [s] (t_k − t_{k−1} added back to t_{k−1} may miss t_k by a rounding)."""
+    return 1e-9 * max(1.0, abs(t))
 
 
 @numba.njit(cache=True, error_model="numpy")  # no fastmath: :func:`matvec`'s products and sums, in order

@@ -413,10 +413,11 @@ class MarinerDisturbance:
         at each step's start. A current field (document 002) is its ``current_kernel()`` parameters,
         evaluated by :func:`~shipgnc.routing.fields.field_velocity` at the position and time it is
         called with (every RK stage when the disturbance is ``per_stage``). The wave noise does not
-        depend on the state: ``table(k0, k1)`` runs the
-        :class:`~shipgnc.environment.filtered_noise.SecondOrderNoise` itself in numpy at
-        t_k = k·``dt`` (needs the run's step ``dt``), so it draws from the run's generator exactly
-        as the numpy loop does (same seed, same sea) and the filter ends in the same state.
+        depend on the state: ``table(k0, k1)`` asks the
+        :class:`~shipgnc.environment.filtered_noise.SecondOrderNoise` itself for its values at
+        t_k = k·``dt`` (``at_times``: the numpy loop's calls at once, to the bit; needs the run's
+        step ``dt``), so it draws from the run's generator exactly as the numpy loop does (same
+        seed, same sea) and the filter ends in the same state.
         """
         from shipgnc.environment.current import CrossCurrent
 
