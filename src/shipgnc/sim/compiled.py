@@ -24,6 +24,10 @@ MAX_CALL_WORK = 5_000_000
 #: so neighbouring ships share its cache lines, and short calls keep them cached from one ship to
 #: the next (a 1 000-ship log of every step is written ≈ 2× faster)
 LOG_SAMPLES_PER_CALL = 256
+#: kernel calls of a run whose guidance can finish: the kernel steps a finished ship on to the end
+#: of its call (only the driver sees that every ship has finished) and the call that holds the
+#: last finish is replayed up to it, so both costs are one call's share of the run, not the run
+FINISH_CHUNKS = 32
 
 
 # ----------------------------------------------------------------------------------------------
@@ -74,6 +78,8 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
         n_chunks = max(n_chunks, PROGRESS_CHUNKS)
     if n_ships > 1:
         n_chunks = max(n_chunks, math.ceil(log_length(setup) / LOG_SAMPLES_PER_CALL))
+    if done_at is not None:
+        n_chunks = max(n_chunks, FINISH_CHUNKS)
     n_chunks = max(n_chunks, math.ceil(n_ships * (n_steps + 1) / MAX_CALL_WORK))
     bounds = np.linspace(0, n_steps + 1, min(n_chunks, n_steps + 1) + 1).round().astype(int)
     if setup.progress is not None:
