@@ -10,6 +10,7 @@ from typer.testing import CliRunner
 
 from shipgnc.cli import app
 from shipgnc.errors import ConfigError
+from shipgnc.scenarios.catamaran import run_kind
 from shipgnc.scenarios.registry import builtin_names, load_scenario
 from shipgnc.scenarios.runner import run_scenario
 
@@ -19,11 +20,35 @@ KEYS = ("final_yaw_rate_rad_s", "final_delta_deg", "final_speed_mps", "turning_d
         "yaw_rate_settling_s", "yaw_rate_overshoot_pct", "max_delta_rate_deg_s", "events", "stable")
 
 
+#: the scenarios written as controller(s) and guidance; the others name a case builder
+CONTROLLED = ("catamaran-turn", "catamaran-sine", "catamaran-heading")
+
+
 def test_every_scenario_is_built_in_and_shows():
     assert set(NAMES) <= set(builtin_names())
     for name in NAMES:
         result = CliRunner().invoke(app, ["show", name])
-        assert result.exit_code == 0 and "builder:" in result.stdout, name
+        shown = ("controllers:", "guidance:") if name in CONTROLLED else ("builder:",)
+        assert result.exit_code == 0 and all(s in result.stdout for s in shown), name
+
+
+@pytest.mark.parametrize(("name", "builder", "options"), [
+    ("catamaran-turn", "turn", "{omega: 0.08}"),
+    ("catamaran-sine", "sine", "{law: 21, reading: pi}"),
+    ("catamaran-heading", "heading", "{law: 21, psi_target: 0.8, omega_c: 0.0022}"),
+])
+def test_controlled_scenarios_run_the_case_builders_runs(name, builder, options):
+    """A scenario of controller(s) and guidance runs what the case builder of the same runs runs:
+    the same runs, keys and metrics, and the same time series to the bit (document 004's laws,
+    references and gains, note 004-4.7)."""
+    short = ["simulation.t_end=150"]
+    controlled = run_scenario(name, overrides=short)
+    as_case = ["controllers=null", "guidance=null", f"case={{builder: {builder}, options: {options}}}"]
+    built = run_scenario(name, overrides=[*short, *as_case])
+    assert controlled.scenario.shape == "controlled" and built.scenario.shape == "case"
+    assert controlled.metrics == built.metrics
+    for var in ("r", "psi", "delta", "u"):
+        assert (controlled.result[var].values == built.result[var].values).all(), var
 
 
 def test_turn_reaches_the_commanded_yaw_rate(tmp_path):
@@ -44,14 +69,14 @@ def test_turn_reaches_the_commanded_yaw_rate(tmp_path):
 
 
 def test_heading_capture_settles_on_the_target():
-    m = run_scenario("catamaran-heading", overrides=["case.options.omega_c=0.02",
+    m = run_scenario("catamaran-heading", overrides=["guidance.omega_c=0.02",
                                                      "simulation.t_end=300"]).metrics
     assert abs(m["final_heading_error_rad"]) < 1e-3
     assert m["stable"]
 
 
-def test_settings_reach_the_builder():
-    run = run_scenario("catamaran-turn", overrides=["case.options.omega=0.04", "simulation.t_end=120",
+def test_settings_reach_the_runs():
+    run = run_scenario("catamaran-turn", overrides=["guidance.omega=0.04", "simulation.t_end=120",
                                                     "vessel.preset=paper"])
     for m in run.metrics.values():
         assert m["final_yaw_rate_rad_s"] == pytest.approx(0.04, abs=1e-4)
@@ -66,17 +91,28 @@ def test_montecarlo_is_one_batch():
     assert run.metrics["final_yaw_rate_max_error_rad_s"] < 1e-3  # every perturbed plant tracks ω*
 
 
-@pytest.mark.parametrize(("overrides", "words"), [
-    (["case.options.omegaa=0.1"], ["case.options.omegaa", "allowed", "omega"]),
-    (["case.options.omega=fast"], ["case.options.omega", "number"]),
-    (["case.builder=spin"], ["case.builder", "spin"]),
-    (["vessel.preset=navy"], ["vessel.preset", "navy"]),
-    (["controller={type: lqr}"], ["controller"]),
-    (["simulation.dt=0.1"], ["simulation.dt"]),
+@pytest.mark.parametrize(("scenario", "overrides", "words"), [
+    ("catamaran-actuator", ["case.options.omegaa=0.1"], ["case.options.omegaa", "allowed", "omega"]),
+    ("catamaran-actuator", ["case.options.omega=fast"], ["case.options.omega", "number"]),
+    ("catamaran-actuator", ["case.builder=spin"], ["case.builder", "spin"]),
+    ("catamaran-actuator", ["controller={type: yaw-rate-fsm}"], ["controller", "does not use"]),
+    ("catamaran-steps", ["simulation.dt=0.1"], ["simulation.dt"]),
+    ("catamaran-turn", ["vessel.preset=navy"], ["vessel.preset", "navy"]),
+    ("catamaran-turn", ["guidance.omega=fast"], ["guidance", "omega"]),
+    ("catamaran-turn", ["guidance.omegaa=0.1"], ["guidance", "omegaa"]),
+    ("catamaran-turn", ["controllers.law20.law=22"], ["law", "22"]),
+    ("catamaran-turn", ["controllers.law20.T_u=-1"], ["T_u"]),
+    ("catamaran-turn", ["controllers.law20={type: lqr}"], ["controllers.law20", "lqr"]),
+    ("catamaran-turn", ["guidance={type: los, waypoints: [[0, 0], [100, 0]]}"],
+     ["yaw-rate-fsm", "needs a guidance section", "heading-capture"]),
+    ("catamaran-turn", ["case={builder: turn}"], ["case"]),
+    ("catamaran-turn", ["metrics=heading-steps"], ["metrics"]),
+    ("catamaran-heading", ["guidance.omega_c=0"], ["guidance", "omega_c"]),
+    ("boat-autopilot", ["controller={type: yaw-rate-fsm}"], ["yaw-rate-fsm", "vectored-thrust-boat"]),
+    ("boat-autopilot", ["metrics=catamaran"], ["catamaran"]),
 ])
-def test_bad_settings_name_the_field(overrides, words):
+def test_bad_settings_name_the_field(scenario, overrides, words):
     with pytest.raises(ConfigError) as info:
-        scenario = "catamaran-steps" if "simulation.dt=0.1" in overrides else "catamaran-turn"
         run_scenario(scenario, overrides=overrides)
     for word in words:
         assert word in str(info.value), (word, str(info.value))
@@ -85,19 +121,19 @@ def test_bad_settings_name_the_field(overrides, words):
 def test_omega_beyond_the_limit_is_reported_not_silent():
     """Notes 004-4.12 check 13 / 004-4.11.1: at the paper preset's feasibility limit law (21) fails with an
     event and ``stable`` false instead of a silent wrong run."""
-    run = run_scenario("catamaran-turn", overrides=["vessel.preset=paper", "case.options.omega=0.2",
+    run = run_scenario("catamaran-turn", overrides=["vessel.preset=paper", "guidance.omega=0.2",
                                                     "simulation.t_end=200"])
     m = run.metrics["law21"]
     assert not m["stable"] or m["events"]
     assert math.isfinite(m["final_delta_deg"])
-    assert load_scenario("catamaran-turn").case.builder == "turn"
+    assert run_kind(load_scenario("catamaran-turn")) == "turn"
 
 
 def test_vessel_options_change_plant_and_design():
     """The sway-sign question of note 004-4.3 is a scenario setting. With the sign-consistent
     Coriolis term the drag-only hull is directionally unstable (note 004-C3): law (20) still holds
     ω*, on the opposite thruster angle (counter-steering), unlike the printed sign's positive angle."""
-    base = ["simulation.t_end=300", "case.options.omega=0.04", "vessel.preset=si"]
+    base = ["simulation.t_end=300", "guidance.omega=0.04", "vessel.preset=si"]
     printed = run_scenario("catamaran-turn", overrides=base).metrics["law20"]
     consistent = run_scenario("catamaran-turn", overrides=[*base, "vessel.coriolis=consistent"])
     law20 = consistent.metrics["law20"]

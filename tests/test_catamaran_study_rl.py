@@ -99,7 +99,7 @@ def test_montecarlo_is_refused_and_compare_needs_one_duration():
 def test_builder_runs_are_variants_of_build():
     scenario = load_scenario("catamaran-turn")
     assert build(scenario, "law21").controller.law_number == 21
-    with pytest.raises(ConfigError, match="not a run of scenario 'catamaran-turn'; have law20, law21"):
+    with pytest.raises(ConfigError, match=r"controller 'law22': not in this scenario; have law20, law21"):
         build(scenario, "law22")
 
 

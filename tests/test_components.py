@@ -107,8 +107,8 @@ def test_a_section_the_vessel_does_not_read_is_refused():
 def test_a_metric_set_of_another_shape_is_refused():
     data, source = raw_scenario("boat-los")
     data["metrics"] = "catamaran"
-    with pytest.raises(ConfigError, match=r"metrics = 'catamaran': scores the cases of vessel model "
-                                          r"'catamaran'"):
+    with pytest.raises(ConfigError, match=r"metrics = 'catamaran': scores vessel model 'catamaran', "
+                                          r"not 'vectored-thrust-boat'"):
         validate(data, source)
 
 
@@ -116,8 +116,21 @@ def test_a_catamaran_case_refuses_what_its_builder_sets_naming_where_it_goes():
     for section, value, message in (
             ("actuator", {"thrust_time_constant": 1.0}, r"actuator: the catamaran's thruster is set "
                                                          r"in case\.options"),
-            ("montecarlo", {"runs": 3}, r"montecarlo: a catamaran scenario's runs come from its case "
-                                        r"builder; set them in case\.options")):
+            ("montecarlo", {"runs": 3}, r"montecarlo: a scenario with a case section takes its runs "
+                                        r"from the case builder \(set them in case\.options\)"),
+            ("guidance", {"type": "yaw-rate"}, r"guidance: a scenario with a case section")):
+        data, source = raw_scenario("catamaran-actuator")
+        data[section] = value
+        with pytest.raises(ConfigError, match=message):
+            validate(data, source)
+    for section, value, message in (  # the same sections on a scenario of controllers and guidance
+            ("actuator", {"thrust_time_constant": 1.0}, r"actuator: applies to vessel model "
+                                                         r"vectored-thrust-boat in this release, not "
+                                                         r"'catamaran'$"),
+            ("montecarlo", {"runs": 3}, r"montecarlo: applies to vessel model mariner"),
+            ("disturbance", {"type": "constant", "values": [1, 0, 0]},
+             r"does not fit vessel model 'catamaran' \(it takes none; an earth-fixed current is the "
+             r"current section\)")):
         data, source = raw_scenario("catamaran-turn")
         data[section] = value
         with pytest.raises(ConfigError, match=message):
@@ -148,10 +161,11 @@ def test_the_runner_dispatches_by_the_registry():
     assert isinstance(build(load_scenario("mariner-cst-heading")).controller, HeadingAutopilot)
 
 
-def test_show_of_a_catamaran_case_lists_what_a_set_can_change():
-    """``shipgnc show`` prints the fields that act on the run: every option of the case's builder
-    (with its default), not the initial state and integrator the case does not read; a ``--set``
-    into one of those is refused instead of being ignored."""
+def test_show_of_a_catamaran_scenario_lists_what_a_set_can_change():
+    """``shipgnc show`` prints the fields that act on the run: a case's every builder option
+    (with its default); a scenario of controllers and guidance its sections' fields; neither the
+    initial state and integrator the runs do not read; a ``--set`` into one of those is refused
+    instead of being ignored."""
     import inspect
 
     import yaml
@@ -159,13 +173,18 @@ def test_show_of_a_catamaran_case_lists_what_a_set_can_change():
     from shipgnc.cases import catamaran as cases
     from shipgnc.scenarios.registry import load_scenario, scenario_yaml
 
-    shown = yaml.safe_load(scenario_yaml(load_scenario("catamaran-heading")))
+    shown = yaml.safe_load(scenario_yaml(load_scenario("catamaran-actuator")))
     assert "initial_state" not in shown["simulation"] and "integrator" not in shown["simulation"]
-    assert "sensors" not in shown and "actuator" not in shown
-    signature = inspect.signature(cases.heading).parameters
+    assert "sensors" not in shown and "actuator" not in shown and "controllers" not in shown
+    signature = inspect.signature(cases.actuator).parameters
     expected = {k for k in signature if k not in ("preset_name", "vessel", "t_end", "dt")}
     assert set(shown["case"]["options"]) == expected
-    assert shown["case"]["options"]["psi_target"] == signature["psi_target"].default
+    assert shown["case"]["options"]["T_a"] == signature["T_a"].default
+    shown = yaml.safe_load(scenario_yaml(load_scenario("catamaran-heading")))
+    assert "initial_state" not in shown["simulation"] and "case" not in shown
+    assert shown["guidance"] == {"type": "heading-capture", "psi_target_rad": 0.8, "omega_c": 0.0022,
+                                 "ramp_s": 0.0}  # document 004, S7: K* = 0.8 rad, ω_c = 0.0022 rad/s
+    assert shown["controllers"] == {"law21": {"type": "yaw-rate-fsm", "law": 21}}
     for key in ("simulation.initial_state.u=3", "simulation.integrator=solve_ivp"):
         with pytest.raises(ConfigError, match=r"does not read simulation\.\w+ .*would be ignored"):
             load_scenario("catamaran-turn", [key])

@@ -20,8 +20,9 @@ Registered ids (scenario; initial offsets drawn at each reset):
   −wrap(ψ − K*)²); heading ±30° at reset;
 * ``shipgnc/Ship-v0``: ``gym.make("shipgnc/Ship-v0", scenario=..., perturb=[...])`` for a boat or
   CyberShip II scenario with guidance and metric set ``heading-steps``, ``waypoints`` or
-  ``course-quality``, or a catamaran scenario of case builder ``turn``, ``sine`` or ``heading``
-  (the others have no per-sample reward: ConfigError).
+  ``course-quality``, or a catamaran scenario of a ``yaw-rate-fsm`` law with guidance
+  ``yaw-rate``, ``yaw-rate-sine`` or ``heading-capture`` (or case builder ``turn``, ``sine`` or
+  ``heading``; the other builders have no per-sample reward: ConfigError).
 """
 
 from __future__ import annotations

@@ -16,8 +16,9 @@ period (the final sample t_end included in the last step):
 * ``waypoints`` (note 001-1.10): r = −Σ e² with e the LOS cross-track error [m], over the samples
   the metric counts (along-track distance past the capture distance on their own leg);
 * document 004's catamaran (metric set ``catamaran``, whose figures are end-of-run values, so the
-  reward is the tracking error its runs are about): a yaw-rate case (builders ``turn``, ``sine``)
-  r = −Σ (r − ω*)² [rad²/s²] with ω* the case's reference; a heading case (``heading``)
+  reward is the tracking error its runs are about): a yaw-rate reference (guidance ``yaw-rate``,
+  ``yaw-rate-sine``; case builders ``turn``, ``sine``) r = −Σ (r − ω*)² [rad²/s²] with ω* the
+  reference; a heading capture (guidance ``heading-capture``, case builder ``heading``)
   r = −Σ wrap(ψ − K*)² [rad²] with K* the heading target (``final_heading_error_rad`` is its
   last sample's error). The observation adds K* and wrap(ψ − K*) (``psi_target``, ``psi_error``)
   to the states, the reference ω* and r − ω*. The agent takes the finite-state law's place: the
@@ -52,8 +53,9 @@ REWARDS = ("heading-steps", "course-quality", "waypoints")
 BACKENDS = ("auto", "numpy", "compiled")
 #: an event that makes the compiled loop skip a member (one already done stays frozen)
 _SKIP = np.iinfo(np.int64).max
-#: document 004's case builders an environment takes, with the kind of their per-sample reward
-#: (one plant and one reference for every run of the builder: the agent replaces the law)
+#: document 004's runs an environment takes (:func:`~shipgnc.scenarios.catamaran.run_kind`: a
+#: case builder, or the builder a guidance type matches), with the kind of their per-sample reward
+#: (one plant and one reference for every run: the agent replaces the law)
 CATAMARAN_REWARDS = {"turn": "yaw-rate", "sine": "yaw-rate", "heading": "heading"}
 
 
@@ -70,13 +72,20 @@ class BatchedEpisode:
             raise ConfigError(f"scenario {sc.name!r}: an environment needs a vessel stepped by the generic "
                               "loop with guidance (the vectored-thrust boat, CyberShip II or document "
                               "004's catamaran)")
-        catamaran = sc.kind.shape == "case"
-        self.reward_kind = CATAMARAN_REWARDS.get(sc.case.builder) if catamaran else sc.metrics
-        if catamaran and self.reward_kind is None:
-            raise ConfigError(f"scenario {sc.name!r}: case builder {sc.case.builder!r} has no per-sample "
-                              f"reward; catamaran environments take builders "
-                              f"{', '.join(CATAMARAN_REWARDS)} (one plant tracking one yaw-rate or "
-                              "heading reference)")
+        catamaran = sc.vessel.model == "catamaran"
+        if catamaran:
+            from shipgnc.scenarios.catamaran import run_kind
+
+            runs = run_kind(sc)
+            self.reward_kind = CATAMARAN_REWARDS.get(runs)
+            if self.reward_kind is None:
+                raise ConfigError(f"scenario {sc.name!r}: case builder {runs!r} has no per-sample "
+                                  f"reward; catamaran environments take a yaw-rate-fsm law with "
+                                  f"guidance yaw-rate, yaw-rate-sine or heading-capture, or case "
+                                  f"builders {', '.join(CATAMARAN_REWARDS)} (one plant tracking one "
+                                  "yaw-rate or heading reference)")
+        else:
+            self.reward_kind = sc.metrics
         if not catamaran and sc.metrics not in REWARDS:
             raise ConfigError(f"scenario {sc.name!r}: metric set {sc.metrics!r} has no per-sample "
                               f"reward; environments take a scenario whose metrics are one of "

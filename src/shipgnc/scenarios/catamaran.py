@@ -1,12 +1,21 @@
-"""Document 004's scenarios: the case builders of :mod:`shipgnc.cases.catamaran` driven by a
-validated :class:`~shipgnc.scenarios.schema.Scenario` (note 004-4.7).
+"""Document 004's scenarios (note 004-4.7), in one of two shapes.
 
-A catamaran scenario names a ``case.builder`` and its ``case.options`` (the builder's keyword
-arguments, checked against its signature); ``vessel.preset``, ``simulation.t_end`` and
-``simulation.dt`` are handed to the builder where it takes them. A builder may return several runs
-(e.g. laws (20) and (21)); they share the result's ``controller`` dimension and the metrics are
-keyed by run. The scenario's ``current`` section puts every run in that earth-fixed current
-(:func:`~shipgnc.cases.catamaran.with_current`; the hull forces on the velocity through the water).
+* **controller(s) and guidance**, like every other vessel: ``controllers`` of type
+  ``yaw-rate-fsm`` (law (20) or (21)) and a ``guidance`` reference — ``yaw-rate`` (ω*, S3/S4),
+  ``yaw-rate-sine`` (S6) or ``heading-capture`` (S7). Each controller is one run, keyed by its
+  name (``catamaran-turn``: ``law20``, ``law21``), built as the case builders build theirs
+  (:func:`~shipgnc.cases.catamaran.yaw_rate_case`): the law holds its own reference object, as in
+  the document, so that a continuous law sees ω*(t) at every RK stage.
+* **a case**: ``case.builder`` and its ``case.options`` (the builder's keyword arguments, checked
+  against its signature), for the comparisons whose runs differ in more than the controller — the
+  reference (``steps``), the plant (``actuator``, ``montecarlo``), the duration (``compare``) or
+  the law's presence (``fixed-angle``). ``vessel.preset``, ``simulation.t_end`` and
+  ``simulation.dt`` are handed to the builder where it takes them.
+
+Either way a scenario may hold several runs; they share the result's ``controller`` dimension and
+the metrics are keyed by run. The scenario's ``current`` section puts every run in that earth-fixed
+current (:func:`~shipgnc.cases.catamaran.with_current`; the hull forces on the velocity through
+the water).
 """
 
 from __future__ import annotations
@@ -46,8 +55,75 @@ def builder_options(name: str) -> dict[str, object]:
             if p.name not in ("preset_name", "vessel")}
 
 
+#: the case builder whose runs (and figures, and environment reward) a controlled scenario's
+#: guidance type matches
+GUIDANCE_RUNS = {"yaw-rate": "turn", "yaw-rate-sine": "sine", "heading-capture": "heading"}
+
+
+def run_kind(scenario: Scenario) -> str:
+    """What the scenario's runs are: its case builder, or for controller(s) and guidance the
+    builder of the same runs (:data:`GUIDANCE_RUNS`: ``turn``, ``sine`` or ``heading``)."""
+    return scenario.case.builder if scenario.case is not None else GUIDANCE_RUNS[scenario.guidance.type]
+
+
+def _reference(guidance):
+    """A fresh reference object of a ``guidance`` section (each run latches its own)."""
+    from shipgnc.cases.catamaran import T_END
+    from shipgnc.control.finite_state import ConstantRate, HeadingCapture, SineRate
+
+    if guidance.type == "yaw-rate":
+        return ConstantRate(guidance.omega)
+    if guidance.type == "yaw-rate-sine":
+        return SineRate.document(guidance.reading, T_END, guidance.amplitude)
+    return HeadingCapture(guidance.psi_target_rad, guidance.omega_c, ramp_s=guidance.ramp_s)
+
+
+def _controlled_cases(scenario: Scenario) -> dict:
+    """The runs of a scenario with controller(s) and guidance: one
+    :func:`~shipgnc.cases.catamaran.yaw_rate_case` per controller, on the scenario's vessel."""
+    from shipgnc.cases.catamaran import yaw_rate_case
+
+    sim, guidance = scenario.simulation, scenario.guidance
+    overrides = _checked_overrides(scenario)
+    built = {}
+    for name, cfg in scenario.variants.items():
+        case = yaw_rate_case(f"{scenario.name}/{name}", scenario.vessel.preset, cfg.law,
+                             _reference(guidance), t_end=sim.t_end, dt=sim.dt, Ts=cfg.Ts,
+                             T_u=cfg.T_u, h=cfg.h, vessel=overrides)
+        if guidance.type == "heading-capture":
+            case.heading_target = float(guidance.psi_target_rad)
+        built[name] = case
+    return built
+
+
+def _checked_overrides(scenario: Scenario) -> dict | None:
+    """The vessel section's parameter overrides (None: none), unknown names and bad values
+    refused here, once."""
+    overrides = scenario.vessel.overrides()
+    if not overrides:
+        return None
+    from shipgnc.models.catamaran import preset
+
+    preset(scenario.vessel.preset, **overrides)
+    return overrides
+
+
 def cases(scenario: Scenario) -> dict:
     """The runs of the scenario: run key → :class:`~shipgnc.cases.catamaran.CatamaranCase`."""
+    if scenario.case is None:
+        built = _controlled_cases(scenario)
+    else:
+        built = _case_runs(scenario)
+    if scenario.current is not None:  # every run in the same current, each with its own object
+        from shipgnc.cases.catamaran import with_current
+
+        for case in built.values():
+            with_current(case, scenario.current.build())
+    return built
+
+
+def _case_runs(scenario: Scenario) -> dict:
+    """The runs of a scenario's case builder (``case.options`` checked against its signature)."""
     from shipgnc.cases.catamaran import DT, CatamaranCase
 
     cfg, sim = scenario.case, scenario.simulation
@@ -71,11 +147,8 @@ def cases(scenario: Scenario) -> dict:
     elif scenario.vessel.preset != "si-consistent":
         raise ConfigError(f"vessel.preset = {scenario.vessel.preset!r}: builder {cfg.builder!r} runs "
                           "preset 'si-consistent' only")
-    overrides = scenario.vessel.overrides()
+    overrides = _checked_overrides(scenario)
     if overrides:
-        from shipgnc.models.catamaran import preset
-
-        preset(scenario.vessel.preset, **overrides)  # unknown names and bad values fail here, once
         kwargs["vessel"] = overrides
     if "t_end" in params and "t_end" not in kwargs:
         kwargs["t_end"] = sim.t_end
@@ -88,11 +161,6 @@ def cases(scenario: Scenario) -> dict:
     if isinstance(built, CatamaranCase):
         law = getattr(built, "notes", {}).get("law")
         built = {f"law{law}" if law else cfg.builder: built}
-    if scenario.current is not None:  # every run in the same current, each with its own object
-        from shipgnc.cases.catamaran import with_current
-
-        for case in built.values():
-            with_current(case, scenario.current.build())
     return built
 
 
@@ -146,7 +214,7 @@ def score(scenario: Scenario, ds, case, controller=None) -> dict:
     note = model_fields(case.model, scenario.vessel.preset)
     if np.ndim(case.x0) > 1:
         return {**montecarlo_summary(ds, case), **note}
-    if scenario.case.builder == "compare":
+    if scenario.case is not None and scenario.case.builder == "compare":
         return {**catamaran_metrics(ds, controller, case.heading_target),
                 **comparison_metrics(ds, case.heading_target), **note}
     return {**catamaran_metrics(ds, controller, case.heading_target), **note}

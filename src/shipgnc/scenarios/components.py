@@ -44,9 +44,9 @@ class VesselKind:
     is its own, e.g. document 000's path-frame controllers), ``run(scenario, seed=, progress=,
     on_divergence=, keep_interrupted=) -> ScenarioRun`` (a vessel whose runs are its own),
     ``controller(cfg, model, scenario)`` (its own controller builder), ``initial_state(scenario,
-    seed) -> x0``, ``check(scenario)`` (rules of its own, raising ValueError). ``shape``:
-    ``controlled`` (vessel, controller(s), guidance, disturbance) or ``case`` (document 004's case
-    builders)."""
+    seed) -> x0``, ``check(scenario)`` (rules of its own, raising ValueError). ``cases``: also
+    takes a ``case`` section (document 004's case builders: comparisons whose runs differ in
+    reference, plant or duration) in place of controller(s) and guidance."""
 
     model: str
     config: type
@@ -58,7 +58,7 @@ class VesselKind:
     sections: tuple[str, ...] = ()
     ignores: tuple[str, ...] = ()
     comparisons: bool = True
-    shape: Literal["controlled", "case"] = "controlled"
+    cases: bool = False
     setup: str | None = None
     run: str | None = None
     controller: str | None = None
@@ -102,14 +102,15 @@ class DisturbanceKind:
 @dataclass(frozen=True)
 class MetricKind:
     """A ``metrics`` set: the guidance type it scores against (None: any), the controller types it
-    needs (None: any), the sections it reads and the scenario shape it scores (``controlled``,
-    ``case``, ``route``; None: any)."""
+    needs (None: any), the sections it reads, the scenario shape it scores (``controlled``,
+    ``route``; None: any) and the vessel models it scores (None: any)."""
 
     name: str
-    shape: Literal["controlled", "case", "route"] | None = None
+    shape: Literal["controlled", "route"] | None = None
     guidance: str | None = None
     controllers: tuple[str, ...] | None = None
     sections: tuple[str, ...] = ()
+    vessels: tuple[str, ...] | None = None
 
 
 CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
@@ -121,6 +122,8 @@ CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
     ControllerKind("lqr", S.PathLQRConfig, guidance=("path",)),
     ControllerKind("fl", S.OutputFLConfig, guidance=("path",)),
     ControllerKind("los-fl", S.LOSFLConfig, guidance=("path",)),
+    ControllerKind("yaw-rate-fsm", S.YawRateFSMConfig,
+                   guidance=("yaw-rate", "yaw-rate-sine", "heading-capture")),
 )}
 
 GUIDANCE: dict[str, GuidanceKind] = {k.type: k for k in (
@@ -128,6 +131,11 @@ GUIDANCE: dict[str, GuidanceKind] = {k.type: k for k in (
     GuidanceKind("los", S.LOSConfig, build="shipgnc.scenarios.runner:los_guidance"),
     GuidanceKind("course-schedule", S.CourseScheduleConfig, build="shipgnc.scenarios.runner:course_schedule"),
     GuidanceKind("path", S.PathConfig, vessels=("mariner",)),
+    # document 004's references: the law holds its reference (evaluated at every RK stage in
+    # continuous mode), so the catamaran's set-up builds them with the controller
+    GuidanceKind("yaw-rate", S.YawRateGuidanceConfig, vessels=("catamaran",)),
+    GuidanceKind("yaw-rate-sine", S.YawRateSineConfig, vessels=("catamaran",)),
+    GuidanceKind("heading-capture", S.HeadingCaptureConfig, vessels=("catamaran",)),
 )}
 
 DISTURBANCES: dict[str, DisturbanceKind] = {k.type: k for k in (
@@ -143,7 +151,7 @@ METRICS: dict[str, MetricKind] = {k.name: k for k in (
     MetricKind("waypoints", "controlled", guidance="los"),
     MetricKind("course-quality", "controlled", guidance="course-schedule", sections=("quality",)),
     MetricKind("path-tracking", "controlled", guidance="path"),
-    MetricKind("catamaran", "case"),
+    MetricKind("catamaran", vessels=("catamaran",)),
     MetricKind("route", "route"),
     MetricKind("none"),
 )}
@@ -162,8 +170,9 @@ VESSEL_KINDS: dict[str, VesselKind] = {k.model: k for k in (
                initial_state="shipgnc.scenarios.mariner:initial_states",
                check="shipgnc.scenarios.mariner:check"),
     VesselKind("catamaran", S.CatamaranVesselConfig, "shipgnc.scenarios.catamaran:vessel_parts",
-               current=True, sections=("case",), shape="case",
-               # a case sets its own initial state and integrates with RK4 at its step
+               controllers=("yaw-rate-fsm",), current=True, cases=True,
+               # its runs set their own initial state (document 004: u = 4 m/s, the rest 0)
+               # and integrate with RK4 at their step
                ignores=("simulation.initial_state", "simulation.integrator", "simulation.method",
                         "simulation.rtol", "simulation.atol"),
                setup="shipgnc.scenarios.catamaran:setup_of", run="shipgnc.scenarios.catamaran:run",
@@ -191,9 +200,9 @@ def having(flag: str) -> tuple[str, ...]:
                  if getattr(kind, flag, False) is True or flag in kind.sections)
 
 
-def having_shape(shape: str) -> tuple[str, ...]:
-    """The vessel models of scenario shape ``shape`` (``controlled`` or ``case``)."""
-    return tuple(name for name, kind in VESSEL_KINDS.items() if kind.shape == shape)
+def having_cases() -> tuple[str, ...]:
+    """The vessel models that take a ``case`` section."""
+    return tuple(name for name, kind in VESSEL_KINDS.items() if kind.cases)
 
 
 def config_classes(table: dict) -> tuple[type, ...]:

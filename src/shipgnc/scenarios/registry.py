@@ -192,7 +192,7 @@ def scenario_yaml(scenario: Scenario) -> str:
             node = node.get(part, {}) if isinstance(node, dict) else {}
         if isinstance(node, dict):
             node.pop(leaf, None)
-    if scenario.route is None and scenario.kind.shape == "case":
+    if scenario.shape == "case":
         from shipgnc.scenarios.catamaran import builder_options
 
         defaults = {k: v for k, v in builder_options(scenario.case.builder).items()

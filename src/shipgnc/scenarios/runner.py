@@ -242,8 +242,9 @@ def wave_loads(d, scenario: Scenario):
 
 def variant_names(scenario: Scenario) -> list[str] | None:
     """The names of a ``controller`` dimension: a comparison's controllers, or the run keys of a
-    catamaran scenario with several runs (e.g. laws 20 and 21); None for one run."""
-    if scenario.kind.shape == "case":
+    catamaran scenario with several runs (e.g. laws 20 and 21; one run has none, as its
+    ``shipgnc run``); None for one run."""
+    if scenario.kind.run is not None:  # a vessel whose runs are its own
         from shipgnc.scenarios import catamaran
 
         keys = catamaran.run_keys(scenario)
@@ -260,7 +261,7 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
     its own (the Mariner's path-frame controllers) is set up by it."""
     kind = scenario.kind
     seed = seed if seed is not None else (scenario.simulation.seed or 0)
-    if kind.shape == "case":
+    if scenario.shape == "case":
         return C.resolve(kind.setup)(scenario, variant, seed)
     variants = scenario.variants
     name = variant if variant is not None else next(iter(variants))

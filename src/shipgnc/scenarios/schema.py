@@ -80,7 +80,8 @@ class Scenario(Strict):
     disturbance: DisturbanceConfig | None = None
     quality: QualityConfig = Field(default_factory=QualityConfig)
     montecarlo: MonteCarloConfig | None = None
-    #: document 004's case (vessel model ``catamaran`` only)
+    #: document 004's case builders (vessel model ``catamaran``), in place of controller(s) and
+    #: guidance: comparisons whose runs differ in reference, plant or duration
     case: CatamaranCaseConfig | None = None
     #: document 002's routing problem, and optionally a ship sailing the route
     route: RouteConfig | None = None
@@ -113,6 +114,14 @@ class Scenario(Strict):
         return C.of_vessel(self.vessel.model)
 
     @property
+    def shape(self) -> str:
+        """``route`` (a route section), ``case`` (document 004's case builders) or ``controlled``
+        (vessel, controller(s), guidance, disturbance)."""
+        if self.route is not None:
+            return "route"
+        return "case" if self.case is not None else "controlled"
+
+    @property
     def variants(self) -> dict[str, object]:
         """Controllers by name (one unnamed controller is called ``controller``)."""
         return dict(self.controllers) if self.controllers else {"controller": self.controller}
@@ -125,18 +134,20 @@ class Scenario(Strict):
         """The top-level sections this kind of scenario reads; a ``--set`` into any other would
         be silently ignored, so :func:`~shipgnc.scenarios.registry.load_scenario` refuses it.
         Every scenario reads its identity (``name``, ``description``, ``document``, ``metrics``,
-        ``document_figures``); a route reads ``route`` and ``sail``; a case-shaped vessel (the
-        catamaran) ``vessel``, ``simulation``, its own sections and ``current``; the others their
-        vessel, simulation, controller(s), guidance and disturbance, plus the sections their
-        registry entry names (the boat's ``actuator``, the Mariner's ``montecarlo``), ``current``
-        and ``sensors``/``estimator`` where the vessel takes them, and the metric set's (document
+        ``document_figures``); a route reads ``route`` and ``sail``; a case (document 004's
+        builders) ``vessel``, ``simulation``, ``case`` and ``current``; the others their vessel,
+        simulation, controller(s), guidance and disturbance, plus the sections their registry
+        entry names (the boat's ``actuator``, the Mariner's ``montecarlo``), ``current`` and
+        ``sensors``/``estimator`` where the vessel takes them, and the metric set's (document
         003's ``quality``)."""
         common = ("name", "description", "document", "metrics", "document_figures")
         if self.route is not None:
             return (*common, "route", "sail")
         kind = self.kind
         used = [*common, "vessel", "simulation"]
-        if kind.shape == "controlled":
+        if self.shape == "case":
+            used.append("case")
+        else:
             used += ["controller", "controllers", "guidance", "disturbance"]
         used += kind.sections
         if kind.current:
@@ -148,7 +159,7 @@ class Scenario(Strict):
 
     def ignored_fields(self) -> tuple[str, ...]:
         """Dotted fields of the used sections that this scenario's vessel does not read (its
-        registry entry's ``ignores``: a catamaran case sets its own initial state)."""
+        registry entry's ``ignores``: the catamaran's runs set their own initial state)."""
         return () if self.route is not None else self.kind.ignores
 
     @model_validator(mode="wrap")
@@ -180,10 +191,10 @@ class Scenario(Strict):
         if self.simulation is None:
             raise ValueError("simulation: required field is missing (dt, t_end, ...)")
         kind = self.kind
-        if self.case is not None and kind.shape != "case":
+        if self.case is not None and not kind.cases:
             raise ValueError(f"case: document 004's cases need vessel model "
-                             f"{' or '.join(map(repr, C.having_shape('case')))}, not {self.vessel.model!r}")
-        if kind.shape == "case":
+                             f"{' or '.join(map(repr, C.having_cases()))}, not {self.vessel.model!r}")
+        if self.shape == "case":
             return self._consistent_case(kind)
         self._ignored_unset(kind)
         self._sections_fit(kind)
@@ -191,8 +202,10 @@ class Scenario(Strict):
         self._guidance_fits(kind)
         dist = self.disturbance.type if self.disturbance is not None else None
         if dist is not None and dist not in kind.disturbances:
+            allowed = (f"allowed: {', '.join(kind.disturbances)}" if kind.disturbances
+                       else "it takes none; an earth-fixed current is the current section")
             raise ValueError(f"disturbance type {dist!r} does not fit vessel model "
-                             f"{self.vessel.model!r} (allowed: {', '.join(kind.disturbances)})")
+                             f"{self.vessel.model!r} ({allowed})")
         if kind.check is not None:
             C.resolve(kind.check)(self)
         return self
@@ -232,8 +245,7 @@ class Scenario(Strict):
     def _sections_fit(self, kind: C.VesselKind) -> None:
         """A section that only some vessels read (their entries' ``sections``) is refused on
         another, with the vessels that read it."""
-        optional = dict.fromkeys(s for k in C.VESSEL_KINDS.values() if k.shape == kind.shape
-                                 for s in k.sections)
+        optional = dict.fromkeys(s for k in C.VESSEL_KINDS.values() for s in k.sections)
         for section in optional:
             default = type(self).model_fields[section].get_default(call_default_factory=True)
             if getattr(self, section) != default and section not in kind.sections:
@@ -241,7 +253,8 @@ class Scenario(Strict):
                 raise ValueError(f"{section}: applies to vessel model {' and '.join(readers)} in "
                                  f"this release, not {self.vessel.model!r}"
                                  + ("; the steering machine is set in vessel (rudder_max_deg, "
-                                    "rudder_rate_deg_s)" if section == "actuator" else ""))
+                                    "rudder_rate_deg_s)" if section == "actuator"
+                                    and hasattr(self.vessel, "rudder_max_deg") else ""))
 
     def _controllers_fit(self, kind: C.VesselKind) -> None:
         if (self.controller is None) == (self.controllers is None):
@@ -281,10 +294,10 @@ class Scenario(Strict):
             raise ValueError(f"metrics = {self.metrics!r} needs controller type "
                              f"{' or '.join(map(repr, metric.controllers))}")
         if metric.shape not in (None, "controlled"):
-            raise ValueError(f"metrics = {self.metrics!r}: scores "
-                             + ("a route scenario" if metric.shape == "route"
-                                else f"the cases of vessel model "
-                                     f"{' or '.join(map(repr, C.having_shape(metric.shape)))}"))
+            raise ValueError(f"metrics = {self.metrics!r}: scores a route scenario")
+        if metric.vessels is not None and self.vessel.model not in metric.vessels:
+            raise ValueError(f"metrics = {self.metrics!r}: scores vessel model "
+                             f"{' or '.join(map(repr, metric.vessels))}, not {self.vessel.model!r}")
 
     def _consistent_route(self) -> Scenario:
         if self.route is None:
@@ -298,17 +311,15 @@ class Scenario(Strict):
         return self
 
     def _consistent_case(self, kind: C.VesselKind) -> Scenario:
-        if self.case is None:
-            raise ValueError("case: a catamaran scenario names a case builder (allowed: "
-                             f"{', '.join(CATAMARAN_BUILDERS)})")
         for name in ("controller", "controllers", "guidance", "disturbance", "montecarlo"):
             if getattr(self, name) is not None:
-                raise ValueError(f"{name}: a catamaran scenario's runs come from its case builder; "
-                                 "set them in case.options")
+                raise ValueError(f"{name}: a scenario with a case section takes its runs from the "
+                                 "case builder (set them in case.options); or leave out case and "
+                                 "give controller(s) and guidance")
         if self.actuator != ActuatorConfig():
             raise ValueError("actuator: the catamaran's thruster is set in case.options")
         self._ignored_unset(kind)
-        if C.METRICS[self.metrics].shape not in (None, "case"):
+        if self.metrics not in ("catamaran", "none"):
             raise ValueError(f"metrics = {self.metrics!r}: a catamaran scenario reports 'catamaran'")
         return self
 

@@ -384,6 +384,21 @@ class ReferenceEntry(Strict):
     u: Positive
 
 
+class YawRateFSMConfig(Strict):
+    """``controller`` type ``yaw-rate-fsm``: document 004's finite-state yaw-rate law (20) (ω̄
+    from the model) or (21) (the measured r), eq. (20)–(21), designed on the scenario's vessel
+    (preset and overrides), its reference the scenario's ``guidance`` (yaw rate, sine or heading
+    capture). ``T_u``, ``h`` [s]: the law's time constants (null: the preset's, note 004-4.7 —
+    2.5 s for ``si`` and ``si-consistent``, 0.1 s and 0.0625 s for ``paper``); ``Ts`` [s]: a
+    sampled law (null: continuous, the document's mode)."""
+
+    type: Literal["yaw-rate-fsm"]
+    law: Literal[20, 21] = 21
+    T_u: Positive | None = None
+    h: Positive | None = None
+    Ts: Positive | None = None
+
+
 class ScheduleGuidanceConfig(Strict):
     """Heading and speed set-points from time t on."""
 
@@ -450,6 +465,33 @@ class PathConfig(Strict):
 
 
 # --------------------------------------------------------------------------- disturbance
+
+class YawRateGuidanceConfig(Strict):
+    """A constant yaw-rate reference ω* [rad/s] (document 004, S3/S4: 0.08, 0.008, 0.00072)."""
+
+    type: Literal["yaw-rate"]
+    omega: Finite = 0.08
+
+
+class YawRateSineConfig(Strict):
+    """The sine yaw-rate reference of S6, ω* = ``amplitude`` sin(8πt/t_f) with t_f = 1 500 s
+    (``reading: pi``, C11) or sin(8t/t_f) (``literal``); ``amplitude`` [rad/s]."""
+
+    type: Literal["yaw-rate-sine"]
+    amplitude: Finite = 0.0072
+    reading: Literal["pi", "literal"] = "pi"
+
+
+class HeadingCaptureConfig(Strict):
+    """Heading capture (17) of S7: ω* = ±``omega_c`` [rad/s] until the heading ``psi_target_rad``
+    (K*, the document's 0.8 rad) is reached, then 0; ``ramp_s`` > 0 replaces the jump to 0 by a
+    ramp of that length (the same area, so the same heading)."""
+
+    type: Literal["heading-capture"]
+    psi_target_rad: Finite = 0.8
+    omega_c: Positive = 0.0022
+    ramp_s: NonNegative = 0.0
+
 
 class ConstantForceConfig(Strict):
     """Constant body-frame force and moment [X N, Y N, N N·m] (a current: the scenario's

@@ -75,7 +75,7 @@ def figure_job(run: ScenarioRun, out: Path):
     lower, upper = model.input_limits()
     limits = {s.name: (float(lower[i]), float(upper[i])) for i, s in enumerate(model.inputs)}
     names = list(run.setups) if run.setups is not None else list(run.scenario.variants)
-    if run.scenario.kind.shape == "case":
+    if run.scenario.vessel.model == "catamaran":
         if "controller" in run.result.dims:
             runs = {n: run.result.sel(controller=n).dropna("time", how="all") for n in names}
         else:
@@ -86,7 +86,9 @@ def figure_job(run: ScenarioRun, out: Path):
         runs = {k: batch_bands(ds) if "ship" in ds.dims else ds for k, ds in runs.items()}
         target = getattr(run.setup.controller, "omega_ref", None)
         omega = getattr(target, "omega", None)
-        options = {"builder": run.scenario.case.builder, "preset": run.scenario.vessel.preset,
+        from shipgnc.scenarios.catamaran import run_kind
+
+        options = {"builder": run_kind(run.scenario), "preset": run.scenario.vessel.preset,
                    "heading_target": float(getattr(target, "psi_target", 0.0) or 0.0),
                    "omega": float(omega) if omega is not None and np.ndim(omega) == 0 else None,
                    "model_note": model_fields(run.setup.model, run.scenario.vessel.preset)["model_note"]}

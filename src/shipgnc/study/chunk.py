@@ -55,7 +55,7 @@ def check_sweepable(scenario) -> None:
     if scenario.route is not None:
         raise ConfigError(f"scenario {scenario.name!r} is a routing problem (document 002): "
                           "sweep a simulation scenario")
-    if scenario.kind.shape == "case":  # its runs: runner.build's Setup of each run key
+    if scenario.shape == "case":  # its runs: runner.build's Setup of each run key
         case, t_end = scenario.case, scenario.simulation.t_end
         if case.builder == "montecarlo":
             raise ConfigError(f"scenario {scenario.name!r} is itself one batched run of plant draws "
