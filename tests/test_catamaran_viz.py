@@ -63,10 +63,11 @@ def test_every_run_is_drawn_and_titles_come_from_the_data():
 
 def test_turn_figure_frames_the_transient_and_names_the_law():
     runs = _fake_runs(["law20", "law21"])
-    figs = dict((name, fig) for fig, name in V.scenario_figures(runs, {"builder": "turn"},
+    figs = dict((name, fig) for fig, name in V.scenario_figures(runs, {"builder": "turn", "omega": 0.04},
                                                                  "catamaran-turn"))
     fig = figs["turn.png"]
     assert "law (21)" in fig._suptitle.get_text()
+    assert "ω* = 0.04 rad/s" in fig._suptitle.get_text()  # the run's reference, not the default's
     zoom = [ax for ax in fig.axes if "transient" in ax.get_title()]
     assert zoom and all(ax.get_xlim()[1] <= 65.0 for ax in zoom)
     assert _lines(figs["yaw_rate.png"]) == 2

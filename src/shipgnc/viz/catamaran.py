@@ -248,7 +248,9 @@ def scenario_figures(runs: dict, options: dict, title: str) -> list[tuple[object
     elif builder == "turn":
         key = "law21" if "law21" in runs else next(iter(runs))
         law = f"law ({key[3:]})" if key.startswith("law") else key
-        figures.append((fig_turn(runs[key], f"{title}: turn at ω* = 0.08 rad/s, FSM {law}", note=note),
+        omega = options.get("omega")
+        at = f" at ω* = {omega:g} rad/s" if omega is not None else ""
+        figures.append((fig_turn(runs[key], f"{title}: turn{at}, FSM {law}", note=note),
                         "turn.png"))
         figures.append((fig_yaw_rate_laws(runs, title=f"{title}: yaw rate, {', '.join(runs)}", note=note),
                         "yaw_rate.png"))
