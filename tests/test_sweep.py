@@ -345,8 +345,8 @@ def test_a_member_run_again_alone_draws_the_sensor_noise_of_its_batch_run():
     setup = build(scenario, seed=study.seed)
     x0 = np.tile(setup.x0, (3, 1))
     seeds = study.member_seeds(0, 3, 1)
-    batch = _run_batch(setup, scenario, x0, seeds, "numpy", False, "mask")[0]
-    alone = _run_batch(_alone(setup, 1), scenario, x0[1:2], seeds[1:2], "numpy", False)[0]
+    batch = _run_batch(setup, scenario.simulation, x0, seeds, "numpy", False, "mask")[0]
+    alone = _run_batch(_alone(setup, 1), scenario.simulation, x0[1:2], seeds[1:2], "numpy", False)[0]
     measured = [v for v in batch.data_vars if v.endswith("_meas")]
     assert {"north_meas", "psi_meas"} <= set(measured)
     for name in (*measured, "north", "psi"):

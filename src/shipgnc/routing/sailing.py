@@ -198,12 +198,32 @@ def boat_sail(route, field, mode: str, *, preset: str = "otter", dt: float = 0.0
     as the set-point at every control sample). Starts on the route's initial heading at speed V through
     the water. Returns the ``xarray.Dataset`` of the run.
     """
+    from shipgnc.sim.simulator import simulate
+
+    run = boat_sail_run(route, field, mode, preset=preset, dt=dt, t_end=t_end, heading=heading,
+                        n_points=n_points, lookahead=lookahead, integral_gain=integral_gain)
+    return simulate(run.model, run.x0, **run.options, seed=seed, backend=backend)
+
+
+@dataclass
+class SailRun:
+    """One sailed run, ready for ``simulate(model, x0, **options)`` (``options``: ``t_end``,
+    ``dt``, ``controller``, ``actuator``, ``guidance``, ``disturbance``)."""
+
+    model: object
+    x0: np.ndarray
+    options: dict
+
+
+def boat_sail_run(route, field, mode: str, *, preset: str = "otter", dt: float = 0.05,
+                  t_end: float, heading=None, n_points: int = 40, lookahead: float | None = None,
+                  integral_gain: float = 0.0) -> SailRun:
+    """The run :func:`boat_sail` simulates (its arguments), not yet simulated."""
     from shipgnc.actuators import Actuator
     from shipgnc.control.heading_speed import HeadingSpeedAutopilot
     from shipgnc.guidance.los import LOSGuidance
     from shipgnc.guidance.schedule import ReferenceSchedule
     from shipgnc.paths import WaypointPath
-    from shipgnc.sim.simulator import simulate
 
     boat = VectoredThrustBoat.from_preset(preset)
     model = BoatInCurrent(boat)
@@ -221,10 +241,10 @@ def boat_sail(route, field, mode: str, *, preset: str = "otter", dt: float = 0.0
         guidance = ReferenceSchedule(samples, psi, np.full(samples.size, V))
     else:
         raise ValueError(f"mode = {mode!r}: allowed path, heading")
-    return simulate(model, x0, t_end=steps * dt, dt=dt,
-                    controller=HeadingSpeedAutopilot(boat.params, Ts=dt),
-                    actuator=Actuator.for_model(model), guidance=guidance,
-                    disturbance=FieldCurrent(field, t0), seed=seed, backend=backend)
+    return SailRun(model, x0, {"t_end": steps * dt, "dt": dt,
+                               "controller": HeadingSpeedAutopilot(boat.params, Ts=dt),
+                               "actuator": Actuator.for_model(model), "guidance": guidance,
+                               "disturbance": FieldCurrent(field, t0)})
 
 
 class ShiftedField:
@@ -266,10 +286,22 @@ def mariner_sail(route, field, heading, *, dt: float, t_end: float, seed: int = 
     :class:`~shipgnc.control.feedback_linearization.HeadingFL` on ``heading``, which then only gives the
     initial heading.
     """
+    from shipgnc.sim.simulator import simulate
+
+    run = mariner_sail_run(route, field, heading, dt=dt, t_end=t_end, model=model,
+                           controller=controller)
+    ds = simulate(run.model, run.x0, **run.options, seed=seed, backend=backend)
+    distance = np.hypot(ds["north"].values - route.target[0], ds["east"].values - route.target[1])
+    k = int(np.argmin(distance))
+    return ds, float(ds["time"].values[k]), float(distance[k])
+
+
+def mariner_sail_run(route, field, heading, *, dt: float, t_end: float, model=None,
+                     controller=None) -> SailRun:
+    """The run :func:`mariner_sail` simulates (its arguments), not yet simulated."""
     from shipgnc.control.feedback_linearization import HeadingFL
     from shipgnc.guidance.schedule import HeadingProfile
     from shipgnc.models.mariner import MarinerDisturbance, MarinerWitOppe, rudder
-    from shipgnc.sim.simulator import simulate
 
     model = MarinerWitOppe() if model is None else model
     p = model.params
@@ -280,14 +312,11 @@ def mariner_sail(route, field, heading, *, dt: float, t_end: float, seed: int = 
     samples = np.arange(steps + 1) * dt
     guidance = None if controller is not None else \
         HeadingProfile(lambda t: heading(t0 + t), samples=samples)
-    ds = simulate(model, x0, t_end=steps * dt, dt=dt,
-                  controller=HeadingFL(p, Ts=dt) if controller is None else controller,
-                  actuator=rudder(p), guidance=guidance,
-                  disturbance=MarinerDisturbance(0.0, current=ShiftedField(field, t0)), seed=seed,
-                  backend=backend)
-    distance = np.hypot(ds["north"].values - route.target[0], ds["east"].values - route.target[1])
-    k = int(np.argmin(distance))
-    return ds, float(ds["time"].values[k]), float(distance[k])
+    return SailRun(model, x0, {
+        "t_end": steps * dt, "dt": dt,
+        "controller": HeadingFL(p, Ts=dt) if controller is None else controller,
+        "actuator": rudder(p), "guidance": guidance,
+        "disturbance": MarinerDisturbance(0.0, current=ShiftedField(field, t0))})
 
 
 def _takes_arrays(fn) -> bool:

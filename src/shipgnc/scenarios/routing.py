@@ -24,6 +24,9 @@ composed loop (the programme tabulated at the control samples, the field by its 
 
 from __future__ import annotations
 
+import functools
+from dataclasses import dataclass
+
 import numpy as np
 
 from shipgnc.routing.sailing import ShiftedField as _shifted  # noqa: F401  (its earlier name here)
@@ -56,17 +59,6 @@ def solve(cfg):
                          horizon=None if cfg.horizon is None else cfg.horizon * hours,
                          grid_spacing=None if cfg.grid is None else cfg.grid * length)
     return field, result
-
-
-def sail(route, field, heading, *, dt: float, t_end: float, seed: int = 0,
-         backend: str = "auto", model=None, controller=None):
-    """The Mariner steering ``heading(t)`` from the route's start through ``field``:
-    :func:`shipgnc.routing.sailing.mariner_sail` (its arguments and its ``(dataset, closest_s,
-    miss_m)``)."""
-    from shipgnc.routing.sailing import mariner_sail
-
-    return mariner_sail(route, field, heading, dt=dt, t_end=t_end, seed=seed, backend=backend,
-                        model=model, controller=controller)
 
 
 #: the vessels that can sail a route, with their default simulation step [s]
@@ -112,13 +104,138 @@ def _check_speed(cfg, route_cfg) -> None:
 def _outcome(prefix: str, ds, route, radius: float) -> dict:
     """``{prefix}_arrived``, ``_arrival_s`` and ``_arrival_ratio`` (None when not arrived) and
     ``_miss_m`` (the closest approach) of one sailed run."""
+    return {f"{prefix}_{key}": value for key, value in outcome(ds, route, radius).items()}
+
+
+def outcome(ds, route, radius: float) -> dict:
+    """``arrived``, ``arrival_s`` and ``arrival_ratio`` (None when not arrived) and ``miss_m``
+    (the closest approach) of one sailed run (:func:`~shipgnc.routing.sailing.arrival`)."""
     from shipgnc.routing.sailing import arrival
 
     a = arrival(ds, route.target, radius)
-    return {f"{prefix}_arrived": a.arrived,
-            f"{prefix}_arrival_s": a.time_s,
-            f"{prefix}_arrival_ratio": None if a.time_s is None else a.time_s / route.time_s,
-            f"{prefix}_miss_m": a.miss_m}
+    return {"arrived": a.arrived, "arrival_s": a.time_s,
+            "arrival_ratio": None if a.time_s is None else a.time_s / route.time_s,
+            "miss_m": a.miss_m}
+
+
+def crosstrack(ds) -> dict:
+    """``crosstrack_rms_m`` and ``crosstrack_max_m`` of a run along the route's waypoints (LOS)."""
+    e = ds["cross_track_error"].values
+    e = e[np.isfinite(e)]
+    return {"crosstrack_rms_m": float(np.sqrt(np.mean(e**2))),
+            "crosstrack_max_m": float(np.max(np.abs(e)))}
+
+
+@dataclass
+class SailPlan:
+    """How the scenario's ship sails its solved route: the acceptance radius [m], the step and
+    duration [s] and (computed when first read) the constant-heading legs."""
+
+    route: object
+    field: object
+    radius: float
+    dt: float
+    t_end: float
+    n_legs: int
+
+    @functools.cached_property
+    def legs(self):
+        """The route's best ``n_legs`` constant-heading legs (``RouteResult.constant_heading_legs``)."""
+        return self.route.constant_heading_legs(n_legs=self.n_legs)
+
+
+def sail_plan(cfg, field, route) -> SailPlan:
+    """The :class:`SailPlan` of a solved, reachable route by the ``sail`` section ``cfg``."""
+    length, _ = sail_vessel(cfg)
+    radius = cfg.acceptance_radius if cfg.acceptance_radius is not None \
+        else cfg.acceptance_lengths * length
+    dt = cfg.dt if cfg.dt is not None else SAIL_DT[cfg.vessel]
+    return SailPlan(route, field, float(radius), dt, route.time_s * (1.0 + cfg.margin), cfg.legs)
+
+
+#: each sailed run's label (figures), by run key: the key is its metrics' prefix
+SAIL_LABELS = {"path": "LOS through the route's waypoints", "sail": "optimal heading programme",
+               "legs": "constant-heading legs"}
+
+
+def sail_runs(scenario: Scenario) -> list[str]:
+    """The run keys of the scenario's sailed runs: the boat ``path``, ``sail`` and ``legs``, the
+    Mariner ``sail`` and ``legs``."""
+    return ["sail", "legs"] if scenario.sail.vessel == "mariner" else ["path", "sail", "legs"]
+
+
+def sail_run(scenario: Scenario, plan: SailPlan, key: str):
+    """Sailed run ``key`` (:func:`sail_runs`) of ``plan``, not yet simulated: a
+    :class:`~shipgnc.routing.sailing.SailRun`."""
+    from shipgnc.routing.sailing import boat_sail_run, mariner_sail_run
+
+    cfg, route = scenario.sail, plan.route
+    heading = route.heading if key == "sail" else plan.legs.heading
+    if cfg.vessel == "mariner":
+        return mariner_sail_run(route, plan.field, heading, dt=plan.dt, t_end=plan.t_end)
+    if key == "path":
+        return boat_sail_run(route, plan.field, "path", preset=cfg.preset, dt=plan.dt,
+                             t_end=plan.t_end, n_points=cfg.path_points, lookahead=cfg.lookahead,
+                             integral_gain=cfg.integral_gain)
+    return boat_sail_run(route, plan.field, "heading", heading=heading, preset=cfg.preset,
+                         dt=plan.dt, t_end=plan.t_end)
+
+
+@functools.lru_cache(maxsize=4)
+def _solved(route_json: str):
+    from shipgnc.scenarios.sections import RouteConfig
+
+    return solve(RouteConfig.model_validate_json(route_json))
+
+
+@functools.lru_cache(maxsize=4)
+def _planned(route_json: str, sail_json: str) -> SailPlan | str:
+    """The :class:`SailPlan` of a routing problem and sail settings, once per process (a study's
+    chunks share it, and the legs are optimised once); why not, for an unreachable target."""
+    from shipgnc.scenarios.sections import SailConfig
+
+    field, route = _solved(route_json)
+    if not route.reachable:
+        return " ".join(str(route.reason).split())
+    return sail_plan(SailConfig.model_validate_json(sail_json), field, route)
+
+
+def sail_setup(scenario: Scenario, variant: str | None = None, seed: int = 0):
+    """The :class:`~shipgnc.scenarios.runner.Setup` of sailed run ``variant`` (default: the
+    first of :func:`sail_runs`), for a study: the route solved once per process and routing
+    problem, the run's own step and duration in ``Setup.simulation``, its :class:`SailPlan` and
+    key in ``Setup.case`` for its metrics (:func:`sail_metrics`)."""
+    from shipgnc.errors import ConfigError
+    from shipgnc.scenarios.runner import Setup
+    from shipgnc.scenarios.sections import SimulationConfig
+
+    if scenario.sail is None:
+        raise ConfigError(f"scenario {scenario.name!r} is a routing problem without a sail section: "
+                          "nothing is simulated (sweep a scenario that sails its route, e.g. "
+                          "zermelo-sail)")
+    runs = sail_runs(scenario)
+    key = variant if variant is not None else runs[0]
+    if key not in runs:
+        raise ConfigError(f"controller {key!r}: not a sailed run of scenario {scenario.name!r}; "
+                          f"have {', '.join(runs)}")
+    _check_speed(scenario.sail, scenario.route)
+    plan = _planned(scenario.route.model_dump_json(), scenario.sail.model_dump_json())
+    if isinstance(plan, str):
+        raise ConfigError(f"scenario {scenario.name!r}: the route is not reachable ({plan}): "
+                          "nothing to sail")
+    run = sail_run(scenario, plan, key)
+    o = run.options
+    return Setup(run.model, run.x0, o["actuator"], o["controller"], o["guidance"], o["disturbance"],
+                 case=(plan, key), simulation=SimulationConfig(t_end=o["t_end"], dt=o["dt"]))
+
+
+def sail_metrics(ds, plan: SailPlan, key: str) -> dict:
+    """A sailed run's figures, without its key's prefix: :func:`outcome` and, along the route's
+    waypoints (``path``), :func:`crosstrack`."""
+    out = outcome(ds, plan.route, plan.radius)
+    if key == "path":
+        out.update(crosstrack(ds))
+    return out
 
 
 def run(scenario: Scenario, *, seed: int):
@@ -145,48 +262,25 @@ def run(scenario: Scenario, *, seed: int):
     result = route.to_dataset() if route.reachable else None
     sailed = {}
     if scenario.sail is not None and route.reachable:
-        cfg = scenario.sail
-        length, _ = sail_vessel(cfg)
-        radius = cfg.acceptance_radius if cfg.acceptance_radius is not None \
-            else cfg.acceptance_lengths * length
-        dt = cfg.dt if cfg.dt is not None else SAIL_DT[cfg.vessel]
-        t_end = route.time_s * (1.0 + cfg.margin)
-        plan = route.constant_heading_legs(n_legs=cfg.legs)
-        metrics.update({"vessel": cfg.vessel, "vessel_length_m": float(length),
-                        "acceptance_radius_m": float(radius)})
-        runs = {}
-        if cfg.vessel == "mariner":
-            runs["sail"] = ("optimal heading programme",
-                            sail(route, field, route.heading, dt=dt, t_end=t_end, seed=seed,
-                                 backend=cfg.backend)[0])
-            runs["legs"] = (f"{cfg.legs} constant-heading legs",
-                            sail(route, field, plan.heading, dt=dt, t_end=t_end, seed=seed,
-                                 backend=cfg.backend)[0])
-        else:
-            from shipgnc.routing.sailing import boat_sail
+        from shipgnc.sim.simulator import simulate
 
-            common = {"preset": cfg.preset, "dt": dt, "t_end": t_end, "seed": seed,
-                      "backend": cfg.backend}
-            runs["path"] = ("LOS through the route's waypoints",
-                            boat_sail(route, field, "path", n_points=cfg.path_points,
-                                      lookahead=cfg.lookahead, integral_gain=cfg.integral_gain,
-                                      **common))
-            runs["sail"] = ("optimal heading programme",
-                            boat_sail(route, field, "heading", heading=route.heading, **common))
-            runs["legs"] = (f"{cfg.legs} constant-heading legs",
-                            boat_sail(route, field, "heading", heading=plan.heading, **common))
-        for prefix, (label, ds) in runs.items():
-            metrics.update(_outcome(prefix, ds, route, radius))
-            sailed[label] = ds
+        cfg = scenario.sail
+        plan = sail_plan(cfg, field, route)
+        metrics.update({"vessel": cfg.vessel, "vessel_length_m": float(sail_vessel(cfg)[0]),
+                        "acceptance_radius_m": plan.radius})
+        runs = {}
+        for key in sail_runs(scenario):
+            run = sail_run(scenario, plan, key)
+            runs[key] = simulate(run.model, run.x0, **run.options, seed=seed, backend=cfg.backend)
+            metrics.update(_outcome(key, runs[key], route, plan.radius))
+            label = SAIL_LABELS[key] if key != "legs" else f"{cfg.legs} {SAIL_LABELS[key]}"
+            sailed[label] = runs[key]
         if "path" in runs:
-            e = runs["path"][1]["cross_track_error"].values
-            e = e[np.isfinite(e)]
-            metrics.update({"path_waypoints": int(cfg.path_points),
-                            "path_crosstrack_rms_m": float(np.sqrt(np.mean(e**2))),
-                            "path_crosstrack_max_m": float(np.max(np.abs(e)))})
-        metrics.update({"legs": cfg.legs, "legs_plan_penalty_s": float(plan.penalty),
-                        "legs_plan_miss_m": float(plan.miss)})
-        result = runs["sail"][1]
+            metrics["path_waypoints"] = int(cfg.path_points)
+            metrics.update({f"path_{k}": v for k, v in crosstrack(runs["path"]).items()})
+        metrics.update({"legs": cfg.legs, "legs_plan_penalty_s": float(plan.legs.penalty),
+                        "legs_plan_miss_m": float(plan.legs.miss)})
+        result = runs["sail"]
     setup = Setup(model=None, x0=np.asarray(route.start), actuator=None, controller=None,
                   guidance=None, disturbance=None)
     return ScenarioRun(scenario, setup, result, metrics, route=route if isinstance(route, RouteResult)

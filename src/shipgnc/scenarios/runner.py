@@ -43,10 +43,20 @@ class Setup:
     u0: np.ndarray | None = None
     #: the waypoint path of document 000's path-frame controllers (they track it themselves)
     path: WaypointPath | None = None
-    #: document 004's case this setup runs (a :class:`~shipgnc.cases.catamaran.CatamaranCase`)
+    #: the run's own record for its metrics: document 004's case (a
+    #: :class:`~shipgnc.cases.catamaran.CatamaranCase`), or document 002's sailed run
+    #: (``(SailPlan, run key)`` of :mod:`shipgnc.scenarios.routing`)
     case: object | None = None
     #: sensors and estimator between the true state and the controller, or None
     navigation: object | None = None
+    #: the run's own step and duration (a ``SimulationConfig``: document 002's sailed runs, whose
+    #: duration follows the route); None: the scenario's ``simulation`` section
+    simulation: object | None = None
+
+
+def simulation_of(scenario: Scenario, setup: Setup):
+    """The ``SimulationConfig`` a setup runs by: its own, else the scenario's."""
+    return setup.simulation if setup.simulation is not None else scenario.simulation
 
 
 @dataclass
@@ -244,6 +254,10 @@ def variant_names(scenario: Scenario) -> list[str] | None:
     """The names of a ``controller`` dimension: a comparison's controllers, or the run keys of a
     catamaran scenario with several runs (e.g. laws 20 and 21; one run has none, as its
     ``shipgnc run``); None for one run."""
+    if scenario.route is not None:  # the sailed runs (path, sail, legs), when it sails
+        from shipgnc.scenarios import routing
+
+        return routing.sail_runs(scenario) if scenario.sail is not None else None
     if scenario.kind.run is not None:  # a vessel whose runs are its own
         from shipgnc.scenarios import catamaran
 
@@ -258,7 +272,12 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
     ``seed`` draws a Monte Carlo batch's initial offsets (default: ``simulation.seed`` or 0).
     A catamaran scenario's ``variant`` is a run key of its case builder (see
     :func:`shipgnc.scenarios.catamaran.setup`); a vessel whose registry entry has a ``setup`` of
-    its own (the Mariner's path-frame controllers) is set up by it."""
+    its own (the Mariner's path-frame controllers) is set up by it; a route scenario's is a
+    sailed run (:func:`shipgnc.scenarios.routing.sail_setup`)."""
+    if scenario.route is not None:
+        from shipgnc.scenarios import routing
+
+        return routing.sail_setup(scenario, variant, seed or 0)
     kind = scenario.kind
     seed = seed if seed is not None else (scenario.simulation.seed or 0)
     if scenario.shape == "case":
@@ -323,7 +342,11 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     from shipgnc.analysis import metrics
 
     diverged = bool(result.attrs.get("diverged", 0))
-    if scenario.metrics == "catamaran" and setup.case is not None:
+    if scenario.metrics == "route" and setup.case is not None:  # one sailed run of a route
+        from shipgnc.scenarios import routing
+
+        out = routing.sail_metrics(result, *setup.case)
+    elif scenario.metrics == "catamaran" and setup.case is not None:
         from shipgnc.scenarios import catamaran
 
         # the events of the member's own run: those in result.attrs, else its logged δ (a batch's

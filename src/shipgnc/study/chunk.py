@@ -52,9 +52,13 @@ def plan_chunks(study: Study, variants: list[str] | None, chunk_size: int) -> li
 def check_sweepable(scenario) -> None:
     """Refuse the scenarios whose runs do not go through the generic loop of one batch, and the
     integrator whose result depends on the batch."""
-    if scenario.route is not None:
-        raise ConfigError(f"scenario {scenario.name!r} is a routing problem (document 002): "
-                          "sweep a simulation scenario")
+    if scenario.route is not None:  # its sailed runs sweep; its routing problem has no members
+        if scenario.sail is None:
+            raise ConfigError(f"scenario {scenario.name!r} is a routing problem (document 002) "
+                              "without a sail section: nothing is simulated, so there are no "
+                              "members to sweep; sweep a scenario that sails its route (e.g. "
+                              "zermelo-sail), or solve this one with shipgnc run")
+        return
     if scenario.shape == "case":  # its runs: runner.build's Setup of each run key
         case, t_end = scenario.case, scenario.simulation.t_end
         if case.builder == "montecarlo":
@@ -139,10 +143,9 @@ def numeric_metrics(metrics: dict) -> dict[str, float]:
     return out
 
 
-def _simulate(setup, scenario, x0, streams, backend: str, log_every: int, on_divergence: str):
+def _simulate(setup, sim, x0, streams, backend: str, log_every: int, on_divergence: str):
     from shipgnc.sim.simulator import simulate
 
-    sim = scenario.simulation
     return simulate(setup.model, x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
                     actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
                     navigation=setup.navigation,
@@ -159,20 +162,20 @@ def ends_early(setup) -> bool:
     return setup.guidance.finished() is not None
 
 
-def on_log_grid(times, scenario) -> np.ndarray:
-    """Which ``times`` are on the scenario's log grid (step k with k % log_every == 0, or the last)."""
-    sim = scenario.simulation
+def on_log_grid(times, sim) -> np.ndarray:
+    """Which ``times`` are on the log grid of ``sim`` (a ``SimulationConfig``: step k with
+    k % log_every == 0, or the last)."""
     k = np.rint(np.asarray(times) / sim.dt).astype(np.int64)
     return (k % sim.log_every == 0) | (k == round(sim.t_end / sim.dt))
 
 
-def route_series(series, scenario, done_at: np.ndarray):
-    """Each member's series on the log grid up to its own completion ``done_at`` (NaN: never),
-    plus its completion sample; NaN elsewhere. Times no member keeps are dropped."""
+def route_series(series, sim, done_at: np.ndarray):
+    """Each member's series on the log grid of ``sim`` up to its own completion ``done_at`` (NaN:
+    never), plus its completion sample; NaN elsewhere. Times no member keeps are dropped."""
     import xarray as xr
 
     t = series.time.values
-    grid = on_log_grid(t, scenario)[:, None]
+    grid = on_log_grid(t, sim)[:, None]
     limit = np.nan_to_num(done_at, nan=np.inf)[None, :]
     keep = (grid | (t[:, None] == limit)) & (t[:, None] <= limit)
     mask = xr.DataArray(keep, dims=("time", "member"), coords={"time": series.time,
@@ -180,19 +183,18 @@ def route_series(series, scenario, done_at: np.ndarray):
     return series.where(mask).isel(time=np.flatnonzero(keep.any(axis=1)))
 
 
-def _run_batch(setup, scenario, x0, seeds, backend: str, route: bool, on_divergence: str = "stop"):
-    """One loop call for ``x0``'s members: the result and, for a route, each member's completion
-    time (NaN: not completed). A batch is logged at every step, so that its metrics see every
-    step whatever ``log_every`` (see :func:`run_chunk`). ``on_divergence="mask"``: a member that
-    diverges stops alone (its time in ``diverged_at``)."""
+def _run_batch(setup, sim, x0, seeds, backend: str, route: bool, on_divergence: str = "stop"):
+    """One loop call for ``x0``'s members, stepped as ``sim`` says: the result and, for a route,
+    each member's completion time (NaN: not completed). A batch is logged at every step, so that
+    its metrics see every step whatever ``log_every`` (see :func:`run_chunk`).
+    ``on_divergence="mask"``: a member that diverges stops alone (its time in ``diverged_at``)."""
     from shipgnc.sim.simulator import scoring_log_every
 
-    sim = scenario.simulation
     if not route:  # an unthinned record beyond the log limit: name log_every and --chunk-size
         scoring_log_every(setup.model, x0, sim.t_end, sim.dt, sim.log_every,
                           fewer="lower --chunk-size")
     try:
-        result = _simulate(setup, scenario, x0, MemberStreams(seeds), backend, 1, on_divergence)
+        result = _simulate(setup, sim, x0, MemberStreams(seeds), backend, 1, on_divergence)
     except ConfigError as exc:
         if route and str(exc).startswith("log size"):
             raise ConfigError(f"{exc} (a route study logs every step of a chunk, so that each "
@@ -239,7 +241,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """
     import xarray as xr
 
-    from shipgnc.scenarios.runner import build, compute_metrics, metric_arrays
+    from shipgnc.scenarios.runner import build, compute_metrics, metric_arrays, simulation_of
 
     scenario = study.scenario_at(study.points[chunk.point])
     check_sweepable(scenario)
@@ -250,12 +252,13 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
         setup = replace(setup, model=member_plant(study, setup.model, chunk.start, chunk.stop, drawn))
     seeds = study.member_seeds(chunk.start, chunk.stop, 1)  # made when a disturbance draws
     route = ends_early(setup)
-    result, done_at = _run_batch(setup, scenario, x0, seeds, backend, route, "mask")
+    sim = simulation_of(scenario, setup)
+    result, done_at = _run_batch(setup, sim, x0, seeds, backend, route, "mask")
     diverged = np.isfinite(result["diverged_at"].values)
     result = result.drop_vars("diverged_at")
     arrays = None
     if diverged.any():
-        runs = [_run_batch(_alone(setup, i), scenario, x0[i:i + 1], seeds[i:i + 1], backend, route)
+        runs = [_run_batch(_alone(setup, i), sim, x0[i:i + 1], seeds[i:i + 1], backend, route)
                 if diverged[i] else _survivor(result, done_at, i) for i in range(chunk.size)]
         ran_on = {r.attrs.get("backend") for r, _ in runs}
         members = [r.isel(member=0) for r, _ in runs]
@@ -265,6 +268,9 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
         ran_on = {result.attrs.get("backend")}
         arrays = metric_arrays(scenario, result, setup)  # every member scored at once
         members = [result.isel(member=i) for i in range(chunk.size)] if arrays is None else []
+    if route and arrays is None:  # each member scored on its own run, which ends at its completion
+        members = [m.isel(time=slice(0, round(d / sim.dt) + 1)) if np.isfinite(d) else m
+                   for m, d in zip(members, done_at, strict=True)]
     if arrays is None:
         rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
         keys = list(dict.fromkeys(k for row in rows for k in row))
@@ -279,9 +285,9 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
         series = result.assign_coords(member=np.arange(chunk.start, chunk.stop))
         series.attrs = {}
         if route:
-            series = route_series(series, scenario, done_at)
+            series = route_series(series, sim, done_at)
         else:  # the series on the log grid (the metrics above saw every step)
-            series = series.isel(time=np.flatnonzero(on_log_grid(series.time.values, scenario)))
+            series = series.isel(time=np.flatnonzero(on_log_grid(series.time.values, sim)))
         out = xr.merge([out, series.rename({k: f"series_{k}" for k in series.data_vars})],
                        combine_attrs="override")
     return out

@@ -48,20 +48,36 @@ def variants_of(study: Study) -> list[str] | None:
     catamaran scenario with several runs, else None; every grid point is loaded here, so a bad
     grid key or value, an unsweepable scenario or a ``--perturb`` field the vessel does not have
     fails before any work starts."""
-    from shipgnc.scenarios.runner import initial_states, variant_names, vessel_parts
+    from shipgnc.scenarios.runner import variant_names
 
     variants = None
     for point in study.points:
         scenario = study.scenario_at(point)
         check_sweepable(scenario)
-        check_perturbable(study.perturb, vessel_parts(scenario)[0],
-                          initial_states(scenario, study.seed))
+        plant = [str(p) for p in study.perturb if p.param is not None]
+        if scenario.route is not None and plant:
+            raise ConfigError(f"--perturb {plant[0]}: a route scenario's ship is sail.vessel at its "
+                              "preset, not a vessel section; perturb its initial state (north, east, "
+                              "psi_deg, u, v, r_deg_s) or sweep sail settings with --grid")
+        model, x0, _ = _vessel_of(scenario, study.seed)
+        check_perturbable(study.perturb, model, x0)
         names = variant_names(scenario)
         if names is not None:
             if variants is not None and names != variants:
                 raise ConfigError(f"--grid: the controllers change across the grid ({variants} vs {names})")
             variants = names
     return variants
+
+
+def _vessel_of(scenario, seed: int):
+    """(model, x0, SimulationConfig) of a scenario's first run: a route's first sailed run (its
+    route solved), else the scenario's vessel, initial state and simulation section."""
+    from shipgnc.scenarios.runner import build, initial_states, simulation_of, vessel_parts
+
+    if scenario.route is not None:
+        setup = build(scenario, seed=seed)
+        return setup.model, setup.x0, simulation_of(scenario, setup)
+    return vessel_parts(scenario)[0], initial_states(scenario, seed), scenario.simulation
 
 
 def connect(scheduler: str | None, workers: str):
@@ -236,12 +252,9 @@ def estimate_memory(study: Study, variants: list[str] | None, chunk_size: int) -
     metrics, with ``--series`` every member's thinned series) and ``chunk`` (one chunk's
     every-step record that the metrics are computed from, about twice for the arrays derived
     from it). The measure of a series is :func:`shipgnc.sim.simulator.logged_numbers`."""
-    from shipgnc.scenarios.runner import vessel_parts
     from shipgnc.sim.simulator import logged_numbers
 
-    scenario = study.scenario_at(study.points[0])
-    model = vessel_parts(scenario)[0]
-    sim = scenario.simulation
+    model, _, sim = _vessel_of(study.scenario_at(study.points[0]), study.seed)
     n_steps = round(sim.t_end / sim.dt)
     cells = len(study.points) * len(variants or [None])
     per_member = NUMBERS_PER_MEMBER
