@@ -33,7 +33,6 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 
-import control
 import numpy as np
 
 from shipgnc.batchmath import row_dot
@@ -113,6 +112,9 @@ def lqr_tracking_gain(a: float, c: float, U: float, Q=PAPER_Q, R: float = PAPER_
             "controller.Q", Q.tolist(), "must be symmetric positive semi-definite")
     require(isinstance(R, (int, float, np.floating)) and np.isfinite(R) and R > 0, "controller.R", R,
             "must be a finite number > 0")
+    import control  # python-control: ≈ 0.7 s to import, paid by the LQR design alone (the
+    # feedback-linearising laws share this module's path frame but design nothing)
+
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore")
