@@ -106,6 +106,7 @@ def test_montecarlo_is_one_batch():
     ("catamaran-turn", ["guidance={type: los, waypoints: [[0, 0], [100, 0]]}"],
      ["yaw-rate-fsm", "needs a guidance section", "heading-capture"]),
     ("catamaran-turn", ["case={builder: turn}"], ["case"]),
+    ("catamaran-turn", ["case.options.omega=0.04"], ["does not use", "guidance.omega", "controllers"]),
     ("catamaran-turn", ["metrics=heading-steps"], ["metrics"]),
     ("catamaran-heading", ["guidance.omega_c=0"], ["guidance", "omega_c"]),
     ("boat-autopilot", ["controller={type: yaw-rate-fsm}"], ["yaw-rate-fsm", "vectored-thrust-boat"]),

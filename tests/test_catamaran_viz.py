@@ -80,3 +80,17 @@ def test_montecarlo_figure_from_a_batch():
     (fig, name), = V.scenario_figures({"montecarlo": bands}, {"builder": "montecarlo", "omega": 0.06},
                                       "catamaran-montecarlo")
     assert name == "montecarlo.png" and "8 ships" in fig._suptitle.get_text()
+
+
+def test_sine_and_heading_name_the_law_and_draw_every_run():
+    """A scenario of controllers may run another law or several: the figure's title names the
+    law that ran (not the document's (21)), and a second run gets a figure of every run."""
+    runs = _fake_runs(["mine", "law21"])
+    figs = dict((name, fig) for fig, name in V.scenario_figures(
+        runs, {"builder": "sine", "laws": {"mine": 20, "law21": 21}}, "catamaran-sine"))
+    assert "law (20)" in figs["fig7_sine.png"]._suptitle.get_text()
+    assert _lines(figs["yaw_rate.png"]) >= 2
+    figs = dict((name, fig) for fig, name in V.scenario_figures(
+        runs, {"builder": "heading", "heading_target": 0.8, "laws": {"mine": 20}}, "catamaran-heading"))
+    assert "law (20)" in figs["fig8_heading.png"]._suptitle.get_text()
+    assert _lines(figs["heading.png"]) == 2

@@ -76,3 +76,9 @@ def test_the_runs_follow_the_vessel_and_are_named():
 def test_what_cannot_be_swept_is_refused_with_the_reason(name, perturb, message):
     with pytest.raises(ConfigError, match=message):
         run_study(Study(name, members=2, perturb=tuple(Perturbation.parse(p) for p in perturb)))
+
+
+def test_a_grid_point_that_leaves_the_target_unreachable_is_named():
+    """A horizon of 0.05 h (3 min) is far below the crossing's optimum (about 11 min): no route."""
+    with pytest.raises(ConfigError, match=r"not reachable .*\(at grid point route\.horizon=0\.05\)"):
+        run_study(Study("zermelo-sail", grid=(("route.horizon", (0.05,)),)))

@@ -125,7 +125,7 @@ def yaw_rate_case(name: str, preset_name: str = DEFAULT_PRESET, law: int = 21, o
                   **controller_options) -> CatamaranCase:
     """A yaw-rate FSM run: plant ``preset_name`` (+ ``vessel`` and ``plant`` overrides), law (20)/(21)
     on the nominal model (``preset_name`` + ``vessel``), reference ``omega_ref`` (number, per-ship
-    array or reference object)."""
+    array or reference object; a :class:`HeadingCapture` sets the run's ``heading_target``)."""
     T_u, h = _gains(preset_name, T_u, h)
     plant_model = Catamaran.from_preset(preset_name, **{**(vessel or {}), **(plant or {})})
     nominal = Catamaran.from_preset(preset_name, **(vessel or {}))
@@ -135,6 +135,7 @@ def yaw_rate_case(name: str, preset_name: str = DEFAULT_PRESET, law: int = 21, o
     if batch is None and isinstance(ref, ConstantRate) and np.ndim(ref.omega) == 1:
         batch = len(ref.omega)
     return CatamaranCase(name, plant_model, initial_state(batch=batch), ctrl, ref, t_end, dt,
+                         heading_target=float(ref.psi_target) if isinstance(ref, HeadingCapture) else None,
                          notes={"preset": preset_name, "law": law, "T_u": T_u, "h": h})
 
 
@@ -204,9 +205,7 @@ def heading(preset_name: str = DEFAULT_PRESET, law: int = 21, psi_target: float 
             "must be a finite heading [rad]")
     t_end = t_end if t_end is not None else (T_END if omega_c < 0.02 else 600.0)
     cap = HeadingCapture(psi_target, omega_c, ramp_s=ramp_s)
-    case = yaw_rate_case(f"catamaran-heading/law{law}", preset_name, law, cap, t_end=t_end, vessel=vessel)
-    case.heading_target = float(psi_target)
-    return case
+    return yaw_rate_case(f"catamaran-heading/law{law}", preset_name, law, cap, t_end=t_end, vessel=vessel)
 
 
 #: S8's true thruster (T_t [s], k_t) per run key; the controller assumes T_a = 2 s, k_a = 1

@@ -85,15 +85,10 @@ def _controlled_cases(scenario: Scenario) -> dict:
 
     sim, guidance = scenario.simulation, scenario.guidance
     overrides = _checked_overrides(scenario)
-    built = {}
-    for name, cfg in scenario.variants.items():
-        case = yaw_rate_case(f"{scenario.name}/{name}", scenario.vessel.preset, cfg.law,
-                             _reference(guidance), t_end=sim.t_end, dt=sim.dt, Ts=cfg.Ts,
-                             T_u=cfg.T_u, h=cfg.h, vessel=overrides)
-        if guidance.type == "heading-capture":
-            case.heading_target = float(guidance.psi_target_rad)
-        built[name] = case
-    return built
+    return {name: yaw_rate_case(f"{scenario.name}/{name}", scenario.vessel.preset, cfg.law,
+                                _reference(guidance), t_end=sim.t_end, dt=sim.dt, Ts=cfg.Ts,
+                                T_u=cfg.T_u, h=cfg.h, vessel=overrides)
+            for name, cfg in scenario.variants.items()}
 
 
 def _checked_overrides(scenario: Scenario) -> dict | None:

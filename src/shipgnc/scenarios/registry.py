@@ -98,9 +98,14 @@ def refuse_unused(scenario: Scenario, keys) -> None:
         if section not in used:
             reads = [s for s in used if s not in ("name", "description", "document", "metrics",
                                                   "document_figures")]
+            hint = ""
+            if section == "case" and scenario.kind.cases:  # the catamaran's earlier shape
+                hint = (f"; {scenario.name} is written with controllers and guidance (e.g. "
+                        "guidance.omega, guidance.psi_target_rad, controllers.NAME.Ts; "
+                        "shipgnc show lists them)")
             raise ConfigError(f"--set {key}: scenario {scenario.name!r} does not use the section "
                               f"{section!r}, so the setting would be ignored; its sections: "
-                              f"{', '.join(reads)}")
+                              f"{', '.join(reads)}{hint}")
         for field in scenario.ignored_fields():
             if key == field or key.startswith(field + "."):
                 raise ConfigError(f"--set {key}: vessel model {scenario.vessel.model!r} does not "

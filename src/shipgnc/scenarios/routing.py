@@ -158,6 +158,11 @@ SAIL_LABELS = {"path": "LOS through the route's waypoints", "sail": "optimal hea
                "legs": "constant-heading legs"}
 
 
+def sail_label(key: str, legs: int) -> str:
+    """Sailed run ``key``'s label in figures (the legs' with their number)."""
+    return f"{legs} {SAIL_LABELS[key]}" if key == "legs" else SAIL_LABELS[key]
+
+
 def sail_runs(scenario: Scenario) -> list[str]:
     """The run keys of the scenario's sailed runs: the boat ``path``, ``sail`` and ``legs``, the
     Mariner ``sail`` and ``legs``."""
@@ -181,14 +186,14 @@ def sail_run(scenario: Scenario, plan: SailPlan, key: str):
                          dt=plan.dt, t_end=plan.t_end)
 
 
-@functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=32)
 def _solved(route_json: str):
     from shipgnc.scenarios.sections import RouteConfig
 
     return solve(RouteConfig.model_validate_json(route_json))
 
 
-@functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=32)
 def _planned(route_json: str, sail_json: str) -> SailPlan | str:
     """The :class:`SailPlan` of a routing problem and sail settings, once per process (a study's
     chunks share it, and the legs are optimised once); why not, for an unreachable target."""
@@ -204,7 +209,8 @@ def sail_setup(scenario: Scenario, variant: str | None = None, seed: int = 0):
     """The :class:`~shipgnc.scenarios.runner.Setup` of sailed run ``variant`` (default: the
     first of :func:`sail_runs`), for a study: the route solved once per process and routing
     problem, the run's own step and duration in ``Setup.simulation``, its :class:`SailPlan` and
-    key in ``Setup.case`` for its metrics (:func:`sail_metrics`)."""
+    key in ``Setup.case`` for its metrics (:func:`sail_metrics`). ``seed``: unused (the ship
+    sails a deterministic current; the argument is :func:`~shipgnc.scenarios.runner.build`'s)."""
     from shipgnc.errors import ConfigError
     from shipgnc.scenarios.runner import Setup
     from shipgnc.scenarios.sections import SimulationConfig
@@ -273,8 +279,7 @@ def run(scenario: Scenario, *, seed: int):
             run = sail_run(scenario, plan, key)
             runs[key] = simulate(run.model, run.x0, **run.options, seed=seed, backend=cfg.backend)
             metrics.update(_outcome(key, runs[key], route, plan.radius))
-            label = SAIL_LABELS[key] if key != "legs" else f"{cfg.legs} {SAIL_LABELS[key]}"
-            sailed[label] = runs[key]
+            sailed[key] = runs[key]
         if "path" in runs:
             metrics["path_waypoints"] = int(cfg.path_points)
             metrics.update({f"path_{k}": v for k, v in crosstrack(runs["path"]).items()})
@@ -285,11 +290,6 @@ def run(scenario: Scenario, *, seed: int):
                   guidance=None, disturbance=None)
     return ScenarioRun(scenario, setup, result, metrics, route=route if isinstance(route, RouteResult)
                        else None, sailed=sailed)
-
-
-#: the metric prefix of each sailed run's label (see :func:`run`)
-def _prefix(label: str) -> str:
-    return "path" if label.startswith("LOS") else "legs" if "legs" in label else "sail"
 
 
 def sail_summary(metrics: dict, prefix: str) -> str:

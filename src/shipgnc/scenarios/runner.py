@@ -69,7 +69,7 @@ class ScenarioRun:
     result: object  # xarray.Dataset
     metrics: dict
     setups: dict | None = None
-    #: document 002: the solved route and the sailed runs by label
+    #: document 002: the solved route and the sailed runs by run key (``path``, ``sail``, ``legs``)
     route: object = None
     sailed: dict | None = None
     #: "interrupted at t = … s" when Ctrl-C cut the run short (``keep_interrupted``), else ""
@@ -270,8 +270,8 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
     """Instantiate the scenario's components for one controller ``variant`` (default: the first).
 
     ``seed`` draws a Monte Carlo batch's initial offsets (default: ``simulation.seed`` or 0).
-    A catamaran scenario's ``variant`` is a run key of its case builder (see
-    :func:`shipgnc.scenarios.catamaran.setup`); a vessel whose registry entry has a ``setup`` of
+    A catamaran scenario's ``variant`` is a run key: a controller's name, or a run of its case
+    builder (see :func:`shipgnc.scenarios.catamaran.setup`); a vessel whose registry entry has a ``setup`` of
     its own (the Mariner's path-frame controllers) is set up by it; a route scenario's is a
     sailed run (:func:`shipgnc.scenarios.routing.sail_setup`)."""
     if scenario.route is not None:

@@ -148,7 +148,9 @@ class Scenario(Strict):
         if self.shape == "case":
             used.append("case")
         else:
-            used += ["controller", "controllers", "guidance", "disturbance"]
+            used += ["controller", "controllers", "guidance"]
+            if kind.disturbances:
+                used.append("disturbance")
         used += kind.sections
         if kind.current:
             used.append("current")
@@ -319,8 +321,11 @@ class Scenario(Strict):
         if self.actuator != ActuatorConfig():
             raise ValueError("actuator: the catamaran's thruster is set in case.options")
         self._ignored_unset(kind)
-        if self.metrics not in ("catamaran", "none"):
-            raise ValueError(f"metrics = {self.metrics!r}: a catamaran scenario reports 'catamaran'")
+        scores = [name for name, m in C.METRICS.items()
+                  if m.vessels is not None and self.vessel.model in m.vessels]
+        if self.metrics != "none" and self.metrics not in scores:
+            raise ValueError(f"metrics = {self.metrics!r}: a scenario with a case section reports "
+                             f"{' or '.join(map(repr, scores))}")
         return self
 
 

@@ -376,14 +376,6 @@ class LOSFLConfig(Navigated):
         return 0.0 if self.knows_disturbance else 0.0625
 
 
-# --------------------------------------------------------------------------- guidance
-
-class ReferenceEntry(Strict):
-    t: NonNegative
-    psi_deg: HeadingDeg
-    u: Positive
-
-
 class YawRateFSMConfig(Strict):
     """``controller`` type ``yaw-rate-fsm``: document 004's finite-state yaw-rate law (20) (ω̄
     from the model) or (21) (the measured r), eq. (20)–(21), designed on the scenario's vessel
@@ -397,6 +389,14 @@ class YawRateFSMConfig(Strict):
     T_u: Positive | None = None
     h: Positive | None = None
     Ts: Positive | None = None
+
+
+# --------------------------------------------------------------------------- guidance
+
+class ReferenceEntry(Strict):
+    t: NonNegative
+    psi_deg: HeadingDeg
+    u: Positive
 
 
 class ScheduleGuidanceConfig(Strict):
@@ -464,8 +464,6 @@ class PathConfig(Strict):
         return self
 
 
-# --------------------------------------------------------------------------- disturbance
-
 class YawRateGuidanceConfig(Strict):
     """A constant yaw-rate reference ω* [rad/s] (document 004, S3/S4: 0.08, 0.008, 0.00072)."""
 
@@ -492,6 +490,8 @@ class HeadingCaptureConfig(Strict):
     omega_c: Positive = 0.0022
     ramp_s: NonNegative = 0.0
 
+
+# --------------------------------------------------------------------------- disturbance
 
 class ConstantForceConfig(Strict):
     """Constant body-frame force and moment [X N, Y N, N N·m] (a current: the scenario's

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from shipgnc.models.fossen3dof import VectoredThrustBoat
-from shipgnc.scenarios.routing import _prefix, sail_summary
+from shipgnc.scenarios.routing import sail_label, sail_summary
 from shipgnc.scenarios.runner import ScenarioRun, comparison_table, metrics_json, run_status, write_table
 from shipgnc.units import NAUTICAL_MILE
 
@@ -76,6 +76,7 @@ def figure_job(run: ScenarioRun, out: Path):
     limits = {s.name: (float(lower[i]), float(upper[i])) for i, s in enumerate(model.inputs)}
     names = list(run.setups) if run.setups is not None else list(run.scenario.variants)
     if run.scenario.vessel.model == "catamaran":
+        setups = run.setups if run.setups is not None else {run.scenario.name: run.setup}
         if "controller" in run.result.dims:
             runs = {n: run.result.sel(controller=n).dropna("time", how="all") for n in names}
         else:
@@ -91,7 +92,9 @@ def figure_job(run: ScenarioRun, out: Path):
         options = {"builder": run_kind(run.scenario), "preset": run.scenario.vessel.preset,
                    "heading_target": float(getattr(target, "psi_target", 0.0) or 0.0),
                    "omega": float(omega) if omega is not None and np.ndim(omega) == 0 else None,
-                   "model_note": model_fields(run.setup.model, run.scenario.vessel.preset)["model_note"]}
+                   "model_note": model_fields(run.setup.model, run.scenario.vessel.preset)["model_note"],
+                   # each run's finite-state law (20 or 21; None without one), for the titles
+                   "laws": {k: getattr(s.controller, "law_number", None) for k, s in setups.items()}}
         return FigureJob(result=runs, out=out, title=run.scenario.name, kind="catamaran",
                          options=options)
     if run.setup.path is not None:
@@ -171,9 +174,10 @@ def _sail_figure(run, path, nautical: bool):
     _, north, east, _ = run.route.sample(400)
     ax.plot(east / scale, north / scale, color=style.COLORS["path"], linestyle="--", linewidth=2.0,
             label=f"optimal route ({run.route.time_s:.1f} s)")
-    for i, (label, ds) in enumerate(run.sailed.items()):
+    for i, (key, ds) in enumerate(run.sailed.items()):
+        label = sail_label(key, int(m["legs"]))
         ax.plot(ds["east"].values / scale, ds["north"].values / scale, color=f"C{i}", linewidth=1.3,
-                label=f"{label}: {sail_summary(m, _prefix(label))}")
+                label=f"{label}: {sail_summary(m, key)}")
     target = run.route.target
     radius = m["acceptance_radius_m"]
     ax.add_patch(Circle((target[1] / scale, target[0] / scale), radius / scale, fill=False,

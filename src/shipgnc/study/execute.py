@@ -59,7 +59,11 @@ def variants_of(study: Study) -> list[str] | None:
             raise ConfigError(f"--perturb {plant[0]}: a route scenario's ship is sail.vessel at its "
                               "preset, not a vessel section; perturb its initial state (north, east, "
                               "psi_deg, u, v, r_deg_s) or sweep sail settings with --grid")
-        model, x0, _ = _vessel_of(scenario, study.seed)
+        try:
+            model, x0, _ = _vessel_of(scenario, study.seed)
+        except ConfigError as exc:  # e.g. a route that a grid point makes unreachable
+            where = ", ".join(f"{k}={v}" for (k, _), v in zip(study.grid, point, strict=True))
+            raise ConfigError(f"{exc} (at grid point {where})" if where else str(exc)) from None
         check_perturbable(study.perturb, model, x0)
         names = variant_names(scenario)
         if names is not None:

@@ -168,8 +168,8 @@ def fig_montecarlo(bands: dict, title: str = "Monte Carlo", reference: float | N
     return fig
 
 
-def fig_sine(ds):
-    """Fig. 7: the meandering track, ω*(t) and r(t)."""
+def fig_sine(ds, law: str = "law (21)"):
+    """Fig. 7: the meandering track, ω*(t) and r(t) of the run of ``law``."""
     fig, axes = _figure(1, 2, size=(12.0, 4.5))
     a0, a1 = axes[0]
     a0.plot(ds.east, ds.north, color=COLORS["track"])
@@ -182,12 +182,12 @@ def fig_sine(ds):
     a1.set_xlabel("t [s]", fontsize=LABEL_SIZE)
     a1.set_ylabel("[rad/s]", fontsize=LABEL_SIZE)
     a1.legend(**LEGEND)
-    fig.suptitle("Fig. 7 — sinusoidal yaw-rate reference, law (21)", fontsize=LABEL_SIZE + 2)
+    fig.suptitle(f"Fig. 7 — sinusoidal yaw-rate reference, {law}", fontsize=LABEL_SIZE + 2)
     return fig
 
 
-def fig_heading(ds, heading_target: float):
-    """Fig. 8: the heading-capture track and K(t) against K*."""
+def fig_heading(ds, heading_target: float, law: str = "law (21)"):
+    """Fig. 8: the heading-capture track and K(t) against K* of the run of ``law``."""
     fig, axes = _figure(1, 2, size=(12.0, 4.5))
     a0, a1 = axes[0]
     a0.plot(ds.east, ds.north, color=COLORS["track"])
@@ -199,7 +199,7 @@ def fig_heading(ds, heading_target: float):
     a1.set_xlabel("t [s]", fontsize=LABEL_SIZE)
     a1.set_ylabel("heading [deg]", fontsize=LABEL_SIZE)
     a1.legend(**LEGEND)
-    fig.suptitle("Fig. 8 — heading capture (17), law (21)", fontsize=LABEL_SIZE + 2)
+    fig.suptitle(f"Fig. 8 — heading capture (17), {law}", fontsize=LABEL_SIZE + 2)
     return fig
 
 
@@ -236,21 +236,30 @@ def save(fig, path) -> Path:
 def scenario_figures(runs: dict, options: dict, title: str) -> list[tuple[object, str]]:
     """The figures of a catamaran scenario run: ``(figure, file name)`` pairs. ``runs``: Datasets
     by run key (a batch reduced by :func:`batch_bands`); ``options``: ``builder``, ``preset``,
-    ``heading_target``, ``model_note``, ``omega`` (the batch's ω*)."""
+    ``heading_target``, ``model_note``, ``omega`` (the batch's ω*), ``laws`` (each run's law
+    number, for the titles; default: read from a run key ``law20``/``law21``)."""
     from shipgnc.models.catamaran import Catamaran
 
     builder, note = options.get("builder"), options.get("model_note")
-    first = next(iter(runs.values()))
+    laws = options.get("laws") or {}
+
+    def law_of(key: str) -> str:
+        number = laws.get(key)
+        if number is not None:
+            return f"law ({number})"
+        return f"law ({key[3:]})" if key.startswith("law") else key
+
+    first_key = next(iter(runs))
+    first = runs[first_key]
     figures = []
     if builder == "montecarlo":
         figures.append((fig_montecarlo(first, f"{title}: law (21), plant J ±30 %, masses ±10 %",
                                        reference=options.get("omega"), note=note), "montecarlo.png"))
     elif builder == "turn":
-        key = "law21" if "law21" in runs else next(iter(runs))
-        law = f"law ({key[3:]})" if key.startswith("law") else key
+        key = "law21" if "law21" in runs else first_key
         omega = options.get("omega")
         at = f" at ω* = {omega:g} rad/s" if omega is not None else ""
-        figures.append((fig_turn(runs[key], f"{title}: turn{at}, FSM {law}", note=note),
+        figures.append((fig_turn(runs[key], f"{title}: turn{at}, FSM {law_of(key)}", note=note),
                         "turn.png"))
         figures.append((fig_yaw_rate_laws(runs, title=f"{title}: yaw rate, {', '.join(runs)}", note=note),
                         "yaw_rate.png"))
@@ -265,9 +274,16 @@ def scenario_figures(runs: dict, options: dict, title: str) -> list[tuple[object
         figures.append((fig_transients(runs, title=f"{title}: initial transients of {', '.join(runs)}",
                                        note=note), "fig4_5_transients.png"))
     elif builder == "sine":
-        figures.append((fig_sine(first), "fig7_sine.png"))
+        figures.append((fig_sine(first, law_of(first_key)), "fig7_sine.png"))
+        if len(runs) > 1:  # every run's yaw rate beside the first's Fig. 7
+            figures.append((fig_yaw_rate_laws(runs, t_max=None, title=f"{title}: yaw rate, "
+                                              f"{', '.join(runs)}", note=note), "yaw_rate.png"))
     elif builder == "heading":
-        figures.append((fig_heading(first, options.get("heading_target", 0.0)), "fig8_heading.png"))
+        target = options.get("heading_target", 0.0)
+        figures.append((fig_heading(first, target, law_of(first_key)), "fig8_heading.png"))
+        if len(runs) > 1:
+            figures.append((fig_heading_runs(runs, target, title=f"{title}: heading capture of "
+                                             f"{', '.join(runs)}", note=note), "heading.png"))
     elif builder == "actuator":
         figures.append((fig_yaw_rate_laws(runs, t_max=None, title=f"{title}: law (21) through the "
                                           f"actuator inverse (23), true lag and gain {', '.join(runs)}",
