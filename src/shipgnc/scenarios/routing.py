@@ -175,13 +175,13 @@ def sail_run(scenario: Scenario, plan: SailPlan, key: str):
     from shipgnc.routing.sailing import boat_sail_run, mariner_sail_run
 
     cfg, route = scenario.sail, plan.route
-    heading = route.heading if key == "sail" else plan.legs.heading
-    if cfg.vessel == "mariner":
-        return mariner_sail_run(route, plan.field, heading, dt=plan.dt, t_end=plan.t_end)
-    if key == "path":
+    if key == "path":  # the boat along the route's waypoints: no heading programme, no legs
         return boat_sail_run(route, plan.field, "path", preset=cfg.preset, dt=plan.dt,
                              t_end=plan.t_end, n_points=cfg.path_points, lookahead=cfg.lookahead,
                              integral_gain=cfg.integral_gain)
+    heading = route.heading if key == "sail" else plan.legs.heading  # legs: optimised when read
+    if cfg.vessel == "mariner":
+        return mariner_sail_run(route, plan.field, heading, dt=plan.dt, t_end=plan.t_end)
     return boat_sail_run(route, plan.field, "heading", heading=heading, preset=cfg.preset,
                          dt=plan.dt, t_end=plan.t_end)
 
