@@ -25,8 +25,8 @@ from shipgnc.streams import MemberStreams, member_seeds
 T_END = 20.0
 
 
-def sensors():
-    return [nav.GNSS(1.0, bias_std=0.5, bias_time_constant=60.0, rate_hz=2.0, latency=2,
+def sensors(latency=2):
+    return [nav.GNSS(1.0, bias_std=0.5, bias_time_constant=60.0, rate_hz=2.0, latency=latency,
                      dropouts=[(5.0, 8.0)]),
             nav.Compass(math.radians(0.5), bias=0.01, bias_std=0.01),
             nav.RateGyro(math.radians(0.1), bias=0.001, bias_walk=1e-4),
@@ -72,10 +72,13 @@ def test_sensors_and_passive_observer_compiled_equal_numpy():
 def test_ekf_compiled_equals_numpy_in_chunks():
     """Started 5 m and 0.2 rad wrong, the filter's first corrections move its estimate by metres;
     both loops linearise with the boat's analytic Jacobian (``state_jacobian`` and its kernel
-    ``boat_current_rhs_jacobian``), so the runs agree to the promise of ``backend`` (1e-9)."""
+    ``boat_current_rhs_jacobian``), so the runs agree to the promise of ``backend`` (1e-9). The
+    filter carries the GNSS Gauss–Markov bias (2 states) and the gyro bias (1) as augmented
+    states (a delayed fix's update runs in the numpy loop only:
+    :func:`test_ekf_with_latency_runs_in_numpy_and_says_why`)."""
 
     def make():
-        return nav.Navigation(sensors(), nav.ExtendedKalmanFilter(
+        return nav.Navigation(sensors(latency=0), nav.ExtendedKalmanFilter(
             x0_offset={"north": 5.0, "psi": 0.2}, P0_std={"north": 5.0, "east": 5.0, "psi": 0.2},
             sample_initial=True, noise="held"))
 
@@ -83,6 +86,23 @@ def test_ekf_compiled_equals_numpy_in_chunks():
     got = assert_same(make, progress=lambda k, n: calls.append(k))
     assert len(calls) > 10  # the run was cut into kernel calls that carried the filter's state
     assert np.all(np.isfinite(got["nees"].values))
+    assert "b_gnss_north_hat" in got and "b_gyro_hat" in got
+    assert float(got["nis_dim"].max()) == 5.0   # GNSS north, east, compass, gyro, log at once
+
+
+def test_ekf_with_latency_runs_in_numpy_and_says_why():
+    from shipgnc.sim.simulator import _validate
+
+    scenario = load_scenario("boat-los-gnss")
+    s = build(scenario)
+    setup = _validate(s.model, s.x0, t_end=1.0, dt=0.05, controller=s.controller, actuator=None,
+                      guidance=s.guidance, disturbance=None, u0=None, integrator="rk4",
+                      method="RK45", rtol=1e-3, atol=1e-6, seed=0, on_divergence="raise",
+                      observer=None, progress=None, log_every=1,
+                      navigation=nav.Navigation(sensors(), nav.ExtendedKalmanFilter()))
+    assert "delayed-measurement" in compose.unsupported_reason(setup)
+    got = run(nav.Navigation(sensors(), nav.ExtendedKalmanFilter()), "compiled-or-numpy")
+    assert got.attrs["backend"] == "numpy" and np.all(np.isfinite(got["nees"].values))
 
 
 def test_ekf_by_central_differences_compiled_equals_numpy():

@@ -87,6 +87,8 @@ class Navigation:
         self.measured = {m: float(v) for s in self.sensors
                          for m, v in zip(s.measures, s.variances(), strict=True)}
         if self.estimator is not None:
+            if callable(getattr(self.estimator, "use_sensors", None)):
+                self.estimator.use_sensors(self.sensors)
             self.estimator.prepare(model, Ts, self.measured)
         out = [sig for s in self.sensors for sig in s.signals()]
         if self.estimator is not None:
@@ -130,13 +132,24 @@ class Navigation:
         """The values of :attr:`signals` at the last :meth:`observe`."""
         return dict(self._values)
 
+    def unmodelled(self) -> list[str]:
+        """The sensor errors the estimator does not model, as ``<sensor>.<error>`` (e.g.
+        ``compass.bias``: a constant compass bias is unobservable without another heading
+        reference); empty without an estimator (the controller then reads the measurements)."""
+        est = self.estimator
+        if est is None:
+            return []
+        return [f"{s.name}.{kind}" for s in self.sensors for kind, ok in est.models_errors(s)
+                if not ok]
+
     # ---- the compiled loop --------------------------------------------------------------------
     def kernel_reason(self) -> str | None:
         """None when the composed loop can run this navigation system, else why not."""
         est = self.estimator
         if est is not None and not callable(getattr(est, "kernel_block", None)):
             return f"estimator {type(est).__name__} has no kernel"
-        return None
+        why = getattr(est, "kernel_reason", None)
+        return why(self.sensors) if callable(why) else None
 
     def kernel(self, batch_shape, dt: float, *, x0: np.ndarray) -> NavigationKernel:
         """The navigation system for the composed loop (after :meth:`reset`; ``x0`` the run's
@@ -204,8 +217,10 @@ class Navigation:
                 at += 2 * k
             return out
 
+        n_filter = (len(self.estimator.state_names) if kind == nk.EKF else 0)
         return NavigationKernel(nk.sensors_observe, nk_flat(params), state, table, n_w,
-                                estimator=kind, n_signals=len(self.signals), hold=hold)
+                                estimator=kind, n_signals=len(self.signals), hold=hold,
+                                n_filter=n_filter)
 
 
 def nk_flat(values) -> np.ndarray:
@@ -216,8 +231,10 @@ def nk_flat(values) -> np.ndarray:
 class NavigationKernel(Kernel):
     """A navigation system's :class:`~shipgnc.kernels.Kernel` with what the composed loop needs
     beyond it: the estimator's kind (a constant of the generated loop), the number of logged
-    signals and the control samples per step (``table`` rows are control samples)."""
+    signals, the control samples per step (``table`` rows are control samples) and the EKF's
+    state dimension (the model's states and its augmented states)."""
 
     estimator: int = 0
     n_signals: int = 0
     hold: int = 1
+    n_filter: int = 0

@@ -23,7 +23,39 @@ adds per step is 3/4 of the continuous form's; with a rate gyro that difference 
 update per measured state the sensors delivered now (innovation of ψ wrapped to (−π, π]); with no
 delivery (a GNSS dropout) the filter dead-reckons on the model and P grows. Every state of the
 model is estimated (logged ``<state>_hat``, ``<state>_std``); ``nees`` is
-(x − x̂)ᵀ P⁻¹ (x − x̂) against the true state.
+(x − x̂)ᵀ P⁻¹ (x − x̂) against the true state, over the model's states (``nees_dim`` of them).
+
+Augmented states (appended after the model's, logged like them, not in the NEES):
+
+* ``bias_states`` {s: q}: a random-walk bias d_s on the derivative of model state s,
+  ẋ_s = f_s(x, u) + d_s, ḋ_s = w, E[w²] = q (Fossen 2021 §13.3's bias model; e.g. a current
+  d_north, d_east [m/s] or a yaw-acceleration bias d_r [rad/s²] the model does not have).
+* the sensors' own errors, when ``sensor_errors`` (default) and the sensor carries them, with the
+  time constant and levels of the sensor's own options: a GNSS receiver's first-order Gauss–Markov
+  position bias b (ḃ = −b/T_b + w, E[w²] = 2σ_b²/T_b, started N(0, σ_b²): the receiver's exact
+  discrete process at any sample period; measurement y = p + b + v with R = σ²), and a rate
+  gyro's bias (random walk, E[w²] = σ_rw², prior std |bias|; y = r + b + v). A compass's constant
+  bias is not estimated: without another heading reference it is unobservable (ψ and ψ + b give
+  the same measurements), so it stays an error the filter does not model
+  (:meth:`~shipgnc.navigation.Navigation.unmodelled`).
+
+Delayed measurements (a sensor's ``latency`` L control samples, ``sensor_errors``): Larsen,
+Andersen, Hansen & Poulsen (1998, *Incorporation of time delayed measurements in a discrete-time
+Kalman filter*, Proc. 37th IEEE CDC, pp. 3972–3977), the extrapolation method. When a delayed
+sensor takes its sample at s the filter records the predicted measurement h_s = c x̂_s, the
+innovation variance S_s = c P_s cᵀ + R and the cross-covariance g = P_s cᵀ of the estimation error
+with the innovation ν_s = y_s − h_s; over the delay g is carried by every prediction (g ← F g,
+Larsen's M* = Π F (I − K c)) and every correction (g ← g − K c g). When y_s arrives at k::
+
+    x̂_k ← x̂_k + g ν_s / S_s,      P_k ← P_k − g gᵀ / S_s
+
+— the linear update on the pair (x̂_k, ν_s) with their exact covariances, so P stays the
+covariance of the error. Several pending samples (north and east of one fix, or a latency longer
+than the sample period) are correlated: Cov(ν_a, ν_b) = c_b g_a when b is taken, and applying a
+carries g_b ← g_b − g_a Cov(ν_a, ν_b)/S_a.
+
+NIS: the sum over the scalar updates of one sample of ν²/S (sequential scalar updates of
+independent measurements: the joint νᵀS⁻¹ν), with ``nis_dim`` the number of rows.
 """
 
 from __future__ import annotations
@@ -31,6 +63,7 @@ from __future__ import annotations
 import numpy as np
 
 from shipgnc.errors import require
+from shipgnc.frames import wrap_angle
 from shipgnc.models.base import names
 from shipgnc.navigation.estimator import GaussianFilter, as_std_vector
 
@@ -53,15 +86,30 @@ class ExtendedKalmanFilter(GaussianFilter):
     substeps : RK4 steps per control period in the prediction.
     noise : ``"continuous"`` (white noise, default) or ``"held"`` (piecewise constant over Ts;
         module docstring).
+    bias_states : dict model state → spectral density q of a random-walk bias on its derivative
+        (state ``d_<state>``; its initial std from ``P0_std``, default 1 in SI units).
+    sensor_errors : estimate the sensors' GNSS and gyro biases and process delayed measurements
+        (module docstring); False folds them into white R and reads late samples as current.
     """
 
     kind = "ekf"
 
     def __init__(self, *, process_psd=None, P0_std=None, x0_offset=None,
                  sample_initial: bool = False, requires=("north", "east", "psi"),
-                 measurement_std=None, substeps: int = 1, noise: str = "continuous"):
+                 measurement_std=None, substeps: int = 1, noise: str = "continuous",
+                 bias_states=None, sensor_errors: bool = True):
         super().__init__(P0_std=P0_std, x0_offset=x0_offset, sample_initial=sample_initial,
                          measurement_std=measurement_std)
+        bias_states = dict(bias_states or {})
+        for k, v in bias_states.items():
+            require(isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
+                    and v >= 0, f"ekf.bias_states.{k}", v,
+                    "must be a spectral density >= 0 [unit²/s³]")
+        self._bias_arg = bias_states
+        require(isinstance(sensor_errors, bool), "ekf.sensor_errors", sensor_errors,
+                "must be true or false")
+        self.sensor_errors = sensor_errors
+        self.sensors = ()
         self._psd_arg = process_psd
         self.requires = tuple(requires)
         require(isinstance(substeps, int) and not isinstance(substeps, bool) and substeps >= 1,
@@ -85,11 +133,93 @@ class ExtendedKalmanFilter(GaussianFilter):
                                 else default, state_names, 0.0)
         require(bool(np.all(psd >= 0)), "ekf.process_psd", psd.tolist(),
                 "spectral densities must be >= 0")
-        self.Qc = np.diag(psd)
-        self._setup_states(model, state_names, [s.unit for s in model.states],
-                           [s.angle and s.name == "psi" for s in model.states])
-        self.rows = [(self.model_names.index(s), s, self.measurement_variance(s, var))
-                     for s, var in measured.items()]
+        self.nx = len(state_names)
+        units = [s.unit for s in model.states]
+        angles = [s.angle and s.name == "psi" for s in model.states]
+        aug = self._augmented(model, state_names, units)
+        self.n_aug = len(aug)
+        self.lam = np.array([a[3] for a in aug])
+        self.Daug = np.zeros((self.n_aug, self.nx))
+        for i, a in enumerate(aug):
+            if a[2] >= 0:
+                self.Daug[i, a[2]] = 1.0
+        self.Qc = np.diag(np.concatenate([psd, [a[4] for a in aug]]))
+        if not hasattr(self, "_P0_user"):
+            self._P0_user = self._P0_std_arg
+        self._P0_std_arg = self._P0_user
+        if isinstance(self._P0_user, dict) or self._P0_user is None:
+            P0 = dict(self._P0_user or {})
+            for a in aug:               # the sensor biases' priors: their stationary levels
+                if a[5] is not None:
+                    P0.setdefault(a[0], a[5])
+            self._P0_std_arg = P0 or None
+        self._setup_states(model, [*state_names, *(a[0] for a in aug)],
+                           [*units, *(a[1] for a in aug)], [*angles, *([False] * len(aug))])
+        self.rows = []       # (c, state, variance, angle, latency, every)
+        for s, var in measured.items():
+            j = self.model_names.index(s)
+            c = np.zeros(self.nx + self.n_aug)
+            c[j] = 1.0
+            sensor, white = self._sensor_of(s)
+            if s in self._row_bias:
+                c[self._row_bias[s]] = 1.0
+                var = white
+            lat = sensor.latency if (sensor is not None and self.sensor_errors) else 0
+            every = sensor.every if sensor is not None else 1
+            self.rows.append((c, s, self.measurement_variance(s, var), s == "psi", lat, every))
+
+    def use_sensors(self, sensors) -> None:
+        """The sensors that feed the filter (:meth:`Navigation.reset`, before :meth:`prepare`):
+        their bias and latency options become states and delayed updates."""
+        self.sensors = tuple(sensors)
+
+    def _sensor_of(self, state):
+        for sensor in self.sensors:
+            if state in sensor.measures:
+                return sensor, float(sensor.noise_std) ** 2
+        return None, None
+
+    def _augmented(self, model, state_names, units) -> list:
+        """The augmented states: (name, unit, model state driven or −1, decay rate 1/T, Q_c,
+        initial std or None), and ``_row_bias``: measured state → its bias state's index."""
+        out = []
+        for s, q in self._bias_arg.items():
+            require(s in state_names, "ekf.bias_states", s,
+                    f"not a state of {type(model).__name__} ({', '.join(state_names)})")
+            j = state_names.index(s)
+            out.append((f"d_{s}", f"{units[j]}/s", j, 0.0, float(q), None))
+        self._row_bias = {}
+        for sensor in self.sensors if self.sensor_errors else ():
+            for kind, modelled in self.models_errors(sensor):
+                if kind != "bias" or not modelled:
+                    continue
+                if sensor.kind == "gnss":
+                    T, sb = sensor.bias_time_constant, sensor.bias_std
+                    for s in sensor.measures:
+                        self._row_bias[s] = len(state_names) + len(out)
+                        out.append((f"b_{sensor.name}_{s}", "m", -1, 1.0 / T, 2 * sb * sb / T, sb))
+                else:  # rate gyro: random walk
+                    self._row_bias[sensor.measures[0]] = len(state_names) + len(out)
+                    out.append((f"b_{sensor.name}", "rad/s", -1, 0.0, sensor.bias_walk**2,
+                                abs(sensor.bias)))
+        return out
+
+    def models_errors(self, sensor) -> list[tuple[str, bool]]:
+        """(error, modelled) for each error ``sensor`` carries (:meth:`Sensor.errors`)."""
+        out = []
+        for kind in sensor.errors():
+            ok = self.sensor_errors and (
+                (kind == "bias" and sensor.kind in ("gnss", "gyro")) or kind == "latency"
+                or kind == "dropouts")
+            out.append((kind, ok or kind == "dropouts"))
+        return out
+
+    def kernel_reason(self, sensors) -> str | None:
+        """None when the composed loop can run this filter on ``sensors``, else why not."""
+        if self.sensor_errors and any(s.latency > 0 for s in sensors):
+            return ("the EKF's delayed-measurement updates (sensor latency) run in the numpy "
+                    "loop")
+        return None
 
     def kernel_block(self, channels, n_ships: int):
         """(kind, parameters, per-ship state, map) for the composed loop after :meth:`start`:
@@ -97,15 +227,41 @@ class ExtendedKalmanFilter(GaussianFilter):
         Q_c diagonal]``; the model's derivatives are its kernel in the loop."""
         from shipgnc.navigation import kernels as nk
 
-        block = [float(self.substeps), self.Ts, float(self.noise == "held"), float(len(self.rows))]
-        for j, s, var in self.rows:
+        block = [float(self.substeps), self.Ts, float(self.noise == "held"), float(len(self.rows)),
+                 float(self.n_aug)]
+        for c, s, var, angle, _lat, _every in self.rows:
+            j = int(np.flatnonzero(c)[0])
+            jb = int(np.flatnonzero(c)[1]) if np.count_nonzero(c) > 1 else -1
             block += [float(j), float(channels[s][0]), float(channels[s][2]), float(var),
-                      float(s == "psi")]
+                      float(angle), float(jb)]
         block += [float(v) for v in np.diagonal(self.Qc)]
+        for a in range(self.n_aug):  # augmented states: the model state driven, decay rate
+            hit = np.flatnonzero(self.Daug[a])
+            block += [float(hit[0]) if hit.size else -1.0, float(self.lam[a])]
         return nk.EKF, block, self.kernel_state(n_ships), self.kernel_map()
 
     def _f(self, x, u):
         return self.model.derivatives(x, u, None)
+
+    def _f_aug(self, z, u):
+        """The augmented state's derivative: [f(x, u) + D d, −λ b] (module docstring)."""
+        if not self.n_aug:
+            return self._f(z, u)
+        nx = self.nx
+        b = z[..., nx:]
+        fx = self._f(z[..., :nx], u) + b @ self.Daug
+        return np.concatenate([fx, -b * self.lam], axis=-1)
+
+    def jacobian_aug(self, z, u) -> np.ndarray:
+        """∂f/∂z of the augmented state: [[A, Dᵀ], [0, −diag λ]]."""
+        if not self.n_aug:
+            return self.jacobian(z, u)
+        nx, n = self.nx, self.nx + self.n_aug
+        A = np.zeros((*z.shape[:-1], n, n))
+        A[..., :nx, :nx] = self.jacobian(z[..., :nx], u)
+        A[..., :nx, nx:] = self.Daug.T
+        A[..., nx:, nx:] = np.diag(-self.lam)
+        return A
 
     def jacobian(self, x, u) -> np.ndarray:
         """A = ∂f/∂x at (x, u): the model's analytic ``state_jacobian(x, u, d)`` when it has one
@@ -131,17 +287,22 @@ class ExtendedKalmanFilter(GaussianFilter):
     def propagate(self, x, u) -> np.ndarray:
         h = self.Ts / self.substeps
         for _ in range(self.substeps):
-            k1 = self._f(x, u)
-            k2 = self._f(x + 0.5 * h * k1, u)
-            k3 = self._f(x + 0.5 * h * k2, u)
-            k4 = self._f(x + h * k3, u)
+            k1 = self._f_aug(x, u)
+            k2 = self._f_aug(x + 0.5 * h * k1, u)
+            k3 = self._f_aug(x + 0.5 * h * k2, u)
+            k4 = self._f_aug(x + h * k3, u)
             x = x + (h / 6.0) * (k1 + 2 * k2 + 2 * k3 + k4)
         return x
 
     def update(self, t, u, meas, first) -> None:
-        if not first:
+        self.begin_sample()
+        if first:
+            self._k = 0
+            self._pending = []
+        else:
+            self._k += 1
             with np.errstate(all="ignore"):
-                A = self.jacobian(self.z, u)
+                A = self.jacobian_aug(self.z, u)
                 At = A * self.Ts
                 n = At.shape[-1]
                 F = np.eye(n) + At
@@ -160,11 +321,56 @@ class ExtendedKalmanFilter(GaussianFilter):
                 self.z = self.propagate(self.z, u)
                 self.P = F @ self.P @ np.swapaxes(F, -1, -2) + Qd
                 self.P = 0.5 * (self.P + np.swapaxes(self.P, -1, -2))
-        n = self.z.shape[-1]
-        for j, s, var in self.rows:
-            c = np.zeros(n)
-            c[j] = 1.0
-            self.correct_row(c, meas[s][0], var, meas[s][1], s == "psi")
+                for entry in self._pending:          # Larsen's M*: g ← F g
+                    entry["g"] = (F @ entry["g"][..., None])[..., 0]
+        carried = [entry["g"] for entry in self._pending]
+        for c, s, var, angle, lat, _every in self.rows:
+            if lat == 0:
+                gs = self.correct_row(c, meas[s][0], var, meas[s][1], angle, carried)
+                for entry, g in zip(self._pending, gs, strict=True):
+                    entry["g"] = g
+                carried = gs
+        if any(row[4] > 0 for row in self.rows):
+            self._delayed(meas)
+
+    def _delayed(self, meas) -> None:
+        """Larsen et al. (1998): apply the delayed samples delivered now, then record the ones
+        the delayed sensors take now (module docstring)."""
+        k = self._k
+        for c, s, _var, angle, lat, _every in self.rows:
+            if lat == 0:
+                continue
+            for entry in [e for e in self._pending if e["row"] == s and e["k"] <= k - lat]:
+                self._pending.remove(entry)
+                fresh = meas[s][1] if entry["k"] == k - lat else np.zeros_like(meas[s][1])
+                ok = fresh & (entry["S"] > 0)
+                if not np.any(ok):
+                    continue
+                S = np.where(ok, entry["S"], 1.0)
+                innov = meas[s][0] - entry["h"]
+                if angle:
+                    innov = wrap_angle(innov)
+                innov = np.where(ok, innov, 0.0)
+                g = np.where(ok[..., None], entry["g"], 0.0)
+                self.nis = self.nis + innov * innov / S
+                self.nis_dim = self.nis_dim + ok
+                self.z = self.z + g * (innov / S)[..., None]
+                P_new = self.P - g[..., :, None] * g[..., None, :] / S[..., None, None]
+                self.P = 0.5 * (P_new + np.swapaxes(P_new, -1, -2))
+                for other in self._pending:
+                    rho = other["rho"].get(entry["id"])
+                    if rho is not None:
+                        other["g"] = other["g"] - g * (rho / S)[..., None]
+        for c, s, var, angle, lat, every in self.rows:
+            if lat == 0 or k % every != 0:
+                continue
+            Pc = self.P @ c
+            entry = {"id": (s, k), "row": s, "k": k, "h": self.z @ c, "S": Pc @ c + var,
+                     "g": Pc, "rho": {}}
+            for other in self._pending:          # Cov(ν_new, ν_other) = c g_other
+                entry["rho"][other["id"]] = other["g"] @ c
+                other["rho"][entry["id"]] = entry["rho"][other["id"]]
+            self._pending.append(entry)
 
 
 def force_psd_to_state_psd(model, force_psd) -> dict[str, float]:

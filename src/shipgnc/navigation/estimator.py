@@ -51,6 +51,11 @@ class Estimator:
     def signal_values(self, x_true: np.ndarray) -> dict[str, np.ndarray]:
         raise NotImplementedError
 
+    def models_errors(self, sensor) -> list[tuple[str, bool]]:
+        """(error, modelled) for each error ``sensor`` carries (:meth:`Sensor.errors`): by
+        default only a dropout is modelled (no measurement, no correction)."""
+        return [(kind, kind == "dropouts") for kind in sensor.errors()]
+
     def _require_measured(self, model, measured) -> None:
         missing = [s for s in self.requires if s not in measured]
         if missing:
@@ -123,14 +128,24 @@ class GaussianFilter(Estimator):
             z = z + self.P0_std * np.asarray(rng.standard_normal((*batch, n)), dtype=float)
         self.z = z
         self.P = np.broadcast_to(np.diag(self.P0_std**2), (*batch, n, n)).copy()
+        self.begin_sample()
+
+    def begin_sample(self) -> None:
+        """Zero this control sample's normalised innovation squared (NIS) and its dimension."""
+        batch = self.z.shape[:-1]
+        self.nis = np.zeros(batch)
+        self.nis_dim = np.zeros(batch)
 
     # ---- the measurement update ---------------------------------------------------------------
     def correct_row(self, c: np.ndarray, y: np.ndarray, var: float, fresh: np.ndarray,
-                    angle: bool) -> None:
+                    angle: bool, carried=()) -> list:
         """Scalar update with y = c·z + v, v ~ N(0, var), for the ships where ``fresh``
-        (sequential processing of independent measurements equals the joint update)."""
+        (sequential processing of independent measurements equals the joint update). Adds ν²/S
+        to this sample's NIS. ``carried``: vectors g (*batch, n), cross-covariances of the error
+        with a pending delayed innovation (:mod:`shipgnc.navigation.ekf`), returned as
+        g − K c g."""
         if not np.any(fresh):
-            return
+            return list(carried)
         Pc = self.P @ c                                   # (*batch, n)
         S = Pc @ c + var                                  # (*batch,)
         ok = fresh & (S > 0)
@@ -140,10 +155,13 @@ class GaussianFilter(Estimator):
         if angle:
             innov = wrap_angle(innov)
         innov = np.where(ok, innov, 0.0)
+        self.nis = self.nis + innov * innov / S
+        self.nis_dim = self.nis_dim + ok
         self.z = self.z + K * innov[..., None]
         P_new = self.P - K[..., :, None] * Pc[..., None, :]
         P_new = 0.5 * (P_new + np.swapaxes(P_new, -1, -2))
         self.P = np.where(ok[..., None, None], P_new, self.P)
+        return [np.where(ok[..., None], g - K * (g @ c)[..., None], g) for g in carried]
 
     def measurement_variance(self, name: str, default: float) -> float:
         if self._meas_std_arg and name in self._meas_std_arg:
@@ -152,9 +170,10 @@ class GaussianFilter(Estimator):
 
     # ---- the compiled loop --------------------------------------------------------------------
     def kernel_state(self, n_ships: int) -> np.ndarray:
-        """Rows ``[ẑ, P (row-major)]`` after :meth:`start`."""
+        """Rows ``[ẑ, P (row-major), NIS, NIS dimension]`` after :meth:`start`."""
         n = len(self.state_names)
-        return np.concatenate([self.z.reshape(n_ships, n), self.P.reshape(n_ships, n * n)], axis=1)
+        return np.concatenate([self.z.reshape(n_ships, n), self.P.reshape(n_ships, n * n),
+                               np.zeros((n_ships, 2))], axis=1)
 
     def kernel_map(self) -> list[float]:
         """``[n, n_mapped, (filter index, model index, angle) × n_mapped]`` (the estimates the
@@ -168,9 +187,15 @@ class GaussianFilter(Estimator):
     def model_estimate(self) -> dict[str, np.ndarray]:
         return {self.state_names[i]: self.z[..., i] for i in self.map}
 
+    @property
+    def nees_dim(self) -> int:
+        """The dimension the NEES is taken over: the filter states that are model states."""
+        return len(self.map)
+
     def nees(self, x_true: np.ndarray) -> np.ndarray:
         """(x − x̂)ᵀ P⁻¹ (x − x̂) over the filter states that are model states (the marginal
-        covariance of that block; angles wrapped)."""
+        covariance of that block; angles wrapped). For a consistent filter it is χ²-distributed
+        with :attr:`nees_dim` degrees of freedom (Bar-Shalom, Li & Kirubarajan 2001, §5.4.2)."""
         idx = list(self.map)
         err = np.stack([x_true[..., self.map[i]] - self.z[..., i] for i in idx], axis=-1)
         for k, i in enumerate(idx):
@@ -192,6 +217,9 @@ class GaussianFilter(Estimator):
             out.append(Signal(f"{s}_std", u, f"standard deviation of the {self.kind}'s {s}"))
         out.append(Signal("nees", "1", "normalised estimation error squared (estimated model "
                                        "states)"))
+        out.append(Signal("nis", "1", "normalised innovation squared of the measurements "
+                                      "processed at this sample (0 when none)"))
+        out.append(Signal("nis_dim", "1", "number of scalar measurements in nis"))
         return tuple(out)
 
     def signal_values(self, x_true) -> dict[str, np.ndarray]:
@@ -199,4 +227,6 @@ class GaussianFilter(Estimator):
         std = np.sqrt(np.maximum(np.diagonal(self.P, axis1=-2, axis2=-1), 0.0))
         out.update({f"{s}_std": std[..., i] for i, s in enumerate(self.state_names)})
         out["nees"] = self.nees(x_true) if self.map else np.full(x_true.shape[:-1], np.nan)
+        out["nis"] = self.nis
+        out["nis_dim"] = self.nis_dim
         return out

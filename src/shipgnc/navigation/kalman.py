@@ -195,6 +195,7 @@ class KalmanFilter(GaussianFilter):
         return nk.KF, block, self.kernel_state(n_ships), self.kernel_map()
 
     def update(self, t, u, meas, first) -> None:
+        self.begin_sample()
         if not first:
             uu = u[..., self.input_index]
             self.z = self.z @ self.A.T + uu @ self.B.T

@@ -24,7 +24,8 @@ bias_std, a, b_scale, z_offset, w_offset, sig_offset, state index × k, (t0, t1)
 step's scale: σ_b √(1 − a²) for the GNSS, σ_rw √h for the gyro); a channel (one measured state):
 ``[state index, z offset of the held value, of the valid flag, of the fresh flag, variance]``.
 
-``z``: ``[first, sensor blocks ..., estimator]``; a sensor block: ``[held × k, valid, fresh, j,
+``z``: ``[first, sensor blocks ..., estimator]`` (a Kalman filter's: ``[ẑ, P, NIS, NIS
+dimension]``); a sensor block: ``[held × k, valid, fresh, j,
 first, bias × k, pipe]`` with the pipe a ring of ``latency + 1`` entries ``[due, lost, value × k]``.
 
 ``w`` (the table row of one control sample): per sensor ``[bias draws × k, noise draws × k]``
@@ -279,7 +280,8 @@ def apply_gain(zh, P, Pc, S, innov):
 
 @kernel_function
 def correct_c(zh, P, c, y, var, angle, Pc):
-    """:meth:`GaussianFilter.correct_row` for one ship and a general row ``c`` (the linear KF)."""
+    """:meth:`GaussianFilter.correct_row` for one ship and a general row ``c`` (the linear KF);
+    returns the row's NIS innov²/S, −1 when S ≤ 0 (no update)."""
     n = zh.shape[0]
     S = var
     yc = 0.0
@@ -292,11 +294,12 @@ def correct_c(zh, P, c, y, var, angle, Pc):
         S += Pc[a] * c[a]
         yc += zh[a] * c[a]
     if not S > 0.0:
-        return
+        return -1.0
     innov = y - yc
     if angle:
         innov = wrap(innov)
     apply_gain(zh, P, Pc, S, innov)
+    return innov * innov / S
 
 
 @kernel_function
@@ -388,13 +391,20 @@ def kf_step(u, z, p):
             zh[i] = zn[i]
     Pc = np.empty(n)
     c = np.empty(n)
+    nis = 0.0
+    nisd = 0.0
     for r in range(nrows):
         o = oR + 4 * r
         if z[int(p[o + 1])] != 0.0:
             for j in range(n):
                 c[j] = p[oC + r * n + j]
-            correct_c(zh, P, c, z[int(p[o])], p[o + 2], p[o + 3] != 0.0, Pc)
+            v = correct_c(zh, P, c, z[int(p[o])], p[o + 2], p[o + 3] != 0.0, Pc)
+            if v >= 0.0:
+                nis += v
+                nisd += 1.0
     for i in range(n):
         z[ez + i] = zh[i]
     for i in range(n * n):
         z[ez + n + i] = P[i]
+    z[ez + n + n * n] = nis
+    z[ez + n + n * n + 1] = nisd

@@ -231,6 +231,19 @@ class Sensor:
         return out
 
     # ---- what the estimators read -------------------------------------------------------------
+    def errors(self) -> list[str]:
+        """The errors beyond white noise this sensor carries: ``bias``, ``latency``,
+        ``dropouts``."""
+        out = ["bias"] if self._biased() else []
+        if self.latency > 0:
+            out.append("latency")
+        if self.dropouts:
+            out.append("dropouts")
+        return out
+
+    def _biased(self) -> bool:
+        return False
+
     def variances(self) -> np.ndarray:
         """The stationary variance of each channel's error (white noise + random bias), the
         default measurement-noise variance R an estimator uses."""
@@ -290,6 +303,9 @@ class GNSS(Sensor):
     def variances(self):
         return np.full(2, self.noise_std**2 + self.bias_std**2)
 
+    def _biased(self) -> bool:
+        return self.bias_std > 0
+
 
 class Compass(Sensor):
     """Compass / gyrocompass heading ψ [rad]: white noise ``noise_std`` [rad], constant ``bias``
@@ -321,6 +337,9 @@ class Compass(Sensor):
 
     def variances(self):
         return np.full(1, self.noise_std**2 + self.bias_std**2)
+
+    def _biased(self) -> bool:
+        return self.bias != 0 or self.bias_std > 0
 
 
 class RateGyro(Sensor):
@@ -362,6 +381,9 @@ class RateGyro(Sensor):
 
     def variances(self):
         return np.full(1, self.noise_std**2)
+
+    def _biased(self) -> bool:
+        return self.bias != 0 or self.bias_walk > 0
 
 
 class SpeedLog(Sensor):

@@ -2,7 +2,7 @@
 the generated module of a combination before the loop body (:mod:`shipgnc.sim.loop_template`), so
 the estimators call the vessel model's kernel ``model_fn`` by name (a numba function passed as an
 argument would make the loop uncacheable). Free names: ``model_fn``, ``nx``, ``nu``, ``nd``,
-``est_kind``, ``CACHE``; ``jac_fn`` (the model's analytic state Jacobian,
+``est_kind``, ``ne`` (the EKF's state dimension: ``nx`` plus its augmented states), ``CACHE``; ``jac_fn`` (the model's analytic state Jacobian,
 :func:`shipgnc.navigation.kernels.jacobian_kernel`) is found from ``model_fn``. The
 arithmetic is :mod:`shipgnc.navigation.kernels`; this is
 :meth:`shipgnc.navigation.Navigation.observe` for one ship at one control sample.
@@ -56,6 +56,7 @@ def nav_observe(t, x, u, zn, pn, w, seen, nsg, pm, wk):
 nav_work = nx * nx + 5 * nx + nd + nu + 96
 #: the size of the EKF's matrices (a constant: :func:`ekf_step`'s arrays live on the stack)
 nn = nx * nx
+nne = ne * ne
 
 
 def observer_step(u, zn, pn, pm, wk):
@@ -141,12 +142,26 @@ def observer_step(u, zn, pn, pm, wk):
         zn[ez + j] = s[j]
 
 
+def ekf_faug(z, u, d0, pm, pn, a0, out):
+    """The EKF's augmented derivative (:meth:`ExtendedKalmanFilter._f_aug`): the model's ẋ plus
+    each bias d on the state it drives, −λ b for the others; ``a0`` the augmented block of ``pn``:
+    (driven state or −1, λ) per augmented state."""
+    model_fn(z[:nx], u, d0, pm, out[:nx])
+    for a in range(ne - nx):
+        tgt = int(pn[a0 + 2 * a])
+        b = z[nx + a]
+        if tgt >= 0:
+            out[tgt] = out[tgt] + b
+        out[nx + a] = -b * pn[a0 + 2 * a + 1]
+
+
 def ekf_step(u, zn, pn, pm, wk):
     """:meth:`ExtendedKalmanFilter.update`: predict (RK4 on the model, its analytic Jacobian
     ``jac_fn`` when it has one, else central differences, F by the 4th-order series, Q_d) unless
     first, then one scalar correction per state whose sensor delivered now (:func:`ekf_correct`).
-    Small loops of known length (n = ``nx``) on arrays on the stack (no BLAS call, no allocation,
-    nothing the compiler must assume aliases ``zn``: at n = 5 or 6 these cost less than a call).
+    Small loops of known length (n = ``ne``: the model's states and the augmented ones) on
+    arrays on the stack (no BLAS call, no allocation, nothing the compiler must assume aliases
+    ``zn``: at n = 5 or 6 these cost less than a call).
 
     The numpy form's arithmetic with fewer operations (equal to it up to round-off):
 
@@ -160,47 +175,59 @@ def ekf_step(u, zn, pn, pm, wk):
     F P Fᵀ 2 × 216, A Q_c Aᵀ 216)."""
     e = int(pn[3])
     ez = int(pn[5])
-    n = nx
+    n = ne
     zh = zn[ez:ez + n]
-    P = zn[ez + n:ez + n + nn]
+    P = zn[ez + n:ez + n + nne]
     substeps = int(pn[e])
     Ts = pn[e + 1]
     held = pn[e + 2] != 0.0
     nrows = int(pn[e + 3])
-    q0 = e + 4 + 5 * nrows          # Q_c diagonal
+    q0 = e + 5 + 6 * nrows          # Q_c diagonal
+    a0 = q0 + n                     # augmented states: (driven state, λ) each
+    nis = 0.0
+    nisd = 0.0
     if zn[0] == 0.0:
         d0 = stack_empty(nd)
         for j in range(nd):
             d0[j] = 0.0
-        A = stack_empty(nn)
-        At = stack_empty(nn)
-        B2 = stack_empty(nn)        # At², then T = F P
-        C = stack_empty(nn)         # At/6 + At²/24, then Γ
-        E = stack_empty(nn)         # F − I
-        Qd = stack_empty(nn)        # Q_d, then P⁻ (upper triangles)
-        q = stack_empty(nx)
-        Pl = stack_empty(nn)
-        xp = stack_empty(nx)
-        k1 = stack_empty(nx)
-        k2 = stack_empty(nx)
-        k3 = stack_empty(nx)
-        k4 = stack_empty(nx)
+        A = stack_empty(nne)
+        Ax = stack_empty(nn)
+        At = stack_empty(nne)
+        B2 = stack_empty(nne)       # At², then T = F P
+        C = stack_empty(nne)        # At/6 + At²/24, then Γ
+        E = stack_empty(nne)        # F − I
+        Qd = stack_empty(nne)       # Q_d, then P⁻ (upper triangles)
+        q = stack_empty(ne)
+        Pl = stack_empty(nne)
+        xp = stack_empty(ne)
+        k1 = stack_empty(ne)
+        k2 = stack_empty(ne)
+        k3 = stack_empty(ne)
+        k4 = stack_empty(ne)
         for j in range(n):
             q[j] = pn[q0 + j]
         if has_jac:  # the model's analytic ∂f/∂x
-            jac_fn(zh, u, d0, pm, A)
+            jac_fn(zh[:nx], u, d0, pm, Ax)
         else:  # central differences
-            for j in range(n):
+            for j in range(nx):
                 hj = 1e-6 * max(1.0, abs(zh[j]))
-                for i in range(n):
+                for i in range(nx):
                     xp[i] = zh[i]
                 xp[j] = zh[j] + hj
-                model_fn(xp, u, d0, pm, k1)
+                model_fn(xp[:nx], u, d0, pm, k1[:nx])
                 xp[j] = zh[j] - hj
-                model_fn(xp, u, d0, pm, k2)
-                for i in range(n):
-                    A[i * n + j] = (k1[i] - k2[i]) / (2.0 * hj)
-        for i in range(nn):
+                model_fn(xp[:nx], u, d0, pm, k2[:nx])
+                for i in range(nx):
+                    Ax[i * nx + j] = (k1[i] - k2[i]) / (2.0 * hj)
+        for i in range(n):
+            for j in range(n):
+                A[i * n + j] = Ax[i * nx + j] if (i < nx and j < nx) else 0.0
+        for a in range(n - nx):     # [[A, Dᵀ], [0, −diag λ]]
+            tgt = int(pn[a0 + 2 * a])
+            if tgt >= 0:
+                A[tgt * n + nx + a] = 1.0
+            A[(nx + a) * n + nx + a] = -pn[a0 + 2 * a + 1]
+        for i in range(nne):
             At[i] = A[i] * Ts
         for i in range(n):   # At², At/6 + At²/24
             for j in range(n):
@@ -240,20 +267,20 @@ def ekf_step(u, zn, pn, pm, wk):
         # x̂⁻ = Φ(x̂, u): RK4, substeps per Ts
         h = Ts / substeps
         for _ in range(substeps):
-            model_fn(zh, u, d0, pm, k1)
+            ekf_faug(zh, u, d0, pm, pn, a0, k1)
             for i in range(n):
                 xp[i] = zh[i] + 0.5 * h * k1[i]
-            model_fn(xp, u, d0, pm, k2)
+            ekf_faug(xp, u, d0, pm, pn, a0, k2)
             for i in range(n):
                 xp[i] = zh[i] + 0.5 * h * k2[i]
-            model_fn(xp, u, d0, pm, k3)
+            ekf_faug(xp, u, d0, pm, pn, a0, k3)
             for i in range(n):
                 xp[i] = zh[i] + h * k3[i]
-            model_fn(xp, u, d0, pm, k4)
+            ekf_faug(xp, u, d0, pm, pn, a0, k4)
             for i in range(n):
                 zh[i] = zh[i] + (h / 6.0) * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i])
         # P⁻ = F P Fᵀ + Q_d: T = P + E P, then the upper triangle of T + T Eᵀ + Q_d, mirrored
-        for i in range(nn):
+        for i in range(nne):
             Pl[i] = P[i]
         for i in range(n):
             for j in range(n):
@@ -270,24 +297,31 @@ def ekf_step(u, zn, pn, pm, wk):
                 P[i * n + j] = Qd[i * n + j]
                 P[j * n + i] = Qd[i * n + j]
     for r in range(nrows):
-        o = e + 4 + 5 * r
+        o = e + 5 + 6 * r
         if zn[int(pn[o + 2])] != 0.0:  # fresh
-            ekf_correct(zh, P, int(pn[o]), zn[int(pn[o + 1])], pn[o + 3], pn[o + 4] != 0.0)
+            v = ekf_correct(zh, P, int(pn[o]), int(pn[o + 5]), zn[int(pn[o + 1])], pn[o + 3],
+                            pn[o + 4] != 0.0)
+            if v >= 0.0:
+                nis += v
+                nisd += 1.0
+    zn[ez + n + nne] = nis
+    zn[ez + n + nne + 1] = nisd
 
 
-def ekf_correct(zh, P, j, y, var, angle):
-    """:meth:`GaussianFilter.correct_row` for one ship and a row c = e_j (a measured state), at
-    the model's size ``nx`` (loops of known length): x̂ += Pc/S·innov, P −= Pc Pcᵀ/S with
-    Pc = P e_j, S = P_jj + var (Simon 2006 §5.1), on the upper triangle of P, mirrored (the
-    symmetrised update up to round-off)."""
-    n = nx
-    Pc = stack_empty(nx)
+def ekf_correct(zh, P, j, jb, y, var, angle):
+    """:meth:`GaussianFilter.correct_row` for one ship and a row c = e_j (a measured state), or
+    c = e_j + e_jb (a measured state and the sensor's bias state jb ≥ 0), at the filter's size
+    ``ne`` (loops of known length): x̂ += Pc/S·innov, P −= Pc Pcᵀ/S with Pc = P cᵀ,
+    S = c P cᵀ + var (Simon 2006 §5.1), on the upper triangle of P, mirrored (the symmetrised
+    update up to round-off). Returns innov²/S (the row's NIS), −1 when S ≤ 0 (no update)."""
+    n = ne
+    Pc = stack_empty(ne)
     for a in range(n):
-        Pc[a] = P[a * n + j]
-    S = Pc[j] + var
+        Pc[a] = P[a * n + j] + P[a * n + jb] if jb >= 0 else P[a * n + j]
+    S = (Pc[j] + Pc[jb] if jb >= 0 else Pc[j]) + var
     if not S > 0.0:
-        return
-    innov = y - zh[j]
+        return -1.0
+    innov = y - (zh[j] + zh[jb] if jb >= 0 else zh[j])
     if angle:
         innov = wrap(innov)
     for a in range(n):
@@ -297,6 +331,7 @@ def ekf_correct(zh, P, j, y, var, angle):
         for b in range(a, n):
             P[a * n + b] = P[a * n + b] - Ka * Pc[b]
             P[b * n + a] = P[a * n + b]
+    return innov * innov / S
 
 
 def gaussian_outputs(x, zn, pn, seen, nsg, wk):
@@ -324,11 +359,14 @@ def gaussian_outputs(x, zn, pn, seen, nsg, wk):
         nsg[so + n + i] = math.sqrt(max(zn[ez + n + i * n + i], 0.0))
     nsg[so + 2 * n] = (nees(err, zn[ez + n:ez + n + n * n], n, idx, m, work[2 * m:]) if m > 0
                        else np.nan)
+    nsg[so + 2 * n + 1] = zn[ez + n + n * n]
+    nsg[so + 2 * n + 2] = zn[ez + n + n * n + 1]
 
 
 _OPTIONS = {**JIT_OPTIONS, "cache": CACHE}
 observer_step = numba.njit(**_OPTIONS)(observer_step)
 ekf_correct = numba.njit(**_OPTIONS)(ekf_correct)
+ekf_faug = numba.njit(**_OPTIONS)(ekf_faug)
 ekf_step = numba.njit(**_OPTIONS)(ekf_step)
 gaussian_outputs = numba.njit(**_OPTIONS)(gaussian_outputs)
 nav_observe = numba.njit(**_OPTIONS)(nav_observe)
