@@ -411,14 +411,18 @@ def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
     return out
 
 
-def navigation_arrays(ds) -> dict[str, np.ndarray]:
+def navigation_arrays(ds, navigation=None) -> dict[str, np.ndarray]:
     """The navigation figures of a run with sensors / an estimator, ``(ship,)`` arrays
     over every logged sample where the quantity exists (NaN-free samples only):
 
     ``heading_est_rmse_deg`` √mean(wrap(ψ̂ − ψ)²), ``position_est_rmse_m`` √mean((N̂ − N)² + (Ê − E)²),
     ``heading_meas_rmse_deg`` √mean(wrap(ψ_meas − ψ)²) over the valid compass samples, and
-    ``nees_mean`` the mean normalised estimation error squared (its expectation is the number of
-    estimated states for a consistent filter). Keys whose signals the run did not log are absent."""
+    ``nees_mean`` the mean normalised estimation error squared (its expectation is ``nees_dim``,
+    the number of model states the NEES is taken over, for a consistent filter: Bar-Shalom, Li &
+    Kirubarajan 2001, §5.4.2), ``nis_mean`` the mean normalised innovation squared over the
+    samples with a measurement (its expectation ``nis_dim``, the mean number of scalar
+    measurements at those samples). ``nees_dim`` needs the run's ``navigation`` (a Kalman filter's
+    mapped states). Keys whose signals the run did not log are absent."""
     out: dict[str, np.ndarray] = {}
 
     def rms(error: np.ndarray) -> np.ndarray:
@@ -436,4 +440,16 @@ def navigation_arrays(ds) -> dict[str, np.ndarray]:
     if "nees" in ds:
         with np.errstate(invalid="ignore"):
             out["nees_mean"] = np.nanmean(series(ds, "nees"), axis=0)
+        dim = getattr(getattr(navigation, "estimator", None), "nees_dim", None)
+        if dim is not None:
+            out["nees_dim"] = np.full(out["nees_mean"].shape, float(dim))
+    if "nis" in ds and "nis_dim" in ds:
+        nis, nd = series(ds, "nis"), series(ds, "nis_dim")
+        seen = nd > 0
+        with np.errstate(invalid="ignore", divide="ignore"):
+            count = seen.sum(axis=0)
+            out["nis_mean"] = np.where(count > 0, np.where(seen, nis, 0.0).sum(axis=0) / count,
+                                       np.nan)
+            out["nis_dim"] = np.where(count > 0, np.where(seen, nd, 0.0).sum(axis=0) / count,
+                                      np.nan)
     return out

@@ -90,6 +90,9 @@ class ExtendedKalmanFilter(GaussianFilter):
         (state ``d_<state>``; its initial std from ``P0_std``, default 1 in SI units).
     sensor_errors : estimate the sensors' GNSS and gyro biases and process delayed measurements
         (module docstring); False folds them into white R and reads late samples as current.
+    force_psd : [S_X, S_Y, S_N] the white body-force noise density the plant is driven by (the
+        scenario's ``gaussian`` disturbance ``psd``): the u, v, r densities then follow from the
+        mass matrix (:func:`force_psd_to_state_psd`; ``process_psd`` still overrides).
     """
 
     kind = "ekf"
@@ -97,7 +100,7 @@ class ExtendedKalmanFilter(GaussianFilter):
     def __init__(self, *, process_psd=None, P0_std=None, x0_offset=None,
                  sample_initial: bool = False, requires=("north", "east", "psi"),
                  measurement_std=None, substeps: int = 1, noise: str = "continuous",
-                 bias_states=None, sensor_errors: bool = True):
+                 bias_states=None, sensor_errors: bool = True, force_psd=None):
         super().__init__(P0_std=P0_std, x0_offset=x0_offset, sample_initial=sample_initial,
                          measurement_std=measurement_std)
         bias_states = dict(bias_states or {})
@@ -111,6 +114,12 @@ class ExtendedKalmanFilter(GaussianFilter):
         self.sensor_errors = sensor_errors
         self.sensors = ()
         self._psd_arg = process_psd
+        if force_psd is not None:
+            force_psd = [float(v) for v in force_psd]
+            require(len(force_psd) == 3 and all(np.isfinite(v) and v >= 0 for v in force_psd),
+                    "ekf.force_psd", force_psd, "must be 3 spectral densities >= 0 [N²s, N²s, "
+                    "(Nm)²s]")
+        self.force_psd = force_psd
         self.requires = tuple(requires)
         require(isinstance(substeps, int) and not isinstance(substeps, bool) and substeps >= 1,
                 "ekf.substeps", substeps, "must be an integer >= 1")
@@ -125,6 +134,8 @@ class ExtendedKalmanFilter(GaussianFilter):
         self.Ts = float(Ts)
         state_names = names(model.states)
         default = {s: (0.0 if s in ("north", "east", "psi") else 1e-4) for s in state_names}
+        if self.force_psd is not None:  # Q from the truth's white body-force noise
+            default.update(force_psd_to_state_psd(model, self.force_psd))
         if isinstance(self._psd_arg, dict):
             default.update(self._psd_arg)
             psd = as_std_vector("ekf.process_psd", default, state_names, 0.0)
@@ -155,6 +166,9 @@ class ExtendedKalmanFilter(GaussianFilter):
             self._P0_std_arg = P0 or None
         self._setup_states(model, [*state_names, *(a[0] for a in aug)],
                            [*units, *(a[1] for a in aug)], [*angles, *([False] * len(aug))])
+        # an augmented state starts at 0: its error is the truth's bias (a GNSS bias drawn from
+        # its stationary N(0, σ_b²), a current), not a draw of the filter's own
+        self.sampled = np.arange(self.nx + self.n_aug) < self.nx
         self.rows = []       # (c, state, variance, angle, latency, every)
         for s, var in measured.items():
             j = self.model_names.index(s)

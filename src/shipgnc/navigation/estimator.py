@@ -116,6 +116,8 @@ class GaussianFilter(Estimator):
         self.x0_offset = as_std_vector(f"{self.kind}.x0_offset", self._x0_offset_arg,
                                        self.state_names, 0.0)
         self.z0 = np.zeros(n) if z0 is None else np.asarray(z0, dtype=float)
+        #: the states whose initial estimate ``sample_initial`` draws from P0 (all by default)
+        self.sampled = np.ones(n, dtype=bool)
 
     def start(self, x_true, rng) -> None:
         batch = x_true.shape[:-1]
@@ -124,8 +126,9 @@ class GaussianFilter(Estimator):
         for i, j in self.map.items():
             z[..., i] = x_true[..., j]
         z = z + self.x0_offset
-        if self.sample_initial:
-            z = z + self.P0_std * np.asarray(rng.standard_normal((*batch, n)), dtype=float)
+        if self.sample_initial:  # the model states' errors; an internal state starts at z0
+            draw = np.asarray(rng.standard_normal((*batch, n)), dtype=float)
+            z = z + self.P0_std * np.where(self.sampled, draw, 0.0)
         self.z = z
         self.P = np.broadcast_to(np.diag(self.P0_std**2), (*batch, n, n)).copy()
         self.begin_sample()

@@ -329,7 +329,9 @@ def navigation(scenario: Scenario, controller=None):
     elif e.type == "ekf":
         estimator = nav.ExtendedKalmanFilter(
             process_psd=dict(e.process_psd) or None, P0_std=dict(e.P0_std) or None,
-            x0_offset=dict(e.x0_offset) or None, substeps=e.substeps, noise=e.noise)
+            x0_offset=dict(e.x0_offset) or None, substeps=e.substeps, noise=e.noise,
+            sample_initial=e.sample_initial, bias_states=dict(e.bias_states) or None,
+            sensor_errors=e.sensor_errors, force_psd=e.force_psd)
     else:
         estimator = nav.PassiveObserver(e.omega0_rad_s, zeta=e.zeta, zeta_notch=e.zeta_notch,
                                         omega_c=e.omega_c_rad_s, omega_lf=e.omega_lf_rad_s,
@@ -386,7 +388,11 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     else:
         out = {}
     if setup.navigation is not None:
-        out.update({k: metrics._scalar(v[0]) for k, v in metrics.navigation_arrays(result).items()})
+        out.update({k: metrics._scalar(v[0]) for k, v in
+                    metrics.navigation_arrays(result, setup.navigation).items()})
+        unmodelled = setup.navigation.unmodelled()
+        if setup.navigation.estimator is not None:
+            out["unmodelled_sensor_errors"] = unmodelled
     out["diverged"] = diverged
     return out
 
@@ -436,7 +442,7 @@ def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndar
     else:
         return None
     if setup.navigation is not None:
-        out.update(metrics.navigation_arrays(result))
+        out.update(metrics.navigation_arrays(result, setup.navigation))
     n = series(result, result.psi.name).shape[1]
     arrays = {key: np.broadcast_to(np.asarray(value, dtype=float), (n,)) for key, value in out.items()}
     arrays["diverged"] = np.zeros(n)

@@ -798,14 +798,22 @@ SensorConfig = Annotated[GNSSConfig | CompassConfig | GyroConfig | SpeedLogConfi
 class EKFConfig(Strict):
     """An extended Kalman filter on the vessel's own model (:class:`~shipgnc.navigation.ekf.
     ExtendedKalmanFilter`): ``process_psd`` by state name [unit²/s], initial ``P0_std`` and
-    ``x0_offset`` (SI; heading in rad), ``noise``: continuous or held over each step."""
+    ``x0_offset`` (SI; heading in rad; ``sample_initial``: the initial error drawn from P0),
+    ``noise``: continuous or held over each step; ``bias_states`` by state name: the spectral
+    density [unit²/s³] of a random-walk bias on that state's derivative (e.g. a current on
+    north/east, a yaw-acceleration bias on r); ``sensor_errors``: estimate the sensors' GNSS and
+    gyro biases and update with delayed fixes (default), or fold them into white noise."""
 
     type: Literal["ekf"]
     process_psd: dict[str, NonNegative] = Field(default_factory=dict)
     P0_std: dict[str, Positive] = Field(default_factory=dict)
     x0_offset: dict[str, Finite] = Field(default_factory=dict)
+    sample_initial: bool = False
     substeps: Annotated[int, Field(ge=1, le=100)] = 1
     noise: Literal["continuous", "held"] = "continuous"
+    bias_states: dict[str, NonNegative] = Field(default_factory=dict)
+    sensor_errors: bool = True
+    force_psd: Triple | None = None
 
 
 class PassiveObserverConfig(Strict):
