@@ -59,7 +59,8 @@ def _gnss_compass_ekf(dropouts=(), **ekf):
 # ---- Kalman filter ------------------------------------------------------------------------------
 def test_kalman_steady_state_gain_equals_dlqe():
     """The running filter's a-priori covariance and gain converge to python-control's dlqe
-    (L = A K, P⁻ = dlqe's P) for the Nomoto + wave + rudder-bias model with compass and gyro."""
+    (L = A K, P⁻ = dlqe's P) for the Nomoto + wave + rudder-bias model with compass and gyro
+    (and the gyro's bias state)."""
     import control  # python-control: a hard dependency (a missing one fails, never skips)
 
     Ts = 0.1
@@ -75,7 +76,7 @@ def test_kalman_steady_state_gain_equals_dlqe():
     P_prior = kf.A @ kf.P[0] @ kf.A.T + kf.Q
     Rm = np.diag(list(R.values()))
     K = P_prior @ kf.C.T @ np.linalg.inv(kf.C @ P_prior @ kf.C.T + Rm)
-    L, P_dlqe, _ = control.dlqe(kf.A, np.eye(5), kf.C, kf.Q, Rm)
+    L, P_dlqe, _ = control.dlqe(kf.A, np.eye(kf.A.shape[0]), kf.C, kf.Q, Rm)
     np.testing.assert_allclose(kf.A @ K, L, atol=1e-6)
     np.testing.assert_allclose(P_prior, P_dlqe, atol=1e-6 * np.abs(P_dlqe).max())
     _, K_ss = kf.steady_state()

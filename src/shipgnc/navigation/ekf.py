@@ -351,7 +351,7 @@ class ExtendedKalmanFilter(GaussianFilter):
         """Larsen et al. (1998): apply the delayed samples delivered now, then record the ones
         the delayed sensors take now (module docstring)."""
         k = self._k
-        for c, s, _var, angle, lat, _every in self.rows:
+        for _c, s, _var, angle, lat, _every in self.rows:
             if lat == 0:
                 continue
             for entry in [e for e in self._pending if e["row"] == s and e["k"] <= k - lat]:
@@ -375,7 +375,7 @@ class ExtendedKalmanFilter(GaussianFilter):
                     rho = other["rho"].get(entry["id"])
                     if rho is not None:
                         other["g"] = other["g"] - g * (rho / S)[..., None]
-        for c, s, var, angle, lat, every in self.rows:
+        for c, s, var, _angle, lat, every in self.rows:
             if lat == 0 or k % every != 0:
                 continue
             Pc = self.P @ c

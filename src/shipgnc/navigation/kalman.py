@@ -27,8 +27,13 @@ with rudder bias, and §10.2.1, the linear wave-response model)::
     ψ̇   = r
     ṙ   = −r/T + (K/T)(δ − b) + w₂           (Nomoto 1st order with rudder bias b)
     ḃ   = w₃
-    y   = ψ + ψ_w  (compass)      [ + r  (rate gyro, optional: the wave yaw rate is then treated
-                                     as measurement noise) ]
+    ḃ_g = w₄                                 (rate-gyro bias, a random walk; with the gyro)
+    y   = ψ + ψ_w  (compass)      [ + r + b_g  (rate gyro, optional: the wave yaw rate is then
+                                     treated as measurement noise) ]
+
+The gyro bias b_g is observable through the compass (ψ̇ = r, so a constant offset of the gyro's
+r is seen against the heading's rate); a constant compass bias is not (no other heading
+reference) and stays an unmodelled error.
 
 The low-frequency heading ψ̂ and rate r̂ are what the controller sees: the wave filter.
 """
@@ -86,6 +91,9 @@ class KalmanFilter(GaussianFilter):
     state_names : a name per filter state; a name equal to a model state (``psi``, ``r``, ...)
         makes it the filter's estimate of that state (what the controller sees); the others are
         internal (logged as ``<name>_hat``, ``<name>_std``).
+    models : the sensor errors the model holds, as (sensor kind, error) pairs (e.g.
+        ``[("gyro", "bias")]`` for a gyro-bias state); any other error a sensor carries is named
+        as unmodelled (:meth:`~shipgnc.navigation.Navigation.unmodelled`).
     measured : the model state whose measurement feeds each row of C (e.g. ``("psi",)``).
     inputs : the model inputs forming u, in the order of B's columns (e.g. ``("delta",)``).
     units : a unit per state (for the log); angles: names of the angle states (wrapped).
@@ -98,7 +106,7 @@ class KalmanFilter(GaussianFilter):
 
     def __init__(self, A, B, C, Q, R=None, *, Ts: float | None, state_names, measured,
                  inputs=(), units=None, angles=("psi",), z0=None, P0_std=None, x0_offset=None,
-                 sample_initial: bool = False, measurement_std=None):
+                 sample_initial: bool = False, measurement_std=None, models=()):
         super().__init__(P0_std=P0_std, x0_offset=x0_offset, sample_initial=sample_initial,
                          measurement_std=measurement_std)
         self._names = tuple(state_names)
@@ -119,6 +127,12 @@ class KalmanFilter(GaussianFilter):
         self._z0 = z0
         self._continuous = None
         self.requires = self.measured
+        #: the sensor errors the model holds, as (sensor kind, error), e.g. ("gyro", "bias")
+        self.models = tuple(tuple(m) for m in models)
+
+    def models_errors(self, sensor) -> list[tuple[str, bool]]:
+        return [(kind, kind == "dropouts" or (sensor.kind, kind) in self.models)
+                for kind in sensor.errors()]
 
     @classmethod
     def from_continuous(cls, Ac, Bc, C, *, E=None, Qc, R=None, Ts: float | None = None, **kw):
@@ -208,7 +222,8 @@ class KalmanFilter(GaussianFilter):
 
 def heading_wave_kf(K: float, T: float, omega0: float, *, lambda_w: float = 0.1,
                     sigma_wave: float = math.radians(1.0), q_r: float = 1e-6,
-                    q_b: float = 1e-8, gyro: bool = False, rudder: str = "delta",
+                    q_b: float = 1e-8, gyro: bool = False, gyro_bias: bool | None = None,
+                    q_bg: float = 1e-10, rudder: str = "delta",
                     Ts: float | None = None, P0_std=None, x0_offset=None,
                     sample_initial: bool = False, measurement_std=None) -> KalmanFilter:
     """The heading Kalman filter with wave filtering and rudder bias (module docstring).
@@ -218,35 +233,49 @@ def heading_wave_kf(K: float, T: float, omega0: float, *, lambda_w: float = 0.1,
     frequency, ``lambda_w`` its relative damping; ``sigma_wave`` [rad]: the stationary std of the
     wave heading ψ_w, which sets K_w (σ² = K_w²/(4λω₀) for white w₁ of unit density);
     ``q_r`` [(rad/s²)²/Hz] and ``q_b`` [(rad)²/s] the densities driving r and the bias.
-    ``gyro``: add a rate-gyro row measuring r."""
+    ``gyro``: add a rate-gyro row measuring r; ``gyro_bias`` (default: with the gyro) adds the
+    gyro's bias b_g [rad/s], a random walk of density ``q_bg`` [(rad/s)²/s], to that row."""
     for field, value in (("K", K), ("T", T), ("omega0", omega0), ("lambda_w", lambda_w)):
         require(isinstance(value, (int, float)) and math.isfinite(value), f"kf.{field}", value,
                 "must be a finite number")
     require(T > 0 and omega0 > 0 and lambda_w > 0 and K != 0, "kf.T, omega0, lambda_w, K",
             (T, omega0, lambda_w, K), "need T > 0 s, omega0 > 0 rad/s, lambda_w > 0, K != 0")
-    for field, value in (("sigma_wave", sigma_wave), ("q_r", q_r), ("q_b", q_b)):
+    for field, value in (("sigma_wave", sigma_wave), ("q_r", q_r), ("q_b", q_b), ("q_bg", q_bg)):
         require(isinstance(value, (int, float)) and math.isfinite(value) and value >= 0,
                 f"kf.{field}", value, "must be a finite number >= 0")
+    gyro_bias = gyro if gyro_bias is None else gyro_bias
+    require(not gyro_bias or gyro, "kf.gyro_bias", gyro_bias, "needs gyro=True (a gyro row)")
     Kw = sigma_wave * math.sqrt(4.0 * lambda_w * omega0)
-    Ac = np.array([[0.0, 1.0, 0.0, 0.0, 0.0],
-                   [-omega0**2, -2.0 * lambda_w * omega0, 0.0, 0.0, 0.0],
-                   [0.0, 0.0, 0.0, 1.0, 0.0],
-                   [0.0, 0.0, 0.0, -1.0 / T, -K / T],
-                   [0.0, 0.0, 0.0, 0.0, 0.0]])
-    Bc = np.array([[0.0], [0.0], [0.0], [K / T], [0.0]])
-    E = np.array([[0, 0, 0], [Kw, 0, 0], [0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])
-    Qc = np.diag([1.0, q_r, q_b])
-    rows = [[0.0, 1.0, 1.0, 0.0, 0.0]]
+    n = 6 if gyro_bias else 5
+    Ac = np.zeros((n, n))
+    Ac[:5, :5] = [[0.0, 1.0, 0.0, 0.0, 0.0],
+                  [-omega0**2, -2.0 * lambda_w * omega0, 0.0, 0.0, 0.0],
+                  [0.0, 0.0, 0.0, 1.0, 0.0],
+                  [0.0, 0.0, 0.0, -1.0 / T, -K / T],
+                  [0.0, 0.0, 0.0, 0.0, 0.0]]
+    Bc = np.zeros((n, 1))
+    Bc[3, 0] = K / T
+    E = np.zeros((n, n - 2))
+    E[1, 0], E[3, 1], E[4, 2] = Kw, 1.0, 1.0
+    if gyro_bias:
+        E[5, 3] = 1.0
+    Qc = np.diag([1.0, q_r, q_b] + ([q_bg] if gyro_bias else []))
+    rows = [[0.0, 1.0, 1.0, 0.0, 0.0] + [0.0] * (n - 5)]
     measured = ["psi"]
     if gyro:
-        rows.append([0.0, 0.0, 0.0, 1.0, 0.0])
+        rows.append([0.0, 0.0, 0.0, 1.0, 0.0] + ([1.0] if gyro_bias else []))
         measured.append("r")
     if P0_std is None:
         P0_std = {"xi_w": sigma_wave / omega0, "psi_w": sigma_wave, "psi": math.radians(2.0),
                   "r": math.radians(0.2), "b": math.radians(2.0)}
+        if gyro_bias:
+            P0_std["b_gyro"] = math.radians(0.2)
+    names_ = ("xi_w", "psi_w", "psi", "r", "b") + (("b_gyro",) if gyro_bias else ())
+    units = ("rad s", "rad", "rad", "rad/s", "rad") + (("rad/s",) if gyro_bias else ())
     return KalmanFilter.from_continuous(
         Ac, Bc, np.array(rows), E=E, Qc=Qc, Ts=Ts,
-        state_names=("xi_w", "psi_w", "psi", "r", "b"), measured=tuple(measured),
-        inputs=(rudder,), units=("rad s", "rad", "rad", "rad/s", "rad"),
+        state_names=names_, measured=tuple(measured),
+        inputs=(rudder,), units=units,
         angles=("psi", "psi_w"), P0_std=P0_std, x0_offset=x0_offset,
-        sample_initial=sample_initial, measurement_std=measurement_std)
+        sample_initial=sample_initial, measurement_std=measurement_std,
+        models=[("gyro", "bias")] if gyro_bias else ())

@@ -2,7 +2,8 @@
 the generated module of a combination before the loop body (:mod:`shipgnc.sim.loop_template`), so
 the estimators call the vessel model's kernel ``model_fn`` by name (a numba function passed as an
 argument would make the loop uncacheable). Free names: ``model_fn``, ``nx``, ``nu``, ``nd``,
-``est_kind``, ``ne`` (the EKF's state dimension: ``nx`` plus its augmented states), ``CACHE``; ``jac_fn`` (the model's analytic state Jacobian,
+``est_kind``, ``ne`` (the EKF's state dimension: ``nx`` plus its augmented states), ``CACHE``;
+``jac_fn`` (the model's analytic state Jacobian,
 :func:`shipgnc.navigation.kernels.jacobian_kernel`) is found from ``model_fn``. The
 arithmetic is :mod:`shipgnc.navigation.kernels`; this is
 :meth:`shipgnc.navigation.Navigation.observe` for one ship at one control sample.
