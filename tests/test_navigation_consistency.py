@@ -101,9 +101,12 @@ def test_unmodelled_errors_are_named_in_the_metrics():
     over = ["simulation.t_end=5",
             "sensors=[{type: gnss, bias_std_m: 1.0, latency: 2}, "
             "{type: compass, bias_deg: 1.0}, {type: gyro, bias_deg_s: 0.1}]"]
-    m = run_scenario("boat-los-gnss", overrides=over).metrics
+    run = run_scenario("boat-los-gnss", overrides=over)
+    m = run.metrics
     # a constant compass bias is unobservable without another heading reference
     assert m["unmodelled_sensor_errors"] == ["compass.bias"]
+    assert "compass.bias" in run.result.attrs["navigation_notes"]
+    assert "unobservable" in run.result.attrs["navigation_notes"]
     m = run_scenario("boat-los-gnss", overrides=[*over, "estimator.sensor_errors=false"]).metrics
     assert m["unmodelled_sensor_errors"] == ["gnss.bias", "gnss.latency", "compass.bias",
                                              "gyro.bias"]

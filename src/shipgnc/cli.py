@@ -175,6 +175,9 @@ def run_command(
             sys.stdout.write(metrics_json(run.metrics) + "\n")
         else:
             _print_metrics(sc.name, run.metrics)
+        notes = run.result.attrs.get("navigation_notes") if run.result is not None else None
+        if notes:
+            stderr.print(f"note: {notes}", soft_wrap=True)
         stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
         if run.interrupted:
             stderr.print(run.interrupted, soft_wrap=True)

@@ -142,6 +142,22 @@ class Navigation:
         return [f"{s.name}.{kind}" for s in self.sensors for kind, ok in est.models_errors(s)
                 if not ok]
 
+    def notes(self) -> list[str]:
+        """One sentence per unmodelled sensor error (:meth:`unmodelled`), for the run's notes."""
+        why = {"bias": "its bias is folded into white measurement noise",
+               "latency": "its late samples are read as current ones",
+               "dropouts": "its lost samples are not accounted for"}
+        out = []
+        for item in self.unmodelled():
+            name, kind = item.rsplit(".", 1)
+            sensor = next(s for s in self.sensors if s.name == name)
+            text = why.get(kind, "not modelled")
+            if sensor.kind == "compass" and kind == "bias":
+                text = ("a constant compass bias is unobservable without another heading "
+                        "reference: the heading estimate carries it")
+            out.append(f"the {type(self.estimator).__name__} does not model {item}: {text}")
+        return out
+
     # ---- the compiled loop --------------------------------------------------------------------
     def kernel_reason(self) -> str | None:
         """None when the composed loop can run this navigation system, else why not."""

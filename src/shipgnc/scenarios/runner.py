@@ -499,6 +499,8 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                 on_divergence="stop" if compare else on_divergence,
                 attrs={"scenario": scenario.name, "controller": name, "seed": seed,
                        **_vessel_attrs(setup.model, scenario)})
+        if setup.navigation is not None and run.result is not None:
+            run.result.attrs["navigation_notes"] = "; ".join(setup.navigation.notes())
         all_metrics[name] = run.metrics(lambda r, s=setup: compute_metrics(scenario, r, s))
         results[name], setups[name] = thin(run.result, sim.log_every // every), setup
         if run.interrupted:
