@@ -40,7 +40,7 @@ Augmented states (appended after the model's, logged like them, not in the NEES)
   (:meth:`~shipgnc.navigation.Navigation.unmodelled`).
 
 Delayed measurements (a sensor's ``latency`` L control samples, ``sensor_errors``): Larsen,
-Andersen, Hansen & Poulsen (1998, *Incorporation of time delayed measurements in a discrete-time
+Andersen, Ravn & Poulsen (1998, *Incorporation of time delayed measurements in a discrete-time
 Kalman filter*, Proc. 37th IEEE CDC, pp. 3972–3977), the extrapolation method. When a delayed
 sensor takes its sample at s the filter records the predicted measurement h_s = c x̂_s, the
 innovation variance S_s = c P_s cᵀ + R and the cross-covariance g = P_s cᵀ of the estimation error
