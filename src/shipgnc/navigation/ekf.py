@@ -109,6 +109,7 @@ class ExtendedKalmanFilter(GaussianFilter):
                     and v >= 0, f"ekf.bias_states.{k}", v,
                     "must be a spectral density >= 0 [unit²/s³]")
         self._bias_arg = bias_states
+        self._P0_user = P0_std
         require(isinstance(sensor_errors, bool), "ekf.sensor_errors", sensor_errors,
                 "must be true or false")
         self.sensor_errors = sensor_errors
@@ -155,8 +156,6 @@ class ExtendedKalmanFilter(GaussianFilter):
             if a[2] >= 0:
                 self.Daug[i, a[2]] = 1.0
         self.Qc = np.diag(np.concatenate([psd, [a[4] for a in aug]]))
-        if not hasattr(self, "_P0_user"):
-            self._P0_user = self._P0_std_arg
         self._P0_std_arg = self._P0_user
         if isinstance(self._P0_user, dict) or self._P0_user is None:
             P0 = dict(self._P0_user or {})
@@ -237,8 +236,9 @@ class ExtendedKalmanFilter(GaussianFilter):
 
     def kernel_block(self, channels, n_ships: int):
         """(kind, parameters, per-ship state, map) for the composed loop after :meth:`start`:
-        ``[substeps, Ts, held, n_rows, (state, held offset, fresh offset, R, angle) × n_rows,
-        Q_c diagonal]``; the model's derivatives are its kernel in the loop."""
+        ``[substeps, Ts, held, n_rows, n_aug, (state, held offset, fresh offset, R, angle, bias
+        state or −1) × n_rows, Q_c diagonal, (driven state or −1, λ) × n_aug]``; the model's
+        derivatives are its kernel in the loop."""
         from shipgnc.navigation import kernels as nk
 
         block = [float(self.substeps), self.Ts, float(self.noise == "held"), float(len(self.rows)),
