@@ -11,8 +11,9 @@ samples is χ²(M) with M the number of scalar measurements: its 99 % band, in m
 form, is checked too.
 
 Each sensor error the EKF models (GNSS Gauss–Markov bias, gyro bias, GNSS latency; the shipped
-scenario's dropout) is switched on alone on boat-los-gnss, shortened to 120 s; without the model
-(``sensor_errors: false``) the same runs fall far outside the band.
+scenario's dropout) is switched on alone on boat-los-gnss, shortened to 120 s, then all at once
+(with a compass latency too); without the model (``sensor_errors: false``) the same runs fall
+far outside the band.
 """
 
 from __future__ import annotations
@@ -77,7 +78,10 @@ def test_boat_los_gnss_is_consistent_over_100_seeds():
     f"[{{type: gnss, noise_m: 1.5}}, {COMPASS}, "
     "{type: gyro, noise_deg_s: 0.1, bias_walk_deg_s: 0.01}]",
     f"[{{type: gnss, noise_m: 1.5, latency: 24}}, {COMPASS}, {GYRO}]",   # 1.2 s > the 1 s period
-], ids=["gnss-bias", "gyro-bias", "gyro-bias-walk", "gnss-latency"])
+    "[{type: gnss, noise_m: 1.5, bias_std_m: 1.5, latency: 24, dropouts: [[60.0, 80.0]]}, "
+    "{type: compass, noise_deg: 0.5, latency: 3}, "
+    "{type: gyro, noise_deg_s: 0.1, bias_deg_s: 0.2, bias_walk_deg_s: 0.01}]",
+], ids=["gnss-bias", "gyro-bias", "gyro-bias-walk", "gnss-latency", "all-at-once"])
 def test_each_modelled_sensor_error_alone_is_consistent(sensors):
     over = ["simulation.t_end=120", f"sensors={sensors}"]
     res, dim = ensemble("boat-los-gnss", 100, over)
