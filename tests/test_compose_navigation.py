@@ -69,16 +69,17 @@ def test_sensors_and_passive_observer_compiled_equal_numpy():
         assert np.all(np.isnan(got["north_meas"].values[t < 0.1 - 1e-9]))
 
 
-def test_ekf_compiled_equals_numpy_in_chunks():
+@pytest.mark.parametrize("latency", [0, 2, 24])
+def test_ekf_compiled_equals_numpy_in_chunks(latency):
     """Started 5 m and 0.2 rad wrong, the filter's first corrections move its estimate by metres;
     both loops linearise with the boat's analytic Jacobian (``state_jacobian`` and its kernel
     ``boat_current_rhs_jacobian``), so the runs agree to the promise of ``backend`` (1e-9). The
     filter carries the GNSS Gauss–Markov bias (2 states) and the gyro bias (1) as augmented
-    states (a delayed fix's update runs in the numpy loop only:
-    :func:`test_ekf_with_latency_runs_in_numpy_and_says_why`)."""
+    states, and with a GNSS latency Larsen et al.'s delayed update, its pending samples carried
+    across the kernel calls (24 samples: three fixes pending at once, 10 samples apart)."""
 
     def make():
-        return nav.Navigation(sensors(latency=0), nav.ExtendedKalmanFilter(
+        return nav.Navigation(sensors(latency=latency), nav.ExtendedKalmanFilter(
             x0_offset={"north": 5.0, "psi": 0.2}, P0_std={"north": 5.0, "east": 5.0, "psi": 0.2},
             sample_initial=True, noise="held"))
 
@@ -87,22 +88,8 @@ def test_ekf_compiled_equals_numpy_in_chunks():
     assert len(calls) > 10  # the run was cut into kernel calls that carried the filter's state
     assert np.all(np.isfinite(got["nees"].values))
     assert "b_gnss_north_hat" in got and "b_gyro_hat" in got
-    assert float(got["nis_dim"].max()) == 5.0   # GNSS north, east, compass, gyro, log at once
-
-
-def test_ekf_with_latency_runs_in_numpy_and_says_why():
-    from shipgnc.sim.simulator import _validate
-
-    scenario = load_scenario("boat-los-gnss")
-    s = build(scenario)
-    setup = _validate(s.model, s.x0, t_end=1.0, dt=0.05, controller=s.controller, actuator=None,
-                      guidance=s.guidance, disturbance=None, u0=None, integrator="rk4",
-                      method="RK45", rtol=1e-3, atol=1e-6, seed=0, on_divergence="raise",
-                      observer=None, progress=None, log_every=1,
-                      navigation=nav.Navigation(sensors(), nav.ExtendedKalmanFilter()))
-    assert "delayed-measurement" in compose.unsupported_reason(setup)
-    got = run(nav.Navigation(sensors(), nav.ExtendedKalmanFilter()), "compiled-or-numpy")
-    assert got.attrs["backend"] == "numpy" and np.all(np.isfinite(got["nees"].values))
+    # GNSS north, east, compass, gyro, log processed at one sample
+    assert float(got["nis_dim"].max()) == 5.0
 
 
 def test_ekf_by_central_differences_compiled_equals_numpy():

@@ -52,7 +52,9 @@ Larsen's M* = Π F (I − K c)) and every correction (g ← g − K c g). When y
 — the linear update on the pair (x̂_k, ν_s) with their exact covariances, so P stays the
 covariance of the error. Several pending samples (north and east of one fix, or a latency longer
 than the sample period) are correlated: Cov(ν_a, ν_b) = c_b g_a when b is taken, and applying a
-carries g_b ← g_b − g_a Cov(ν_a, ν_b)/S_a.
+carries g_b ← g_b − g_a Cov(ν_a, ν_b)/S_a. The composed loop keeps the pending samples in fixed
+slots of the filter's state (:meth:`ExtendedKalmanFilter.kernel_state`; ``ekf_delayed`` of
+:mod:`shipgnc.sim.nav_template`).
 
 NIS: the sum over the scalar updates of one sample of ν²/S (sequential scalar updates of
 independent measurements: the joint νᵀS⁻¹ν), with ``nis_dim`` the number of rows.
@@ -227,27 +229,41 @@ class ExtendedKalmanFilter(GaussianFilter):
             out.append((kind, ok or kind == "dropouts"))
         return out
 
-    def kernel_reason(self, sensors) -> str | None:
-        """None when the composed loop can run this filter on ``sensors``, else why not."""
-        if self.sensor_errors and any(s.latency > 0 for s in sensors):
-            return ("the EKF's delayed-measurement updates (sensor latency) run in the numpy "
-                    "loop")
-        return None
+    def _slots(self) -> list[tuple[int, int]]:
+        """(first slot, slots) per row: a delayed row holds at most ⌊L/m⌋ + 1 pending samples
+        (taken every m samples, each kept L samples); 0 slots for a row without latency."""
+        out, at = [], 0
+        for _c, _s, _var, _angle, lat, every in self.rows:
+            k = lat // every + 1 if lat > 0 else 0
+            out.append((at, k))
+            at += k
+        return out
+
+    def kernel_state(self, n_ships: int) -> np.ndarray:
+        """Rows ``[ẑ, P, NIS, NIS dimension, sample count, pending slots]``: a slot (a delayed
+        sample not yet arrived) ``[active, taken at, h, S, g × n, Cov(ν, ν_other) × slots]``
+        (:meth:`_delayed`)."""
+        n = len(self.state_names)
+        total = sum(k for _at, k in self._slots())
+        return np.concatenate([super().kernel_state(n_ships),
+                               np.zeros((n_ships, 1 + total * (4 + n + total)))], axis=1)
 
     def kernel_block(self, channels, n_ships: int):
         """(kind, parameters, per-ship state, map) for the composed loop after :meth:`start`:
-        ``[substeps, Ts, held, n_rows, n_aug, (state, held offset, fresh offset, R, angle, bias
-        state or −1) × n_rows, Q_c diagonal, (driven state or −1, λ) × n_aug]``; the model's
-        derivatives are its kernel in the loop."""
+        ``[substeps, Ts, held, n_rows, n_aug, n_slots, (state, held offset, fresh offset, R,
+        angle, bias state or −1, latency, period, first slot, slots) × n_rows, Q_c diagonal,
+        (driven state or −1, λ) × n_aug]``; the model's derivatives are its kernel in the
+        loop."""
         from shipgnc.navigation import kernels as nk
 
+        slots = self._slots()
         block = [float(self.substeps), self.Ts, float(self.noise == "held"), float(len(self.rows)),
-                 float(self.n_aug)]
-        for c, s, var, angle, _lat, _every in self.rows:
+                 float(self.n_aug), float(sum(k for _at, k in slots))]
+        for (c, s, var, angle, lat, every), (at, k) in zip(self.rows, slots, strict=True):
             j = int(np.flatnonzero(c)[0])
             jb = int(np.flatnonzero(c)[1]) if np.count_nonzero(c) > 1 else -1
             block += [float(j), float(channels[s][0]), float(channels[s][2]), float(var),
-                      float(angle), float(jb)]
+                      float(angle), float(jb), float(lat), float(every), float(at), float(k)]
         block += [float(v) for v in np.diagonal(self.Qc)]
         for a in range(self.n_aug):  # augmented states: the model state driven, decay rate
             hit = np.flatnonzero(self.Daug[a])

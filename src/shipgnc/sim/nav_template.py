@@ -58,6 +58,8 @@ nav_work = nx * nx + 5 * nx + nd + nu + 96
 #: the size of the EKF's matrices (a constant: :func:`ekf_step`'s arrays live on the stack)
 nn = nx * nx
 nne = ne * ne
+#: fields of an EKF measurement row in its parameter block (ExtendedKalmanFilter.kernel_block)
+ROW = 10
 
 
 def observer_step(u, zn, pn, pm, wk):
@@ -183,11 +185,18 @@ def ekf_step(u, zn, pn, pm, wk):
     Ts = pn[e + 1]
     held = pn[e + 2] != 0.0
     nrows = int(pn[e + 3])
-    q0 = e + 5 + 6 * nrows          # Q_c diagonal
+    nslt = int(pn[e + 5])           # pending delayed samples (Larsen et al. 1998)
+    q0 = e + 6 + ROW * nrows        # Q_c diagonal
     a0 = q0 + n                     # augmented states: (driven state, λ) each
+    kc = ez + n + nne + 2           # the sample count, then the slots
+    sb = kc + 1
+    ssz = 4 + n + nslt
     nis = 0.0
     nisd = 0.0
-    if zn[0] == 0.0:
+    if zn[0] != 0.0:
+        zn[kc] = 0.0
+    else:
+        zn[kc] += 1.0
         d0 = stack_empty(nd)
         for j in range(nd):
             d0[j] = 0.0
@@ -297,24 +306,102 @@ def ekf_step(u, zn, pn, pm, wk):
                 Qd[i * n + j] = acc + Qd[i * n + j]
                 P[i * n + j] = Qd[i * n + j]
                 P[j * n + i] = Qd[i * n + j]
+        for sl in range(nslt):      # Larsen's M*: g ← F g = g + E g
+            g0 = sb + sl * ssz + 4
+            if zn[sb + sl * ssz] != 0.0:
+                for i in range(n):
+                    acc = zn[g0 + i]
+                    for m in range(n):
+                        acc += E[i * n + m] * zn[g0 + m]
+                    xp[i] = acc
+                for i in range(n):
+                    zn[g0 + i] = xp[i]
     for r in range(nrows):
-        o = e + 5 + 6 * r
-        if zn[int(pn[o + 2])] != 0.0:  # fresh
+        o = e + 6 + ROW * r
+        if pn[o + 6] == 0.0 and zn[int(pn[o + 2])] != 0.0:  # no latency, fresh
             v = ekf_correct(zh, P, int(pn[o]), int(pn[o + 5]), zn[int(pn[o + 1])], pn[o + 3],
-                            pn[o + 4] != 0.0)
+                            pn[o + 4] != 0.0, zn, sb, nslt)
             if v >= 0.0:
                 nis += v
                 nisd += 1.0
+    if nslt > 0:
+        nis, nisd = ekf_delayed(zh, P, zn, pn, e, nrows, sb, nslt, int(zn[kc]), nis, nisd)
     zn[ez + n + nne] = nis
     zn[ez + n + nne + 1] = nisd
 
 
-def ekf_correct(zh, P, j, jb, y, var, angle):
+def ekf_delayed(zh, P, zn, pn, e, nrows, sb, nslt, k, nis, nisd):
+    """:meth:`ExtendedKalmanFilter._delayed` for one ship (Larsen et al. 1998): apply the delayed
+    samples delivered now, then record the ones the delayed rows take now, in slots
+    ``[active, taken at, h, S, g, Cov(ν, ν_other) per slot]``; returns the updated NIS and its
+    dimension."""
+    n = ne
+    ssz = 4 + n + nslt
+    for r in range(nrows):
+        o = e + 6 + ROW * r
+        lat = int(pn[o + 6])
+        if lat == 0:
+            continue
+        for sl in range(int(pn[o + 8]), int(pn[o + 8]) + int(pn[o + 9])):
+            b = sb + sl * ssz
+            if zn[b] == 0.0 or zn[b + 1] > k - lat:
+                continue
+            zn[b] = 0.0
+            if zn[b + 1] != k - lat or zn[int(pn[o + 2])] == 0.0 or not zn[b + 3] > 0.0:
+                continue
+            S = zn[b + 3]
+            innov = zn[int(pn[o + 1])] - zn[b + 2]
+            if pn[o + 4] != 0.0:
+                innov = wrap(innov)
+            nis += innov * innov / S
+            nisd += 1.0
+            g = zn[b + 4:b + 4 + n]
+            for a in range(n):
+                zh[a] = zh[a] + g[a] * (innov / S)
+            for a in range(n):
+                for c in range(a, n):
+                    P[a * n + c] = P[a * n + c] - g[a] * g[c] / S
+                    P[c * n + a] = P[a * n + c]
+            for ot in range(nslt):
+                bo = sb + ot * ssz
+                if ot != sl and zn[bo] != 0.0:
+                    rho = zn[bo + 4 + n + sl]
+                    for a in range(n):
+                        zn[bo + 4 + a] = zn[bo + 4 + a] - g[a] * (rho / S)
+    for r in range(nrows):
+        o = e + 6 + ROW * r
+        lat = int(pn[o + 6])
+        if lat == 0 or k % int(pn[o + 7]) != 0:
+            continue
+        j = int(pn[o])
+        jb = int(pn[o + 5])
+        for sl in range(int(pn[o + 8]), int(pn[o + 8]) + int(pn[o + 9])):
+            b = sb + sl * ssz
+            if zn[b] != 0.0:
+                continue
+            zn[b] = 1.0
+            zn[b + 1] = float(k)
+            zn[b + 2] = zh[j] + zh[jb] if jb >= 0 else zh[j]
+            for a in range(n):
+                zn[b + 4 + a] = P[a * n + j] + P[a * n + jb] if jb >= 0 else P[a * n + j]
+            zn[b + 3] = (zn[b + 4 + j] + zn[b + 4 + jb] if jb >= 0 else zn[b + 4 + j]) + pn[o + 3]
+            for ot in range(nslt):   # Cov(ν_new, ν_other) = c g_other
+                bo = sb + ot * ssz
+                if ot != sl and zn[bo] != 0.0:
+                    rho = zn[bo + 4 + j] + zn[bo + 4 + jb] if jb >= 0 else zn[bo + 4 + j]
+                    zn[b + 4 + n + ot] = rho
+                    zn[bo + 4 + n + sl] = rho
+            break
+    return nis, nisd
+
+
+def ekf_correct(zh, P, j, jb, y, var, angle, zn, sb, nslt):
     """:meth:`GaussianFilter.correct_row` for one ship and a row c = e_j (a measured state), or
     c = e_j + e_jb (a measured state and the sensor's bias state jb ≥ 0), at the filter's size
     ``ne`` (loops of known length): x̂ += Pc/S·innov, P −= Pc Pcᵀ/S with Pc = P cᵀ,
     S = c P cᵀ + var (Simon 2006 §5.1), on the upper triangle of P, mirrored (the symmetrised
-    update up to round-off). Returns innov²/S (the row's NIS), −1 when S ≤ 0 (no update)."""
+    update up to round-off); the pending delayed samples' g ← g − K c g (slots at ``sb``).
+    Returns innov²/S (the row's NIS), −1 when S ≤ 0 (no update)."""
     n = ne
     Pc = stack_empty(ne)
     for a in range(n):
@@ -325,6 +412,13 @@ def ekf_correct(zh, P, j, jb, y, var, angle):
     innov = y - (zh[j] + zh[jb] if jb >= 0 else zh[j])
     if angle:
         innov = wrap(innov)
+    ssz = 4 + n + nslt
+    for sl in range(nslt):
+        g0 = sb + sl * ssz + 4
+        if zn[sb + sl * ssz] != 0.0:
+            cg = zn[g0 + j] + zn[g0 + jb] if jb >= 0 else zn[g0 + j]
+            for a in range(n):
+                zn[g0 + a] = zn[g0 + a] - Pc[a] / S * cg
     for a in range(n):
         zh[a] = zh[a] + Pc[a] / S * innov
     for a in range(n):
@@ -368,6 +462,7 @@ _OPTIONS = {**JIT_OPTIONS, "cache": CACHE}
 observer_step = numba.njit(**_OPTIONS)(observer_step)
 ekf_correct = numba.njit(**_OPTIONS)(ekf_correct)
 ekf_faug = numba.njit(**_OPTIONS)(ekf_faug)
+ekf_delayed = numba.njit(**_OPTIONS)(ekf_delayed)
 ekf_step = numba.njit(**_OPTIONS)(ekf_step)
 gaussian_outputs = numba.njit(**_OPTIONS)(gaussian_outputs)
 nav_observe = numba.njit(**_OPTIONS)(nav_observe)
