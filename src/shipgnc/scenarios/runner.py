@@ -362,7 +362,8 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     elif scenario.metrics == "course-quality":
         out = metrics.course_quality_metrics(result, lam=scenario.quality.lam,
                                              t_end=scenario.simulation.t_end, diverged=diverged,
-                                             delta_max=float(setup.model.params.delta_max))
+                                             delta_max=float(setup.model.params.delta_max),
+                                             delta_rate=rudder_rate(setup))
     elif scenario.metrics == "path-tracking":
         from shipgnc.analysis import path_tracking
 
@@ -389,6 +390,14 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
         out.update({k: metrics._scalar(v[0]) for k, v in metrics.navigation_arrays(result).items()})
     out["diverged"] = diverged
     return out
+
+
+def rudder_rate(setup: Setup) -> float | None:
+    """The steering machine's rudder rate limit [rad/s] (channel ``delta``), None if absent."""
+    act = setup.actuator
+    if act is None or "delta" not in act.names:
+        return None
+    return float(act.rate[act.names.index("delta")])
 
 
 def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndarray] | None:
@@ -418,7 +427,7 @@ def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndar
             psi=series(result, "psi") if has_ref else None,
             psi_z=series(result, "psi_z") if has_ref else None,
             psi_d=series(result, "psi_d") if "psi_d" in result else None,
-            delta_max=float(setup.model.params.delta_max))
+            delta_max=float(setup.model.params.delta_max), delta_rate=rudder_rate(setup))
     elif scenario.metrics == "path-tracking" and scenario.montecarlo is None:
         from shipgnc.analysis import path_tracking
 
