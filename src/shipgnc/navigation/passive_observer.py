@@ -37,12 +37,15 @@ published tuning rule (H_i(s) strictly positive real)::
 
     1/T_bᵢ ≪ k₃ᵢ/k₄ᵢ < ω₀ᵢ < ω_cᵢ
 
-Their size is not fixed by the rule. Here k₄ᵢ = 2 Mᵢᵢ ω_lfᵢ ω_cᵢ, k₃ᵢ = Mᵢᵢ ω_lfᵢ² ω_cᵢ (Mᵢᵢ the
-DOF's own mass or inertia, so the gains stay diagonal): the low-frequency loop of one DOF,
-η̃ → ν̃ → b̃, then has (neglecting Dᵢᵢ/Mᵢᵢ, the wave branch and the coupling through M's
-off-diagonal terms) the characteristic polynomial (s + ω_c)(s² + 2ω_lf s + ω_lf²), a critically
-damped pair at the low-frequency bandwidth ω_lf (default ω₀/10), and k₃ᵢ/k₄ᵢ = ω_lfᵢ/2 meets the
-rule whenever 2/T_bᵢ < ω_lfᵢ < 2ω₀ᵢ (checked). K₃ and K₄ may be given directly (diagonal).
+Their size is not fixed by the rule. Here k₄ᵢ = 2ζ_lf Mᵢᵢ ω_lfᵢ ω_cᵢ, k₃ᵢ = Mᵢᵢ ω_lfᵢ² ω_cᵢ (Mᵢᵢ
+the DOF's own mass or inertia, so the gains stay diagonal): below ω_c, h_0,i ≈ 1/(s + ω_c), and
+the low-frequency loop of one DOF, η̃ → ν̃ → b̃, has (neglecting Dᵢᵢ/Mᵢᵢ, the wave branch and the
+coupling through M's off-diagonal terms) the characteristic polynomial
+(s + ω_c)(s² + 2ζ_lf ω_lf s + ω_lf²): a pair at the low-frequency bandwidth ω_lf (default ω₀/10)
+with damping ζ_lf (default 1, critical). k₃ᵢ/k₄ᵢ = ω_lfᵢ/(2ζ_lf) must meet the rule (checked).
+Above ω_c the innovation reaches ν̂ unfiltered, Mᵢᵢ⁻¹k₄ᵢ ỹ: white measurement noise of σ per
+sample moves r̂ by ≈ 2ζ_lf ω_lf ω_c σ Ts per sample, which a derivative gain turns into rudder
+rate. K₃ and K₄ may be given directly (diagonal).
 
 The passivity proof needs dissipative damping, D + Dᵀ > 0. A vessel in transit need not have it:
 CyberShip II at 0.3 m/s is course-unstable (its sway–yaw model linearised at speed has a pole at
@@ -128,7 +131,8 @@ class PassiveObserver(Estimator):
     omega0 : dominant wave (encounter) frequency ω₀ [rad/s], per DOF or one for all.
     zeta : the wave model's relative damping ζ (default 0.1); ``zeta_notch`` ζ_n (default 1.0).
     omega_c : cut-off [rad/s] > ω₀ (default 1.2 ω₀).
-    omega_lf : low-frequency bandwidth [rad/s] setting K₃, K₄ (default ω₀/10).
+    omega_lf : low-frequency bandwidth [rad/s] setting K₃, K₄ (default ω₀/10); ``zeta_lf`` its
+        damping (default 1).
     K3, K4 : diagonal gains (3 numbers or a diagonal 3 × 3) overriding those from ``omega_lf``.
     T_b : bias time constants [s] (default 1000).
     M, D : 3 × 3 matrices overriding the model's.
@@ -139,7 +143,7 @@ class PassiveObserver(Estimator):
     kind = "passive-observer"
 
     def __init__(self, omega0, *, zeta=0.1, zeta_notch=1.0, omega_c=None, omega_lf=None,
-                 K3=None, K4=None, T_b=1000.0, M=None, D=None, velocity_model: str = "linear",
+                 zeta_lf=1.0, K3=None, K4=None, T_b=1000.0, M=None, D=None, velocity_model: str = "linear",
                  x0_offset=None, substeps: int | None = None):
         self.omega0 = _per_dof("passive-observer.omega0", omega0)
         self.zeta = _per_dof("passive-observer.zeta", zeta)
@@ -153,6 +157,7 @@ class PassiveObserver(Estimator):
                 self.omega_c.tolist(), f"the cut-off must exceed omega0 = {self.omega0.tolist()}")
         self.omega_lf = (self.omega0 / 10 if omega_lf is None
                          else _per_dof("passive-observer.omega_lf", omega_lf))
+        self.zeta_lf = _per_dof("passive-observer.zeta_lf", zeta_lf)
         self.T_b = _per_dof("passive-observer.T_b", T_b)
         if K3 is not None:
             K3 = _diagonal("passive-observer.K3", K3)
@@ -209,7 +214,7 @@ class PassiveObserver(Estimator):
         self.K1b = 2.0 * w0 * (zn - z)                # rows of ξ₂
         self.K2 = wc
         m = np.diag(self.M)
-        k4 = 2.0 * m * self.omega_lf * wc if self._K4 is None else self._K4
+        k4 = 2.0 * self.zeta_lf * m * self.omega_lf * wc if self._K4 is None else self._K4
         k3 = m * self.omega_lf**2 * wc if self._K3 is None else self._K3
         ratio = k3 / k4
         given = self._K3 is not None or self._K4 is not None

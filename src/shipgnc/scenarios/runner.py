@@ -333,6 +333,7 @@ def navigation(scenario: Scenario, controller=None):
     else:
         estimator = nav.PassiveObserver(e.omega0_rad_s, zeta=e.zeta, zeta_notch=e.zeta_notch,
                                         omega_c=e.omega_c_rad_s, omega_lf=e.omega_lf_rad_s,
+                                        zeta_lf=e.zeta_lf,
                                         T_b=e.T_b_s, velocity_model=e.velocity_model)
     return nav.Navigation(sensors, estimator)
 
