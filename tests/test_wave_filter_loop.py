@@ -54,9 +54,9 @@ def test_gains_are_diagonal_and_follow_the_published_closed_form():
 
 
 def test_gains_that_break_the_structure_or_the_rule_are_refused():
-    with pytest.raises(ConfigError, match="K4.*diagonal"):
+    with pytest.raises(ConfigError, match=r"K4.*diagonal"):
         PassiveObserver(8.3, K4=[[1.0, 0.1, 0.0], [0.1, 1.0, 0.0], [0.0, 0.0, 1.0]])
-    with pytest.raises(ConfigError, match="K3.*outside"):   # k₃/k₄ = 10 > ω₀ = 8.3
+    with pytest.raises(ConfigError, match=r"K3.*outside"):   # k₃/k₄ = 10 > ω₀ = 8.3
         _prepared(K3=[10.0, 10.0, 10.0], K4=[1.0, 1.0, 1.0])
 
 
