@@ -15,10 +15,10 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from shipgnc.scenarios.runner import run_scenario  # noqa: E402
+from shipgnc.scenarios.runner import run_scenario
 
 OUT = Path(__file__).resolve().parent / "figures" / "observer-loop-rudder.png"
 SCENARIO = "cybership-waves-observer"
