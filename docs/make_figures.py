@@ -40,6 +40,7 @@ SETS = {
     "study": ("make_figures:study_figure", ("study-boat-autopilot.png",)),
     "routing-geo": ("shipgnc.routing.geo.figures:document_figure", ("routing-geo-channel.png",)),
     "cybership-analysis": ("cybership_analysis:figure", ("cybership-analysis.png",)),
+    "observer-loop": ("observer_loop:figure", ("observer-loop-rudder.png",)),
     "trials": ("shipgnc.trials.figures:document_figures",
                tuple(f"trials-{v}-{w}.png" for v in ("mariner", "kvlcc2")
                      for w in ("turning", "zigzag-20", "zigzag-10", "spiral"))),
@@ -70,7 +71,7 @@ def _generator(path: str):
     module, _, name = path.partition(":")
     if module == "make_figures":
         return globals()[name]
-    if module == "cybership_analysis":  # a script beside this one (docs/)
+    if module in ("cybership_analysis", "observer_loop"):  # scripts beside this one (docs/)
         sys.path.insert(0, str(Path(__file__).resolve().parent))
     return getattr(importlib.import_module(module), name)
 

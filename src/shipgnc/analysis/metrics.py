@@ -328,11 +328,28 @@ def actuator_motion_arrays(t, actuator) -> tuple[np.ndarray, np.ndarray]:
     return np.where(time_sum(ok) > 0, rate_rms, np.nan), time_sum(np.abs(step0))
 
 
+def rate_limit_fraction(t, actuator, rate: float | None, rel_tol: float = 1e-6) -> np.ndarray:
+    """Fraction of the sample intervals in which the actuator series ``(time, ship)`` moves at its
+    rate limit ``rate`` [unit/s]: |Δa/Δt| ≥ rate (1 − ``rel_tol``) (a rate-limited steering
+    machine moves exactly rate·Δt then). NaN without a finite rate limit or samples."""
+    t = np.asarray(t, dtype=float)
+    a = np.asarray(actuator, dtype=float).reshape(t.size, -1)
+    step = np.diff(a, axis=0)
+    ok = np.isfinite(step)
+    if rate is None or not np.isfinite(rate):
+        return np.full(a.shape[1], np.nan)
+    with np.errstate(invalid="ignore"):
+        at_limit = ok & (np.abs(step) / np.diff(t)[:, None] >= rate * (1.0 - rel_tol))
+    n = time_sum(ok)
+    return np.where(n > 0, time_sum(at_limit) / np.maximum(n, 1), np.nan)
+
+
 def course_quality_arrays(t, psi_error, delta, u, *, lam: float = 1.0, t_end: float | None = None,
                           diverged=False, psi=None, psi_z=None, bound_deg: float = 90.0,
                           settle_window_s: float = 30.0, settle_band_deg: float = 2.0,
                           psi_d=None, delta_max: float | None = None,
-                          oscillation_deg: float = COURSE_OSCILLATION_DEG) -> dict:
+                          oscillation_deg: float = COURSE_OSCILLATION_DEG,
+                          delta_rate: float | None = None) -> dict:
     """The figures of :func:`course_quality_metrics` for every ship: arrays ``(time, ship)`` →
     ``(ship,)`` arrays; samples after a ship's run stopped (NaN padding) are left out."""
     t = np.asarray(t, dtype=float)[:, None]
@@ -360,6 +377,7 @@ def course_quality_arrays(t, psi_error, delta, u, *, lam: float = 1.0, t_end: fl
         "final_heading_error_deg": to_deg(np.take_along_axis(dpsi0, last[None, :], axis=0)[0]),
         "max_rudder_deg": to_deg(np.max(np.where(finite, np.abs(delta), -np.inf), axis=0)),
         "rudder_rate_rms_deg_s": to_deg(rate_rms),
+        "rudder_rate_limit_fraction": rate_limit_fraction(t[:, 0], delta_arr, delta_rate),
         "rudder_travel_deg": to_deg(travel),
         "stable": verdict["stable"],
         "settled": np.all(~late | (dpsi_deg <= settle_band_deg), axis=0),
@@ -377,7 +395,8 @@ def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
                            diverged: bool = False, bound_deg: float = 90.0,
                            settle_window_s: float = 30.0, settle_band_deg: float = 2.0,
                            delta_max: float | None = None,
-                           oscillation_deg: float = COURSE_OSCILLATION_DEG) -> dict:
+                           oscillation_deg: float = COURSE_OSCILLATION_DEG,
+                           delta_rate: float | None = None) -> dict:
     """Document 003's quality index and course-keeping figures (notes 003-3.1, 003-3.8).
 
     On every sample t_i: Δψ_i = wrap(ψ_d − ψ_i) [rad]; ``psi_E`` = Σ Δψ_i², ``delta_E`` = λ Σ δ_i²
@@ -385,7 +404,9 @@ def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
     ``final_heading_error_deg`` (Δψ at the last sample), ``max_rudder_deg`` (applied).
     J does not see how hard the rudder works; beside it: ``rudder_rate_rms_deg_s``, the RMS of
     the applied rudder rate Δδ_i/Δt_i, and ``rudder_travel_deg`` = Σ|Δδ_i|, the rudder's total
-    travel (wear of the steering machine).
+    travel (wear of the steering machine); ``rudder_rate_limit_fraction`` the fraction of the
+    sample intervals the rudder moves at the steering machine's rate limit ``delta_rate`` [rad/s]
+    (:func:`rate_limit_fraction`; None without a rate limit).
 
     ``stable`` (:func:`stable_arrays`): the run reached ``t_end`` without the divergence guard,
     |Δψ| stayed below 90°, and over the last 20 % of each course step (a segment of constant
@@ -405,7 +426,8 @@ def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
                               bound_deg=bound_deg, settle_window_s=settle_window_s,
                               settle_band_deg=settle_band_deg,
                               psi_d=series(ds, "psi_d") if "psi_d" in ds else None,
-                              delta_max=delta_max, oscillation_deg=oscillation_deg)
+                              delta_max=delta_max, oscillation_deg=oscillation_deg,
+                              delta_rate=delta_rate)
     out = {key: _scalar(value[0]) for key, value in a.items()}
     out["stable"], out["settled"] = bool(a["stable"][0]), bool(a["settled"][0])
     return out

@@ -12,19 +12,46 @@ With the measurement y = η + η_w of position and heading (GNSS + compass), η 
     ỹ = y − η̂ − C_w ξ̂
 
 per degree of freedom i: A_w,i = [[0, 1], [−ω₀ᵢ², −2ζᵢω₀ᵢ]], C_w,i = [0, 1]; R(ψ_y) uses the
-measured heading (which makes the error dynamics passive). Gains by the published tuning rules:
+measured heading (which makes the error dynamics passive). All four gains are diagonal, as in
+Fossen & Strand (1999): the error dynamics then split into one loop per degree of freedom,
+H_i(s) = h_B,i(s) h_0,i(s) with h_B,i(s) = k₄ᵢ + k₃ᵢ/(s + 1/T_bᵢ), and the gains are chosen per DOF
+so that each H_i is strictly positive real.
+
+*Wave filter (K₁, K₂).* Without the velocity injection the low-frequency estimate of DOF i
+answers the measurement through ω_cᵢ h_0,i(s), with (the paper's h₀, reproduced by Fossen's MSS
+example ``ExPassiveObs.m``)::
+
+    h_0,i(s) = (s² + 2ζᵢω₀ᵢ s + ω₀ᵢ²) / ((s² + 2ζ_nᵢω₀ᵢ s + ω₀ᵢ²)(s + ω_cᵢ))
+
 a notch at the dominant wave frequency ω₀ (relative damping ζ_n > ζ, ζ the wave model's, e.g.
-ζ_n = 1, ζ = 0.1) and a cut-off ω_c > ω₀::
+ζ_n = 1, ζ = 0.1) in series with a first-order low-pass at the cut-off ω_c > ω₀. Matching the
+coefficients of the observer's own third-order denominator gives the gains in closed form::
 
-    K₁ = [diag(−2(ζ_n − ζ) ω_c/ω₀); diag(2ω₀(ζ_n − ζ))],   K₂ = diag(ω_c)
-    1/T_b ≪ K₃ᵢ/K₄ᵢ < ω₀ᵢ < ω_cᵢ
+    K₁ = [diag(−2(ζ_nᵢ − ζᵢ) ω_cᵢ/ω₀ᵢ); diag(2ω₀ᵢ(ζ_nᵢ − ζᵢ))],   K₂ = diag(ω_cᵢ)
 
-(Fossen's MSS example ``ExPassiveObs.m``: ζ_n = 1, ζ = 0.1, ω_c/ω₀ ≈ 1.23, K₃ = 0.1 K₄.) Here
-K₄ = M·diag(k₄) so that it is an acceleration per metre (radian) of innovation, and K₃ = κ K₄
-with k₄ = 2ω_lf ω_c, κ = ω_lf/2: the low-frequency loop η̃ → ν̃ → b̃ then has (neglecting D/M
-and the wave branch) the characteristic polynomial (s + ω_c)(s² + 2ω_lf s + ω_lf²), a critically
-damped pair at the low-frequency bandwidth ω_lf (default ω₀/10), and K₃ᵢ/K₄ᵢ = ω_lf/2 satisfies
-the rule. K₃ and K₄ may be given directly.
+so at ω₀ the wave motion reaches η̂ attenuated by |ω_c h₀(jω₀)| = (ζ/ζ_n) ω_c/√(ω₀² + ω_c²)
+(:func:`wave_filter_gain`).
+
+*Bias and velocity (K₃, K₄, T).* K₃ = diag(k₃ᵢ), K₄ = diag(k₄ᵢ), T = diag(T_bᵢ), with the
+published tuning rule (H_i(s) strictly positive real)::
+
+    1/T_bᵢ ≪ k₃ᵢ/k₄ᵢ < ω₀ᵢ < ω_cᵢ
+
+Their size is not fixed by the rule. Here k₄ᵢ = 2ζ_lf Mᵢᵢ ω_lfᵢ ω_cᵢ, k₃ᵢ = Mᵢᵢ ω_lfᵢ² ω_cᵢ (Mᵢᵢ
+the DOF's own mass or inertia, so the gains stay diagonal): below ω_c, h_0,i ≈ 1/(s + ω_c), and
+the low-frequency loop of one DOF, η̃ → ν̃ → b̃, has (neglecting Dᵢᵢ/Mᵢᵢ, the wave branch and the
+coupling through M's off-diagonal terms) the characteristic polynomial
+(s + ω_c)(s² + 2ζ_lf ω_lf s + ω_lf²): a pair at the low-frequency bandwidth ω_lf (default ω₀/10)
+with damping ζ_lf (default 1, critical). k₃ᵢ/k₄ᵢ = ω_lfᵢ/(2ζ_lf) must meet the rule (checked).
+Above ω_c the innovation reaches ν̂ unfiltered, Mᵢᵢ⁻¹k₄ᵢ ỹ: white measurement noise of σ per
+sample moves r̂ by ≈ 2ζ_lf ω_lf ω_c σ Ts per sample, which a derivative gain turns into rudder
+rate. K₃ and K₄ may be given directly (diagonal).
+
+The passivity proof needs dissipative damping, D + Dᵀ > 0. A vessel in transit need not have it:
+CyberShip II at 0.3 m/s is course-unstable (its sway–yaw model linearised at speed has a pole at
++0.36 rad/s), so with ``velocity_model="model"`` the error dynamics are stable only if ω_lf is
+well above that pole; :mod:`shipgnc.analysis.wave_filter_loop` checks the linearised error
+dynamics and the heading loop closed through the observer.
 
 M and D: the model's own where it exposes them (CyberShip II: ``params.mass_matrix``; the boat:
 diag(M₁₁, M₂₂, M₃₃)); D is the model linearised at ν = 0, u = 0: D = −M ∂ν̇/∂ν (for CyberShip II
@@ -64,6 +91,26 @@ def _per_dof(field: str, value, positive: bool = True) -> np.ndarray:
     return out
 
 
+def _diagonal(field: str, value) -> np.ndarray:
+    """A diagonal gain as its 3 diagonal entries: 3 numbers, one for all, or a diagonal 3 × 3."""
+    a = np.asarray(value, dtype=float)
+    if a.shape == (3, 3):
+        off = a - np.diag(np.diag(a))
+        require(not np.any(off), field, a.tolist(), "must be diagonal (Fossen & Strand's K3, K4: "
+                "one gain per degree of freedom)")
+        a = np.diag(a)
+    return _per_dof(field, a)
+
+
+def wave_filter_gain(omega, omega0, zeta, zeta_n, omega_c):
+    """ω_c h₀(jω) of one DOF (module docstring): the complex response of the low-frequency
+    estimate η̂ to the measurement y without the velocity injection; at ω = ω₀ its magnitude is
+    (ζ/ζ_n) ω_c/√(ω₀² + ω_c²)."""
+    s = 1j * np.asarray(omega, dtype=float)
+    return omega_c * ((s**2 + 2 * zeta * omega0 * s + omega0**2)
+                      / ((s**2 + 2 * zeta_n * omega0 * s + omega0**2) * (s + omega_c)))
+
+
 def mass_matrix(model) -> np.ndarray | None:
     """The 3 × 3 M of ``model`` when it exposes one (CyberShip II, the boat), else None."""
     p = getattr(model, "params", None)
@@ -84,8 +131,9 @@ class PassiveObserver(Estimator):
     omega0 : dominant wave (encounter) frequency ω₀ [rad/s], per DOF or one for all.
     zeta : the wave model's relative damping ζ (default 0.1); ``zeta_notch`` ζ_n (default 1.0).
     omega_c : cut-off [rad/s] > ω₀ (default 1.2 ω₀).
-    omega_lf : low-frequency bandwidth [rad/s] setting K₃, K₄ (default ω₀/10).
-    K3, K4 : 3 × 3 gains overriding those from ``omega_lf``.
+    omega_lf : low-frequency bandwidth [rad/s] setting K₃, K₄ (default ω₀/10); ``zeta_lf`` its
+        damping (default 1).
+    K3, K4 : diagonal gains (3 numbers or a diagonal 3 × 3) overriding those from ``omega_lf``.
     T_b : bias time constants [s] (default 1000).
     M, D : 3 × 3 matrices overriding the model's.
     velocity_model : ``"linear"`` (published) or ``"model"`` (see the module docstring).
@@ -95,7 +143,7 @@ class PassiveObserver(Estimator):
     kind = "passive-observer"
 
     def __init__(self, omega0, *, zeta=0.1, zeta_notch=1.0, omega_c=None, omega_lf=None,
-                 K3=None, K4=None, T_b=1000.0, M=None, D=None, velocity_model: str = "linear",
+                 zeta_lf=1.0, K3=None, K4=None, T_b=1000.0, M=None, D=None, velocity_model: str = "linear",
                  x0_offset=None, substeps: int | None = None):
         self.omega0 = _per_dof("passive-observer.omega0", omega0)
         self.zeta = _per_dof("passive-observer.zeta", zeta)
@@ -109,7 +157,12 @@ class PassiveObserver(Estimator):
                 self.omega_c.tolist(), f"the cut-off must exceed omega0 = {self.omega0.tolist()}")
         self.omega_lf = (self.omega0 / 10 if omega_lf is None
                          else _per_dof("passive-observer.omega_lf", omega_lf))
+        self.zeta_lf = _per_dof("passive-observer.zeta_lf", zeta_lf)
         self.T_b = _per_dof("passive-observer.T_b", T_b)
+        if K3 is not None:
+            K3 = _diagonal("passive-observer.K3", K3)
+        if K4 is not None:
+            K4 = _diagonal("passive-observer.K4", K4)
         require(velocity_model in ("linear", "model"), "passive-observer.velocity_model",
                 velocity_model, "allowed: linear, model")
         self.velocity_model = velocity_model
@@ -160,14 +213,17 @@ class PassiveObserver(Estimator):
         self.K1a = -2.0 * (zn - z) * wc / w0          # rows of ξ₁
         self.K1b = 2.0 * w0 * (zn - z)                # rows of ξ₂
         self.K2 = wc
-        if self._K4 is not None:
-            self.K4 = np.asarray(self._K4, dtype=float).reshape(3, 3)
-        else:
-            self.K4 = self.M @ np.diag(2.0 * self.omega_lf * wc)
-        if self._K3 is not None:
-            self.K3 = np.asarray(self._K3, dtype=float).reshape(3, 3)
-        else:
-            self.K3 = np.diag(self.omega_lf / 2.0) @ self.K4
+        m = np.diag(self.M)
+        k4 = 2.0 * self.zeta_lf * m * self.omega_lf * wc if self._K4 is None else self._K4
+        k3 = m * self.omega_lf**2 * wc if self._K3 is None else self._K3
+        ratio = k3 / k4
+        given = self._K3 is not None or self._K4 is not None
+        require(bool(np.all((ratio > 1.0 / self.T_b) & (ratio < w0))),
+                "passive-observer." + ("K3" if given else "omega_lf"),
+                (k3 if given else self.omega_lf).tolist(),
+                f"gives K3/K4 = {ratio.tolist()}, outside (1/T_b, omega0) = "
+                f"({(1.0 / self.T_b).tolist()}, {w0.tolist()}) (Fossen & Strand's rule)")
+        self.K3, self.K4 = np.diag(k3), np.diag(k4)
         fastest = max(float(np.max(wc)), float(np.max(w0)), float(np.max(self.K1b)),
                       float(np.max(np.abs(np.linalg.eigvals(self.Minv @ self.D)))))
         self.substeps = self._substeps or max(1, math.ceil(self.Ts * fastest / 0.5))

@@ -335,6 +335,7 @@ def navigation(scenario: Scenario, controller=None):
     else:
         estimator = nav.PassiveObserver(e.omega0_rad_s, zeta=e.zeta, zeta_notch=e.zeta_notch,
                                         omega_c=e.omega_c_rad_s, omega_lf=e.omega_lf_rad_s,
+                                        zeta_lf=e.zeta_lf,
                                         T_b=e.T_b_s, velocity_model=e.velocity_model)
     return nav.Navigation(sensors, estimator)
 
@@ -364,7 +365,8 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     elif scenario.metrics == "course-quality":
         out = metrics.course_quality_metrics(result, lam=scenario.quality.lam,
                                              t_end=scenario.simulation.t_end, diverged=diverged,
-                                             delta_max=float(setup.model.params.delta_max))
+                                             delta_max=float(setup.model.params.delta_max),
+                                             delta_rate=rudder_rate(setup))
     elif scenario.metrics == "path-tracking":
         from shipgnc.analysis import path_tracking
 
@@ -397,6 +399,14 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     return out
 
 
+def rudder_rate(setup: Setup) -> float | None:
+    """The steering machine's rudder rate limit [rad/s] (channel ``delta``), None if absent."""
+    act = setup.actuator
+    if act is None or "delta" not in act.names:
+        return None
+    return float(act.rate[act.names.index("delta")])
+
+
 def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndarray] | None:
     """Every ship's scalar metrics at once, ``(ship,)`` arrays in :func:`compute_metrics`'s key
     order (lists left out; NaN where a figure does not exist), from a batch result that did not
@@ -424,7 +434,7 @@ def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndar
             psi=series(result, "psi") if has_ref else None,
             psi_z=series(result, "psi_z") if has_ref else None,
             psi_d=series(result, "psi_d") if "psi_d" in result else None,
-            delta_max=float(setup.model.params.delta_max))
+            delta_max=float(setup.model.params.delta_max), delta_rate=rudder_rate(setup))
     elif scenario.metrics == "path-tracking" and scenario.montecarlo is None:
         from shipgnc.analysis import path_tracking
 

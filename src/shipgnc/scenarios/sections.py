@@ -821,15 +821,17 @@ class PassiveObserverConfig(Strict):
     passive_observer.PassiveObserver`): the dominant wave (encounter) frequency ``omega0_rad_s``,
     the wave model's damping ``zeta`` and the notch's ``zeta_notch``, the cut-off
     ``omega_c_rad_s`` (default 1.2 ω₀), the low-frequency bandwidth ``omega_lf_rad_s`` (default
-    ω₀/10), bias time constant ``T_b_s``, and the velocity model (``linear``, as published, or the
-    vessel's own ``model``). It needs position and heading measurements."""
+    ω₀/10; one for all or [surge, sway, yaw]) and its damping ``zeta_lf`` (default 1), bias time
+    constant ``T_b_s``, and the velocity model (``linear``, as published, or the vessel's own
+    ``model``). It needs position and heading measurements."""
 
     type: Literal["passive-observer"]
     omega0_rad_s: Positive
     zeta: Positive = 0.1
     zeta_notch: Positive = 1.0
     omega_c_rad_s: Positive | None = None
-    omega_lf_rad_s: Positive | None = None
+    omega_lf_rad_s: Positive | tuple[Positive, Positive, Positive] | None = None
+    zeta_lf: Positive = 1.0
     T_b_s: Positive = 1000.0
     velocity_model: Literal["linear", "model"] = "linear"
 
