@@ -182,6 +182,49 @@ def test_gpx_geojson_rtz_read_back_with_the_same_waypoints_and_etas(walled, tmp_
     assert all(w.find("r:leg", ns) is not None for w in wps[1:])
 
 
+def _schema(name):
+    from pathlib import Path
+
+    import xmlschema
+
+    return xmlschema.XMLSchema(Path(__file__).parent / "data" / name)
+
+
+def test_rtz_and_gpx_are_valid_against_their_schemas(walled, tmp_path):
+    """route.rtz against RTZ 1.1 (IEC 61174 Annex S) and route.gpx against GPX 1.1, by an XSD-validating
+    reader: the subsets in tests/data carry the standards' names, order, types and ranges for every
+    element shipgnc writes (``portsideXTD``, not ``portXTD``; no speed on a leg; longitudes in
+    [−180°, 180°); XTD < 10 nm)."""
+    from shipgnc.routing.geo.writers import RTZ_NS, write_gpx, write_rtz
+
+    *_, route = walled
+    write_gpx(tmp_path / "r.gpx", route.waypoints)
+    write_rtz(tmp_path / "r.rtz", route.waypoints, xte_m=18519.0)  # just under 10 nm
+    rtz, gpx = _schema("rtz-1.1-subset.xsd"), _schema("gpx-1.1-subset.xsd")
+    assert [e.reason for e in rtz.iter_errors(str(tmp_path / "r.rtz"))] == []
+    assert [e.reason for e in gpx.iter_errors(str(tmp_path / "r.gpx"))] == []
+    # a schedule element's speed is the leg arriving at its waypoint: its geodesic length over the
+    # time between the two ETAs (whole seconds), in knots to the written 0.01 kn
+    ns = {"r": RTZ_NS}
+    root = ET.parse(tmp_path / "r.rtz").getroot()
+    elems = root.findall("r:schedules/r:schedule/r:calculated/r:scheduleElement", ns)
+    assert elems[0].get("speed") is None
+    w = route.waypoints
+    for k in range(1, len(w)):
+        _, _, d = GEOD.inv(w[k - 1]["lon"], w[k - 1]["lat"], w[k]["lon"], w[k]["lat"])
+        sog_kn = d / (w[k]["eta_s"] - w[k - 1]["eta_s"]) / (1852.0 / 3600.0)
+        assert float(elems[k].get("speed")) == pytest.approx(sog_kn, rel=2e-3, abs=0.006)
+    # a waypoint on the antimeridian is written at −180°, inside both schemas' longitude range
+    edge = [dict(w[0], lon=179.999999999), dict(w[1], lon=-179.9)]
+    write_gpx(tmp_path / "e.gpx", edge)
+    write_rtz(tmp_path / "e.rtz", edge)
+    assert [e.reason for e in rtz.iter_errors(str(tmp_path / "e.rtz"))] == []
+    assert [e.reason for e in gpx.iter_errors(str(tmp_path / "e.gpx"))] == []
+    # 10 nm of cross-track is beyond RTZ's XTD: refused in one line, not written out of range
+    with pytest.raises(ConfigError, match=r"xte-m.*10 nm"):
+        write_rtz(tmp_path / "x.rtz", route.waypoints, xte_m=18520.0)
+
+
 def _same(got, expect):
     assert len(got) == len(expect)
     for g, e in zip(got, expect, strict=True):

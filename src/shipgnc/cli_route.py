@@ -268,6 +268,12 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     require(obstacles is None, "--obstacles", str(obstacles),
             "is for the local plane; with --geo give --land")
     require(radius == 0.0, "--radius", radius, "is not used with --geo (the target is a point)")
+    if out is not None:  # route.rtz's cross-track limits: RTZ 1.1 allows XTD < 10 nm
+        from shipgnc.routing.geo.writers import RTZ_XTD_MAX_NM
+
+        require(xte_m < RTZ_XTD_MAX_NM * NAUTICAL_MILE, "--xte-m", xte_m,
+                f"with --out, below {RTZ_XTD_MAX_NM * NAUTICAL_MILE:g} m (RTZ 1.1's cross-track limit, "
+                f"{RTZ_XTD_MAX_NM:g} nm)")
     a = _pair(start, "--start", 1.0)
     b = _pair(target, "--target", 1.0)
     if a == b:
