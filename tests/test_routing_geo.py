@@ -310,3 +310,48 @@ def test_nan_cells_are_land(tmp_path):
     box = shapely.box(lon[25], lat[15], lon[35], lat[25])  # the NaN nodes' hull
     for p, q in zip(route.waypoints[:-1], route.waypoints[1:], strict=True):
         assert not shapely.LineString(geodesic_points((p["lat"], p["lon"]), (q["lat"], q["lon"]))).intersects(box)
+
+
+# ------------------------------------------------------------------ true headings, CF units
+def test_every_heading_in_the_json_is_true_not_the_projections():
+    """Still water, 60°N 5°E → 60.5°N 9°E: the route is the geodesic, so every extremal's heading at the
+    start and at the end is the geodesic's azimuth there (pyproj Geod.inv, Karney 2013), not the
+    oblique Mercator's grid heading (its meridian convergence is 1.7° at both ends)."""
+    a, b = (60.0, 5.0), (60.5, 9.0)
+    route = GeoProblem(a, b, 3.0, current=None, land="none").solve(T0)
+    js = route.to_json()
+    az, back, _ = GEOD.inv(a[1], a[0], b[1], b[0])
+    start, end = az % 360.0, (back + 180.0) % 360.0
+    assert abs(route.problem.projection.true_north_deg(*a)) > 1.0  # the grid frame is visibly off
+    entries = [js, *js["extremal_details"]]
+    assert len(entries) >= 2
+    for e in entries:
+        assert e["heading_start_deg"] == pytest.approx(start, abs=1e-3)
+        assert e["heading_end_deg"] == pytest.approx(end, abs=1e-3)
+    assert route.to_json()["extremal_details"] == js["extremal_details"]  # converted once, not twice
+
+
+def test_a_current_without_units_is_refused_per_cf(tmp_path):
+    """CF conventions §3.1: a dimensional variable must carry ``units``; a velocity without them was read
+    as m/s. Refused in one line naming the file and the variable, on the ellipsoid and on the plane."""
+    lat, lon = np.arange(50.0, 51.01, 0.1), np.arange(-11.0, -9.99, 0.1)
+    z = np.zeros((lat.size, lon.size))
+    path = tmp_path / "nounits.nc"
+    write_current(path, lat, lon, z, z + 0.5, units="")
+    with pytest.raises(ConfigError, match="no units attribute") as exc:
+        GeoProblem((50.5, -10.5), (50.5, -10.2), 5.0, current=str(path), land="none")
+    assert "\n" not in str(exc.value) and "nounits.nc" in str(exc.value)
+    from shipgnc.routing.field_spec import parse_field
+
+    plane = tmp_path / "plane.nc"
+    n = np.linspace(0.0, 1000.0, 11)
+    ds = xr.Dataset({"current_north": (("north", "east"), np.zeros((11, 11))),
+                     "current_east": (("north", "east"), np.ones((11, 11)), {"units": "knots"})},
+                    coords={"north": n, "east": n})
+    ds.to_netcdf(plane, engine="h5netcdf")
+    with pytest.raises(ConfigError, match="current_north has no units attribute"):
+        parse_field(str(plane))
+    ds["current_north"].attrs["units"] = "m s-1"
+    ds.to_netcdf(tmp_path / "plane2.nc", engine="h5netcdf")
+    fld = parse_field(str(tmp_path / "plane2.nc"))  # knots converted: 1 kn = 1852/3600 m/s
+    assert fld.velocity(0.0, 500.0, 500.0)[1] == pytest.approx(1852.0 / 3600.0)

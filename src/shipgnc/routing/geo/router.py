@@ -141,9 +141,14 @@ class GeoRoute:
         js = self.plane.to_json()
         pr = self.problem
         plane_time = js.get("time_s")
-        for key in ("heading_start_deg", "heading_end_deg"):  # grid headings → true headings
-            if js.get(key) is not None:
-                js[key] = float((js[key] - pr.grid_north_deg(key == "heading_start_deg")) % 360.0)
+        # plane headings → true headings: at the start and at the target, by the meridian convergence
+        north = {"heading_start_deg": pr.projection.true_north_deg(*pr.start),
+                 "heading_end_deg": pr.projection.true_north_deg(*pr.target)}
+        js["extremal_details"] = [dict(e) for e in js.get("extremal_details", [])]  # not the plane's own
+        for entry in (js, *js["extremal_details"]):
+            for key, ang in north.items():
+                if entry.get(key) is not None:
+                    entry[key] = float((entry[key] - ang) % 360.0)
         js.update({
             "reachable": bool(self.reachable),
             "time_s": None if self.time_s is None else float(self.time_s),
