@@ -355,3 +355,27 @@ def test_a_current_without_units_is_refused_per_cf(tmp_path):
     ds.to_netcdf(tmp_path / "plane2.nc", engine="h5netcdf")
     fld = parse_field(str(tmp_path / "plane2.nc"))  # knots converted: 1 kn = 1852/3600 m/s
     assert fld.velocity(0.0, 500.0, 500.0)[1] == pytest.approx(1852.0 / 3600.0)
+
+
+def test_a_geo_horizon_is_a_limit_on_the_route_sailed(tmp_path):
+    """--horizon H with --geo: never a route that takes longer than H (it answered 11.02 h for 11 h). A
+    northward route across an eastward jet (2 m/s, 0.15° wide) thinned to waypoints 3 km from the optimal
+    track sails 0.8 % slower than the plane optimum; a horizon between the two is not met by the route
+    sailed: unreachable, not a route beyond it. Just above the sailed time: that route."""
+    lat, lon = np.arange(49.5, 51.51, 0.05), np.arange(-12.0, -8.99, 0.05)
+    ve = 2.0 * np.exp(-((lat[:, None] - 50.5) / 0.15) ** 2) * np.ones((1, lon.size))
+    write_current(tmp_path / "jet.nc", lat, lon, np.zeros_like(ve), ve)
+
+    def solve(horizon=None):
+        return GeoProblem((50.1, -10.5), (50.9, -10.5), 5.0, current=str(tmp_path / "jet.nc"), land="none",
+                          xte_m=3000.0).solve(T0, horizon=horizon)
+
+    free = solve()
+    t_sail, t_plane = free.time_s, free.plane.time_s
+    assert t_sail > 1.002 * t_plane  # the waypoints cut the track's bends
+    between = solve(0.5 * (t_sail + t_plane))
+    js = between.to_json()
+    assert not between.reachable and js["reachable"] is False and js["time_s"] is None
+    assert any(n.startswith("unreachable") and "as sailed" in n for n in js["notes"])
+    above = solve(1.001 * t_sail)
+    assert above.reachable and above.time_s == pytest.approx(t_sail, rel=1e-6)

@@ -409,6 +409,7 @@ class GeoProblem:
 
         fld = self.field_from(depart_s)
         notes = []
+        limit = horizon  # a horizon given limits the route sailed along its waypoints too
         if horizon is None:
             horizon = 4.0 * float(np.hypot(*(self.B - self.A))) / self.speed
         gridded = self.current.grid is not None
@@ -424,6 +425,12 @@ class GeoProblem:
             out.notes.append(f"unreachable: {res.reason}")
             return out
         self._finish(out)
+        if limit is not None and out.reachable and out.time_s > limit * (1 + 1e-9):
+            t = out.time_s
+            out.notes.append(f"unreachable: within T_max = {limit:.6g} s ({limit / 3600:.4g} h) as sailed: "
+                             f"the route along its waypoints takes {t:.6g} s ({t / 3600:.4g} h) on the "
+                             f"ellipsoid (the plane optimum {res.time_s:.6g} s); a longer --horizon")
+            out.reachable, out.time_s = False, None
         return out
 
     def _round_land(self, fld, horizon, notes):
