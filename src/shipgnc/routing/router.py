@@ -219,9 +219,10 @@ def _horizon_verdict(res: RouteResult, horizon: float, search: float, horizon_gi
         return
     if (not res.reachable and search < horizon and not _closed_form(res)
             and not str(res.reason).startswith("undecided")):
+        found = str(res.reason).replace("target not reachable within T_max =", "no route within")
         res.reason = (f"undecided: no route of duration ≤ {search:.6g} s (the search's bound, "
-                      f"{SEARCH_CAP:g}·|AB|/V); routes up to T_max = {horizon:.6g} s were not searched — "
-                      f"{res.reason}")
+                      f"{SEARCH_CAP:g}·|AB|/V); routes up to T_max = {horizon:.6g} s were not searched "
+                      f"({found})")
 
 
 def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = True, progress=None):
