@@ -270,6 +270,9 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     require(obstacles is None, "--obstacles", str(obstacles),
             "is for the local plane; with --geo give --land")
     require(radius == 0.0, "--radius", radius, "is not used with --geo (the target is a point)")
+    for name, value in (("--draft", draft), ("--ukc", ukc)):  # a draft is checked against a depth only
+        require(depth is not None or value == 0.0, name, value,
+                "needs --depth (a bathymetry file): without it no water counts as too shallow")
     if out is not None:  # route.rtz's cross-track limits: RTZ 1.1 allows XTD < 10 nm
         from shipgnc.routing.geo.writers import RTZ_XTD_MAX_NM
 
