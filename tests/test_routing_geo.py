@@ -182,6 +182,49 @@ def test_gpx_geojson_rtz_read_back_with_the_same_waypoints_and_etas(walled, tmp_
     assert all(w.find("r:leg", ns) is not None for w in wps[1:])
 
 
+def _schema(name):
+    from pathlib import Path
+
+    import xmlschema
+
+    return xmlschema.XMLSchema(Path(__file__).parent / "data" / name)
+
+
+def test_rtz_and_gpx_are_valid_against_their_schemas(walled, tmp_path):
+    """route.rtz against RTZ 1.1 (IEC 61174 Annex S) and route.gpx against GPX 1.1, by an XSD-validating
+    reader: the subsets in tests/data carry the standards' names, order, types and ranges for every
+    element shipgnc writes (``portsideXTD``, not ``portXTD``; no speed on a leg; longitudes in
+    [−180°, 180°); XTD < 10 nm)."""
+    from shipgnc.routing.geo.writers import RTZ_NS, write_gpx, write_rtz
+
+    *_, route = walled
+    write_gpx(tmp_path / "r.gpx", route.waypoints)
+    write_rtz(tmp_path / "r.rtz", route.waypoints, xte_m=18519.0)  # just under 10 nm
+    rtz, gpx = _schema("rtz-1.1-subset.xsd"), _schema("gpx-1.1-subset.xsd")
+    assert [e.reason for e in rtz.iter_errors(str(tmp_path / "r.rtz"))] == []
+    assert [e.reason for e in gpx.iter_errors(str(tmp_path / "r.gpx"))] == []
+    # a schedule element's speed is the leg arriving at its waypoint: its geodesic length over the
+    # time between the two ETAs (whole seconds), in knots to the written 0.01 kn
+    ns = {"r": RTZ_NS}
+    root = ET.parse(tmp_path / "r.rtz").getroot()
+    elems = root.findall("r:schedules/r:schedule/r:calculated/r:scheduleElement", ns)
+    assert elems[0].get("speed") is None
+    w = route.waypoints
+    for k in range(1, len(w)):
+        _, _, d = GEOD.inv(w[k - 1]["lon"], w[k - 1]["lat"], w[k]["lon"], w[k]["lat"])
+        sog_kn = d / (w[k]["eta_s"] - w[k - 1]["eta_s"]) / (1852.0 / 3600.0)
+        assert float(elems[k].get("speed")) == pytest.approx(sog_kn, rel=2e-3, abs=0.006)
+    # a waypoint on the antimeridian is written at −180°, inside both schemas' longitude range
+    edge = [dict(w[0], lon=179.999999999), dict(w[1], lon=-179.9)]
+    write_gpx(tmp_path / "e.gpx", edge)
+    write_rtz(tmp_path / "e.rtz", edge)
+    assert [e.reason for e in rtz.iter_errors(str(tmp_path / "e.rtz"))] == []
+    assert [e.reason for e in gpx.iter_errors(str(tmp_path / "e.gpx"))] == []
+    # 10 nm of cross-track is beyond RTZ's XTD: refused in one line, not written out of range
+    with pytest.raises(ConfigError, match=r"xte-m.*10 nm"):
+        write_rtz(tmp_path / "x.rtz", route.waypoints, xte_m=18520.0)
+
+
 def _same(got, expect):
     assert len(got) == len(expect)
     for g, e in zip(got, expect, strict=True):
@@ -267,3 +310,72 @@ def test_nan_cells_are_land(tmp_path):
     box = shapely.box(lon[25], lat[15], lon[35], lat[25])  # the NaN nodes' hull
     for p, q in zip(route.waypoints[:-1], route.waypoints[1:], strict=True):
         assert not shapely.LineString(geodesic_points((p["lat"], p["lon"]), (q["lat"], q["lon"]))).intersects(box)
+
+
+# ------------------------------------------------------------------ true headings, CF units
+def test_every_heading_in_the_json_is_true_not_the_projections():
+    """Still water, 60°N 5°E → 60.5°N 9°E: the route is the geodesic, so every extremal's heading at the
+    start and at the end is the geodesic's azimuth there (pyproj Geod.inv, Karney 2013), not the
+    oblique Mercator's grid heading (its meridian convergence is 1.7° at both ends)."""
+    a, b = (60.0, 5.0), (60.5, 9.0)
+    route = GeoProblem(a, b, 3.0, current=None, land="none").solve(T0)
+    js = route.to_json()
+    az, back, _ = GEOD.inv(a[1], a[0], b[1], b[0])
+    start, end = az % 360.0, (back + 180.0) % 360.0
+    assert abs(route.problem.projection.true_north_deg(*a)) > 1.0  # the grid frame is visibly off
+    entries = [js, *js["extremal_details"]]
+    assert len(entries) >= 2
+    for e in entries:
+        assert e["heading_start_deg"] == pytest.approx(start, abs=1e-3)
+        assert e["heading_end_deg"] == pytest.approx(end, abs=1e-3)
+    assert route.to_json()["extremal_details"] == js["extremal_details"]  # converted once, not twice
+
+
+def test_a_current_without_units_is_refused_per_cf(tmp_path):
+    """CF conventions §3.1: a dimensional variable must carry ``units``; a velocity without them was read
+    as m/s. Refused in one line naming the file and the variable, on the ellipsoid and on the plane."""
+    lat, lon = np.arange(50.0, 51.01, 0.1), np.arange(-11.0, -9.99, 0.1)
+    z = np.zeros((lat.size, lon.size))
+    path = tmp_path / "nounits.nc"
+    write_current(path, lat, lon, z, z + 0.5, units="")
+    with pytest.raises(ConfigError, match="no units attribute") as exc:
+        GeoProblem((50.5, -10.5), (50.5, -10.2), 5.0, current=str(path), land="none")
+    assert "\n" not in str(exc.value) and "nounits.nc" in str(exc.value)
+    from shipgnc.routing.field_spec import parse_field
+
+    plane = tmp_path / "plane.nc"
+    n = np.linspace(0.0, 1000.0, 11)
+    ds = xr.Dataset({"current_north": (("north", "east"), np.zeros((11, 11))),
+                     "current_east": (("north", "east"), np.ones((11, 11)), {"units": "knots"})},
+                    coords={"north": n, "east": n})
+    ds.to_netcdf(plane, engine="h5netcdf")
+    with pytest.raises(ConfigError, match="current_north has no units attribute"):
+        parse_field(str(plane))
+    ds["current_north"].attrs["units"] = "m s-1"
+    ds.to_netcdf(tmp_path / "plane2.nc", engine="h5netcdf")
+    fld = parse_field(str(tmp_path / "plane2.nc"))  # knots converted: 1 kn = 1852/3600 m/s
+    assert fld.velocity(0.0, 500.0, 500.0)[1] == pytest.approx(1852.0 / 3600.0)
+
+
+def test_a_geo_horizon_is_a_limit_on_the_route_sailed(tmp_path):
+    """--horizon H with --geo: never a route that takes longer than H (it answered 11.02 h for 11 h). A
+    northward route across an eastward jet (2 m/s, 0.15° wide) thinned to waypoints 3 km from the optimal
+    track sails 0.8 % slower than the plane optimum; a horizon between the two is not met by the route
+    sailed: unreachable, not a route beyond it. Just above the sailed time: that route."""
+    lat, lon = np.arange(49.5, 51.51, 0.05), np.arange(-12.0, -8.99, 0.05)
+    ve = 2.0 * np.exp(-((lat[:, None] - 50.5) / 0.15) ** 2) * np.ones((1, lon.size))
+    write_current(tmp_path / "jet.nc", lat, lon, np.zeros_like(ve), ve)
+
+    def solve(horizon=None):
+        return GeoProblem((50.1, -10.5), (50.9, -10.5), 5.0, current=str(tmp_path / "jet.nc"), land="none",
+                          xte_m=3000.0).solve(T0, horizon=horizon)
+
+    free = solve()
+    t_sail, t_plane = free.time_s, free.plane.time_s
+    assert t_sail > 1.002 * t_plane  # the waypoints cut the track's bends
+    between = solve(0.5 * (t_sail + t_plane))
+    js = between.to_json()
+    assert not between.reachable and js["reachable"] is False and js["time_s"] is None
+    assert any(n.startswith("unreachable") and "as sailed" in n for n in js["notes"])
+    above = solve(1.001 * t_sail)
+    assert above.reachable and above.time_s == pytest.approx(t_sail, rel=1e-6)

@@ -78,6 +78,8 @@ def test_geo_numeric_depart_is_an_offset_from_the_files_first_time(files):
     (("--start", "52.0,-1.5", "--target", "50.3,-2.0"), r"--start = 52\.00000,-1\.50000: on land \(GSHHG"),
     (("--start", "50.5,-11.1", "--target", "50.5,-9.9", "--field", "missing.nc"), r"missing\.nc: no such file"),
     (("--start", "50.5,-11.1", "--target", "95,-9.9"), r"--target = \[95\.0, -9\.9\]: must be LAT,LON"),
+    (("--start", "50.5,-11.1", "--target", "50.5,-9.9", "--land", "none", "--draft", "12"),
+     r"--draft = 12\.0: needs --depth"),
 ])
 def test_geo_bad_input_is_one_line_exit_2(args, pattern):
     full = ["--geo", "--speed", "10", "--field", "still", *args]

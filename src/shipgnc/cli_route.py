@@ -20,7 +20,8 @@ display on stderr follows the sweep's polish and the level set's advance (nothin
 
 SI by default; ``--units nautical`` reads positions in nm, speeds in kn, k and ω in 1/h, Γ in nm²/h and prints
 times in h beside s. JSON keys stay SI. Exit codes: 0 a route, 2 bad input, 3 unreachable (one-line reason on
-stderr, ``reachable: false`` in the JSON), 1 internal error.
+stderr, ``reachable: false`` in the JSON) or undecided (a search stopped by its effort bound: ``reachable:
+null``, the reason names the bound), 1 internal error.
 """
 
 from __future__ import annotations
@@ -152,12 +153,13 @@ def _plane_route(a, b, speed, field, units, method, obstacles, json_, out, horiz
 
         polys = load_geojson(obstacles, units)
     from shipgnc.routing.memory import route_memory_estimate
-    from shipgnc.routing.router import _validate
+    from shipgnc.routing.router import _validate, check_grid
 
     t0 = depart_value * tscale
     t_h = None if horizon is None else horizon * tscale
     spacing = None if grid is None else grid * length
     _validate(fld, speed, a, b, t0, radius * length)  # the router's own errors, before the estimate
+    check_grid(spacing, a, b, radius * length)
     _check_memory(route_memory_estimate(fld, speed, a, b, method=method, grid_spacing=spacing, horizon=t_h,
                                         obstacles=polys, t0=t0, radius=radius * length), limit)
     with _progress() as progress:
@@ -268,6 +270,15 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     require(obstacles is None, "--obstacles", str(obstacles),
             "is for the local plane; with --geo give --land")
     require(radius == 0.0, "--radius", radius, "is not used with --geo (the target is a point)")
+    for name, value in (("--draft", draft), ("--ukc", ukc)):  # a draft is checked against a depth only
+        require(depth is not None or value == 0.0, name, value,
+                "needs --depth (a bathymetry file): without it no water counts as too shallow")
+    if out is not None:  # route.rtz's cross-track limits: RTZ 1.1 allows XTD < 10 nm
+        from shipgnc.routing.geo.writers import RTZ_XTD_MAX_NM
+
+        require(xte_m < RTZ_XTD_MAX_NM * NAUTICAL_MILE, "--xte-m", xte_m,
+                f"with --out, below {RTZ_XTD_MAX_NM * NAUTICAL_MILE:g} m (RTZ 1.1's cross-track limit, "
+                f"{RTZ_XTD_MAX_NM:g} nm)")
     a = _pair(start, "--start", 1.0)
     b = _pair(target, "--target", 1.0)
     if a == b:
@@ -420,7 +431,7 @@ def _print(console, res, nautical: bool) -> None:
     def row(name: str, value: str) -> None:  # "[deg]" is a unit, not rich markup
         table.add_row(escape(name), escape(value))
 
-    row("reachable", "yes" if js["reachable"] else "no")
+    row("reachable", {True: "yes", False: "no", None: "undecided"}[js["reachable"]])
     if res.reachable:
         t = js["time_s"]
         row("time to target", f"{t:.2f} s = {t / 3600:.6f} h")

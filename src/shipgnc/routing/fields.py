@@ -546,6 +546,32 @@ class Modulated(CurrentField):
         return self.field.grid_cell()
 
 
+#: velocity units of a current file [unit text, lower case, single spaces → factor to m/s]: the UDUNITS
+#: spellings of m/s (CF's canonical "m s-1"), cm/s and knots
+VELOCITY_UNITS = {"m/s": 1.0, "m s-1": 1.0, "m s^-1": 1.0, "m s**-1": 1.0, "m.s-1": 1.0,
+                  "meter second-1": 1.0, "meters/second": 1.0, "meter/second": 1.0, "metre/second": 1.0,
+                  "metres/second": 1.0, "meters per second": 1.0, "ms-1": 1.0, "m/sec": 1.0,
+                  "cm/s": 0.01, "cm s-1": 0.01, "cm s^-1": 0.01, "cm s**-1": 0.01, "cm.s-1": 0.01,
+                  "centimeter/second": 0.01, "centimeters/second": 0.01, "centimeter second-1": 0.01,
+                  "kn": 1852.0 / 3600.0, "knot": 1852.0 / 3600.0, "knots": 1852.0 / 3600.0,
+                  "kt": 1852.0 / 3600.0, "kts": 1852.0 / 3600.0}
+
+
+def velocity_factor(units, where: str) -> float:
+    """The factor to m/s of a current variable's ``units`` attribute. CF requires ``units`` on every
+    dimensional variable (CF conventions §3.1): a velocity without it is refused, not guessed as m/s, and
+    so is a unit outside :data:`VELOCITY_UNITS`; ``where`` names the file and the variable."""
+    text = "" if units is None else str(units).strip()
+    if not text:
+        raise ConfigError(f"{where} has no units attribute: CF requires one (e.g. units = 'm s-1'); "
+                          "add it rather than let the current be guessed in m/s")
+    key = " ".join(text.lower().split())
+    if key not in VELOCITY_UNITS:
+        raise ConfigError(f"{where} has units {text!r}; allowed: m/s, cm/s, knots (and CF spellings such "
+                          "as 'm s-1')")
+    return VELOCITY_UNITS[key]
+
+
 class GriddedCurrent(CurrentField):
     """Gridded data (note 002-2.9.1): an ``xarray.Dataset`` with ``current_north`` and ``current_east``
     [m/s] on coordinates ``north`` and ``east`` [m], optionally ``time`` [s].
@@ -603,6 +629,10 @@ class GriddedCurrent(CurrentField):
                 ds.load()
         except (OSError, ValueError) as exc:
             raise ConfigError(f"field = {str(path)!r}: cannot read as NetCDF ({exc})") from None
+        for name in ("current_north", "current_east"):  # in m/s from the file's units (CF)
+            if name in ds.data_vars:
+                factor = velocity_factor(ds[name].attrs.get("units"), f"field = {str(path)!r}: {name}")
+                ds[name] = ds[name] * factor
         return cls(ds, method)
 
     def describe(self):

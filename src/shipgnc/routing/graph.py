@@ -79,8 +79,9 @@ def _crab(field, speed, t0, p0, p1):
 
 
 def graph_route(field, speed, start, target, domain, spacing, *, directions=80, t0=0.0,
-                obstacles=None) -> GraphRoute:
-    """Dijkstra from the node nearest ``start`` to ``target`` (a node) on a grid of ``spacing`` [m]."""
+                obstacles=None, radius=0.0) -> GraphRoute:
+    """Dijkstra from the node nearest ``start`` to ``target`` (a node) on a grid of ``spacing`` [m]; with
+    ``radius`` > 0 [m] to the nearest-in-time node of the disc |x − B| ≤ radius (B's node included)."""
     from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import dijkstra
 
@@ -89,7 +90,9 @@ def graph_route(field, speed, start, target, domain, spacing, *, directions=80, 
     require(isinstance(spacing, (int, float)) and math.isfinite(spacing) and spacing > 0, "grid_spacing",
             spacing, "must be a finite length > 0 m")
     cells = ((n1 - n0) / spacing + 2) * ((e1 - e0) / spacing + 2)
-    require(cells * directions <= 30_000_000, "grid_spacing", spacing,
+    from shipgnc.routing.memory import require_grid
+
+    require_grid(cells * directions <= 30_000_000, spacing,
             f"gives about {cells:.3g} cells × {directions} directions; coarsen the grid")
     north = target[0] + spacing * np.arange(math.floor((n0 - target[0]) / spacing),
                                             math.ceil((n1 - target[0]) / spacing) + 1)
@@ -99,7 +102,7 @@ def graph_route(field, speed, start, target, domain, spacing, *, directions=80, 
         (b0, b1), (c0, c1) = field.bounds
         north, east = north[(north >= b0) & (north <= b1)], east[(east >= c0) & (east <= c1)]
     nn_, ne_ = north.size, east.size
-    require(nn_ * ne_ * directions <= 30_000_000, "grid_spacing", spacing, "too many graph edges; coarsen")
+    require_grid(nn_ * ne_ * directions <= 30_000_000, spacing, "too many graph edges; coarsen the grid")
     ii, jj = np.meshgrid(np.arange(nn_), np.arange(ne_), indexing="ij")
     src_all, dst_all, w_all = [], [], []
     blocked = None
@@ -133,6 +136,11 @@ def graph_route(field, speed, start, target, domain, spacing, *, directions=80, 
     j_b = int(np.argmin(np.abs(east - target[1])))
     a_node, b_node = i_a * ne_ + j_a, i_b * ne_ + j_b
     dist, pred = dijkstra(graph, indices=a_node, return_predecessors=True)
+    if radius > 0:  # the disc's node reached first
+        nn_g, ee_g = np.meshgrid(north, east, indexing="ij")
+        disc = np.flatnonzero((np.hypot(nn_g - target[0], ee_g - target[1]) <= radius).ravel())
+        disc = np.union1d(disc, [b_node])
+        b_node = int(disc[np.argmin(dist[disc])])
     if not np.isfinite(dist[b_node]):
         return GraphRoute(None, float(spacing), directions, t0=t0)
     nodes = [b_node]

@@ -9,7 +9,9 @@ The scheme is the one the reference numbers of note 002-2.9.2 come from:
 * TVD-RK3 (Shu–Osher) time stepping at CFL 0.5;
 * the front started at t₀ + r₀/V from the endpoints of the short-time extremal field (F8),
   r₀ = max(5h, |AB|/20) (with obstacles: at most their distance from A less 2h, at least 1.2h);
-* the crossing at B found by cubic interpolation in time (B is a grid node).
+* the crossing at B found by cubic interpolation in time (B is a grid node); for a target disc of radius
+  R > 0 (Z12) the crossing of min φ over its circle (bilinear φ at points h/4 apart): the front enters a
+  convex disc through its boundary, and the route is recovered from the point where it touches.
 
 The route is recovered by integrating ẋ = V∇φ/‖∇φ‖ + v backwards from (B, T(B)) over stored fronts. Obstacle
 cells (2.9.3) are frozen: their φ never changes and their speed is zero. SI throughout.
@@ -189,6 +191,7 @@ class LevelSetResult:
     notes: list
     frozen: np.ndarray | None = None  #: obstacle cells (north, east), frozen (2.9.3)
     band: float | None = None  #: narrow-band half-width b·h [m] (φ ≤ b·h), None if unclipped
+    searched: float = math.inf  #: the horizon the front was run to [s after t₀] (below ``horizon``: effort)
     _grads: dict = dc_field(default_factory=dict, repr=False)
 
     def isochrones(self, every: float = 3600.0):
@@ -299,7 +302,7 @@ def _initial_radius(spacing, dist, start, obstacles):
 
 def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizon=None, obstacles=None,
                  cfl=0.5, store_every=None, recover=True, compiled=True, band=6, r0=None, n_rays=720,
-                 ray_steps=60, progress=None) -> LevelSetResult:
+                 ray_steps=60, progress=None, radius=0.0, truncate=False) -> LevelSetResult:
     """Propagate the reachability front from ``start`` until it covers ``target`` (note 002-2.9.2).
 
     ``domain`` = ((north_min, north_max), (east_min, east_max)) [m]; ``spacing`` h [m]; ``obstacles`` a
@@ -312,7 +315,11 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     time slice at a time (:class:`_GridSlices`, equal results). Returns a :class:`LevelSetResult`.
     ``compiled=False`` uses the numpy reference of the right-hand side (:func:`front_rate`) instead of its
     numba twin. ``progress(fraction)``, if given, is called after every step with the fraction of the
-    horizon's steps done (rising, 1.0 when the loop ends: at the arrival or the horizon).
+    horizon's steps done (rising, 1.0 when the loop ends: at the arrival or the horizon). ``radius`` > 0
+    [m]: the target is the disc |x − B| ≤ radius, reached when the front meets its circle. Past the effort
+    bound (:data:`MAX_CELL_STEPS`) it raises :class:`EffortBound`, or with ``truncate`` runs to the
+    longest horizon within the bound: ``searched`` [s] then says how far it looked (an arrival found is an
+    answer; none is not "unreachable" within ``horizon``).
     """
     from shipgnc.routing import pmp
 
@@ -326,14 +333,16 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
         require(n0 <= p[0] <= n1 and e0 <= p[1] <= e1, name, p.tolist(),
                 f"must lie in the level-set domain N [{n0:g}, {n1:g}] × E [{e0:g}, {e1:g}] m")
     cells = ((n1 - n0) / spacing + 2) * ((e1 - e0) / spacing + 2)
-    require(cells <= 4_000_000, "grid_spacing", spacing,
+    from shipgnc.routing.memory import require_grid
+
+    require_grid(cells <= 4_000_000, spacing,
             f"gives about {cells:.3g} cells over the domain; use a coarser grid (at most 4e6 cells)")
     north, east = _axis(target[0], n0, n1, spacing), _axis(target[1], e0, e1, spacing)
     if field.bounds is not None:
         (b0, b1), (c0, c1) = field.bounds
         north = north[(north >= b0) & (north <= b1)]
         east = east[(east >= c0) & (east <= c1)]
-    require(north.size * east.size <= 4_000_000, "grid_spacing", spacing,
+    require_grid(north.size * east.size <= 4_000_000, spacing,
             f"gives {north.size}×{east.size} cells; use a coarser grid")
     nn, ee = np.meshgrid(north, east, indexing="ij")
     ib, jb = int(np.argmin(np.abs(north - target[0]))), int(np.argmin(np.abs(east - target[1])))
@@ -343,6 +352,22 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     # --- initial front: endpoints of the short-time extremal field (F8)
     if r0 is None:
         r0 = _initial_radius(spacing, dist, start, obstacles)
+        if radius > 0:  # the first front stays outside the disc
+            r0 = min(r0, max(0.5 * (dist - radius), 1.2 * spacing))
+    ring = None
+    if radius > 0:
+        m = max(64, math.ceil(TWO_PI * radius / (spacing / 4)))
+        ang = np.linspace(0.0, TWO_PI, m, endpoint=False)
+        ring = target[:, None] + radius * np.stack([np.cos(ang), np.sin(ang)])
+        keep = ((ring[0] >= north[0]) & (ring[0] <= north[-1]) & (ring[1] >= east[0])
+                & (ring[1] <= east[-1]))
+        ring = ring[:, keep] if keep.any() else target[:, None]
+
+    def at_target(ph) -> float:
+        """φ at B, or its minimum over the disc's circle."""
+        if ring is None:
+            return float(ph[ib, jb])
+        return float(np.min(_bilinear(ph, north, east, ring)))
     t_init = r0 / speed
     rays = np.linspace(0, TWO_PI, n_rays, endpoint=False)
     ends = pmp.integrate_family(field, speed, start, rays, t0, t_init, ray_steps)[-1]
@@ -392,11 +417,16 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
         store_every = max(1, round(0.01 * dist / speed / dt))  # ~ 100 snapshots per |AB|/V
     t = t_init
     snaps_t, snaps = [t_init], [phi.astype(np.float32)]
-    history_t, history_phi = [t], [float(phi[ib, jb])]
+    history_t, history_phi = [t], [at_target(phi)]
     arrival = None
     notes: list[str] = []
     steps = 0
-    max_steps = math.ceil((horizon - t_init) / dt) + 1
+    max_steps = min((horizon - t_init) / dt, 1e300)  # a float: a horizon of 1e308 s stays a number
+    searched = horizon
+    if (max_steps + 1) * nn.size > MAX_CELL_STEPS and truncate:
+        max_steps = max(MAX_CELL_STEPS // nn.size - 1, 1)
+        searched = t_init + max_steps * dt
+    max_steps = math.ceil(max_steps) + 1
     if max_steps * nn.size > MAX_CELL_STEPS:
         raise EffortBound(
             f"level set: {max_steps:.3g} steps of Δt = {dt:.3g} s to the horizon on its {north.size}×"
@@ -414,7 +444,7 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
             t += dt
             steps += 1
             history_t.append(t)
-            history_phi.append(float(phi[ib, jb]))
+            history_phi.append(at_target(phi))
             if progress is not None:
                 progress(steps / max_steps)
             if steps % store_every == 0:
@@ -436,10 +466,14 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
         reached = phi <= 0
         gap = np.hypot(nn - target[0], ee - target[1])
         closest = float(np.min(gap[reached])) if np.any(reached) else dist
+        closest = max(closest - radius, 0.0)
     res = LevelSetResult(arrival, float(spacing), north, east, np.array(snaps_t), np.array(snaps), None,
-                         closest, steps, notes, frozen, cap)
+                         closest, steps, notes, frozen, cap, searched=float(searched))
     if arrival is not None and recover:
-        res.route = _recover(field, speed, start, target, res, t0, t_init, ends)
+        touch = target
+        if ring is not None:  # where the front meets the circle
+            touch = ring[:, int(np.argmin(_bilinear(res.snapshots[-1].astype(float), north, east, ring)))]
+        res.route = _recover(field, speed, start, touch, res, t0, t_init, ends)
         margin = min(np.min(res.route.xy[:, 0] - north[0]), np.min(north[-1] - res.route.xy[:, 0]),
                      np.min(res.route.xy[:, 1] - east[0]), np.min(east[-1] - res.route.xy[:, 1]))
         if margin < 5 * spacing:
@@ -457,6 +491,17 @@ def time_step(cfl, spacing, speed, vmax, field) -> float:
         raise ConfigError(f"field {field.describe()}: the current {reach} over the level set's grid, "
                           f"beyond any time step (ship speed {speed:.3g} m/s)")
     return dt
+
+
+def _bilinear(phi, north, east, pts):
+    """φ at points ``pts`` (2, m) of the grid (north, east), by bilinear interpolation."""
+    h_n, h_e = north[1] - north[0], east[1] - east[0]
+    i = np.clip(((pts[0] - north[0]) // h_n).astype(int), 0, north.size - 2)
+    j = np.clip(((pts[1] - east[0]) // h_e).astype(int), 0, east.size - 2)
+    a = np.clip((pts[0] - north[i]) / h_n, 0.0, 1.0)
+    b = np.clip((pts[1] - east[j]) / h_e, 0.0, 1.0)
+    return ((1 - a) * (1 - b) * phi[i, j] + (1 - a) * b * phi[i, j + 1] + a * (1 - b) * phi[i + 1, j]
+            + a * b * phi[i + 1, j + 1])
 
 
 def _cubic_crossing(t, f):

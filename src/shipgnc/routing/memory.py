@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from shipgnc.errors import require
+from shipgnc.errors import ConfigError, require
 
 #: bytes per (step, angle) entry of the sweep's candidate search (:func:`~shipgnc.routing.pmp._candidates`):
 #: finite mask 1 + masked copy 4 + two rolled neighbour copies 8 + comparison masks ≈ 3 + the positions'
@@ -78,6 +78,13 @@ class RouteMemory:
         return phase
 
 
+
+def require_grid(condition: bool, spacing: float, rule: str) -> None:
+    """A ConfigError ``grid_spacing = <h> m: <rule>`` unless ``condition`` holds: the spacing with its
+    unit, so that the command line restates it in the units the user typed (nm with ``--units nautical``)."""
+    if not condition:
+        raise ConfigError(f"grid_spacing = {spacing:.6g} m: {rule}")
+
 def _axis_size(b: float, lo: float, hi: float, h: float, bounds: tuple[float, float] | None):
     """(nodes, first, last) of :func:`~shipgnc.routing.levelset._axis` (b + h·k covering [lo, hi]) inside
     ``bounds``, counted without building the axis when it is long."""
@@ -108,7 +115,7 @@ def levelset_memory(fld, speed, start, target, domain, spacing, *, t0=0.0, horiz
     (n0, n1), (e0, e1) = domain
     require(spacing > 0 and math.isfinite(spacing), "grid_spacing", spacing, "must be > 0 m")
     rough = ((n1 - n0) / spacing + 2) * ((e1 - e0) / spacing + 2)
-    require(rough <= LEVELSET_MAX_CELLS, "grid_spacing", spacing,
+    require_grid(rough <= LEVELSET_MAX_CELLS, spacing,
             f"gives about {rough:.3g} cells over the domain; use a coarser grid (at most 4e6 cells)")
     bn = be = None
     if fld.bounds is not None:
@@ -123,7 +130,7 @@ def levelset_memory(fld, speed, start, target, domain, spacing, *, t0=0.0, horiz
     vmax = fld.max_speed(((lo_n, hi_n), (lo_e, hi_e)), t0)
     dt = time_step(cfl, spacing, speed, vmax, fld)
     store_every = max(1, round(0.01 * dist / speed / dt))
-    max_steps = max(0, math.ceil((horizon - r0 / speed) / dt) + 1)
+    max_steps = max(0, math.ceil(min((horizon - r0 / speed) / dt, 1e300)) + 1)
     snaps = min(1 + max_steps // store_every, MAX_SNAPSHOTS) + 1  # thinned beyond MAX_SNAPSHOTS
     out.grid, out.snapshots = (n_n, n_e), snaps
     unsteady = 0 if fld.steady else 2 * 16 * cells  # v(t) on the grid and its blend, per step
@@ -173,7 +180,7 @@ def graph_memory(fld, target, domain, spacing, directions=80, out: RouteMemory |
     (n0, n1), (e0, e1) = domain
     require(math.isfinite(spacing) and spacing > 0, "grid_spacing", spacing, "must be a finite length > 0 m")
     rough = ((n1 - n0) / spacing + 2) * ((e1 - e0) / spacing + 2)
-    require(rough * directions <= GRAPH_MAX_EDGES, "grid_spacing", spacing,
+    require_grid(rough * directions <= GRAPH_MAX_EDGES, spacing,
             f"gives about {rough:.3g} cells × {directions} directions; coarsen the grid")
     bn, be = (None, None) if fld.bounds is None else fld.bounds
     n_n = _axis_size(target[0], n0, n1, spacing, bn)[0]

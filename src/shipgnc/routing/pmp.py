@@ -393,6 +393,60 @@ def finish_extremal(field, speed, start, target, theta, dur, t0=0.0, radius=0.0,
     return ext
 
 
+def disc_entry(field, speed, start, target, radius, theta_lo, theta_hi, t_max, t0=0.0, effort=None,
+               n_scan=17):
+    """The extremal that enters the disc |x − B| ≤ R first, for initial headings in [θ_lo, θ_hi]
+    (Z12): a target disc is reached at T = min over θ₀ of the first time the extremal from θ₀ meets its
+    circle, T(θ₀) = min{t : |x(t; θ₀) − B| = R}. The reachable set first touches the disc at a point of its
+    boundary, which an extremal reaches at that time, and every extremal is a feasible route, so the
+    minimum is the disc's optimal time (the transversality condition, arrival heading towards B, holds there
+    without being imposed). T(θ₀) is found on each extremal's dense output (first sign change of
+    |x − B| − R on 400 samples, then Brent), minimised over θ₀ by a scan of ``n_scan`` headings and a
+    bounded Brent search (scipy ``minimize_scalar``) about the best — a formulation that needs no
+    derivative, so it holds on gridded data where the two-point shooting of :func:`shoot` stalls on the
+    bilinear interpolant's kinks. Returns an :class:`Extremal` (``miss`` = its distance to the circle) or
+    None when no extremal of the bracket enters the disc before ``t_max``."""
+    from scipy.optimize import brentq, minimize_scalar
+
+    target = np.asarray(target, float)
+
+    def entry(theta):
+        res = _solve(field, speed, start, [theta], t0, t_max, dense=True, effort=effort)
+        t = t0 + t_max * np.linspace(0.0, 1.0, 401)
+        y = res.sol(t)
+        gap = np.hypot(y[0] - target[0], y[1] - target[1]) - radius
+        inside = np.flatnonzero(gap <= 0)
+        if inside.size == 0:  # not reached: above every entry, rising with the miss (keeps Brent away)
+            return 2.0 * t_max + float(np.min(gap)) / speed
+        k = int(inside[0])
+        if k == 0:
+            return 0.0
+
+        def g(tt):
+            yy = res.sol(tt)
+            return math.hypot(yy[0] - target[0], yy[1] - target[1]) - radius
+
+        return float(brentq(g, t[k - 1], t[k], xtol=1e-13 * max(t_max, 1.0), rtol=1e-14)) - t0
+
+    scan = np.linspace(theta_lo, theta_hi, n_scan)
+    vals = np.array([entry(th) for th in scan])
+    j = int(np.argmin(vals))
+    if not vals[j] <= t_max:
+        return None
+    lo, hi = scan[max(j - 1, 0)], scan[min(j + 1, n_scan - 1)]
+    opt = minimize_scalar(entry, bounds=(lo, hi), method="bounded",
+                          options={"xatol": 1e-12 * max(1.0, abs(hi - lo)), "maxiter": 200})
+    theta, dur = (float(opt.x), float(opt.fun)) if opt.fun <= vals[j] else (float(scan[j]), float(vals[j]))
+    if not 0 < dur <= t_max:
+        return None
+    ext = finish_extremal(field, speed, start, target, theta, dur, t0, 0.0, effort=effort)
+    if ext is None:
+        return None
+    end = ext.position(ext.t_end)
+    ext.miss = abs(float(np.hypot(*(np.asarray(end) - target))) - radius)
+    return ext
+
+
 class _ScaledSolution:
     def __init__(self, sol, scale):
         self._sol, self._scale = sol, scale
@@ -515,6 +569,18 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
     closest = float(dist_tab[best]) if th.size else dist
     closest_t = float(best[0] * dt)
     candidates = _candidates(dist_tab, pos, th.size, speed * dt) if th.size > 2 else []
+    entries: list[tuple[int, int]] = []
+    if radius > 0 and th.size:
+        # a disc: the table holds | |x − B| − R |, zero wherever an extremal crosses the circle. The
+        # closest approach is to the disc (0 once an extremal is inside it), and the first entries into it
+        # (local minima over the angle of the first sample inside) are the candidates that come first
+        with np.errstate(invalid="ignore"):
+            signed = np.where(finite, np.hypot(pos[..., 0] - target[0], pos[..., 1] - target[1]) - radius,
+                              np.inf)
+        best = np.unravel_index(np.argmin(signed), signed.shape)
+        closest, closest_t = max(float(signed[best]), 0.0), float(best[0] * dt)
+        entries = _entry_candidates(signed <= 0)
+        candidates = entries + [c for c in candidates if c not in entries]
     extremals: list[Extremal] = []
     seeds: list[tuple[int, int]] = []
     effort = Effort()
@@ -535,6 +601,9 @@ def sweep(field, speed, start, target, *, t0=0.0, horizon=None, n_angles=1440, n
         if cf is not None:
             seed = _refine_seed(cf, field, speed, start, target, th, i, k, dt, t0, radius, dth)
         ext = shoot(field, speed, start, target, *seed, t0=t0, radius=radius, effort=effort)
+        if ext is None and (k, i) in entries:  # the disc's first entry, without derivatives
+            ext = disc_entry(field, speed, start, target, radius, th[i] - dth, th[i] + dth,
+                             min(horizon, (k + 2) * dt), t0, effort)
         if ext is None or ext.duration > horizon * (1 + 1e-9):
             continue
         if any(abs(ext.duration - o.duration) <= 1e-6 * o.duration
@@ -571,6 +640,26 @@ def _refine_seed(cf, field, speed, start, target, th, i, k, dt, t0, radius, dth)
     _, dist, _ = extremal_kernels.family(cf, speed, y0, t0, steps * dt, steps, target, radius)
     kk, j = np.unravel_index(np.argmin(dist), dist.shape)
     return float(sub[j]), float(max(kk, 1) * dt)
+
+
+def _entry_candidates(inside) -> list[tuple[int, int]]:
+    """(sample, angle) of each extremal's first sample inside the target disc where that sample is a
+    local minimum over the angle (circular), earliest first (at most 8)."""
+    entered = inside.any(axis=0)
+    if not entered.any():
+        return []
+    first = np.where(entered, np.argmax(inside, axis=0), np.iinfo(np.int64).max)
+    is_min = entered & (first <= np.roll(first, 1)) & (first <= np.roll(first, -1))
+    idx = np.flatnonzero(is_min)
+    idx = idx[np.argsort(first[idx], kind="stable")]
+    out, seen = [], set()
+    for i in idx:  # one per run of equal minima
+        if (i - 1) % first.size in seen or (i + 1) % first.size in seen:
+            seen.add(int(i))
+            continue
+        seen.add(int(i))
+        out.append((int(first[i]), int(i)))
+    return out[:8]
 
 
 def _candidates(dist_tab, pos, n, step_len):

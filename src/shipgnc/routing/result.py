@@ -143,12 +143,17 @@ class RouteResult:
 
     # ------------------------------------------------------------------ output
     def to_json(self) -> dict:
-        """The keys of note 002-2.9.6 (SI): reachable, time_s, time_h, heading_start_deg, ..."""
+        """The keys of note 002-2.9.6 (SI): reachable, time_s, time_h, heading_start_deg, ...
+
+        ``reachable`` is true (a route), false (none of duration ≤ the horizon) or null when the answer is
+        undecided (a search stopped by its effort bound or unable to resolve the scale; ``reason`` says
+        which and how far it looked)."""
         def deg(x):
             return None if x is None else float(np.mod(math.degrees(x), 360.0))
 
+        undecided = not self.reachable and str(self.reason or "").startswith("undecided")
         out = {
-            "reachable": bool(self.reachable),
+            "reachable": None if undecided else bool(self.reachable),
             "time_s": None if self.time_s is None else float(self.time_s),
             "time_h": None if self.time_s is None else float(self.time_s / 3600.0),
             "heading_start_deg": deg(self.heading_start),

@@ -23,6 +23,10 @@ from shipgnc.routing.result import RouteResult
 
 METHODS = ("auto", "pmp", "levelset", "graph")
 TWO_PI = 2.0 * math.pi
+#: the searches (sweep, level set, graph's confirmation) look for routes of duration up to this many
+#: times |AB|/V; a longer --horizon is honoured as a limit, and a search it cuts short answers
+#: "undecided" with the bound rather than "unreachable" (a uniform current is exact for any horizon)
+SEARCH_CAP = 64.0
 
 
 class _StraightPath:
@@ -93,6 +97,25 @@ def _validate(fld, speed, start, target, t0, radius):
     require(bool(np.all(np.isfinite(v))), "field", fld.describe(), "current at the start is not finite")
 
 
+#: a grid method needs at least this many cells between the start and the target (or its disc)
+MIN_CELLS_TO_TARGET = 10
+
+
+def check_grid(spacing, start, target, radius=0.0) -> None:
+    """Refuse a grid too coarse for the problem: the level set starts its front r₀ ≥ 5 cells from A and
+    the graph snaps A and B to nodes, so with fewer than MIN_CELLS_TO_TARGET cells between A and the
+    target neither sees the route (the front would already cover B)."""
+    if spacing is None:
+        return
+    from shipgnc.routing.memory import require_grid
+
+    gap = float(np.hypot(*(np.asarray(target, float) - np.asarray(start, float)))) - radius
+    require_grid(spacing <= gap / MIN_CELLS_TO_TARGET, spacing,
+                 f"too coarse: the level set and the graph need at least {MIN_CELLS_TO_TARGET} cells between "
+                 f"the start and the target ({gap:.6g} m apart), a spacing of at most "
+                 f"{gap / MIN_CELLS_TO_TARGET:.6g} m")
+
+
 def _ext_dict(ext, speed):
     return {"time_s": float(ext.duration), "heading_start_deg": float(math.degrees(ext.theta0)),
             "heading_end_deg": float(math.degrees(ext.heading_end)), "status": ext.status,
@@ -136,6 +159,10 @@ def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0
     if horizon is None:
         horizon = 4.0 * dist / speed
     require(math.isfinite(horizon) and horizon > 0, "horizon", horizon, "must be a finite time > 0 s")
+    # one meaning of the horizon for every method: a route of duration ≤ horizon, or "unreachable within
+    # it" only when every route up to it was searched; each search looks at most SEARCH_CAP·|AB|/V ahead
+    search = min(horizon, SEARCH_CAP * dist / speed)
+    check_grid(grid_spacing, start, target, radius)
     polys = None
     if obstacles:
         from shipgnc.routing.obstacles import as_polygons, check_endpoints
@@ -148,26 +175,54 @@ def solve_route(fld: CurrentField, speed: float, start, target, *, t0: float = 0
         if polys:
             from shipgnc.routing.obstacles import route_around
 
-            route_around(res, polys, horizon=horizon, n_angles=n_angles)
+            route_around(res, polys, horizon=search, n_angles=n_angles)
         else:
-            _pmp(res, horizon, n_angles, n_steps, horizon_given, progress)
-        if method == "auto" and (global_check is None or global_check) and res.reachable:
-            _levelset_check(res, polys, grid_spacing, horizon, domain, progress)
-        elif global_check and res.reachable:
-            _levelset_check(res, polys, grid_spacing, horizon, domain, progress)
+            _pmp(res, horizon if _closed_form(res) else search, n_angles, n_steps, horizon_given, progress)
+        if res.reachable and (global_check or (method == "auto" and global_check is None)):
+            # the check needs to run only a little past the route's own time
+            check = min(search, max(2.0 * res.time_s, 4.0 * dist / speed))
+            _levelset_check(res, polys, grid_spacing, check, domain, progress)
         if not res.reachable and method == "auto" and polys:
             # a detour past several vertices: the obstacle-aware graph search decides (2.9.3, F7)
             res.notes.append("no collision-free extremal or one-vertex chain: graph search around the "
                              "obstacles")
-            _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles)
+            _graph_primary(res, polys, grid_spacing, directions, search, domain, n_angles)
         elif not res.reachable and method == "auto" and not isinstance(fld, UniformCurrent):
-            _levelset_check(res, polys, grid_spacing, horizon, domain, progress)
-        return res
-    if method == "levelset":
-        _levelset_primary(res, polys, grid_spacing, horizon, domain, progress)
-        return res
-    _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles)
+            _levelset_check(res, polys, grid_spacing, search, domain, progress)
+    elif method == "levelset":
+        _levelset_primary(res, polys, grid_spacing, search, domain, progress)
+    else:
+        _graph_primary(res, polys, grid_spacing, directions, search, domain, n_angles,
+                       limit=search if horizon_given else None)
+    _horizon_verdict(res, horizon, search, horizon_given)
     return res
+
+
+def _closed_form(res) -> bool:
+    """A uniform steady current to a point without obstacles: solved exactly (closed form)."""
+    return isinstance(res.field, UniformCurrent) and res.radius == 0 and not getattr(res, "_obstacles", None)
+
+
+def _horizon_verdict(res: RouteResult, horizon: float, search: float, horizon_given: bool) -> None:
+    """The horizon's one meaning for every method: reachable within T_max ⇔ a route of duration ≤ T_max.
+    A route found longer than a given T_max (a grid method's arrival polished past it, a graph's route)
+    makes the target unreachable within it; a search stopped short of T_max by SEARCH_CAP without a route
+    is undecided, with the bound, not unreachable."""
+    if res.reachable and horizon_given and res.time_s > horizon * (1 + 1e-9):
+        t_f = res.time_s
+        gap = float(np.hypot(*(np.asarray(res.position(res.t0 + horizon)) - res.target))) - res.radius
+        res.notes.append(f"the fastest route found takes {t_f:.6g} s ({res.method}), beyond T_max")
+        res.reachable, res.time_s = False, None
+        res.closest_approach_m, res.closest_time_s = max(gap, 0.0), float(horizon)
+        res.reason = (f"target not reachable within T_max = {horizon:.6g} s: the fastest route takes "
+                      f"{t_f:.6g} s; at T_max it is {max(gap, 0.0):.3g} m short of the target")
+        return
+    if (not res.reachable and search < horizon and not _closed_form(res)
+            and not str(res.reason).startswith("undecided")):
+        found = str(res.reason).replace("target not reachable within T_max =", "no route within")
+        res.reason = (f"undecided: no route of duration ≤ {search:.6g} s (the search's bound, "
+                      f"{SEARCH_CAP:g}·|AB|/V); routes up to T_max = {horizon:.6g} s were not searched "
+                      f"({found})")
 
 
 def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = True, progress=None):
@@ -206,8 +261,17 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = Tru
             res.notes.append(f"reachable only during a window: the target leaves the reachable set at "
                              f"t = {sol.exit_time:.1f} s; a later arrival is infeasible")
         return res
-    sw = pmp.sweep(fld, V, A, B, t0=res.t0, horizon=horizon, n_angles=n_angles, n_steps=n_steps,
-                   radius=res.radius, progress=None if progress is None else _stage(progress, "extremals"))
+    # a long horizon given: first the default's span (finer samples), then the whole horizon
+    stages = [horizon]
+    short = 4.0 * float(np.hypot(*(B - A))) / V
+    if horizon_given and horizon > short:
+        stages = [short, horizon]
+    for span in stages:
+        sw = pmp.sweep(fld, V, A, B, t0=res.t0, horizon=span, n_angles=n_angles, n_steps=n_steps,
+                       radius=res.radius,
+                       progress=None if progress is None else _stage(progress, "extremals"))
+        if any(e.conjugate_at is None for e in sw.extremals):
+            break
     res.method = "pmp"
     res.extremals = [_ext_dict(e, V) for e in sw.extremals]
     res.extremal_paths = list(sw.extremals)
@@ -228,6 +292,12 @@ def _pmp(res: RouteResult, horizon, n_angles, n_steps, horizon_given: bool = Tru
                       f"to {sw.max_sample_step:.3g} m between two of the sweep's samples "
                       f"({sw.sample_dt:.3g} s apart), more than half the distance to the target, so a "
                       "pass through it goes unseen")
+        return res
+    if not optimal and res.radius > 0 and sw.closest_approach <= 0:
+        # an extremal is inside the disc: the target is reached, only the polish failed
+        res.reason = (f"undecided: an extremal of the sweep enters the target disc (radius "
+                      f"{res.radius:.6g} m) at t = {sw.closest_time:.6g} s but none could be polished to its "
+                      "boundary; a finer sweep (n_angles) or --method levelset decides")
         return res
     if not optimal:
         res.closest_approach_m, res.closest_time_s = sw.closest_approach, sw.closest_time
@@ -280,7 +350,7 @@ def _stage(progress, stage):
     return lambda fraction: progress(stage, fraction)
 
 
-def _levelset_run(res, polys, grid_spacing, horizon, domain, progress=None):
+def _levelset_run(res, polys, grid_spacing, horizon, domain, progress=None, truncate=False):
     from shipgnc.routing.levelset import reachability
 
     dom = domain if domain is not None else default_domain(res.field, res.start, res.target,
@@ -289,7 +359,7 @@ def _levelset_run(res, polys, grid_spacing, horizon, domain, progress=None):
         size = max(dom[0][1] - dom[0][0], dom[1][1] - dom[1][0])
         grid_spacing = size / 160.0
     return reachability(res.field, res.speed, res.start, res.target, dom, grid_spacing, t0=res.t0,
-                        horizon=horizon, obstacles=polys,
+                        horizon=horizon, obstacles=polys, radius=res.radius, truncate=truncate,
                         progress=None if progress is None else _stage(progress, "level set"))
 
 
@@ -453,14 +523,21 @@ def _polish_from_seed(res, theta0, duration):
 
 
 def _levelset_primary(res, polys, grid_spacing, horizon, domain, progress=None):
-    from shipgnc.routing.levelset import FrontOutOfGrid
+    from shipgnc.routing.levelset import MAX_CELL_STEPS, FrontOutOfGrid
 
     try:
-        ls = _levelset_run(res, polys, grid_spacing, horizon, domain, progress)
+        ls = _levelset_run(res, polys, grid_spacing, horizon, domain, progress, truncate=True)
     except FrontOutOfGrid as exc:  # no answer from this method: said as the reason (exit 3)
-        res.reason = str(exc)
+        res.reason = f"undecided: {exc}"
         return
     res.isochrones, res.grid_spacing = ls, ls.spacing
+    if ls.arrival is None and ls.searched < horizon:
+        res.reason = (f"undecided: the level set's front did not reach the target by {ls.searched:.6g} s, "
+                      f"where its effort bound ({MAX_CELL_STEPS:.0e} cell updates) stops it short of "
+                      f"T_max = {horizon:.6g} s; a coarser --grid or a shorter --horizon lets it search "
+                      f"further (closest approach {ls.closest_approach:.1f} m)")
+        res.closest_approach_m = ls.closest_approach
+        return
     if ls.arrival is None:
         res.reason = (f"target not reachable within T_max = {horizon:.0f} s in {res.field.describe()} "
                       f"at ship speed {res.speed:.4f} m/s: the reachability front's closest approach is "
@@ -474,7 +551,27 @@ def _levelset_primary(res, polys, grid_spacing, horizon, domain, progress=None):
     _adopt_levelset(res, ls, polys, "method levelset")
 
 
-def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles):
+def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angles, limit=None):
+    """The graph search's route, polished when it can be. With ``limit`` [s] (a horizon given) a route
+    longer than it is not the verdict: the graph's time is no optimum, and the sweep of extremals up to
+    ``limit`` decides."""
+    _graph_search(res, polys, grid_spacing, directions, horizon, domain, n_angles)
+    if limit is not None and res.reachable and res.time_s > limit * (1 + 1e-9):
+        found = res.time_s
+        res.reachable, res.time_s, res.path, res.global_check, res.extremals = False, None, None, None, []
+        res.notes.append(f"the graph's route takes {found:.6g} s, beyond T_max = {limit:.6g} s: the sweep "
+                         "of extremals decides")
+        if polys:
+            from shipgnc.routing.obstacles import route_around
+
+            route_around(res, polys, horizon=limit, n_angles=n_angles)
+        else:
+            _pmp(res, limit, n_angles, None)
+        if not res.reachable:
+            res.method = "graph"
+
+
+def _graph_search(res, polys, grid_spacing, directions, horizon, domain, n_angles):
     from shipgnc.routing.graph import graph_route
 
     dom = domain if domain is not None else default_domain(res.field, res.start, res.target,
@@ -483,7 +580,7 @@ def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angl
         size = max(dom[0][1] - dom[0][0], dom[1][1] - dom[1][0])
         grid_spacing = size / 200.0
     g = graph_route(res.field, res.speed, res.start, res.target, dom, grid_spacing, directions=directions,
-                    t0=res.t0, obstacles=polys)
+                    t0=res.t0, obstacles=polys, radius=res.radius)
     res.grid_spacing = g.spacing
     if g.time_s is None:
         res.notes.append(f"graph search ({directions} directions) found no route; a graph's 'unreachable' is "
@@ -512,4 +609,4 @@ def _graph_primary(res, polys, grid_spacing, directions, horizon, domain, n_angl
     res.notes.append("graph route (a coarse seed, not polished)")
 
 
-__all__ = ["METHODS", "ConfigError", "default_domain", "solve_route"]
+__all__ = ["METHODS", "ConfigError", "check_grid", "default_domain", "solve_route"]

@@ -6,7 +6,8 @@ name table).
   prefix or a ``_assuming_no_tide`` style suffix) or by the common names (``uo``/``vo``, ``u``/``v``,
   ``water_u``/``water_v``, ``ucur``/``vcur``), the coordinates ``latitude``/``longitude`` (``lat``/``lon``,
   or any 1-D coordinate with ``standard_name`` or ``units`` ``degrees_north``/``degrees_east``) and an
-  optional ``time``; converts m/s, cm/s and knots to m/s from the ``units`` attribute. NaN cells are land.
+  optional ``time``; converts m/s, cm/s and knots to m/s from the ``units`` attribute (a velocity without
+  one is refused: CF §3.1 requires it). NaN cells are land.
 * :func:`read_depth` reads a bathymetry grid (positive-down depth, or an elevation that is negative
   below the sea surface) on the same kind of coordinates.
 
@@ -22,18 +23,9 @@ from pathlib import Path
 import numpy as np
 
 from shipgnc.errors import ConfigError
-from shipgnc.units import KNOT
 
 EAST_NAMES = ("uo", "u", "water_u", "ucur", "u_current", "eastward_velocity", "current_east")
 NORTH_NAMES = ("vo", "v", "water_v", "vcur", "v_current", "northward_velocity", "current_north")
-#: velocity units [unit text → factor to m/s]
-_UNITS = {"m/s": 1.0, "m s-1": 1.0, "m s^-1": 1.0, "m s**-1": 1.0, "m.s-1": 1.0, "meter second-1": 1.0,
-          "meters/second": 1.0, "meter/second": 1.0, "metre/second": 1.0, "metres/second": 1.0,
-          "meters per second": 1.0, "ms-1": 1.0, "m/sec": 1.0,
-          "cm/s": 0.01, "cm s-1": 0.01, "cm s^-1": 0.01, "cm s**-1": 0.01, "cm.s-1": 0.01,
-          "centimeter/second": 0.01, "centimeters/second": 0.01, "centimeter second-1": 0.01,
-          "kn": KNOT, "knot": KNOT, "knots": KNOT, "kt": KNOT, "kts": KNOT}
-
 
 @dataclass
 class GeoGrid:
@@ -180,15 +172,9 @@ def _find_velocity(ds, name):
 
 
 def _factor(var, vname, name, notes):
-    units = str(var.attrs.get("units", "")).strip()
-    if not units:
-        notes.append(f"{name}: {vname} has no units attribute; read as m/s")
-        return 1.0
-    key = " ".join(units.lower().split())
-    if key not in _UNITS:
-        raise ConfigError(f"{name}: {vname} has units {units!r}; allowed: m/s, cm/s, knots (and CF spellings "
-                          "such as 'm s-1')")
-    return _UNITS[key]
+    from shipgnc.routing.fields import velocity_factor
+
+    return velocity_factor(var.attrs.get("units"), f"{name}: {vname}")
 
 
 def _order(var, tname, latn, lonn, name, notes):

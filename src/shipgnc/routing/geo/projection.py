@@ -72,6 +72,13 @@ class RouteProjection:
                                    np.atleast_1d(np.asarray(lat, float)))
         return np.asarray(f.parallel_scale, float)
 
+    def true_north_deg(self, lat, lon) -> float:
+        """The direction of true north in the plane at (lat, lon), clockwise from the plane's north [deg]:
+        minus PROJ's meridian convergence (``Proj.get_factors``); a heading in the plane less this is the
+        true heading."""
+        f = self._proj.get_factors(float(lon), float(lat))
+        return -float(f.meridian_convergence)
+
     def rotate(self, lat, lon, vn, ve):
         """A vector given by true (north, east) components at (lat, lon) in the plane's (north, east) axes
         (direction kept, length kept: the projection's scale k is left out, see :meth:`scale`)."""

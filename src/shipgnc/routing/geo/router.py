@@ -141,9 +141,14 @@ class GeoRoute:
         js = self.plane.to_json()
         pr = self.problem
         plane_time = js.get("time_s")
-        for key in ("heading_start_deg", "heading_end_deg"):  # grid headings → true headings
-            if js.get(key) is not None:
-                js[key] = float((js[key] - pr.grid_north_deg(key == "heading_start_deg")) % 360.0)
+        # plane headings → true headings: at the start and at the target, by the meridian convergence
+        north = {"heading_start_deg": pr.projection.true_north_deg(*pr.start),
+                 "heading_end_deg": pr.projection.true_north_deg(*pr.target)}
+        js["extremal_details"] = [dict(e) for e in js.get("extremal_details", [])]  # not the plane's own
+        for entry in (js, *js["extremal_details"]):
+            for key, ang in north.items():
+                if entry.get(key) is not None:
+                    entry[key] = float((entry[key] - ang) % 360.0)
         js.update({
             "reachable": bool(self.reachable),
             "time_s": None if self.time_s is None else float(self.time_s),
@@ -404,6 +409,7 @@ class GeoProblem:
 
         fld = self.field_from(depart_s)
         notes = []
+        limit = horizon  # a horizon given limits the route sailed along its waypoints too
         if horizon is None:
             horizon = 4.0 * float(np.hypot(*(self.B - self.A))) / self.speed
         gridded = self.current.grid is not None
@@ -419,6 +425,12 @@ class GeoProblem:
             out.notes.append(f"unreachable: {res.reason}")
             return out
         self._finish(out)
+        if limit is not None and out.reachable and out.time_s > limit * (1 + 1e-9):
+            t = out.time_s
+            out.notes.append(f"unreachable: within T_max = {limit:.6g} s ({limit / 3600:.4g} h) as sailed: "
+                             f"the route along its waypoints takes {t:.6g} s ({t / 3600:.4g} h) on the "
+                             f"ellipsoid (the plane optimum {res.time_s:.6g} s); a longer --horizon")
+            out.reachable, out.time_s = False, None
         return out
 
     def _round_land(self, fld, horizon, notes):

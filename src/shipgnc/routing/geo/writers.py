@@ -5,8 +5,13 @@
 * GeoJSON (RFC 7946) — a LineString through the waypoints and one Point feature per waypoint with its
   ETA, course and speed over ground of the leg that leaves it.
 * RTZ 1.1 (IEC 61174:2015 Annex S, namespace ``http://www.cirm.org/RTZ/1/1``) — ``routeInfo``,
-  ``waypoints/waypoint`` with ``position`` and ``leg``, and a ``schedules/schedule/calculated`` with one
-  ``scheduleElement`` per waypoint (``etd`` at the first, ``eta`` at the others).
+  ``waypoints/waypoint`` with ``position`` and ``leg`` (the leg arriving at the waypoint: ``starboardXTD``,
+  ``portsideXTD`` [nm], ``geometryType``; a leg carries no speed in RTZ), and a
+  ``schedules/schedule/calculated`` with one ``scheduleElement`` per waypoint: ``etd`` at the first,
+  ``eta`` and the ``speed`` [kn] over ground of the leg arriving there at the others.
+
+Both XML files keep to their schemas' ranges: longitudes in [−180°, 180°), RTZ's cross-track distances
+below 10 nm (:data:`RTZ_XTD_MAX_NM`).
 
 A waypoint is a dict with ``lat``, ``lon`` [deg], ``eta_s`` [s since the epoch, or None], ``course_deg``,
 ``sog_mps`` (of the leg leaving it; None at the last) and ``name``.
@@ -21,6 +26,12 @@ from shipgnc.routing.geo.timefmt import iso, to_datetime
 from shipgnc.units import KNOT, NAUTICAL_MILE
 
 RTZ_NS = "http://www.cirm.org/RTZ/1/1"
+RTZ_XTD_MAX_NM = 10.0  #: RTZ 1.1's XtdType: 0 ≤ XTD < 10 nm
+
+
+def _lon(lon: float, digits: int = 8) -> float:
+    """A longitude in [−180°, 180°) after rounding to ``digits`` (GPX's and RTZ's LongitudeType)."""
+    return (round(float(lon), digits) + 180.0) % 360.0 - 180.0
 
 
 def write_gpx(path, waypoints, name="shipgnc time-optimal route", description="") -> None:
@@ -30,7 +41,7 @@ def write_gpx(path, waypoints, name="shipgnc time-optimal route", description=""
     gpx.creator = "shipgnc"
     rte = gpxpy.gpx.GPXRoute(name=name, description=description or None)
     for w in waypoints:
-        pt = gpxpy.gpx.GPXRoutePoint(w["lat"], w["lon"], name=w["name"],
+        pt = gpxpy.gpx.GPXRoutePoint(w["lat"], _lon(w["lon"]), name=w["name"],
                                      time=None if w["eta_s"] is None else to_datetime(w["eta_s"]))
         if w.get("sog_mps") is not None:
             pt.comment = f"COG {w['course_deg']:.1f} deg, SOG {w['sog_mps'] / KNOT:.2f} kn"
@@ -63,6 +74,12 @@ def write_geojson(path, waypoints, properties=None) -> None:
 
 
 def write_rtz(path, waypoints, name="shipgnc time-optimal route", xte_m=100.0, speed_mps=None) -> None:
+    """RTZ 1.1; ``xte_m`` [m] is written as each leg's port and starboard XTD [nm] (< 10 nm)."""
+    from shipgnc.errors import require
+
+    require(0.0 <= xte_m < RTZ_XTD_MAX_NM * NAUTICAL_MILE, "--xte-m", xte_m,
+            f"RTZ 1.1 allows a cross-track distance of 0 to under {RTZ_XTD_MAX_NM:g} nm "
+            f"({RTZ_XTD_MAX_NM * NAUTICAL_MILE:g} m)")
     ET.register_namespace("", RTZ_NS)
 
     def q(tag):
@@ -78,15 +95,12 @@ def write_rtz(path, waypoints, name="shipgnc time-optimal route", xte_m=100.0, s
     wps = ET.SubElement(root, q("waypoints"))
     xtd = f"{xte_m / NAUTICAL_MILE:.4f}"
     default = ET.SubElement(wps, q("defaultWaypoint"), {"radius": "0.1"})
-    ET.SubElement(default, q("leg"), {"starboardXTD": xtd, "portXTD": xtd, "geometryType": "Orthodrome"})
+    leg = {"starboardXTD": xtd, "portsideXTD": xtd, "geometryType": "Orthodrome"}
+    ET.SubElement(default, q("leg"), leg)
     for k, w in enumerate(waypoints, start=1):
         el = ET.SubElement(wps, q("waypoint"), {"id": str(k), "name": w["name"], "revision": "0"})
-        ET.SubElement(el, q("position"), {"lat": f"{w['lat']:.8f}", "lon": f"{w['lon']:.8f}"})
+        ET.SubElement(el, q("position"), {"lat": f"{w['lat']:.8f}", "lon": f"{_lon(w['lon']):.8f}"})
         if k > 1:  # the leg arriving at this waypoint
-            prev = waypoints[k - 2]
-            leg = {"starboardXTD": xtd, "portXTD": xtd, "geometryType": "Orthodrome"}
-            if prev.get("sog_mps") is not None:
-                leg["speedPlanned"] = f"{prev['sog_mps'] / KNOT:.2f}"
             ET.SubElement(el, q("leg"), leg)
     if waypoints and waypoints[0]["eta_s"] is not None:
         sch = ET.SubElement(ET.SubElement(root, q("schedules")), q("schedule"),
@@ -95,8 +109,9 @@ def write_rtz(path, waypoints, name="shipgnc time-optimal route", xte_m=100.0, s
         for k, w in enumerate(waypoints, start=1):
             attrs = {"waypointId": str(k)}
             attrs["etd" if k == 1 else "eta"] = iso(w["eta_s"])
-            if w.get("sog_mps") is not None:
-                attrs["speed"] = f"{w['sog_mps'] / KNOT:.2f}"
+            sog = None if k == 1 else waypoints[k - 2].get("sog_mps")  # the leg arriving here
+            if sog is not None:
+                attrs["speed"] = f"{sog / KNOT:.2f}"
             ET.SubElement(calc, q("scheduleElement"), attrs)
     tree = ET.ElementTree(root)
     ET.indent(tree)
