@@ -1,7 +1,8 @@
 """Trial figures as naval architects draw them (``shipgnc trial --out``, ``docs/trials.md``).
 
-* :func:`turning_figure`: the track of the body-fixed origin (midship) of each side with advance, transfer and tactical diameter
-  marked (original course up, north; positions relative to the execute point);
+* :func:`turning_figure`: the track of the body-fixed origin (midship) of each side with
+  advance, transfer and tactical diameter marked (original course up, north; positions relative
+  to the execute point);
 * :func:`zigzag_figure`: heading change and rudder angle against time, one panel per side, with
   the ±ψ switching lines and the heading extremes;
 * :func:`spiral_figure`: steady yaw rate against rudder angle for both sweep directions (and the
