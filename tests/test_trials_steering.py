@@ -114,3 +114,21 @@ def test_a_zigzag_rudder_beyond_the_limit_is_refused():
 def test_an_unknown_steering_gear_is_refused():
     msg = _one_line_exit_2("trial", "zigzag", "--vessel", "mariner-cst", "--steering-gear", "fast")
     assert "--steering-gear" in msg and "solas, model" in msg
+
+
+def test_a_vessel_file_is_read_as_a_scenario_reads_it(tmp_path):
+    """A linear-3dof ship from main dimensions with its own 15°/s, 30° steering machine: the trial
+    keeps its length (so the IMO criteria in ship lengths are evaluated), its rate (with
+    ``--steering-gear model``), its rudder limit, and calls it by the file's name."""
+    f = tmp_path / "coaster.yaml"
+    f.write_text("vessel: {model: linear-3dof, speed_mps: 5.0, L: 100.0, B: 12.0, T: 5.0, "
+                 "Cb: 0.55, rudder_rate_deg_s: 15, rudder_max_deg: 30}\n", encoding="utf-8")
+    r = runner.invoke(app, ["trial", "turning-circle", "--vessel", str(f), "--side", "starboard",
+                            "--steering-gear", "model", "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["length_m"] == 100.0 and d["rudder_rate_deg_s"] == pytest.approx(15.0)
+    assert d["rudder_deg"] == pytest.approx(30.0)  # 35° or the limit if smaller
+    assert d["vessel"] == "coaster.yaml (linear-3dof)"
+    r = runner.invoke(app, ["trial", "turning-circle", "--vessel", str(f), "--json"])
+    assert json.loads(r.stdout)["rudder_rate_deg_s"] == pytest.approx(65.0 / 28.0)

@@ -84,7 +84,13 @@ def run_trial(kind: str, vessel: str, *, speed_kn: float | None = None, rudder_d
         if not entry.can_reverse:
             raise ConfigError(f"trial stopping: vessel {entry.name} has no propulsion that can go full "
                               "astern (can_reverse is false), so it has no stopping trial")
+    if steering_gear == "solas":  # the SOLAS gear replaces the vessel file's own rate
+        params = {k: v for k, v in params.items() if k != "rudder_rate_deg_s"}
     ship = prepare(name, speed, steering_gear=steering_gear, **params)
+    if name != vessel:  # a vessel file: named by the file, as a scenario's run would show it
+        import dataclasses
+
+        ship = dataclasses.replace(ship, name=f"{Path(vessel).name} ({name})")
     if kind == "turning-circle":
         return turning.turning_circle(ship=ship, rudder_deg=rudder_deg, sides=sides)
     if kind == "zigzag":

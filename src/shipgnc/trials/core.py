@@ -143,7 +143,10 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
         model = models[0]
         name, source = entry.name, entry.source
         length = entry.length_m if length_m is None else length_m
-        max_rudder = entry.max_rudder_rad
+        if length is None and params.get("L") is not None:  # a ship from its main dimensions
+            length = float(params["L"])
+        max_rudder = (math.radians(params["rudder_max_deg"]) if params.get("rudder_max_deg")
+                      is not None else entry.max_rudder_rad)
         rate = (math.radians(params["rudder_rate_deg_s"]) if params.get("rudder_rate_deg_s")
                 is not None else entry.max_rudder_rate_rad_s)
         can_reverse = bool(entry.can_reverse)
