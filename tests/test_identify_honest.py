@@ -33,7 +33,9 @@ GM_TAU, GM_SIGMA = 10.0, math.radians(1.0)  # Gauss-Markov rudder-equivalent yaw
 
 @pytest.fixture(scope="module")
 def zigzag():
-    """The noise-free 20°/5° zig-zag of the Nomoto ship (rudder 35° limit, 5°/s)."""
+    """The noise-free 20°/5° zig-zag of the Nomoto ship (rudder 35° limit, 5°/s). Every log
+    below has this rudder (open loop: the reversals do not react to the noise) and its yaw rate
+    plus that log's noise."""
     from shipgnc.actuators import Actuator
     from shipgnc.models.nomoto import NomotoModel
 
