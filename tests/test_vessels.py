@@ -51,14 +51,18 @@ def test_clarke83_against_the_formulae_by_hand():
     # −Y'_r/S = −0.5 + 2.2·0.15 − 0.08·2.5 = −0.37    →  N₁₂ = −½ρL³U·S·0.37 = −10 723 041.1
     # −N'_v/S = 0.5 + 2.4·0.06 = 0.644                →  N₂₁ = ½ρL³U·S·0.644 = 18 663 887.8
     # −N'_r/S = 0.25 + 0.039·2.5 − 0.56·0.15 = 0.2635 →  N₂₂ = ½ρL⁴U·S·0.2635 = 763 654 415
+    # rigid-body centripetal term (Fossen 2021 §7.1, C*_RB): N₁₂ += m U = 32 287 500
+    #                                                    →  N₁₂ = −10 723 041.1 + 32 287 500
     M, N = clarke83(5.0, 100.0, 15.0, 6.0, 0.7, 25.0, 0.0, 100.0)
     M_hand = [[7_052_232.78, 0, 0], [0, 13_211_566.8, 46_297_454.6], [0, 36_226_490.3, 7.721379112e9]]
-    N_hand = [[70_522.33, 0, 0], [0, 492_680.27, -10_723_041.1], [0, 18_663_887.8, 763_654_415.0]]
+    N_hand = [[70_522.33, 0, 0], [0, 492_680.27, 21_564_458.9], [0, 18_663_887.8, 763_654_415.0]]
     np.testing.assert_allclose(M, M_hand, rtol=1e-7)
     np.testing.assert_allclose(N, N_hand, rtol=1e-7)
-    # the CG ahead of the origin couples sway and yaw inertia: m x_g off the diagonal
-    M2, _ = clarke83(5.0, 100.0, 15.0, 6.0, 0.7, 25.0, 2.0, 100.0)
+    # the CG ahead of the origin couples sway and yaw inertia, m x_g off the diagonal, and adds
+    # the centripetal moment m x_g U to N₂₂
+    M2, N2 = clarke83(5.0, 100.0, 15.0, 6.0, 0.7, 25.0, 2.0, 100.0)
     assert M2[1, 2] - M[1, 2] == pytest.approx(6_457_500 * 2.0)
+    assert N2[2, 2] - N[2, 2] == pytest.approx(6_457_500 * 2.0 * 5.0)
 
 
 @pytest.mark.parametrize("args, field", [
@@ -156,21 +160,21 @@ def test_linear_3dof_steady_turn_is_the_closed_form_solve():
     from shipgnc.models.linear3dof import rudder_input
     from shipgnc.sim.simulator import simulate
 
-    U = 5.0
-    M, N = clarke83(U, 100.0, 15.0, 6.0, 0.7, 25.0, 0.0, 100.0)
-    B = rudder_input(U, 100.0, 6.0)
+    U = 5.0  # a slender hull (with the rigid-body terms, L/B 6.7 at C_b 0.7 is course-unstable)
+    M, N = clarke83(U, 100.0, 12.0, 5.0, 0.55, 25.0, 0.0, 100.0)
+    B = rudder_input(U, 100.0, 5.0)
     model = get_vessel("linear-3dof").build(U, M=M.tolist(), N=N.tolist(), B=B.tolist())
     # course stable: the sway-yaw block of N has a positive determinant and M⁻¹N positive eigenvalues
     assert np.all(np.linalg.eigvals(np.linalg.solve(M, N)).real > 0)
     delta = math.radians(5.0)
     expected = np.linalg.solve(N, B[:, 0] * delta)  # N ν = B δ
-    run = simulate(model, model.straight_state(), t_end=900.0, dt=0.5,
+    run = simulate(model, model.straight_state(), t_end=1500.0, dt=0.5,
                    u0=np.array([delta]), backend="numpy")
     got = [float(run.u[-1]) - U, float(run.v[-1]), float(run.r[-1])]
     np.testing.assert_allclose(got, expected, rtol=1e-6, atol=1e-12)
     assert expected[2] > 0  # δ > 0: turning to starboard
     # the same ship built from main dimensions gives the same matrices
-    built = get_vessel("linear-3dof").build(U, L=100.0, B=15.0, T=6.0, Cb=0.7, R66=25.0,
+    built = get_vessel("linear-3dof").build(U, L=100.0, B=12.0, T=5.0, Cb=0.55, R66=25.0,
                                             T_surge=100.0)
     np.testing.assert_allclose(built.N, N)
     np.testing.assert_allclose(built.steady_turn(delta), expected)

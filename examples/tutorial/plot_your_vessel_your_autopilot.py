@@ -19,7 +19,7 @@ Download the script at the bottom of the page and change the dimensions to your 
 # %%
 # 1. A model from the main dimensions
 # -----------------------------------
-# A 60 m coaster at 12 knots. :func:`~shipgnc.models.linear3dof.clarke83` returns the inertia
+# A slender 60 m vessel at 12 knots. :func:`~shipgnc.models.linear3dof.clarke83` returns the inertia
 # matrix M and the damping matrix N(U) of M ν̇ + N ν = τ over (surge, sway, yaw), from Clarke et
 # al.'s regressions; :func:`~shipgnc.models.linear3dof.rudder_input` gives the rudder's force and
 # moment per radian, B.
@@ -36,7 +36,7 @@ from shipgnc.guidance.schedule import CourseSchedule
 from shipgnc.models.base import Signal
 from shipgnc.models.linear3dof import clarke83, rudder_input
 
-L, B, T, Cb = 60.0, 11.0, 3.5, 0.6           # length, beam, draft [m], block coefficient
+L, B, T, Cb = 60.0, 8.0, 3.5, 0.45           # length, beam, draft [m], block coefficient
 U = 12 * 1852 / 3600                          # speed [m/s]
 M, N = clarke83(U, L, B, T, Cb, R66=0.25 * L, xg=0.0, T_surge=L)
 b = rudder_input(U, L, T)                     # (3, 1): [X, Y, N] per rad of rudder
@@ -45,7 +45,9 @@ print("M =\n", M.round(0), "\nN =\n", N.round(0), "\nb =", b.ravel().round(0))
 # %%
 # The sway–yaw part is a two-state linear system with the rudder as input; python-control gives
 # its transfer function r/δ, a second-order Nomoto model K(1 + T₃s)/((1 + T₁s)(1 + T₂s)) (here
-# with a complex pair of poles), and its first-order reduction K/(1 + Ts) with T = T₁ + T₂ − T₃.
+# with two real poles, one slow: a slender hull, course-stable; a beamier, fuller one, e.g.
+# B = 11 m, C_b = 0.6, is course-unstable once the rigid body's centripetal terms are in N), and
+# its first-order reduction K/(1 + Ts) with T = T₁ + T₂ − T₃.
 
 A_sy = -np.linalg.solve(M[1:, 1:], N[1:, 1:])
 B_sy = np.linalg.solve(M[1:, 1:], b[1:])
@@ -152,8 +154,8 @@ def pid_gains(omega, zeta):
 
 
 # %%
-# **Tuning with python-control.** This ship's yaw poles are a complex pair, so the first-order
-# Nomoto model is only a rough design model: the loop is therefore checked on the full
+# **Tuning with python-control.** The first-order Nomoto model is only a rough design model
+# (its zero and second pole are dropped): the loop is therefore checked on the full
 # second-order model with the steering machine as a first-order lag — its phase and gain margins
 # and its closed-loop step response — for a bandwidth ω = 0.2 rad/s and three damping ratios.
 
@@ -175,8 +177,8 @@ ax.legend()
 fig.tight_layout()
 
 # %%
-# ζ = 0.8 leaves 45° of phase margin and almost 30 % overshoot on the full model; ζ = 1.2 gives about
-# 70° and single-digit overshoot with a larger derivative gain. We take ζ = 1.2.
+# On this ship all three leave 65–68° of phase margin and single-digit overshoot on the full
+# model; ζ = 1.2 has the least overshoot, with a larger derivative gain. We take ζ = 1.2.
 
 from shipgnc.vessels.autopilot import HeadingAutopilot  # noqa: E402
 

@@ -8,8 +8,9 @@ LOG is a CSV (header row; ``#`` comment lines skipped) or a NetCDF file, e.g. th
 ``shipgnc run`` (run 0 of a batch unless ``--ship``). Prints the parameters with 95 % confidence
 intervals and the held-out NRMSE; ``--out`` writes ``identify.json``, ``identify.png`` (measured vs
 re-simulated) and ``vessel.yaml`` (the fitted model as a scenario's vessel section). Methods:
-:mod:`shipgnc.identify.fitting`. Exit codes: 0 fitted, 2 bad input (one line naming the
-problem), 1 internal error.
+:mod:`shipgnc.identify.fitting`. Exit codes: 0 fitted, 2 bad input or a log that does not identify
+the model (one line naming the problem, :mod:`shipgnc.identify.verdict`; nothing written), 1
+internal error.
 """
 
 from __future__ import annotations
@@ -39,8 +40,9 @@ def identify(
                                                              "out of the fit and scored.")] = 0.3,
     speed: Annotated[float | None, typer.Option("--speed", help="Ship speed \\[m/s] for the vessel "
                                                 "YAML (default: the mean surge of the log).")] = None,
-    horizon: Annotated[float | None, typer.Option("--horizon", help="linear-3dof: fit prediction "
-                                                  "windows of this length \\[s].")] = None,
+    horizon: Annotated[float | None, typer.Option("--horizon", help="nomoto1, linear-3dof: fit "
+                                                  "prediction windows of this length \\[s] "
+                                                  "(shorter than the fitted log).")] = None,
     json_: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
     out: Annotated[Path | None, typer.Option("--out", help="Write identify.json, identify.png and "
                                              "vessel.yaml here.")] = None,

@@ -1,7 +1,7 @@
 """``shipgnc trial``: standard manoeuvring trials of a catalogue vessel (docs/trials.md).
 
     shipgnc trial KIND --vessel NAME [--speed-kn V] [--rudder-deg D] [--angles D/PSI]
-                  [--side port|starboard] [--json] [--out DIR]
+                  [--side port|starboard] [--steering-gear solas|model] [--json] [--out DIR]
 
 KIND: turning-circle | zigzag | spiral | stopping | pull-out | all (every trial as one batch, with
 the IMO MSC.137(76) criteria report). ``--vessel`` is a catalogue name (``shipgnc vessels``) or a
@@ -58,7 +58,7 @@ def clean(obj):
 
 
 def run_trial(kind: str, vessel: str, *, speed_kn: float | None = None, rudder_deg: float | None = None,
-              angles: str | None = None, side: str | None = None) -> dict:
+              angles: str | None = None, side: str | None = None, steering_gear: str = "solas") -> dict:
     """The trial's result dict (with ``_history`` entries for the figures)."""
     from shipgnc.errors import require
     from shipgnc.trials import imo, pullout, spiral, stopping, turning, zigzag
@@ -84,7 +84,13 @@ def run_trial(kind: str, vessel: str, *, speed_kn: float | None = None, rudder_d
         if not entry.can_reverse:
             raise ConfigError(f"trial stopping: vessel {entry.name} has no propulsion that can go full "
                               "astern (can_reverse is false), so it has no stopping trial")
-    ship = prepare(name, speed, **params)
+    if steering_gear == "solas":  # the SOLAS gear replaces the vessel file's own rate
+        params = {k: v for k, v in params.items() if k != "rudder_rate_deg_s"}
+    ship = prepare(name, speed, steering_gear=steering_gear, **params)
+    if name != vessel:  # a vessel file: named by the file, as a scenario's run would show it
+        import dataclasses
+
+        ship = dataclasses.replace(ship, name=f"{Path(vessel).name} ({name})")
     if kind == "turning-circle":
         return turning.turning_circle(ship=ship, rudder_deg=rudder_deg, sides=sides)
     if kind == "zigzag":
@@ -111,6 +117,10 @@ def trial(
     angles: Annotated[str | None, typer.Option("--angles", help="Zig-zag D/PSI \\[deg] (default "
                                                "20/20).")] = None,
     side: Annotated[str | None, typer.Option("--side", help="port | starboard (default: both).")] = None,
+    steering_gear: Annotated[str, typer.Option(
+        "--steering-gear", help="solas: the rudder at SOLAS II-1 reg. 29's 35° to 30° in 28 s "
+                                "(2.32°/s), as the IMO criteria presume; model: the vessel's own "
+                                "rate.")] = "solas",
     json_: Annotated[bool, typer.Option("--json", help="Print only the result JSON on stdout.")] = False,
     out: Annotated[Path | None, typer.Option(
         "--out", help="Write trial.json, the figures and each manoeuvre's time series (.nc) here.")] = None,
@@ -123,7 +133,8 @@ def trial(
             from shipgnc.outputs import check_out
 
             check_out(out)
-        res = run_trial(kind, vessel, speed_kn=speed_kn, rudder_deg=rudder_deg, angles=angles, side=side)
+        res = run_trial(kind, vessel, speed_kn=speed_kn, rudder_deg=rudder_deg, angles=angles, side=side,
+                        steering_gear=steering_gear)
         payload = clean(res)
         text = json.dumps(payload, indent=2, ensure_ascii=False)
         if out is not None:
@@ -168,7 +179,8 @@ def _print(console, res: dict) -> None:
     def head(r):
         lv = r.get("l_over_v_s")
         return (f"{r['vessel']} at {r['speed_kn']:.2f} kn ({r['speed_mps']:.3f} m/s), trim rudder "
-                f"δ0 = {r['trim_rudder_deg']:+.3f}°" + ("" if lv is None else f", L/V = {lv:.2f} s"))
+                f"δ0 = {r['trim_rudder_deg']:+.3f}°" + ("" if lv is None else f", L/V = {lv:.2f} s")
+                + f", rudder {r['rudder_rate_deg_s']:.3g}°/s ({r['steering_gear']} steering gear)")
 
     def sided(r, kind, title):
         sides = r.get("sides", {})

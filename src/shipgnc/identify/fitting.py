@@ -46,9 +46,18 @@ for each fitted output y (r; or u, v, r).
 Confidence intervals (95 %, two-sided): θ̂ ± t₀.₉₇₅(n − p) · SE, with the covariance
 s² (JᵀJ)⁻¹, J the Jacobian of the (weighted) residuals at the optimum (central differences),
 s² = RSS/(n − p), n the residuals and p the parameters (Seber & Wild 1989, Nonlinear Regression,
-§5.1; Ljung 1999, System Identification, §9.2). They assume white residuals; the lag-1
-autocorrelation of the residuals is reported, and a note says when it exceeds 0.5 (a model error
-or coloured noise: then the intervals are too narrow).
+§5.1; Ljung 1999, System Identification, §9.2), when the residuals are white. Residuals are
+rarely white (wind, waves and unmodelled dynamics act through the ship's slow yaw response): an
+autoregressive model of the residuals is fitted (order by BIC) and the covariance is the
+least-squares estimator's under those autocorrelated errors, (JᵀJ)⁻¹ Jᵀ Cov(ε) J (JᵀJ)⁻¹
+(:mod:`shipgnc.identify.noise`; Seber & Wild 1989, §6.1–6.2). The lag-1 autocorrelation of the
+residuals is reported, and a note says when it exceeds 0.5 (coloured noise or a model error; a
+model error is a bias the intervals do not hold).
+
+A fit the log does not support is refused (one line, no vessel file): undetermined parameters,
+no significant rudder effect, a time constant of undecided sign, no better than the mean, a yaw
+rate that leads the rudder (:mod:`shipgnc.identify.verdict`); so is a ``--horizon`` not shorter
+than the fitted part of the log.
 
 Too little excitation is refused before fitting: the rudder must span at least
 :data:`MIN_RUDDER_SPAN` over the fitted part, and the equation-error regressor ([r, δ] for the
@@ -74,6 +83,8 @@ from shipgnc.analysis.identification import (
     fit_nomoto2,
 )
 from shipgnc.errors import ConfigError
+from shipgnc.identify.noise import ARNoise
+from shipgnc.identify.verdict import check_time_scale, refuse_unidentified
 
 MODELS = ("nomoto1", "nomoto2", "linear-3dof")
 LEVEL = 0.95
@@ -85,6 +96,9 @@ MIN_RUDDER_SPAN = math.radians(1.0)
 SURGE_MIN_CHANGE = 0.02
 #: fewest samples in the fitted part
 MIN_FIT_SAMPLES = 20
+COVARIANCE_WHITE = "s^2 (J^T J)^-1 at the optimum, s^2 = RSS/(n - p)"
+COVARIANCE = ("least squares under AR residuals: (J^T J)^-1 J^T Cov(res) J (J^T J)^-1, Cov(res) of "
+              "the AR model A(q) res = e fitted to the residuals, s_e^2 = |e|^2/(n_e - p - AR orders)")
 
 
 @dataclass(frozen=True)
@@ -126,6 +140,7 @@ class Identification:
     method: str
     heading: np.ndarray | None = None
     notes: list[str] = field(default_factory=list)
+    noise: dict | None = None
 
     @property
     def holdout_start(self) -> float:
@@ -146,7 +161,8 @@ class Identification:
                       "holdout_fraction": self.holdout, "holdout_start_s": self.holdout_start},
             "parameters": {k: p.to_json() for k, p in self.parameters.items()},
             "confidence": {"level": LEVEL, "distribution": "student-t", "dof": dofs,
-                           "covariance": "s^2 (J^T J)^-1 at the optimum, s^2 = RSS/(n - p)"},
+                           "covariance": COVARIANCE if self.noise else COVARIANCE_WHITE,
+                           "noise_model": self.noise},
             "nrmse_holdout": self.nrmse_holdout,
             "nrmse_fit": self.nrmse_fit,
             "residual_rms": self.residual_rms,
@@ -196,6 +212,18 @@ def check_excitation(columns, labels: str, rudder: np.ndarray) -> float:
     return cond
 
 
+def check_horizon(horizon: float, t_fit: np.ndarray) -> None:
+    """A prediction window [s] must be a time > 0 shorter than the fitted part of the log
+    (a window as long as the log is one free run: no --horizon)."""
+    if not (isinstance(horizon, (int, float)) and math.isfinite(horizon) and horizon > 0):
+        raise ConfigError(f"--horizon {horizon!r}: must be a time > 0 s")
+    span = float(t_fit[-1] - t_fit[0])
+    if horizon >= span:
+        raise ConfigError(f"--horizon {horizon:g}: the prediction window is not shorter than the "
+                          f"fitted part of the log ({span:.4g} s); use a shorter window, or no "
+                          "--horizon for one free run over the log")
+
+
 def jacobian(fun: Callable, theta, rel_step: float = 1e-6) -> np.ndarray:
     """Central-difference Jacobian of ``fun`` at ``theta`` (steps relative to each parameter)."""
     theta = np.asarray(theta, dtype=float)
@@ -210,24 +238,47 @@ def jacobian(fun: Callable, theta, rel_step: float = 1e-6) -> np.ndarray:
     return np.column_stack(cols)
 
 
-def confidence(fun: Callable, theta, specs) -> tuple[dict[str, Parameter], np.ndarray]:
-    """Parameters with standard errors and 95 % t intervals (module docstring) for the residual
-    function ``fun`` at its optimum ``theta``; ``specs`` = [(name, unit, meaning), ...] (a name
-    starting with ``_`` is a nuisance parameter: in the covariance, not in the result)."""
+def covariance(fun: Callable, theta, noise: ARNoise | None = None
+               ) -> tuple[np.ndarray, np.ndarray, int]:
+    """(Cov θ̂, prediction errors, d.o.f.) of the least-squares optimum ``theta`` of the residual
+    function ``fun`` (module docstring). White residuals (``noise`` None or of order 0):
+    s²(JᵀJ)⁻¹, s² = RSS/(n − p). AR residuals (:mod:`shipgnc.identify.noise`): the least-squares
+    estimator's covariance under autocorrelated errors, (JᵀJ)⁻¹ Jᵀ Cov(ε) J (JᵀJ)⁻¹ with
+    Cov(ε) = s_e² F Fᵀ of the fitted AR model, s_e² = ‖e‖²/(n_e − p − Σ orders), e = A(q)ε.
+    A singular JᵀJ (condition number > 10¹⁴) gives an infinite covariance."""
     theta = np.asarray(theta, dtype=float)
     res = np.asarray(fun(theta), dtype=float)
     J = jacobian(fun, theta)
-    n, p = J.shape
-    dof = max(n - p, 1)
-    s2 = float(res @ res) / dof
+    p = J.shape[1]
+    coloured = noise is not None and not noise.white
+    e = noise.whiten(res) if coloured else res
+    dof = max(e.size - p - (noise.n_params if coloured else 0), 1)
+    s2 = float(e @ e) / dof
     JTJ = J.T @ J
     try:
-        cov = s2 * np.linalg.inv(JTJ)
-        se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
         if np.linalg.cond(JTJ) > 1e14:
-            se = np.full(p, math.inf)
+            raise np.linalg.LinAlgError("singular")
+        inv = np.linalg.inv(JTJ)
+        if coloured:
+            G = noise.colour_transpose(J)
+            cov = s2 * inv @ (G.T @ G) @ inv
+        else:
+            cov = s2 * inv
     except np.linalg.LinAlgError:
-        se = np.full(p, math.inf)
+        cov = np.full((p, p), math.inf)
+    return cov, e, dof
+
+
+def confidence(fun: Callable, theta, specs, noise: ARNoise | None = None
+               ) -> tuple[dict[str, Parameter], np.ndarray]:
+    """Parameters with standard errors and 95 % t intervals (module docstring) for the residual
+    function ``fun`` at its optimum ``theta``; ``specs`` = [(name, unit, meaning), ...] (a name
+    starting with ``_`` is a nuisance parameter: in the covariance, not in the result). With a
+    ``noise`` model the covariance allows for autocorrelated residuals (:func:`covariance`)."""
+    theta = np.asarray(theta, dtype=float)
+    cov, _, dof = covariance(fun, theta, noise)
+    res = np.asarray(fun(theta), dtype=float)
+    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     q = float(stats.t.ppf(0.5 + LEVEL / 2.0, dof))
     out = {}
     for (name, unit, meaning), value, e in zip(specs, theta, se, strict=True):
@@ -266,8 +317,9 @@ def _scores(ident_measured, ident_simulated, split) -> tuple[dict, dict, dict]:
 
 def _lag_note(rho: float) -> list[str]:
     if rho > 0.5:
-        return [f"the residuals are correlated (lag-1 autocorrelation {rho:.2f}): a model error or "
-                "coloured noise; the confidence intervals assume white residuals and are too narrow"]
+        return [f"the residuals are correlated (lag-1 autocorrelation {rho:.2f}): coloured noise or "
+                "a model error; the intervals allow for the correlation (an AR model of the "
+                "residuals), not for a model error (a bias)"]
     return []
 
 
@@ -282,8 +334,7 @@ def _nomoto1_best(tf, df, rf, horizon: float | None) -> tuple[object, float | No
     (a, b), *_ = np.linalg.lstsq(np.column_stack([rf, df]), np.gradient(rf, h), rcond=None)
     notes = []
     if horizon is not None:
-        if not (math.isfinite(horizon) and horizon > 0):
-            raise ConfigError(f"--horizon {horizon!r}: must be a time > 0 s")
+        check_horizon(horizon, tf)
     elif a > 0:
         horizon = max(10 * h, 0.5 / a)
         notes.append(f"the equation-error estimate is course-unstable (T = {-1 / a:.3g} s): fitted "
@@ -344,7 +395,8 @@ def identify_nomoto1(t, delta, r, *, holdout: float = 0.3, speed: float | None =
             return _simulate_segments(theta[0], theta[1], h, df, rf, seg_fit)[1:] - rf[1:]
 
         theta = [fit.K, fit.T]
-    params, res = confidence(fun, theta, specs)
+    noise = ARNoise.fit(fun(theta))
+    params, res = confidence(fun, theta, specs, noise)
     K, T = params["K"].value, params["T"].value
     if steps is None:
         r_sim = _foh_first_order(K, T, h, delta, float(theta[2]))
@@ -355,10 +407,12 @@ def identify_nomoto1(t, delta, r, *, holdout: float = 0.3, speed: float | None =
     method += f", {horizon:.3g} s prediction windows)" if horizon is not None else ")"
     ident = _finish("nomoto1", params, t, delta, {"r": r}, {"r": r_sim}, k, holdout, res, cond,
                     "[r, delta]", vessel, speed, heading, method)
+    ident.noise = noise.to_json(("r",))
     if abs(T) < 2 * h:
         notes.append(f"|T| = {abs(T):.3g} s is below two sampling steps: the time constant is not "
                      "resolved (the log looks like a static gain r = K delta)")
     ident.notes = notes + ident.notes
+    refuse_unidentified(ident)
     return ident
 
 
@@ -408,6 +462,7 @@ def identify_nomoto2(t, delta, r, *, holdout: float = 0.3, speed: float | None =
                                 "yaw mode that real T1, T2 cannot express; linear-3dof can")
     except (ValueError, np.linalg.LinAlgError):
         pass
+    noise = ARNoise.fit(fun(phi))
     sp, res = confidence(fun, phi, [
         ("K", "1/s", "yaw-rate gain r/delta in a steady turn"),
         ("T1+T2", "s", "sum of the time constants (denominator's s coefficient)"),
@@ -418,13 +473,7 @@ def identify_nomoto2(t, delta, r, *, holdout: float = 0.3, speed: float | None =
     root = math.sqrt(D) if D > 0 else 0.0
     T1, T2 = 0.5 * (S + root), 0.5 * (S - root)
     # delta method for T1, T2 from the (S, P) block of the covariance
-    J = jacobian(fun, phi)
-    dof = sp["K"].dof
-    s2 = float(res @ res) / dof
-    try:
-        cov = s2 * np.linalg.inv(J.T @ J)
-    except np.linalg.LinAlgError:
-        cov = np.full((4, 4), math.inf)
+    cov, _, dof = covariance(fun, phi, noise)
     q = float(stats.t.ppf(0.5 + LEVEL / 2.0, dof))
     params = {"K": sp["K"]}
     for name, value, sign, meaning in (("T1", T1, 1.0, "first (larger) time constant"),
@@ -442,6 +491,7 @@ def identify_nomoto2(t, delta, r, *, holdout: float = 0.3, speed: float | None =
     ident = _finish("nomoto2", params, t, delta, {"r": r}, {"r": r_sim}, k, holdout, res, cond,
                     "[r, delta]", vessel, speed, heading,
                     "output error (fit_nomoto2: scipy.signal.lsim, least squares)")
+    ident.noise = noise.to_json(("r",))
     if D <= 0 or not math.isfinite(params["T1"].std_error):
         ident.notes.append(f"T1 = T2 = {T1:.4g} s (a double pole; the best real pair for a response "
                            "that may have complex poles): T1 and T2 separately are undetermined, "
@@ -454,6 +504,7 @@ def identify_nomoto2(t, delta, r, *, holdout: float = 0.3, speed: float | None =
         ident.notes.append(f"{', '.join(wide)} poorly determined (standard error > |value|): the "
                            "log does not separate the second-order model's time constants "
                            "(pole-zero near cancellation); nomoto1 may serve better")
+    refuse_unidentified(ident)
     return ident
 
 
@@ -565,8 +616,7 @@ def identify_linear3dof(t, delta, u, v, r, *, holdout: float = 0.3, horizon: flo
     theta0 = np.array([cv[0], cv[1], cr[0], cr[1], cv[2], cr[2]])
     steps = None
     if horizon is not None:
-        if not (math.isfinite(horizon) and horizon > 0):
-            raise ConfigError(f"--horizon {horizon!r}: must be a time > 0 s")
+        check_horizon(horizon, t[:k])
         steps = max(1, round(horizon / h))
     else:
         lam = np.linalg.eigvals(theta0[:4].reshape(2, 2))
@@ -596,7 +646,8 @@ def identify_linear3dof(t, delta, u, v, r, *, holdout: float = 0.3, horizon: flo
         resid = simulate(theta, df, xm, windows) - xm
         w = 1.0 / np.maximum(np.sqrt(np.mean(resid**2, axis=0)), 1e-15)
     specs = SWAY_YAW + ([("_v0", "m/s", ""), ("_r0", "rad/s", "")] if free_x0 else [])
-    params, res = confidence(fun, theta, specs)
+    noise = ARNoise.fit(fun(theta), channels=2)
+    params, res = confidence(fun, theta, specs, noise)
     rho = lag1(res[: res.size // 2]) * 0.5 + lag1(res[res.size // 2:]) * 0.5
     # surge
     mean_u = float(np.mean(uf))
@@ -650,14 +701,16 @@ def identify_linear3dof(t, delta, u, v, r, *, holdout: float = 0.3, horizon: flo
     notes = _lag_note(rho) + notes
     notes.append("M is not identifiable from motions (only M^-1 N and M^-1 B are): the vessel "
                  "YAML has M = I, N = -A, B = b (the equations per unit inertia)")
-    return Identification(model="linear-3dof", parameters=all_params, t=t, rudder=delta,
+    ident = Identification(model="linear-3dof", parameters=all_params, t=t, rudder=delta,
                           measured=measured, simulated=simulated, split=k, holdout=float(holdout),
                           nrmse_holdout=hold, nrmse_fit=fitq, residual_rms=rms, residual_lag1=rho,
                           condition_number=cond, regressor="[v, r, delta]", vessel=vessel,
                           method="output error (exact first-order hold, least squares; start: "
                                  "equation error on numerically differentiated v, r)",
                           heading=None if heading is None else np.asarray(heading, dtype=float),
-                          notes=notes)
+                          notes=notes, noise=noise.to_json(("v", "r")))
+    refuse_unidentified(ident)
+    return ident
 
 
 # --------------------------------------------------------------------------- from a log
@@ -670,6 +723,10 @@ def identify_log(log, model: str = "nomoto1", *, holdout: float = 0.3, speed: fl
         raise ConfigError(f"--model {model!r}: allowed: {', '.join(MODELS)}")
     if speed is not None and not (math.isfinite(speed) and speed > 0):
         raise ConfigError(f"--speed {speed!r}: must be a speed > 0 m/s")
+    if horizon is not None and model == "nomoto2":
+        raise ConfigError(f"--horizon {horizon!r}: prediction windows are fitted for nomoto1 and "
+                          "linear-3dof only (nomoto2 fits one free run)")
+    check_time_scale(log.t, log.names.get("time", "time"))
     notes = list(log.notes)
     if log.has("yaw_rate"):
         r = log.data["yaw_rate"]

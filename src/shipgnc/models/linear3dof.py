@@ -4,10 +4,11 @@
 
     M ν̇ + N(U) ν = τ,    ν = [u, v, r]  (surge, sway, yaw; SI)
 
-with N(U) including the linearised Coriolis-centripetal terms at speed U, as in Fossen (2021),
-Handbook of Marine Craft Hydrodynamics and Motion Control, 2nd ed., §7.2 and Appendix D, and his
-MSS/PVS function ``clarke83``. The sway-yaw derivatives are Clarke et al.'s regressions
-(Trans. RINA 125, 45–68, 1983) in the prime system, with the scale S = π (T/L)²::
+with N(U) = D(U) + C*_RB(U): the hydrodynamic damping of Clarke et al.'s regressions and the
+rigid-body Coriolis-centripetal terms linearised about straight running at u = U (Fossen 2021,
+Handbook of Marine Craft Hydrodynamics and Motion Control, 2nd ed., §6.5 and §7.1:
+C*_RB = [[0, 0, 0], [0, 0, m U], [0, 0, m x_g U]]). The sway-yaw derivatives are Clarke et al.'s
+regressions (Trans. RINA 125, 45–68, 1983) in the prime system, with the scale S = π (T/L)²::
 
     Y'_v̇ = −S (1 + 0.16 C_b B/T − 5.1 (B/L)²)     Y'_ṙ = −S (0.67 B/L − 0.0033 (B/T)²)
     N'_v̇ = −S (1.1 B/L − 0.041 B/T)                N'_ṙ = −S (1/12 + 0.017 C_b B/T − 0.33 B/L)
@@ -21,7 +22,19 @@ line, CG at x_g)::
 
     m = ρ L B T C_b,  ρ = 1025 kg/m³,   I_z = m R66²,
     M_RB = [[m, 0, 0], [0, m, m x_g], [0, m x_g, I_z]],   M_A = −[[X_u̇,0,0],[0,Y_v̇,Y_ṙ],[0,N_v̇,N_ṙ]]
-    N = −[[X_u, 0, 0], [0, Y_v, Y_r], [0, N_v, N_r]],      X_u = −(m − X_u̇)/T_surge
+    N = −[[X_u, 0, 0], [0, Y_v, Y_r − m U], [0, N_v, N_r − m x_g U]],   X_u = −(m − X_u̇)/T_surge
+
+**The rigid-body terms.** Clarke, Gedling & Hine regressed *hydrodynamic* derivatives (measured
+forces on captive models, rotating-arm and PMM tests), so their Y′_r, N′_r do not contain the
+rigid body's centripetal force m U r and moment m x_g U r; the sway and yaw equations of motion
+carry them (Y_r − m U, N_r − m x_g U; Fossen 2021 eq. 7.11–7.12; Clarke et al.'s own stability
+index C = Y′_v (N′_r − m′x′_g) − N′_v (Y′_r − m′) > 0 for a course-stable ship). Check: for the
+Mariner's dimensions (L = 160.93, B = 23.17, T = 8.23 m) the regression gives Y′_r = +0.00336,
+the Mariner's published hydrodynamic part Y′_r − (its Y′_r with m′) = −0.00499 + 0.00798 =
++0.00299; without the −m′ the regression's ships have oscillatory sway–yaw poles and a full
+tanker comes out course-stable (KVLCC2's dimensions: C/S² = +0.70 without, −0.14 with the terms,
+unstable as its MMG model's spiral loop says). Fossen's MSS ``clarke83.m`` (and the first version
+of this function) has the same omission.
 
 ``R66`` is the radius of gyration in yaw about the body origin (I_z enters M_RB as given).
 Fossen's MSS/PVS ``clarke83`` reads R66 about the CG and uses I_z = m R66² + m x_g²: pass
@@ -90,8 +103,8 @@ def clarke83(U: float, L: float, B: float, T: float, Cb: float, R66: float, xg: 
                     [0.0, -q * L**3 * Yvdot, -q * L**4 * Yrdot],
                     [0.0, -q * L**4 * Nvdot, -q * L**5 * Nrdot]])
     N = np.array([[-Xu, 0.0, 0.0],
-                  [0.0, -q * L**2 * U * Yv, -q * L**3 * U * Yr],
-                  [0.0, -q * L**3 * U * Nv, -q * L**4 * U * Nr]])
+                  [0.0, -q * L**2 * U * Yv, -q * L**3 * U * Yr + m * U],
+                  [0.0, -q * L**3 * U * Nv, -q * L**4 * U * Nr + m * xg * U]])
     return M_RB + M_A, N
 
 

@@ -68,6 +68,7 @@ class TrialShip:
     source: str = ""
     dt: float = 0.5
     index: dict = field(default_factory=dict)
+    steering_gear: str = "model"
 
     @property
     def steering_in_model(self) -> bool:
@@ -94,9 +95,23 @@ def _entry(vessel):
     return None
 
 
+#: steering gears a trial can run with (``--steering-gear``)
+STEERING_GEARS = ("solas", "model")
+
+
+def solas_rudder_rate(entry=None) -> float:
+    """SOLAS II-1 reg. 29.3.2 steering gear [rad/s]: 35° on one side to 30° on the other in
+    28 s, i.e. 65°/28 s ≈ 2.32°/s on average; a model-scale catalogue vessel's rate Froude-scaled
+    by √λ (time scales as √λ at equal Froude number)."""
+    from shipgnc.vessels.base import SOLAS_RUDDER_RATE
+
+    scale = 1.0 if entry is None else float(getattr(entry, "froude_scale", 1.0))
+    return SOLAS_RUDDER_RATE * math.sqrt(scale)
+
+
 def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
             max_rudder_deg: float | None = None, rudder_rate_deg_s: float | None = None,
-            dt: float | None = None, **params) -> TrialShip:
+            dt: float | None = None, steering_gear: str = "model", **params) -> TrialShip:
     """Set a vessel up for trials: build it, solve the straight approach with its trim rudder.
 
     ``vessel``: a catalogue name (:mod:`shipgnc.vessels`), a catalogue entry, or a model object
@@ -104,8 +119,18 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
     ``speed_mps``: one test speed or a sequence (a speed range: one batch); default the design
     speed. ``params`` go to the entry's ``build`` (e.g. K, T of ``nomoto``). The overrides
     ``length_m``, ``max_rudder_deg``, ``rudder_rate_deg_s`` replace the catalogue's values.
+    ``steering_gear``: ``"model"`` — the rudder moves at the vessel's own rate (the catalogue's
+    steering machine); ``"solas"`` — at the SOLAS steering gear's 65°/28 s (:func:`solas_rudder_rate`),
+    the rate the IMO criteria presume. An explicit ``rudder_rate_deg_s`` argument wins over both
+    (a ``rudder_rate_deg_s`` among ``params``, e.g. from a vessel file, is the vessel's own).
     """
+    require(steering_gear in STEERING_GEARS, "--steering-gear", steering_gear,
+            f"allowed: {', '.join(STEERING_GEARS)}")
     entry = _entry(vessel)
+    if steering_gear == "solas" and rudder_rate_deg_s is None:  # (over a vessel file's own rate)
+        rudder_rate_deg_s = math.degrees(solas_rudder_rate(entry))
+    if entry is not None and rudder_rate_deg_s is not None:
+        params = {**params, "rudder_rate_deg_s": rudder_rate_deg_s}  # the model's steering machine
     if entry is not None:
         speeds = np.atleast_1d(np.asarray(entry.design_speed_mps if speed_mps is None else speed_mps,
                                           dtype=float))
@@ -118,8 +143,12 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
         model = models[0]
         name, source = entry.name, entry.source
         length = entry.length_m if length_m is None else length_m
-        max_rudder = entry.max_rudder_rad
-        rate = entry.max_rudder_rate_rad_s
+        if length is None and params.get("L") is not None:  # a ship from its main dimensions
+            length = float(params["L"])
+        max_rudder = (math.radians(params["rudder_max_deg"]) if params.get("rudder_max_deg")
+                      is not None else entry.max_rudder_rad)
+        rate = (math.radians(params["rudder_rate_deg_s"]) if params.get("rudder_rate_deg_s")
+                is not None else entry.max_rudder_rate_rad_s)
         can_reverse = bool(entry.can_reverse)
     else:
         model = vessel
@@ -166,7 +195,7 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
                      delta0=inputs0[:, 0].copy(),
                      speed=speed, length_m=length, max_rudder=float(max_rudder), rudder_rate=float(rate),
                      can_reverse=can_reverse, full_astern=getattr(model, "full_astern", None),
-                     source=source, dt=float(dt), index=index)
+                     source=source, dt=float(dt), index=index, steering_gear=steering_gear)
 
 
 #: the time steps :func:`default_dt` chooses from [s]
@@ -615,7 +644,8 @@ def header(ship: TrialShip, i: int = 0) -> dict:
     return {"vessel": ship.name, "source": ship.source, "length_m": ship.length_m,
             "speed_mps": float(ship.speed[i]), "speed_kn": float(ship.speed[i] / KNOT),
             "trim_rudder_deg": float(np.degrees(ship.delta0[i])),
-            "l_over_v_s": None if lv is None else float(lv), "dt_s": ship.dt}
+            "l_over_v_s": None if lv is None else float(lv), "dt_s": ship.dt,
+            "steering_gear": ship.steering_gear, "rudder_rate_deg_s": float(np.degrees(ship.rudder_rate))}
 
 
 def finite(x):

@@ -1,7 +1,8 @@
 """Trial figures as naval architects draw them (``shipgnc trial --out``, ``docs/trials.md``).
 
-* :func:`turning_figure`: the CG track of each side with advance, transfer and tactical diameter
-  marked (original course up, north; positions relative to the execute point);
+* :func:`turning_figure`: the track of the body-fixed origin (midship) of each side with
+  advance, transfer and tactical diameter marked (original course up, north; positions relative
+  to the execute point);
 * :func:`zigzag_figure`: heading change and rudder angle against time, one panel per side, with
   the ±ψ switching lines and the heading extremes;
 * :func:`spiral_figure`: steady yaw rate against rudder angle for both sweep directions (and the
@@ -49,7 +50,7 @@ def turning_figure(res: dict, path, literature: dict | None = None) -> Path:
         turned = np.abs(hist.state("psi")[:, j] - hist.state("psi")[0, j])
         stop = int(np.argmax(turned >= math.radians(400.0))) or turned.size
         n, e = hist.state("north")[:stop, j], hist.state("east")[:stop, j]
-        ax.plot(e, n, color=c, lw=1.8, label=f"{side} (rudder {res['rudder_deg']:g}°)")
+        ax.plot(e, n, color=c, lw=1.8, label=f"{side} (rudder {res['rudder_deg']:g}°), body origin")
         s = 1.0 if side == "starboard" else -1.0
         if r["advance_m"] is not None:
             adv, tr = r["advance_m"], r["transfer_m"]
@@ -208,7 +209,7 @@ def document_figures(directory) -> list[Path]:
     directory = Path(directory)
     out = []
     for vessel, prefix in DOC_VESSELS:
-        res = run_all(vessel)
+        res = run_all(vessel, steering_gear="model")  # the vessel's own steering machine
         out.append(turning_figure(res["turning-circle"], directory / f"{prefix}-turning.png"))
         out.append(zigzag_figure(res["zigzag-20/20"], directory / f"{prefix}-zigzag-20.png"))
         out.append(zigzag_figure(res["zigzag-10/10"], directory / f"{prefix}-zigzag-10.png"))

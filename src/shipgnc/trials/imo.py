@@ -10,7 +10,9 @@ Criteria (L in m, V in m/s, L/V in s; ``docs/trials.md``):
   L/V ≥ 30 s, else (17.5 + 0.75 L/V)°; 20°/20° first overshoot ≤ 25°;
 * stopping: track reach ≤ 15 L (an Administration may allow up to 20 L for large ships).
 
-Each criterion takes the worse of the two sides. :func:`run_all` runs every trial (turning both
+Each criterion takes the worse of the two sides. The criteria presume a steering gear that meets
+SOLAS II-1 reg. 29 (35° to 30° the other side in 28 s): ``shipgnc trial`` runs with it unless
+``--steering-gear model`` (the vessel's own rate). :func:`run_all` runs every trial (turning both
 sides, 10/10 and 20/20 both sides, the spiral, the pull-out and, when the vessel can reverse,
 stopping) as ONE batch and returns their figures with the criteria report.
 """
@@ -99,12 +101,15 @@ def criteria(length_m: float | None, speed_mps: float, turning: dict, zz10: dict
 
 
 def run_all(vessel=None, *, speed_mps=None, rudder_deg: float | None = None, ship=None,
-            sides=("starboard", "port"), spiral_max_deg: float | None = None, **kw) -> dict:
-    """Every trial of the IMO set plus spiral and pull-out, as ONE batch; figures and criteria."""
+            sides=("starboard", "port"), spiral_max_deg: float | None = None,
+            steering_gear: str = "solas", **kw) -> dict:
+    """Every trial of the IMO set plus spiral and pull-out, as ONE batch; figures and criteria.
+    A ship prepared here has the SOLAS steering gear the criteria presume (``steering_gear``,
+    :func:`shipgnc.trials.core.prepare`); a given ``ship`` keeps its own."""
     from shipgnc.trials import pullout, spiral, stopping, turning, zigzag
     from shipgnc.trials.core import header, prepare, run_parts
 
-    ship = ship if ship is not None else prepare(vessel, speed_mps, **kw)
+    ship = ship if ship is not None else prepare(vessel, speed_mps, steering_gear=steering_gear, **kw)
     rudder = turning.rudder_angle(ship, rudder_deg)
     angles, spiral_parts = spiral.parts(ship, spiral_max_deg)
     parts = [(turning.plan(ship, rudder, sides), turning.finished),

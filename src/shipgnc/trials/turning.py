@@ -8,7 +8,9 @@ along north and the execute position at the origin, for a turn to side s (+1 sta
 * **steady turning radius** U/|r| and **steady speed** U once r is steady (the yaw rate varies
   less than 2·10⁻⁴ |r| over max(60 s, 3 L/V)); **speed loss** 100·(1 − U_steady/V) %.
 
-Positions are the CG's (the model's north/east), interpolated linearly in the heading.
+Positions are those of the body-fixed origin (the model's north/east state; midship for the
+catalogue's Mariner and KVLCC2 — MSC.137(76) §4.2 measures the midship point), not of the
+centre of gravity; interpolated linearly in the heading.
 """
 
 from __future__ import annotations

@@ -108,6 +108,17 @@ def parse_angles(text: str) -> tuple[float, float]:
     return vals[0], vals[1]
 
 
+def check_rudder(ship, delta_deg: float) -> None:
+    """Refuse a zig-zag rudder beyond the vessel's limit (the command would be clipped, and the
+    trial labelled with an angle it did not sail)."""
+    from shipgnc.errors import ConfigError
+
+    limit = math.degrees(ship.max_rudder)
+    if delta_deg > limit + 1e-9:
+        raise ConfigError(f"--angles: the zig-zag rudder D = {delta_deg:g}° is beyond "
+                          f"{ship.name}'s rudder limit {limit:g}°; allowed: D in (0, {limit:g}]")
+
+
 def plan(ship, delta_deg: float, psi_deg: float, sides=("starboard", "port"), *, t_max=None):
     """The programme of a zig-zag ``delta_deg``/``psi_deg`` to each of ``sides`` (one ship each)."""
     from shipgnc.trials.core import SIDES, programme
@@ -177,6 +188,7 @@ def zigzag(vessel, delta_deg: float = 20.0, psi_deg: float = 20.0, *, sides=("st
     from shipgnc.trials.core import prepare, run_parts
 
     ship = ship if ship is not None else prepare(vessel, speed_mps, **kw)
+    check_rudder(ship, delta_deg)
     (hist,) = run_parts(ship, [(plan(ship, delta_deg, psi_deg, sides), finished)])
     return collect(ship, hist, delta_deg, psi_deg, sides)
 

@@ -39,6 +39,8 @@ class VesselEntry:
     param_names: tuple[str, ...] = ()
     #: state names beyond north, east, psi, u, v, r, delta
     extra_states: tuple[str, ...] = ()
+    #: Froude scale λ of a model-scale vessel (its SOLAS steering-gear rate is 2.32°/s·√λ)
+    froude_scale: float = 1.0
 
     @property
     def states(self) -> tuple[str, ...]:
@@ -197,7 +199,8 @@ register(VesselEntry(
     length_m=7.0, design_speed_mps=1.179,
     speed_range_mps=(round(5 * KNOT / _L7, 3), round(16.5 * KNOT / _L7, 3)),
     max_rudder_rad=math.radians(35.0), max_rudder_rate_rad_s=math.radians(15.8),
-    can_reverse=False, builder=_kvlcc2("model"), param_names=("T_n",), extra_states=("n",)))
+    can_reverse=False, builder=_kvlcc2("model"), param_names=("T_n",), extra_states=("n",),
+    froude_scale=320.0 / 7.0))
 
 register(VesselEntry(
     name="nomoto", title="first-order Nomoto steering model (or Norrbin with a0..a3)",
