@@ -128,8 +128,9 @@ def run_command(
                                "'interrupted'); without it an earlier run in --out stays "
                                "untouched.")] = False,
     overwrite: Annotated[bool, typer.Option(
-        "--overwrite", help="Replace --out whole even when it holds files that are not a shipgnc "
-                            "run (a directory of an earlier run is always replaced whole).")] = False,
+        "--overwrite", help="Write into --out even when it holds files that are not a shipgnc run: "
+                            "they are kept, only an earlier run's files are replaced (a directory "
+                            "of an earlier run alone is always replaced whole).")] = False,
 ) -> None:
     """Run a scenario: write result.nc, metrics.json and figures; print the metrics.
 
@@ -155,8 +156,8 @@ def run_command(
         if live and (sc.vessel.model != "vectored-thrust-boat" or sc.controllers is not None):
             raise ConfigError(f"--live: the live dashboard shows the vectored-thrust boat; scenario "
                               f"{sc.name!r} ({sc.vessel.model}) writes its figures after the run")
-        out_dir = check_out(out if out is not None else Path("runs") / sc.name,
-                            overwrite=overwrite)  # before any work
+        out_dir = check_out(out if out is not None else Path("runs") / sc.name, overwrite=overwrite,
+                            inputs=(Path(scenario),))  # before any work; never over its input
         observer = _live_observer(sc, realtime) if live else None
         with _progress(enabled=not live) as progress:
             run = run_scenario(sc, observer=observer, progress=progress,
