@@ -5,12 +5,14 @@ EACCES on write) are injected in ``test_outputs_atomic.py``."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -173,3 +175,60 @@ def test_a_usage_error_is_one_line_and_exit_2(args, words):
     assert result.returncode == 2, result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and words in lines[0] and "--help" in lines[0], result.stderr
+
+
+def _children(pid: int) -> list[int]:
+    """The child processes of ``pid`` (Linux: /proc/PID/task/*/children)."""
+    found = []
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        try:
+            found += [int(c) for c in (task / "children").read_text().split()]
+        except OSError:
+            pass
+    return found
+
+
+def _running(pid: int) -> bool:
+    """Whether ``pid`` is a live process (a zombie awaiting its reaper is not)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return False
+    return state not in ("Z", "X")
+
+
+def _eventually(condition, timeout: float = 60.0):
+    """Poll ``condition`` until it holds (its value) or ``timeout`` s pass (None): a bound on
+    the outcome, not on the time it takes."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.05)
+    return None
+
+
+#: a run long enough to be running still when it is signalled, with the figure worker
+LONG_WITH_FIGURES = ["run", "boat-autopilot", "--set", "simulation.t_end=60000"]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc, fork: Linux")
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
+def test_a_killed_run_takes_its_figure_worker_with_it(tmp_path, sig):
+    """F39: kill -9 or SIGTERM of ``shipgnc run`` left its forked figure worker running (orphans
+    holding gigabytes). The worker now dies with its parent."""
+    proc = subprocess.Popen([sys.executable, "-m", "shipgnc", *LONG_WITH_FIGURES, "--out",
+                             str(tmp_path / "o")], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        workers = _eventually(lambda: _children(proc.pid))
+        assert workers, "the figure worker never started"
+        assert proc.poll() is None, "the run ended before the signal: make it longer"
+        os.kill(proc.pid, sig)
+        assert proc.wait(timeout=60) == -sig
+        assert _eventually(lambda: not any(_running(w) for w in workers)), "a worker outlived its parent"
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
