@@ -48,7 +48,9 @@ def friendly_errors():
         stderr.print(f"[bold red]error:[/] {_one_line(exc)}{hint}", soft_wrap=True)
         raise typer.Exit(exc.exit_code) from None
     except KeyboardInterrupt as exc:  # Ctrl-C: one line, no traceback (Interrupted names the time)
-        stderr.print(_one_line(exc) if str(exc) else "interrupted", soft_wrap=True)
+        from shipgnc.interrupts import say_once
+
+        say_once(" ".join(str(exc).split()) if str(exc) else "interrupted")
         raise typer.Exit(130) from None
     except BrokenPipeError:  # `shipgnc … | head`: the reader left; say nothing, exit as SIGPIPE would
         devnull = os.open(os.devnull, os.O_WRONLY)
@@ -138,7 +140,11 @@ def run_command(
     complete, with a marker file .shipgnc-run (see shipgnc.outputs)."""
     with friendly_errors(), ExitStack() as stack:
         from shipgnc.errors import ConfigError
+        from shipgnc.interrupts import keeping
         from shipgnc.outputs import check_out
+
+        if keep_partial:  # Ctrl-C waits for the partial result to be written (a second one not)
+            stack.enter_context(keeping())
         from shipgnc.scenarios.registry import load_scenario
         from shipgnc.scenarios.runner import divergence_message, metrics_json, run_scenario
         from shipgnc.scenarios.write import write_outputs
@@ -178,7 +184,9 @@ def run_command(
             _print_metrics(sc.name, run.metrics)
         stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
         if run.interrupted:
-            stderr.print(run.interrupted, soft_wrap=True)
+            from shipgnc.interrupts import say_once
+
+            say_once(run.interrupted)
             raise typer.Exit(130)
         if observer is not None and not observer.closed:
             stderr.print("close the live window to exit")
@@ -311,11 +319,18 @@ def main() -> None:
     """Console-script entry point. A usage error (an unknown option or command, a value that does
     not parse, a missing argument) is one line and exit 2 like every other bad input, not the
     parser's boxed usage text."""
+    from shipgnc.interrupts import arm_exit_deadline, exit_now, install, say_once
+
+    install()
+    arm_exit_deadline()  # Ctrl-C ends the command within half a second, whatever it is doing
+    # a pool's resource tracker (dask's workers) outlives a command ended at the deadline by a
+    # moment: it unlinks what the pool left, and is not to print a warning after the one line
+    sys.warnoptions.append("ignore::UserWarning:multiprocessing.resource_tracker")
     try:
         code = app(standalone_mode=False)
     except typer.Abort:
-        stderr.print("interrupted", soft_wrap=True)
-        raise SystemExit(130) from None
+        say_once("interrupted")
+        exit_now(130)
     except Exception as exc:  # the parser's own errors (click's, as vendored by typer)
         code = getattr(exc, "exit_code", None)
         if not (callable(getattr(exc, "format_message", None)) and isinstance(code, int)):
@@ -324,6 +339,8 @@ def main() -> None:
         hint = f" (see {ctx.command_path} --help)" if code == 2 and ctx is not None else ""
         stderr.print(f"[bold red]error:[/] {_one_line(exc.format_message())}{hint}", soft_wrap=True)
         raise SystemExit(code) from None
+    if code == 130:  # interrupted, its line said: end now
+        exit_now(130)
     raise SystemExit(code if isinstance(code, int) else 0)
 
 

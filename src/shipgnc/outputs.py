@@ -45,7 +45,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from shipgnc.errors import ConfigError, ShipGNCError
-from shipgnc.interrupts import latched
+from shipgnc.interrupts import latched, on_hard_exit
 
 #: the marker file written with every run's outputs
 MARKER = ".shipgnc-run"
@@ -200,6 +200,7 @@ def atomic_dir(out: Path, *, overwrite: bool = False, command: str = "run", stat
         tmp = _new_dir(parent, f".{out.name}.tmp-")
     except OSError as exc:
         raise output_error(out, exc, option) from None
+    on_hard_exit(id(tmp), lambda: shutil.rmtree(tmp, ignore_errors=True))  # Ctrl-C's deadline
     try:
         yield tmp
         if status == "complete" and latched():  # a Ctrl-C a callback swallowed: not complete
@@ -215,6 +216,8 @@ def atomic_dir(out: Path, *, overwrite: bool = False, command: str = "run", stat
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+    finally:
+        on_hard_exit(id(tmp), None)
 
 
 #: a temporary directory's name: ``.<out>.tmp-<host>-<pid>-<random>`` (or ``.old-``)

@@ -26,6 +26,7 @@ import numpy as np
 from shipgnc.actuators import Actuator
 from shipgnc.errors import ConfigError, DivergenceError, Interrupted, require
 from shipgnc.frames import wrap_angle
+from shipgnc.interrupts import note
 from shipgnc.models.base import Signal, names
 from shipgnc.sim.integrators import rk4_step, solve_ivp_step
 from shipgnc.streams import MemberStreams, is_generator
@@ -178,14 +179,21 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
             evaluator = getattr(disturbance, "evaluator", None)
             if evaluator is not None and evaluator() != "numpy":
                 ran_on = f"{ran_on}+{evaluator()}"
-    from shipgnc.sim.result import batch_dim_names, build_dataset
-
     run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold,
                  "t_end": t_end, "model": type(model).__name__, **(attrs or {})}
-    if log.status.get("interrupted"):  # the partial Dataset is built only if someone reads it
-        last = float(log.time[-1]) if log.time.size else 0.0
-        raise Interrupted(last, partial=lambda: build_dataset(log, setup.batch_shape, batch_dims,
-                                                               run_attrs))
+    if log.status.get("interrupted"):  # the partial Dataset is built (xarray imported) only if
+        last = float(log.time[-1]) if log.time.size else 0.0  # someone reads it
+
+        def partial():
+            from shipgnc.sim.result import build_dataset
+
+            return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
+
+        error = Interrupted(last, partial=partial if log.time.size else None)
+        note(str(error))  # the line said if the command is not done by the deadline
+        raise error
+    from shipgnc.sim.result import batch_dim_names, build_dataset
+
     result = build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
     if log.diverged_at is not None:
         dims = batch_dim_names(setup.batch_shape, batch_dims)
@@ -636,7 +644,7 @@ def mask_diverged(log: Log, diverged_at: np.ndarray, first_error, dt: float) -> 
     flat = diverged_at.reshape(-1)
     after = log.time[:, None] >= flat[None, :] - 0.5 * dt  # NaN compares False: kept
     for name, values in log.data.items():
-        rows = values.reshape(values.shape[0], -1)
+        rows = values.reshape(values.shape[0], flat.size)  # (also no samples: Ctrl-C at once)
         rows[after] = np.nan
         log.data[name] = rows.reshape(values.shape)
     n = int(np.count_nonzero(np.isfinite(flat)))

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from shipgnc.errors import ConfigError, Interrupted, ShipGNCWarning
+from shipgnc.interrupts import note
 from shipgnc.study.chunk import Chunk, check_perturbable, check_sweepable, plan_chunks, run_chunk
 from shipgnc.study.spec import Study
 
@@ -141,7 +142,9 @@ def run_chunks(study: Study, chunks: list[Chunk], *, client=None,
             return out
         return _run_on_dask(study, chunks, client, counted)
     except KeyboardInterrupt:  # Ctrl-C: one line, whatever was running
-        raise Interrupted(message=f"interrupted after {finished[0]} of {total} chunks") from None
+        message = f"interrupted after {finished[0]} of {total} chunks"
+        note(message)  # said at once if closing the cluster would keep the command waiting
+        raise Interrupted(message=message) from None
 
 
 def _run_on_dask(study: Study, chunks: list[Chunk], client, on_chunk) -> list:
