@@ -317,3 +317,38 @@ def test_a_killed_run_takes_its_figure_worker_with_it(tmp_path, sig):
         with contextlib.suppress(ProcessLookupError):
             os.killpg(proc.pid, signal.SIGKILL)
         proc.wait()
+
+
+def _address_space(limit_bytes: int):
+    import resource
+
+    def limit():  # as ``ulimit -v`` does
+        resource.setrlimit(resource.RLIMIT_AS, (limit_bytes, limit_bytes))
+
+    return limit
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="address-space limits: Linux")
+def test_a_run_too_large_for_the_memory_is_refused_before_work(tmp_path):
+    """F17: a 10⁶ s run under a 2 GB ``ulimit -v`` died of a MemoryError (exit 1, "internal
+    error") where ``sweep`` refuses with exit 2. Its record is estimated before the run: one line,
+    exit 2, the estimate and a t_end that fits (and not simulation.log_every: the metrics of
+    boat-autopilot are computed from every step, whatever it thins)."""
+    result = _cli(["run", "boat-autopilot", "--set", "simulation.t_end=1e6", "--no-figures",
+                   "--out", str(tmp_path / "o")], preexec=_address_space(2 * 10**9))
+    assert result.returncode == 2, result.stderr[-2000:]
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "needs about" in lines[0] and "simulation.t_end" in lines[0], lines
+    assert "fits" in lines[0] and "log_every" not in lines[0] and "fewer ships" not in lines[0]
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_long_thinned_one_ship_run_is_not_told_to_use_fewer_ships():
+    """F19: the refusal of a long one-ship run (log thinned by simulation.log_every, whose metrics
+    still need every step) advised "use fewer ships"; it names what fits a single ship."""
+    from shipgnc.scenarios.runner import run_scenario
+
+    with pytest.raises(ConfigError) as info:
+        run_scenario("boat-autopilot", overrides=["simulation.t_end=4e6", "simulation.log_every=1000"])
+    message = str(info.value)
+    assert "fewer ships" not in message and "simulation.t_end" in message and "fits" in message
