@@ -227,3 +227,58 @@ def test_sensor_fields_are_checked_before_the_run(override, words):
 def test_a_sensor_latency_within_the_run_is_accepted():
     sc = load_scenario("boat-los-gnss", ["sensors.0.latency=6000", "sensors.2.noise_deg_s=1e150"])
     assert sc.sensors[0].latency == 6000
+
+
+@pytest.mark.parametrize("bad", [123, None, ["boat-autopilot"]])
+def test_load_scenario_of_a_non_name_is_one_clear_error(bad):
+    """``load_scenario(123)`` was a raw TypeError from the path machinery."""
+    with pytest.raises(ConfigError, match="expected a built-in scenario name or the path"):
+        load_scenario(bad)
+
+
+def _warnings_to_stderr(monkeypatch):
+    """Warnings printed on stderr, as outside pytest (which records them instead)."""
+    import sys
+    import warnings
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+    monkeypatch.setattr(warnings, "showwarning", show)
+
+
+@pytest.mark.filterwarnings("default")
+def test_a_librarys_warning_is_not_printed_before_the_one_line_error(monkeypatch):
+    """A numpy RuntimeWarning printed by the work before the command's one-line error made it
+    several lines; warnings are shown when the command succeeds, and dropped when it fails."""
+    import warnings
+
+    import shipgnc.scenarios.registry as registry
+
+    def warns_then_fails(*args, **kwargs):
+        warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
+        raise ConfigError("simulation.dt = 1e308: too large")
+
+    _warnings_to_stderr(monkeypatch)
+    monkeypatch.setattr(registry, "load_scenario", warns_then_fails)
+    result = runner.invoke(app, ["show", "boat-autopilot"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == ["error: simulation.dt = 1e308: too large"]
+
+
+@pytest.mark.filterwarnings("default")
+def test_a_librarys_warning_is_still_shown_when_the_command_succeeds(monkeypatch):
+    import warnings
+
+    import shipgnc.scenarios.registry as registry
+
+    real = registry.load_scenario
+
+    def warns(*args, **kwargs):
+        warnings.warn("something to know", UserWarning, stacklevel=1)
+        return real(*args, **kwargs)
+
+    _warnings_to_stderr(monkeypatch)
+    monkeypatch.setattr(registry, "load_scenario", warns)
+    result = runner.invoke(app, ["show", "boat-autopilot"])
+    assert result.exit_code == 0 and "something to know" in result.stderr

@@ -36,12 +36,19 @@ stderr = Console(stderr=True, highlight=False)
 @contextmanager
 def friendly_errors():
     """Turn errors into one line on stderr and an exit code (Ctrl-C latched: :mod:`shipgnc.interrupts`)."""
+    import warnings
+
     from shipgnc.interrupts import latching
 
+    held = warnings.catch_warnings(record=True)  # a library's warnings: shown if the command
+    caught = held.__enter__()  # succeeds; before a one-line error they are noise, and dropped
+    ok = False
     try:
         with latching():
             yield
-    except typer.Exit:
+        ok = True
+    except typer.Exit as exc:
+        ok = exc.exit_code == 0
         raise
     except ShipGNCError as exc:
         hint = "; --keep-partial writes the partial result" if isinstance(exc, DivergenceError) else ""
@@ -62,6 +69,10 @@ def friendly_errors():
         stderr.print(f"[bold red]internal error:[/] {type(exc).__name__}: {_one_line(exc)} "
                      "(set SHIPGNC_DEBUG=1 for the traceback)", soft_wrap=True)
         raise typer.Exit(1) from None
+    finally:
+        held.__exit__(None, None, None)
+        for w in caught if ok else ():
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)
 
 
 def _one_line(exc: BaseException) -> str:
