@@ -103,7 +103,7 @@ def latching() -> Iterator[None]:
 
 
 #: seconds from Ctrl-C to the end of the process, at most (the requirement is 0.5 s)
-EXIT_DEADLINE_S = 0.25
+EXIT_DEADLINE_S = 0.2
 #: the exit code of an interrupted command (128 + SIGINT, as a shell reports it)
 EXIT_INTERRUPTED = 130
 
