@@ -137,12 +137,14 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
 
 def _timed_calls(bounds: list[int], n_ships: int):
     """The calls ``(k0, k1)`` of a run: each interval of ``bounds`` cut into calls of about
-    :data:`CALL_S` seconds, the steps per second measured on the calls before (the first call
-    :data:`FIRST_CALL_WORK` ship-steps, each call at most :data:`CALL_GROWTH` times the last).
-    How the steps are cut changes no result (the calls carry each ship's state exactly)."""
+    :data:`CALL_S` seconds, the steps per second measured on the calls before (the first two
+    calls :data:`FIRST_CALL_WORK` ship-steps: the first may compile the kernel; each call at most
+    :data:`CALL_GROWTH` times the last). How the steps are cut changes no result (the calls carry
+    each ship's state exactly)."""
     import time
 
     size = max(1, FIRST_CALL_WORK // max(n_ships, 1))
+    first = True
     for a, b in itertools.pairwise(bounds):
         k = a
         while k < b:
@@ -150,8 +152,10 @@ def _timed_calls(bounds: list[int], n_ships: int):
             start = time.perf_counter()
             yield k, k1
             elapsed = time.perf_counter() - start
-            rate = (k1 - k) / max(elapsed, 1e-6)
-            size = max(1, min(int(rate * CALL_S), CALL_GROWTH * (k1 - k)))
+            if not first:  # the first call's time is mostly compiling, not stepping
+                rate = (k1 - k) / max(elapsed, 1e-6)
+                size = max(1, min(int(rate * CALL_S), CALL_GROWTH * (k1 - k)))
+            first = False
             k = k1
 
 
