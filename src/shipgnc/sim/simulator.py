@@ -396,7 +396,10 @@ def check_run_memory(model, x0, t_end: float, dt: float, log_every: int, *,
     if not math.isfinite(steps) or steps > MAX_STEPS:
         return  # simulate's own check names it
     batch = np.shape(x0)[:-1]
-    need = 8 * RUN_MEMORY_FACTOR * logged_numbers(model, batch, round(steps), log_every)
+    numbers = logged_numbers(model, batch, round(steps), log_every)
+    if numbers > MAX_LOGGED:
+        return  # simulate's own log-size guard names it
+    need = 8 * RUN_MEMORY_FACTOR * numbers
     have = available_memory() if limit is None else limit
     if need <= have:
         return
