@@ -201,3 +201,84 @@ def test_a_reader_that_leaves_early_is_not_an_internal_error():
     stderr = proc.stderr.read().decode()
     assert proc.wait(timeout=60) == 141
     assert "internal error" not in stderr
+
+
+@pytest.mark.parametrize("override, words", [
+    # F15: an OverflowError in the run (the variance noise² is not a float)
+    ("sensors.2.noise_deg_s=1e300", ["sensors.2.gyro.noise_deg_s", "at most 1e+150"]),
+    ("sensors.1.bias_std_deg=1e200", ["sensors.1.compass.bias_std_deg", "at most"]),
+    ("sensors.0.noise_m=1e300", ["sensors.0.gnss.noise_m", "at most"]),
+    # F16: MemoryError, 29.8 GiB for the latency's pipe
+    ("sensors.0.latency=1000000000", ["sensors.0.latency = 1000000000", "longer than the run"]),
+    # a latency longer than the run (300 s of 0.05 s steps) was accepted
+    ("sensors.0.latency=6001", ["sensors.0.latency = 6001", "longer than the run"]),
+])
+def test_sensor_fields_are_checked_before_the_run(override, words):
+    """F15, F16: sensor noise whose square overflows, and a latency longer than the run, are one
+    line naming the field (exit 2) before any work."""
+    result = runner.invoke(app, ["show", "boat-los-gnss", "--set", override])
+    assert result.exit_code == 2, (result.exit_code, result.stderr)
+    message = result.stderr.strip()
+    assert len(message.splitlines()) == 1, message
+    for word in words:
+        assert word in message, message
+
+
+def test_a_sensor_latency_within_the_run_is_accepted():
+    sc = load_scenario("boat-los-gnss", ["sensors.0.latency=6000", "sensors.2.noise_deg_s=1e150"])
+    assert sc.sensors[0].latency == 6000
+
+
+@pytest.mark.parametrize("bad", [123, None, ["boat-autopilot"]])
+def test_load_scenario_of_a_non_name_is_one_clear_error(bad):
+    """``load_scenario(123)`` was a raw TypeError from the path machinery."""
+    with pytest.raises(ConfigError, match="expected a built-in scenario name or the path"):
+        load_scenario(bad)
+
+
+def _warnings_to_stderr(monkeypatch):
+    """Warnings printed on stderr, as outside pytest (which records them instead)."""
+    import sys
+    import warnings
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+    monkeypatch.setattr(warnings, "showwarning", show)
+
+
+@pytest.mark.filterwarnings("default")
+def test_a_librarys_warning_is_not_printed_before_the_one_line_error(monkeypatch):
+    """A numpy RuntimeWarning printed by the work before the command's one-line error made it
+    several lines; warnings are shown when the command succeeds, and dropped when it fails."""
+    import warnings
+
+    import shipgnc.scenarios.registry as registry
+
+    def warns_then_fails(*args, **kwargs):
+        warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
+        raise ConfigError("simulation.dt = 1e308: too large")
+
+    _warnings_to_stderr(monkeypatch)
+    monkeypatch.setattr(registry, "load_scenario", warns_then_fails)
+    result = runner.invoke(app, ["show", "boat-autopilot"])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == ["error: simulation.dt = 1e308: too large"]
+
+
+@pytest.mark.filterwarnings("default")
+def test_a_librarys_warning_is_still_shown_when_the_command_succeeds(monkeypatch):
+    import warnings
+
+    import shipgnc.scenarios.registry as registry
+
+    real = registry.load_scenario
+
+    def warns(*args, **kwargs):
+        warnings.warn("something to know", UserWarning, stacklevel=1)
+        return real(*args, **kwargs)
+
+    _warnings_to_stderr(monkeypatch)
+    monkeypatch.setattr(registry, "load_scenario", warns)
+    result = runner.invoke(app, ["show", "boat-autopilot"])
+    assert result.exit_code == 0 and "something to know" in result.stderr

@@ -3,7 +3,7 @@ level and inside functions alike (an import moved into a function to dodge a cyc
 dependency). The layers, lowest first::
 
     core       errors, units, frames, paths, timeseries, streams, batchmath, params, kernels, outputs,
-               interrupts, user_files, config_types
+               interrupts, lifeline, memory, user_files, config_types
     physics    models, actuators, environment, routing.fields, routing.field_spec
     gnc        guidance, control, navigation
     sim        sim
@@ -27,7 +27,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "shipgnc"
 
 LAYERS = [
     ("core", ("errors", "units", "frames", "paths", "timeseries", "streams", "batchmath", "params",
-              "kernels", "outputs", "interrupts", "user_files", "config_types", "")),
+              "kernels", "outputs", "interrupts", "lifeline", "memory", "user_files", "config_types", "")),
     ("physics", ("models", "actuators", "environment", "routing.fields", "routing.field_spec")),
     ("gnc", ("guidance", "control", "navigation")),
     ("sim", ("sim",)),

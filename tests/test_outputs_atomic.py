@@ -68,6 +68,8 @@ def test_a_run_writes_its_marker_and_no_temporary_directory(tmp_path):
 def test_an_earlier_run_is_replaced_whole(tmp_path):
     out = earlier_run(tmp_path)
     (out / "dashboard.png").write_bytes(b"an old figure")  # a file the new run does not write
+    marker = json.loads((out / MARKER).read_text())  # ... that the earlier run wrote
+    (out / MARKER).write_text(json.dumps({**marker, "files": [*marker["files"], "dashboard.png"]}))
     result = invoke("run", "boat-stern-kick", "--out", out, *SHORT)
     assert result.exit_code == 0, result.output
     assert not (out / "dashboard.png").exists()
@@ -93,7 +95,67 @@ def test_a_foreign_directory_is_refused_before_any_work_unless_overwrite(tmp_pat
     monkeypatch.setenv("SHIPGNC_FIGURE_PROCESS", "0")
     result = invoke("run", "boat-stern-kick", "--out", out, *SHORT, "--overwrite")
     assert result.exit_code == 0, result.output
-    assert not (out / "notes.txt").exists() and (out / "result.nc").exists()
+    # --overwrite writes beside what shipgnc did not write, and deletes none of it
+    assert (out / "notes.txt").read_text() == "keep me" and (out / "result.nc").exists()
+
+
+def test_overwrite_never_deletes_the_input_or_what_it_did_not_write(tmp_path, monkeypatch):
+    """F6: ``run proj/scen.yaml --out proj --overwrite`` deleted proj/scen.yaml and proj/sub/."""
+    monkeypatch.chdir(tmp_path)
+    proj = tmp_path / "proj"
+    (proj / "sub").mkdir(parents=True)
+    (proj / "sub" / "data.txt").write_text("mine")
+    text = invoke("show", "boat-stern-kick").stdout
+    (proj / "scen.yaml").write_text(text)
+    result = invoke("run", "proj/scen.yaml", "--out", "proj", "--overwrite", *SHORT)
+    assert result.exit_code == 2
+    line = one_line(result)
+    assert "holds the input" in line and "scen.yaml" in line
+    assert (proj / "scen.yaml").read_text() == text
+    assert (proj / "sub" / "data.txt").read_text() == "mine"
+    # the scenario elsewhere: --overwrite writes beside sub/ and scen.yaml, deleting neither
+    (tmp_path / "s.yaml").write_text(text)
+    for _ in range(2):  # the second run replaces the first one's files, and only them
+        result = invoke("run", "s.yaml", "--out", "proj", "--overwrite", *SHORT)
+        assert result.exit_code == 0, result.output
+    assert (proj / "scen.yaml").read_text() == text
+    assert (proj / "sub" / "data.txt").read_text() == "mine"
+    marker = json.loads((proj / MARKER).read_text())
+    assert {p.name for p in proj.iterdir()} == {*marker["files"], MARKER, "scen.yaml", "sub"}
+    assert leftovers(tmp_path) == []
+
+
+def test_an_earlier_run_with_added_files_is_not_replaced_whole(tmp_path):
+    """F6: a directory of an earlier run the user added a file to was replaced whole, deleting it."""
+    out = earlier_run(tmp_path)
+    (out / "notes.txt").write_text("my notes on this run")
+    result = invoke("run", "boat-stern-kick", "--out", out, *SHORT)
+    assert result.exit_code == 2 and "notes.txt" in one_line(result)
+    result = invoke("run", "boat-stern-kick", "--out", out, *SHORT, "--overwrite")
+    assert result.exit_code == 0, result.output
+    assert (out / "notes.txt").read_text() == "my notes on this run"
+
+
+def test_overwrite_refuses_to_replace_a_file_of_the_same_name_it_did_not_write(tmp_path):
+    """F6: a user's own ``metrics.json`` beside other files is not replaced by --overwrite."""
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "metrics.json").write_text("{}")
+    (out / "notes.txt").write_text("x")
+    result = invoke("run", "boat-stern-kick", "--out", out, *SHORT, "--overwrite")
+    assert result.exit_code == 2 and "metrics.json" in one_line(result)
+    assert (out / "metrics.json").read_text() == "{}"
+
+
+def test_a_folder_of_pictures_is_not_an_earlier_run(tmp_path):
+    """F6: a directory holding only PNG files counted as a run from before the marker, and was
+    replaced whole without --overwrite."""
+    out = tmp_path / "photos"
+    out.mkdir()
+    (out / "holiday.png").write_bytes(b"\x89PNG")
+    result = invoke("run", "boat-stern-kick", "--out", out, *SHORT)
+    assert result.exit_code == 2 and "holiday.png" in one_line(result)
+    assert (out / "holiday.png").exists()
 
 
 @pytest.mark.parametrize("command", ["run", "sweep"])
@@ -355,3 +417,40 @@ def test_a_netcdf_write_needs_no_dask(tmp_path, monkeypatch):
     write_netcdf(ds, tmp_path / "r.nc")
     with xr.open_dataset(tmp_path / "r.nc", engine="h5netcdf") as back:
         xr.testing.assert_identical(back.load(), ds)
+
+
+KILLED_MIDWAY = """
+import os, signal, sys
+from pathlib import Path
+from shipgnc.outputs import atomic_dir
+with atomic_dir(Path(sys.argv[1])) as tmp:
+    (tmp / "result.nc").write_bytes(b"half a file")
+    print(tmp, flush=True)
+    os.kill(os.getpid(), signal.{sig})
+    signal.pause()
+"""
+
+
+@pytest.mark.parametrize("sig", ["SIGKILL", "SIGTERM"])
+def test_a_killed_runs_temporary_directory_is_removed_by_the_next_run(tmp_path, sig):
+    """F21: kill -9 or SIGTERM while writing left ``.out.tmp-*`` behind for ever. The next run
+    writing beside it removes it once its process is gone; a live run's is left alone."""
+    import subprocess
+
+    out = tmp_path / "out"
+    killed = subprocess.run([sys.executable, "-c", KILLED_MIDWAY.format(sig=sig), str(out)],
+                            capture_output=True, text=True, timeout=60)
+    assert killed.returncode == -getattr(__import__("signal"), sig), killed.stderr
+    stale = Path(killed.stdout.strip())
+    assert stale.is_dir() and stale.parent == tmp_path  # what a killed run leaves
+    alive = subprocess.Popen([sys.executable, "-c", KILLED_MIDWAY.format(sig="SIGSTOP"), str(out)],
+                             stdout=subprocess.PIPE, text=True)
+    try:
+        live = Path(alive.stdout.readline().strip())
+        result = invoke("run", "boat-stern-kick", "--out", out, *SHORT)
+        assert result.exit_code == 0, result.output
+        assert not stale.exists()
+        assert live.is_dir()  # its owner is alive (stopped): not touched
+    finally:
+        alive.kill()
+        alive.wait()

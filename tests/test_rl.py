@@ -281,3 +281,12 @@ def test_an_episode_backend_without_kernels_is_named():
 
     with pytest.raises(ConfigError, match="backend"):
         BatchedEpisode("boat-autopilot", backend="fast")
+
+
+@pytest.mark.parametrize("action", ["abc", [1.0, "x"], {"T": 1}])
+def test_an_action_that_is_not_numbers_is_one_clear_error(action):
+    """A string (or other non-numeric) action was a raw numpy ValueError."""
+    env = ShipEnv()
+    env.reset(seed=0)
+    with pytest.raises(ConfigError, match=r"action .*must be numbers"):
+        env.step(action)

@@ -315,7 +315,7 @@ def test_chunks_from_different_loops_are_flagged():
 
 def test_a_foreign_output_directory_is_refused_not_mixed(tmp_path, local_result):
     # outputs are atomic: a directory holding files that are not a shipgnc run is
-    # refused (its files untouched) unless overwrite, which replaces it whole
+    # refused (its files untouched) unless overwrite, which writes beside them and deletes none
     from shipgnc.cli_sweep import write_study
     from shipgnc.errors import ConfigError
 
@@ -326,7 +326,7 @@ def test_a_foreign_output_directory_is_refused_not_mixed(tmp_path, local_result)
         write_study(local_result, out, figures=False)
     assert (out / "notes.txt").read_text() == "a user's notes\n"
     write_study(local_result, out, figures=False, overwrite=True)
-    assert not (out / "notes.txt").exists()
+    assert (out / "notes.txt").read_text() == "a user's notes\n"
     assert (out / "summary.csv").exists() and (out / "summary.md").exists()
 
 

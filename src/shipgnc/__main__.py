@@ -12,9 +12,10 @@ EXIT_INTERRUPTED = 130
 
 
 def main() -> None:
-    from shipgnc.interrupts import install
+    from shipgnc.interrupts import arm_exit_deadline, install
 
     install()  # from the first moment: a Ctrl-C swallowed while importing still ends the command
+    arm_exit_deadline()  # and the command ends within half a second of it, whatever it is doing
     try:
         from shipgnc.cli import main as cli_main
     except KeyboardInterrupt:

@@ -36,19 +36,28 @@ stderr = Console(stderr=True, highlight=False)
 @contextmanager
 def friendly_errors():
     """Turn errors into one line on stderr and an exit code (Ctrl-C latched: :mod:`shipgnc.interrupts`)."""
+    import warnings
+
     from shipgnc.interrupts import latching
 
+    held = warnings.catch_warnings(record=True)  # a library's warnings: shown if the command
+    caught = held.__enter__()  # succeeds; before a one-line error they are noise, and dropped
+    ok = False
     try:
         with latching():
             yield
-    except typer.Exit:
+        ok = True
+    except typer.Exit as exc:
+        ok = exc.exit_code == 0
         raise
     except ShipGNCError as exc:
         hint = "; --keep-partial writes the partial result" if isinstance(exc, DivergenceError) else ""
         stderr.print(f"[bold red]error:[/] {_one_line(exc)}{hint}", soft_wrap=True)
         raise typer.Exit(exc.exit_code) from None
     except KeyboardInterrupt as exc:  # Ctrl-C: one line, no traceback (Interrupted names the time)
-        stderr.print(_one_line(exc) if str(exc) else "interrupted", soft_wrap=True)
+        from shipgnc.interrupts import say_once
+
+        say_once(" ".join(str(exc).split()) if str(exc) else "interrupted")
         raise typer.Exit(130) from None
     except BrokenPipeError:  # `shipgnc … | head`: the reader left; say nothing, exit as SIGPIPE would
         devnull = os.open(os.devnull, os.O_WRONLY)
@@ -60,6 +69,10 @@ def friendly_errors():
         stderr.print(f"[bold red]internal error:[/] {type(exc).__name__}: {_one_line(exc)} "
                      "(set SHIPGNC_DEBUG=1 for the traceback)", soft_wrap=True)
         raise typer.Exit(1) from None
+    finally:
+        held.__exit__(None, None, None)
+        for w in caught if ok else ():
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)
 
 
 def _one_line(exc: BaseException) -> str:
@@ -128,8 +141,9 @@ def run_command(
                                "'interrupted'); without it an earlier run in --out stays "
                                "untouched.")] = False,
     overwrite: Annotated[bool, typer.Option(
-        "--overwrite", help="Replace --out whole even when it holds files that are not a shipgnc "
-                            "run (a directory of an earlier run is always replaced whole).")] = False,
+        "--overwrite", help="Write into --out even when it holds files that are not a shipgnc run: "
+                            "they are kept, only an earlier run's files are replaced (a directory "
+                            "of an earlier run alone is always replaced whole).")] = False,
 ) -> None:
     """Run a scenario: write result.nc, metrics.json and figures; print the metrics.
 
@@ -137,7 +151,11 @@ def run_command(
     complete, with a marker file .shipgnc-run (see shipgnc.outputs)."""
     with friendly_errors(), ExitStack() as stack:
         from shipgnc.errors import ConfigError
+        from shipgnc.interrupts import keeping
         from shipgnc.outputs import check_out
+
+        if keep_partial:  # Ctrl-C waits for the partial result to be written (a second one not)
+            stack.enter_context(keeping())
         from shipgnc.scenarios.registry import load_scenario
         from shipgnc.scenarios.runner import divergence_message, metrics_json, run_scenario
         from shipgnc.scenarios.write import write_outputs
@@ -155,8 +173,8 @@ def run_command(
         if live and (sc.vessel.model != "vectored-thrust-boat" or sc.controllers is not None):
             raise ConfigError(f"--live: the live dashboard shows the vectored-thrust boat; scenario "
                               f"{sc.name!r} ({sc.vessel.model}) writes its figures after the run")
-        out_dir = check_out(out if out is not None else Path("runs") / sc.name,
-                            overwrite=overwrite)  # before any work
+        out_dir = check_out(out if out is not None else Path("runs") / sc.name, overwrite=overwrite,
+                            inputs=(Path(scenario),))  # before any work; never over its input
         observer = _live_observer(sc, realtime) if live else None
         with _progress(enabled=not live) as progress:
             run = run_scenario(sc, observer=observer, progress=progress,
@@ -180,7 +198,9 @@ def run_command(
             stderr.print(f"note: {notes}", soft_wrap=True)
         stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
         if run.interrupted:
-            stderr.print(run.interrupted, soft_wrap=True)
+            from shipgnc.interrupts import say_once
+
+            say_once(run.interrupted)
             raise typer.Exit(130)
         if observer is not None and not observer.closed:
             stderr.print("close the live window to exit")
@@ -313,11 +333,18 @@ def main() -> None:
     """Console-script entry point. A usage error (an unknown option or command, a value that does
     not parse, a missing argument) is one line and exit 2 like every other bad input, not the
     parser's boxed usage text."""
+    from shipgnc.interrupts import arm_exit_deadline, exit_now, install, say_once
+
+    install()
+    arm_exit_deadline()  # Ctrl-C ends the command within half a second, whatever it is doing
+    # a pool's resource tracker (dask's workers) outlives a command ended at the deadline by a
+    # moment: it unlinks what the pool left, and is not to print a warning after the one line
+    sys.warnoptions.append("ignore::UserWarning:multiprocessing.resource_tracker")
     try:
         code = app(standalone_mode=False)
     except typer.Abort:
-        stderr.print("interrupted", soft_wrap=True)
-        raise SystemExit(130) from None
+        say_once("interrupted")
+        exit_now(130)
     except Exception as exc:  # the parser's own errors (click's, as vendored by typer)
         code = getattr(exc, "exit_code", None)
         if not (callable(getattr(exc, "format_message", None)) and isinstance(code, int)):
@@ -326,6 +353,8 @@ def main() -> None:
         hint = f" (see {ctx.command_path} --help)" if code == 2 and ctx is not None else ""
         stderr.print(f"[bold red]error:[/] {_one_line(exc.format_message())}{hint}", soft_wrap=True)
         raise SystemExit(code) from None
+    if code == 130:  # interrupted, its line said: end now
+        exit_now(130)
     raise SystemExit(code if isinstance(code, int) else 0)
 
 

@@ -61,7 +61,7 @@ def identify(
         if out is not None:
             from shipgnc.outputs import check_out
 
-            check_out(out)  # before any work
+            check_out(out, inputs=(log,))  # before any work
         optional = ("heading", "yaw_rate", "u", "v")
         data = read_log(log, required=("time", "rudder"), optional=optional, columns=columns,
                         units=units, ship=ship, need_one_of=("yaw_rate", "heading"))

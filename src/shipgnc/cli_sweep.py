@@ -53,8 +53,9 @@ def sweep(
         "--keep-partial", help="If every member diverges (exit 3), still write the study "
                                "(the marker file .shipgnc-run says 'diverged').")] = False,
     overwrite: Annotated[bool, typer.Option(
-        "--overwrite", help="Replace --out whole even when it holds files that are not a shipgnc "
-                            "run (a directory of an earlier run is always replaced whole).")] = False,
+        "--overwrite", help="Write into --out even when it holds files that are not a shipgnc run: "
+                            "they are kept, only an earlier run's files are replaced (a directory "
+                            "of an earlier run alone is always replaced whole).")] = False,
 ) -> None:
     """Sweep a scenario over a grid of settings and a Monte Carlo of seeded members."""
     from rich.markup import escape
@@ -76,7 +77,7 @@ def sweep(
         from shipgnc.outputs import check_out
 
         out_dir = check_out(out if out is not None else Path("runs") / f"sweep-{Path(scenario).stem}",
-                            overwrite=overwrite)  # before any work
+                            overwrite=overwrite, inputs=(Path(scenario),))  # before any work
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ShipGNCWarning)
             run = _run_with_progress(study, workers, scheduler, chunk_size, limit)

@@ -6,8 +6,18 @@ The finished directory holds a marker file, :data:`MARKER` (``.shipgnc-run``, a 
 the tool, its version, the command, the run's status and the files written), by which a later
 command recognises "a directory holding an earlier shipgnc run" (as does a directory holding
 nothing but files shipgnc writes, :data:`OUTPUT_FILES`: a run from before the marker): such a
-directory is replaced whole, never mixed with the new files. Any other non-empty directory is
-refused unless ``overwrite`` (``--overwrite``) is given, and then replaced whole too.
+directory is replaced whole, never mixed with the new files.
+
+Nothing shipgnc did not write is ever deleted. A directory holding anything else (a file or
+folder the marker does not list: the scenario file, the user's notes) is refused, unless
+``overwrite`` (``--overwrite``) is given: the new files are then moved in beside that content,
+replacing only the files the earlier run listed in its marker, and a file of the same name as one
+shipgnc writes that shipgnc did not write is refused still. An input of the command inside
+``--out`` is always refused (``check_out(..., inputs=...)``).
+
+A temporary directory is named after its owner (``.<name>.tmp-<host>-<pid>-<random>``): one left
+behind by a run that was killed (``kill -9``, SIGTERM, a power cut) is removed by the next
+command writing beside it once that process is gone (:func:`remove_stale`).
 
 :func:`check_out` checks ``--out`` before any work (a file, an unwritable parent, a foreign
 directory: a :class:`~shipgnc.errors.ConfigError`, exit 2). :func:`atomic_dir` turns a failing
@@ -20,19 +30,22 @@ from __future__ import annotations
 
 import errno
 import fnmatch
+import glob
+import hashlib
 import json
 import os
+import re
 import secrets
 import shutil
 import signal
-import tempfile
+import socket
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from shipgnc.errors import ConfigError, ShipGNCError
-from shipgnc.interrupts import latched
+from shipgnc.interrupts import latched, on_hard_exit
 
 #: the marker file written with every run's outputs
 MARKER = ".shipgnc-run"
@@ -56,19 +69,48 @@ OUTPUT_FILES = ("result.nc", "metrics.json", "table.csv", "table.md", "sweep.nc"
 
 def is_shipgnc_run(path: Path) -> bool:
     """Whether ``path`` is a directory holding an earlier shipgnc run: it has :data:`MARKER`, or
-    it holds nothing but files shipgnc writes (:data:`OUTPUT_FILES`)."""
+    it holds nothing but files shipgnc writes (:data:`OUTPUT_FILES`, one of them not a figure)."""
     path = Path(path)
     if (path / MARKER).is_file():
         return True
     entries = list(path.iterdir())
-    return bool(entries) and all(any(fnmatch.fnmatch(p.name, pattern) for pattern in OUTPUT_FILES)
-                                 for p in entries)
+    return (bool(entries) and all(p.is_file() and _output_name(p.name) for p in entries)
+            and any(not p.name.endswith(".png") for p in entries))
 
 
-def check_out(out: Path, *, overwrite: bool = False, option: str = "--out") -> Path:
+def _output_name(name: str) -> bool:
+    return any(fnmatch.fnmatch(name, pattern) for pattern in OUTPUT_FILES)
+
+
+def _written_by_us(path: Path) -> set[str] | None:
+    """The entries of ``path`` an earlier shipgnc run wrote (its marker's list, and the marker),
+    or None when it is not a shipgnc run."""
+    if (path / MARKER).is_file():
+        try:
+            files = json.loads((path / MARKER).read_text(encoding="utf-8")).get("files")
+        except (OSError, ValueError, AttributeError):
+            files = None
+        if not (isinstance(files, list) and all(isinstance(f, str) for f in files)):
+            files = [p.name for p in path.iterdir() if _output_name(p.name)]  # an unreadable list
+        return {*files, MARKER}
+    if is_shipgnc_run(path):
+        return {p.name for p in path.iterdir()}
+    return None
+
+
+def foreign_entries(path: Path) -> list[str]:
+    """The entries of the directory ``path`` that shipgnc did not write (sorted): everything but
+    the files its marker lists (or, before the marker, the files shipgnc writes)."""
+    ours = _written_by_us(Path(path)) or set()
+    return sorted(p.name for p in Path(path).iterdir() if p.name not in ours)
+
+
+def check_out(out: Path, *, overwrite: bool = False, option: str = "--out",
+              inputs: tuple = ()) -> Path:
     """Check an output directory before any work; return it. A ConfigError (exit 2) when it is a
-    file, the current directory (or holds it), a non-empty directory that is not a shipgnc run
-    (unless ``overwrite``), or when its parent cannot be written."""
+    file, the current directory (or holds it), holds one of ``inputs`` (files the command reads),
+    holds entries shipgnc did not write (unless ``overwrite``: they are then kept, see the module
+    docstring), or when its parent cannot be written."""
     out = Path(out)
     if str(out) == "":
         raise ConfigError(f"{option} '': name a directory")
@@ -79,15 +121,24 @@ def check_out(out: Path, *, overwrite: bool = False, option: str = "--out") -> P
     if Path.cwd().resolve().is_relative_to(resolved):
         raise ConfigError(f"{option} {shown!r}: is the current directory (or holds it): name a "
                           "directory for the outputs")
+    for item in inputs:
+        if item is not None and Path(item).exists() and Path(item).resolve().is_relative_to(resolved):
+            raise ConfigError(f"{option} {shown!r}: holds the input {str(item)!r}, which a run there "
+                              "could replace; name another directory for the outputs")
     if out.is_dir():
         try:
-            entries = sorted(p.name for p in out.iterdir())
+            foreign = foreign_entries(out)
         except OSError as exc:
             raise ConfigError(f"{option} {shown!r}: cannot read the directory ({_reason(exc)})") from None
-        if entries and not overwrite and not is_shipgnc_run(out):
-            listed = ", ".join(entries[:3]) + (", ..." if len(entries) > 3 else "")
+        if foreign and not overwrite:
+            listed = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
             raise ConfigError(f"{option} {shown!r}: holds files that are not a shipgnc run ({listed}); "
-                              "name another directory, or pass --overwrite to replace it whole")
+                              "name another directory, or pass --overwrite to write beside them "
+                              "(nothing shipgnc did not write is deleted)")
+        clash = [name for name in foreign if _output_name(name)]
+        if clash:
+            raise ConfigError(f"{option} {shown!r}: holds {clash[0]!r}, which shipgnc did not write "
+                              "and a run would replace; move it, or name another directory")
     parent = _existing_ancestor(resolved.parent)
     if not parent.is_dir():
         raise ConfigError(f"{option} {shown!r}: {str(parent)!r} is not a directory")
@@ -136,16 +187,20 @@ def output_error(out: Path, exc: BaseException, option: str = "--out") -> ShipGN
 def atomic_dir(out: Path, *, overwrite: bool = False, command: str = "run", status: str = "complete",
                option: str = "--out") -> Iterator[Path]:
     """Yield a temporary directory beside ``out``; when the block ends normally, write the marker
-    and move the directory into place (replacing an earlier shipgnc run, or with ``overwrite``
-    any directory, whole). On any error or Ctrl-C the temporary directory is removed and ``out``
-    is left as it was; an OSError becomes one line (see :func:`output_error`)."""
+    and move the directory into place (replacing an earlier shipgnc run whole, or with
+    ``overwrite`` moving the files in beside what shipgnc did not write). On any error or Ctrl-C
+    the temporary directory is removed and ``out`` is left as it was; an OSError becomes one line
+    (see :func:`output_error`). Temporary directories of dead runs beside ``out`` are removed
+    first (:func:`remove_stale`)."""
     out = check_out(Path(out), overwrite=overwrite, option=option)
     parent = out.resolve().parent
     try:
         parent.mkdir(parents=True, exist_ok=True)
+        remove_stale(parent, out.name)
         tmp = _new_dir(parent, f".{out.name}.tmp-")
     except OSError as exc:
         raise output_error(out, exc, option) from None
+    on_hard_exit(id(tmp), lambda: shutil.rmtree(tmp, ignore_errors=True))  # Ctrl-C's deadline
     try:
         yield tmp
         if status == "complete" and latched():  # a Ctrl-C a callback swallowed: not complete
@@ -161,13 +216,54 @@ def atomic_dir(out: Path, *, overwrite: bool = False, command: str = "run", stat
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+    finally:
+        on_hard_exit(id(tmp), None)
+
+
+#: a temporary directory's name: ``.<out>.tmp-<host>-<pid>-<random>`` (or ``.old-``)
+_OWNED = re.compile(r"\.(?P<out>.+)\.(?:tmp|old)-(?P<host>[0-9a-f]{8})-(?P<pid>[0-9]+)-[0-9a-f]{8}")
+
+
+def _host() -> str:
+    """This machine, in 8 hex digits (a directory shared by several machines keeps each one's)."""
+    return hashlib.sha1(socket.gethostname().encode()).hexdigest()[:8]
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):  # someone else's process (or no such number)
+        return pid < 2**31
+    return True
+
+
+def remove_stale(parent: Path, name: str) -> list[Path]:
+    """Remove the temporary directories of ``parent/name`` (``.name.tmp-*``, ``.name.old-*``)
+    whose owner, a process on this machine, is gone; return them. A live owner's, another
+    machine's and an unnamed one's are left alone."""
+    removed = []
+    host = _host()
+    try:
+        candidates = list(Path(parent).glob(f".{glob.escape(name)}.*-*"))
+    except OSError:
+        return removed
+    for path in candidates:
+        match = _OWNED.fullmatch(path.name)
+        if (match is None or match["out"] != name or match["host"] != host
+                or int(match["pid"]) == os.getpid() or _alive(int(match["pid"]))):
+            continue
+        shutil.rmtree(path, ignore_errors=True)
+        removed.append(path)
+    return removed
 
 
 def _new_dir(parent: Path, prefix: str) -> Path:
-    """A new directory ``parent/<prefix><random>`` with the usual permissions (the umask's;
-    ``tempfile.mkdtemp`` would make it private, and the run's directory keeps its mode)."""
+    """A new directory ``parent/<prefix><host>-<pid>-<random>`` with the usual permissions (the
+    umask's; ``tempfile.mkdtemp`` would make it private, and the run's directory keeps its mode)."""
     for _ in range(100):
-        path = parent / f"{prefix}{secrets.token_hex(4)}"
+        path = parent / f"{prefix}{_host()}-{os.getpid()}-{secrets.token_hex(4)}"
         try:
             path.mkdir()
         except FileExistsError:
@@ -177,11 +273,16 @@ def _new_dir(parent: Path, prefix: str) -> Path:
 
 
 def _replace(tmp: Path, out: Path) -> None:
-    """Move ``tmp`` to ``out``; an existing ``out`` is set aside first and removed after."""
+    """Move ``tmp`` to ``out``. An existing ``out`` holding only an earlier run is set aside
+    first and removed after; one holding anything else gets the new files moved in
+    (:func:`_merge`)."""
     if not out.exists():
         os.rename(tmp, out)
         return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
+    if foreign_entries(out):
+        _merge(tmp, out)
+        return
+    old = _new_dir(out.parent, f".{out.name}.old-")
     os.rmdir(old)
     os.rename(out, old)
     try:
@@ -190,6 +291,37 @@ def _replace(tmp: Path, out: Path) -> None:
         os.rename(old, out)  # put the earlier run back
         raise
     shutil.rmtree(old, ignore_errors=True)
+
+
+def _merge(tmp: Path, out: Path) -> None:
+    """Move the files of ``tmp`` into ``out`` beside what shipgnc did not write there: the files
+    of the earlier run (its marker's list) are set aside first and removed after; on a failure
+    they are put back. A name clash with a file shipgnc did not write is refused."""
+    ours = _written_by_us(out) or set()
+    new = sorted(p.name for p in tmp.iterdir())
+    clash = [n for n in new if (out / n).exists() and n not in ours]
+    if clash:
+        raise ConfigError(f"--out {str(out)!r}: holds {clash[0]!r}, which shipgnc did not write; "
+                          "nothing was written")
+    old = _new_dir(out.parent, f".{out.name}.old-")
+    moved_old, moved_new = [], []
+    try:
+        for n in sorted(ours):
+            if (out / n).exists() or (out / n).is_symlink():
+                os.rename(out / n, old / n)
+                moved_old.append(n)
+        for n in [n for n in new if n != MARKER] + [MARKER]:  # the marker last
+            os.rename(tmp / n, out / n)
+            moved_new.append(n)
+    except OSError:
+        for n in moved_new:
+            os.rename(out / n, tmp / n)
+        for n in moved_old:
+            os.rename(old / n, out / n)
+        shutil.rmtree(old, ignore_errors=True)
+        raise
+    shutil.rmtree(old, ignore_errors=True)
+    os.rmdir(tmp)
 
 
 @contextmanager

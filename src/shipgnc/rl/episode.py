@@ -217,7 +217,11 @@ class BatchedEpisode:
     def step(self, action: np.ndarray):
         """Hold ``action`` (shape ``(batch, n_inputs)``) over one control period; returns
         (observation, reward, terminated, truncated). Members already done stay frozen (reward 0)."""
-        action = np.asarray(action, dtype=float)
+        try:
+            action = np.asarray(action, dtype=float)
+        except (TypeError, ValueError):
+            raise ConfigError(f"action {action!r}: must be numbers, one command per ship and input, "
+                              f"shape ({self.batch}, {self.actuator.n})") from None
         if action.size != self.batch * self.actuator.n:
             raise ConfigError(f"action of shape {action.shape}: must hold one command per ship and input, "
                               f"shape ({self.batch}, {self.actuator.n})")

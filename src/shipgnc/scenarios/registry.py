@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 from importlib import resources
 from pathlib import Path
@@ -67,6 +68,11 @@ def raw_scenario(name_or_path: str) -> tuple[dict, str]:
 def load_scenario(name_or_path: str, overrides: list[str] | tuple[str, ...] = ()) -> Scenario:
     """Load a built-in scenario by name or a YAML file by path, apply ``key=value`` overrides
     (dotted keys, YAML values: ``simulation.dt=0.01``, ``vessel.preset=otter-munk``) and validate."""
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        raise ConfigError(f"scenario = {name_or_path!r}: expected a built-in scenario name or the "
+                          f"path of a YAML file (a str or a path), not {type(name_or_path).__name__}")
+    if isinstance(overrides, (str, bytes)) or not all(isinstance(o, str) for o in overrides):
+        raise ConfigError(f"overrides = {overrides!r}: expected a list of 'KEY=VALUE' strings")
     data, source = raw_scenario(name_or_path)
     keys = []
     for item in overrides:

@@ -473,7 +473,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     ``result.attrs["diverged"]`` and ``metrics["diverged"]``) instead of raising; comparisons
     always keep going, since a controller that diverges is a finding, not an error.
     """
-    from shipgnc.sim.simulator import scoring_log_every, simulate, thin
+    from shipgnc.sim.simulator import check_run_memory, scoring_log_every, simulate, thin
 
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario, overrides)
@@ -498,6 +498,8 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         # the metrics see every step: an unthinned record, thinned to log_every once scored
         every = scoring_log_every(setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every,
                                   scored=scenario.metrics is not None)
+        check_run_memory(setup.model, setup.x0, sim.t_end, sim.dt, every,
+                         scored=scenario.metrics is not None)  # before the run, not a MemoryError
         with interruptible(keep_interrupted) as run:
             run.result = simulate(
                 setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,

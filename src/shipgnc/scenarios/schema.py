@@ -10,6 +10,7 @@ allowed (:func:`format_validation_error`).
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Literal, Union
 
 from pydantic import Discriminator, Field, Tag, ValidationError, field_validator, model_validator
@@ -222,6 +223,13 @@ class Scenario(Strict):
                 raise ValueError("sensors / estimator with montecarlo: the Monte Carlo summary is "
                                  "scored without navigation figures; sweep the scenario instead "
                                  "(shipgnc sweep NAME --mc N scores every member's navigation)")
+            steps = self.simulation.t_end / self.simulation.dt if self.simulation else math.inf
+            for i, sensor in enumerate(self.sensors):  # a latency is held in memory, sample by sample
+                if sensor.latency > steps:
+                    raise ValueError(f"sensors.{i}.latency = {sensor.latency}: longer than the run "
+                                     f"({steps:.0f} steps of simulation.dt = {self.simulation.dt:g} s "
+                                     f"in t_end = {self.simulation.t_end:g} s); the latency counts "
+                                     "control samples")
             if self.estimator is not None and not self.sensors:
                 raise ValueError("estimator: needs sensors to correct it (e.g. sensors: "
                                  "[{type: gnss}, {type: compass}])")

@@ -744,6 +744,10 @@ class QualityConfig(Strict):
     lam: NonNegative = 1.0
 
 
+#: the largest sensor noise or bias (in its field's unit): its square is a finite float
+MAX_SENSOR_ERROR = 1e150
+
+
 class _SensorBase(Strict):
     """Common sensor settings (:mod:`shipgnc.navigation.sensors`): its own sample rate
     (a whole multiple of the control period; default every control sample), a latency in control
@@ -753,6 +757,17 @@ class _SensorBase(Strict):
     rate_hz: Positive | None = None
     latency: Annotated[int, Field(ge=0)] = 0
     dropouts: list[tuple[NonNegative, NonNegative]] = Field(default_factory=list)
+
+    @field_validator("*", mode="after")
+    @classmethod
+    def _variance_finite(cls, value, info):
+        """A noise or bias whose square (the variance the filter and the draws use) overflows
+        a float is refused here, not met as an OverflowError in the run."""
+        if info.field_name.startswith(("noise", "bias")) and isinstance(value, float) \
+                and abs(value) > MAX_SENSOR_ERROR:
+            raise ValueError(f"too large: its square (the variance) overflows; at most "
+                             f"{MAX_SENSOR_ERROR:g}")
+        return value
 
 
 class GNSSConfig(_SensorBase):

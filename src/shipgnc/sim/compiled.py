@@ -2,13 +2,15 @@
 replay, the ``Log``.
 
 :mod:`shipgnc.sim.compose` composes any combination of components with kernels into one loop and
-runs it through :func:`drive` and :func:`make_log`. A run is one kernel call, or several that
-carry each ship's state from one to the next (bit-identical results): about twenty with a
-progress callback, and short ones for a batch logging many samples.
+runs it through :func:`drive` and :func:`make_log`. A run is several kernel calls that carry
+each ship's state from one to the next (bit-identical results): each about :data:`CALL_S` long
+(Ctrl-C is seen between calls), at least twenty with a progress callback, and short ones for a
+batch logging many samples.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import NamedTuple
 
@@ -24,6 +26,12 @@ MAX_CALL_WORK = 5_000_000
 #: so neighbouring ships share its cache lines, and short calls keep them cached from one ship to
 #: the next (a 1 000-ship log of every step is written ≈ 2× faster)
 LOG_SAMPLES_PER_CALL = 256
+#: seconds a kernel call should last at most: Ctrl-C is answered between calls (a signal waits
+#: for compiled code to return), so each run is cut into calls about this long, measured as it goes
+CALL_S = 0.05
+#: ship-steps of the first call (before the rate is known), and the growth of a call over the last
+FIRST_CALL_WORK = 20_000
+CALL_GROWTH = 4
 #: kernel calls of a run whose guidance can finish: the kernel steps a finished ship on to the end
 #: of its call (only the driver sees that every ship has finished) and the call that holds the
 #: last finish is replayed up to it, so both costs are one call's share of the run, not the run
@@ -87,7 +95,7 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
     done_through = -1  # the last step every ship has completed (Ctrl-C keeps the log up to it)
     masking = setup.on_divergence == "mask"
     try:
-        for k0, k1 in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+        for k0, k1 in _timed_calls(bounds.tolist(), n_ships):
             if prepare is not None:
                 prepare(k0, k1)
             start = S.copy()
@@ -125,6 +133,30 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
     except KeyboardInterrupt:  # Ctrl-C between (or within) kernel calls
         return Stop(None, done_through, interrupted=True)
     return Stop(None, n_steps)
+
+
+def _timed_calls(bounds: list[int], n_ships: int):
+    """The calls ``(k0, k1)`` of a run: each interval of ``bounds`` cut into calls of about
+    :data:`CALL_S` seconds, the steps per second measured on the calls before (the first two
+    calls :data:`FIRST_CALL_WORK` ship-steps: the first may compile the kernel; each call at most
+    :data:`CALL_GROWTH` times the last). How the steps are cut changes no result (the calls carry
+    each ship's state exactly)."""
+    import time
+
+    size = max(1, FIRST_CALL_WORK // max(n_ships, 1))
+    first = True
+    for a, b in itertools.pairwise(bounds):
+        k = a
+        while k < b:
+            k1 = min(b, k + size)
+            start = time.perf_counter()
+            yield k, k1
+            elapsed = time.perf_counter() - start
+            if not first:  # the first call's time is mostly compiling, not stepping
+                rate = (k1 - k) / max(elapsed, 1e-6)
+                size = max(1, min(int(rate * CALL_S), CALL_GROWTH * (k1 - k)))
+            first = False
+            k = k1
 
 
 def finish_steps(done_at: np.ndarray, div_event: np.ndarray) -> np.ndarray:

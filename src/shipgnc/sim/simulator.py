@@ -26,6 +26,7 @@ import numpy as np
 from shipgnc.actuators import Actuator
 from shipgnc.errors import ConfigError, DivergenceError, Interrupted, require
 from shipgnc.frames import wrap_angle
+from shipgnc.interrupts import note
 from shipgnc.models.base import Signal, names
 from shipgnc.sim.integrators import rk4_step, solve_ivp_step
 from shipgnc.streams import MemberStreams, is_generator
@@ -178,14 +179,21 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
             evaluator = getattr(disturbance, "evaluator", None)
             if evaluator is not None and evaluator() != "numpy":
                 ran_on = f"{ran_on}+{evaluator()}"
-    from shipgnc.sim.result import batch_dim_names, build_dataset
-
     run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold,
                  "t_end": t_end, "model": type(model).__name__, **(attrs or {})}
-    if log.status.get("interrupted"):  # the partial Dataset is built only if someone reads it
-        last = float(log.time[-1]) if log.time.size else 0.0
-        raise Interrupted(last, partial=lambda: build_dataset(log, setup.batch_shape, batch_dims,
-                                                               run_attrs))
+    if log.status.get("interrupted"):  # the partial Dataset is built (xarray imported) only if
+        last = float(log.time[-1]) if log.time.size else 0.0  # someone reads it
+
+        def partial():
+            from shipgnc.sim.result import build_dataset
+
+            return build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
+
+        error = Interrupted(last, partial=partial if log.time.size else None)
+        note(str(error))  # the line said if the command is not done by the deadline
+        raise error
+    from shipgnc.sim.result import batch_dim_names, build_dataset
+
     result = build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
     if log.diverged_at is not None:
         dims = batch_dim_names(setup.batch_shape, batch_dims)
@@ -336,7 +344,7 @@ def logged_numbers(model, batch_shape: tuple[int, ...], n_steps: int, log_every:
 
 def scoring_log_every(model, x0, t_end: float, dt: float, log_every: int, *,
                       scored: bool = True, what: str = "simulation.log_every",
-                      fewer: str = "use fewer ships") -> int:
+                      fewer: str | None = None) -> int:
     """The ``log_every`` to simulate with so that metrics see every step: 1 when the run is
     ``scored`` (thin the written result afterwards with :func:`thin`), else ``log_every``. An
     unthinned record beyond :data:`MAX_LOGGED` is a ConfigError naming ``what`` (thinning the
@@ -349,11 +357,62 @@ def scoring_log_every(model, x0, t_end: float, dt: float, log_every: int, *,
     batch = np.shape(x0)[:-1]
     numbers = logged_numbers(model, batch, round(steps), 1)
     if numbers > MAX_LOGGED:
+        fits = _fitting_t_end(t_end, MAX_LOGGED / numbers)
+        if fewer is None:
+            fewer = "use fewer ships" if math.prod(batch) > 1 else ""
         raise ConfigError(f"{what} = {log_every}: the metrics are computed from every step, and "
                           f"this run's unthinned record ({numbers * 8 / 2**30:.1f} GiB) exceeds the "
                           f"{MAX_LOGGED * 8 / 2**30:.0f} GiB log limit ({what} thins only the written "
-                          f"result): shorten simulation.t_end, raise simulation.dt or {fewer}")
+                          f"result): shorten simulation.t_end (about {fits:g} s fits), raise "
+                          f"simulation.dt" + (f" or {fewer}" if fewer else ""))
     return 1
+
+
+def _fitting_t_end(t_end: float, share: float) -> float:
+    """``t_end · share`` rounded down to two significant digits (a t_end that fits)."""
+    value = t_end * min(share, 1.0)
+    if value <= 0:
+        return 0.0
+    scale = 10.0 ** (math.floor(math.log10(value)) - 1)
+    return math.floor(value / scale) * scale
+
+
+#: the arrays a run holds besides its record, in records: the metrics' derived series and the
+#: written file's encoding (the sweep's chunk estimate counts the same)
+RUN_MEMORY_FACTOR = 2
+
+
+def check_run_memory(model, x0, t_end: float, dt: float, log_every: int, *,
+                     limit: float | None = None, scored: bool = False) -> None:
+    """A ConfigError (exit 2) naming the estimate and what fits when a run's record (logged
+    every ``log_every`` steps, :func:`logged_numbers`), about :data:`RUN_MEMORY_FACTOR` times
+    over, needs more than ``limit`` bytes (default: the memory available now, ``ulimit -v``
+    counted: :func:`shipgnc.memory.available_memory`). ``scored``: the metrics are computed
+    from every step (see :func:`scoring_log_every`), so ``simulation.log_every`` would not help
+    and is not named."""
+    from shipgnc.memory import available_memory
+
+    steps = t_end / dt
+    if not math.isfinite(steps) or steps > MAX_STEPS:
+        return  # simulate's own check names it
+    batch = np.shape(x0)[:-1]
+    numbers = logged_numbers(model, batch, round(steps), log_every)
+    if numbers > MAX_LOGGED:
+        return  # simulate's own log-size guard names it
+    need = 8 * RUN_MEMORY_FACTOR * numbers
+    have = available_memory() if limit is None else limit
+    if need <= have:
+        return
+    fits = _fitting_t_end(t_end, have / need)
+    gib = 2.0 ** 30
+    advice = f"shorten simulation.t_end (about {fits:g} s fits) or raise simulation.dt"
+    if not scored:
+        advice += ", or log fewer samples (simulation.log_every)"
+    if math.prod(batch) > 1:
+        advice += ", or use fewer ships"
+    raise ConfigError(f"simulation.t_end = {t_end:g} s: the run needs about {need / gib:.1f} GiB "
+                      f"({round(steps):,} steps of {dt:g} s logged every {log_every}), more than the "
+                      f"memory available ({have / gib:.1f} GiB): {advice}")
 
 
 def thin(result, log_every: int):
@@ -636,7 +695,7 @@ def mask_diverged(log: Log, diverged_at: np.ndarray, first_error, dt: float) -> 
     flat = diverged_at.reshape(-1)
     after = log.time[:, None] >= flat[None, :] - 0.5 * dt  # NaN compares False: kept
     for name, values in log.data.items():
-        rows = values.reshape(values.shape[0], -1)
+        rows = values.reshape(values.shape[0], flat.size)  # (also no samples: Ctrl-C at once)
         rows[after] = np.nan
         log.data[name] = rows.reshape(values.shape)
     n = int(np.count_nonzero(np.isfinite(flat)))

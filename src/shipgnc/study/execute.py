@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from shipgnc.errors import ConfigError, Interrupted, ShipGNCWarning
+from shipgnc.interrupts import note
+from shipgnc.memory import available_memory
 from shipgnc.study.chunk import Chunk, check_perturbable, check_sweepable, plan_chunks, run_chunk
 from shipgnc.study.spec import Study
 
@@ -141,7 +143,9 @@ def run_chunks(study: Study, chunks: list[Chunk], *, client=None,
             return out
         return _run_on_dask(study, chunks, client, counted)
     except KeyboardInterrupt:  # Ctrl-C: one line, whatever was running
-        raise Interrupted(message=f"interrupted after {finished[0]} of {total} chunks") from None
+        message = f"interrupted after {finished[0]} of {total} chunks"
+        note(message)  # said at once if closing the cluster would keep the command waiting
+        raise Interrupted(message=message) from None
 
 
 def _run_on_dask(study: Study, chunks: list[Chunk], client, on_chunk) -> list:
@@ -216,39 +220,6 @@ def assemble(study: Study, chunks: list[Chunk], parts: list, variants: list[str]
 #: numbers kept per member and cell besides the series: its metrics, parameters and offsets
 #: (a generous bound: the richest metric set holds about forty)
 NUMBERS_PER_MEMBER = 64
-
-
-def available_memory() -> int:
-    """Bytes this process can allocate now: the machine's ``MemAvailable`` (else its physical
-    memory), and no more than what an address-space limit (``ulimit -v``) leaves."""
-    machine = _proc_kib("/proc/meminfo", "MemAvailable:")
-    if machine is None:
-        try:
-            machine = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-        except (ValueError, OSError, AttributeError):
-            machine = 1 << 62
-    try:
-        import resource
-
-        soft, unlimited = resource.getrlimit(resource.RLIMIT_AS)[0], resource.RLIM_INFINITY
-    except (ImportError, OSError, ValueError):  # no address-space limits here (Windows)
-        return machine
-    used = _proc_kib("/proc/self/status", "VmSize:")
-    if soft != unlimited and used is not None:
-        machine = min(machine, max(0, soft - used))
-    return machine
-
-
-def _proc_kib(path: str, key: str) -> int | None:
-    """A ``key: N kB`` line of a /proc file, in bytes (None where there is no /proc)."""
-    try:
-        with open(path, encoding="ascii") as handle:
-            for line in handle:
-                if line.startswith(key):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError):
-        pass
-    return None
 
 
 def estimate_memory(study: Study, variants: list[str] | None, chunk_size: int) -> dict[str, int]:

@@ -4,7 +4,8 @@ Importing matplotlib and rendering the PNGs of a small scenario take about as lo
 xarray and simulating it. A worker forked first, while the command line has imported little more
 than typer (no numpy threads yet), imports matplotlib on the second core meanwhile, so
 a command-line run costs the longer of the two, not their sum. Linux only (``fork``); elsewhere,
-and on any failure of the worker, the figures are drawn in this process.
+and on any failure of the worker, the figures are drawn in this process. The worker dies with
+this process and ignores Ctrl-C, which this process answers (:mod:`shipgnc.lifeline`).
 """
 
 from __future__ import annotations
@@ -16,7 +17,10 @@ import sys
 from collections.abc import Callable
 
 
-def _preload() -> None:
+def _preload(parent_pid: int) -> None:
+    from shipgnc.lifeline import die_with_parent
+
+    die_with_parent(parent_pid)  # killed with the command, and deaf to the terminal's Ctrl-C
     import matplotlib
 
     matplotlib.use("Agg")
@@ -37,11 +41,14 @@ class FigureProcess:
         self._pool = None
         if os.environ.get("SHIPGNC_FIGURE_PROCESS", "1") == "0" or not sys.platform.startswith("linux"):
             return
+        from shipgnc.lifeline import forking
+
         try:
             ctx = multiprocessing.get_context("fork")
             self._pool = concurrent.futures.ProcessPoolExecutor(
-                max_workers=1, mp_context=ctx, initializer=_preload)
-            self._pool.submit(_ready)  # start the worker (and its imports) now
+                max_workers=1, mp_context=ctx, initializer=_preload, initargs=(os.getpid(),))
+            with forking():
+                self._pool.submit(_ready)  # start the worker (and its imports) now
         except (OSError, RuntimeError, ValueError):
             self._pool = None
 
