@@ -115,3 +115,43 @@ def region_polygons(x, y, value, level: float) -> list:
             poly = shapely.make_valid(shapely.Polygon(rings[0], rings[1:]))
             polys.extend(g for g in shapely.get_parts(poly) if g.geom_type == "Polygon" and g.area > 0)
     return polys
+
+
+def coastline_size(lon0, lat0, lon1, lat1) -> tuple[int, int]:
+    """(polygons, coordinates) of the GSHHG polygons meeting the box, counted before any clipping: the
+    size of the coastline work a route's set-up does (for the estimate before it)."""
+    import shapely
+
+    geoms, tree = _gshhg()
+    idx = tree.query(shapely.box(lon0, lat0, lon1, lat1), predicate="intersects")
+    return int(idx.size), int(shapely.get_num_coordinates(geoms[idx]).sum()) if idx.size else 0
+
+
+class PlaneLand:
+    """Land as separate polygons (not their union: the union of a coastline with thousands of islands is
+    the costly step) behind an STR tree: ``intersects``/``contains`` answer as the union would."""
+
+    def __init__(self, polys):
+        import shapely
+
+        self.polys = np.array([p for p in polys if not p.is_empty], dtype=object)
+        self.tree = shapely.STRtree(self.polys)
+        shapely.prepare(self.polys)
+
+    @property
+    def is_empty(self) -> bool:
+        return self.polys.size == 0
+
+    def intersects(self, geom) -> bool:
+        return self.polys.size > 0 and self.tree.query(geom, predicate="intersects").size > 0
+
+    def contains(self, geom) -> bool:
+        return self.polys.size > 0 and self.tree.query(geom, predicate="within").size > 0
+
+    def distance(self, geom) -> float:
+        import shapely
+
+        if self.polys.size == 0:
+            return float("inf")
+        k = self.tree.nearest(geom)
+        return float(shapely.distance(self.polys[k], geom))

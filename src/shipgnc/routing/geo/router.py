@@ -197,6 +197,8 @@ class GeoProblem:
         self.h = float(grid) if grid is not None else size / 200.0
         require(math.isfinite(self.h) and self.h > 0, "--grid", grid, "must be a spacing > 0")
         self.clearance = self.h if clearance is None else float(clearance)
+        self._grid = None if grid is None else float(grid)
+        self._clearance = None if clearance is None else float(clearance)
         # ---- the current
         if current is None:
             current = GeoCurrent(uniform=(0.0, 0.0))
@@ -290,7 +292,7 @@ class GeoProblem:
         import shapely
 
         from shipgnc.routing.geo import cf
-        from shipgnc.routing.geo.land import coastline, load_land, region_polygons
+        from shipgnc.routing.geo.land import PlaneLand, coastline, load_land, region_polygons
 
         proj = self.projection
         (n0, n1), (e0, e1) = self.box
@@ -334,42 +336,59 @@ class GeoProblem:
         geo_box = shapely.box(*self.geo_box)
         self.land_geo = [p for g in groups if g[2] for p in g[2] if p.intersects(geo_box)]
         self.land_kinds = [g[1] for g in groups]
-        box = shapely.box(n0, e0, n1, e1)
+        box = shapely.box(n0, e0, n1, e1).buffer(4 * self.clearance)
         parts = []
         for what, kind, geo_polys, plane_polys in groups:
-            plane = plane_polys if plane_polys is not None else [
-                self._to_plane_geom(p) for p in geo_polys if p.intersects(geo_box)]
+            plane = plane_polys if plane_polys is not None else self._to_plane_geoms(
+                [p for p in geo_polys if p.intersects(geo_box)])
+            plane = [q for p in plane for q in shapely.get_parts(shapely.intersection(p, box))
+                     if q.geom_type == "Polygon" and q.area > 0]
             if not plane:
                 continue
-            u = shapely.intersection(shapely.union_all([shapely.make_valid(p) for p in plane]),
-                                     box.buffer(4 * self.clearance))
+            here = PlaneLand(plane)
             for name, p, q in (("start", self.A, self.start), ("target", self.B, self.target)):
-                if u.contains(shapely.Point(p)):
+                if here.contains(shapely.Point(p)):
                     raise ConfigError(f"--{name} = {q[0]:.5f},{q[1]:.5f}: {what} ({kind})")
-            parts.append(u)
-        self.hard = shapely.union_all(parts) if parts else shapely.Polygon()  # (north, east) m
-        shapely.prepare(self.hard)
-        kinds = self.land_kinds
+            parts.extend(plane)
+        self.hard = PlaneLand(parts)  # (north, east) m, every polygon apart (no union)
+        self._router_obstacles = None
         if self.hard.is_empty:
-            self.router_obstacles = []
+            self._router_obstacles = []
             return
-        soft = self.hard.simplify(self.clearance / 10).buffer(self.clearance, quad_segs=2)
-        soft = soft.difference(shapely.Point(self.A).buffer(1.5 * self.clearance))
-        soft = soft.difference(shapely.Point(self.B).buffer(1.5 * self.clearance))
-        soft = shapely.intersection(soft, box).simplify(self.clearance / 8)
-        self.router_obstacles = [g for g in shapely.get_parts(soft)
-                                 if g.geom_type == "Polygon" and g.area > 0 and g.is_valid]
-        self.notes.append(f"land/shallow water: {'; '.join(kinds)}; the router keeps {self.clearance:.0f} m "
-                          "(one level-set cell) off it")
+        self.notes.append(f"land/shallow water: {'; '.join(self.land_kinds)}")
 
-    def _to_plane_geom(self, geom):
+    @property
+    def router_obstacles(self) -> list:
+        """The land the level set freezes: every polygon simplified within clearance/10 and grown by the
+        clearance (one level-set cell), the disc of 1.5 clearances about A and B left open; built on
+        first use (only the level set needs it)."""
+        if self._router_obstacles is None:
+            import shapely
+
+            cl = self.clearance
+            (n0, n1), (e0, e1) = self.box
+            grown = shapely.buffer(shapely.simplify(self.hard.polys, cl / 10), cl, quad_segs=2)
+            soft = shapely.union_all(grown)
+            soft = soft.difference(shapely.Point(self.A).buffer(1.5 * cl))
+            soft = soft.difference(shapely.Point(self.B).buffer(1.5 * cl))
+            soft = shapely.intersection(soft, shapely.box(n0, e0, n1, e1)).simplify(cl / 8)
+            self._router_obstacles = [g for g in shapely.get_parts(soft)
+                                      if g.geom_type == "Polygon" and g.area > 0 and g.is_valid]
+        return self._router_obstacles
+
+    def _to_plane_geoms(self, geoms) -> list:
+        """Lon/lat polygons in the plane ((north, east) m), all in one projection call."""
         import shapely
+
+        if not geoms:
+            return []
 
         def f(xy):
             n, e = self.projection.to_plane(xy[:, 1], xy[:, 0])
             return np.column_stack([n, e])
 
-        return shapely.make_valid(shapely.transform(geom, f))
+        out = shapely.make_valid(shapely.transform(np.array(geoms, dtype=object), f))
+        return [q for g in out for q in shapely.get_parts(g) if q.geom_type == "Polygon" and q.area > 0]
 
     # ------------------------------------------------------------------ solving
     def departure(self, depart_s=None, offset_s=0.0):
@@ -396,30 +415,136 @@ class GeoProblem:
         fld.times = self.field.times - float(depart_s)
         return fld
 
+    def plan(self, method="auto") -> str:
+        """The method :meth:`solve` runs: ``open sea`` (no land in the box: the plane router,
+        ``method``), ``levelset`` (the level set round land over the box: a gridded current with
+        ``method`` auto/levelset, or ``method`` levelset), or ``sea graph`` (land in the box, a uniform
+        current or ``method`` graph: the open-sea route when it is clear of land, else the graph on the
+        sea's cells and its taut string, :mod:`.seagraph`). ``method`` pmp with land: the open-sea
+        extremal, refused when it meets land."""
+        gridded = self.current.grid is not None
+        if self.hard.is_empty:
+            return "levelset" if gridded and method in ("auto", "levelset") else "open sea"
+        if method == "levelset" or (gridded and method == "auto"):
+            return "levelset"
+        return "sea graph"
+
+    def sea_spacing(self) -> float:
+        """The sea graph's raster spacing g [m]: ``--grid`` when given, else the box's larger side / 800."""
+        if self._grid is not None:
+            return float(self._grid)
+        (n0, n1), (e0, e1) = self.box
+        return max(n1 - n0, e1 - e0) / 800.0
+
+    def memory_estimate(self, fld, method="auto", horizon=None):
+        """The :class:`~shipgnc.routing.memory.RouteMemory` of :meth:`solve` with this ``method``, before
+        any work: the level set's arrays (:func:`~shipgnc.routing.memory.levelset_memory`), the sea graph's
+        raster and edges (:mod:`.seagraph`: ``CELL_BYTES`` per cell, ``EDGE_BYTES`` per edge, 16 per free
+        cell at most), or the plane router's (:func:`~shipgnc.routing.memory.route_memory_estimate`)."""
+        from shipgnc.routing.geo import seagraph
+        from shipgnc.routing.memory import RouteMemory, levelset_memory, route_memory_estimate
+
+        plan = self.plan(method)
+        if plan == "levelset":
+            return levelset_memory(fld, self.speed, self.A, self.B, self.box, self.h, horizon=horizon,
+                                   r0=1.2 * self.h, n_rays=360, ray_steps=20)  # routing.geo.frontier
+        out = route_memory_estimate(fld, self.speed, self.A, self.B, method="pmp" if plan == "sea graph"
+                                    else method, grid_spacing=self.h, domain=self.box, horizon=horizon)
+        if plan == "sea graph":
+            g = self.sea_spacing()
+            cells = seagraph.raster_cells(self.box, g)
+            edges = seagraph.DIRECTIONS * cells
+            out.items["sea graph: raster"] = seagraph.CELL_BYTES * cells
+            out.items["sea graph: edges"] = seagraph.EDGE_BYTES * edges
+            out.phases["graph"] = out.items["sea graph: raster"] + out.items["sea graph: edges"]
+            out.graph_edges = edges
+            out.grid = (cells, 1)
+        return out if out.phases else RouteMemory()
+
     def solve(self, depart_s=None, *, method="auto", horizon=None, global_check=None, **kw) -> GeoRoute:
-        """The route for a departure [s since epoch, or None without a clock]. With land in the box, or a
-        gridded current (``method`` auto/levelset), the level set of :mod:`.frontier` (the global method);
-        otherwise :func:`~shipgnc.routing.router.solve_route` (``method``; ``kw`` passed on)."""
+        """The route for a departure [s since epoch, or None without a clock], by the method of
+        :meth:`plan`; ``kw`` passed on to :func:`~shipgnc.routing.router.solve_route`."""
         from shipgnc.routing.router import solve_route
 
         fld = self.field_from(depart_s)
         notes = []
         if horizon is None:
             horizon = 4.0 * float(np.hypot(*(self.B - self.A))) / self.speed
-        gridded = self.current.grid is not None
-        if self.router_obstacles or (gridded and method in ("auto", "levelset")):
+        plan = self.plan(method)
+        if plan == "levelset":
             if method not in ("auto", "levelset"):
                 notes.append(f"--method {method}: land in the route's box; the level set is used")
             res = self._round_land(fld, horizon, notes)
         else:
-            res = solve_route(fld, self.speed, self.A, self.B, t0=0.0, method=method, horizon=horizon,
-                              grid_spacing=self.h, domain=self.box, global_check=global_check, **kw)
+            res = solve_route(fld, self.speed, self.A, self.B, t0=0.0, method="auto" if method == "graph"
+                              else method, horizon=horizon, grid_spacing=self.h, domain=self.box,
+                              global_check=global_check, **kw)
+            if plan == "sea graph":
+                res = self._sea_graph(fld, res, method, notes)
         out = GeoRoute(res, self, False, depart_s=depart_s, notes=notes)
         if not res.reachable:
             out.notes.append(f"unreachable: {res.reason}")
             return out
         self._finish(out)
         return out
+
+    def _open_sea_clear(self, res) -> bool:
+        """Does the open-sea route's plane track (2000 points) miss every land polygon?"""
+        import shapely
+
+        if not res.reachable:
+            return False
+        _t, north, east, _ = res.sample(2000)
+        return not self.hard.intersects(shapely.LineString(np.column_stack([north, east])))
+
+    def _sea_graph(self, fld, open_sea, method, notes):
+        """Land in the box: the open-sea route when it misses the land (the optimum without land is a lower
+        bound, reached), else the graph route of :mod:`.seagraph` on the sea's cells."""
+        from shipgnc.routing.geo import seagraph
+        from shipgnc.routing.result import RouteResult
+
+        if method != "graph" and self._open_sea_clear(open_sea):
+            notes.append("land in the route's box, none on the open-sea route: the open-sea optimum is the "
+                         "route (no shorter route exists round the land)")
+            return open_sea
+        if method == "pmp":
+            raise ConfigError("--method pmp: the extremals' route meets land; --method auto or graph goes "
+                              "round it")
+        g = self.sea_spacing()
+        cl = self._clearance if self._clearance is not None else g
+        tol = g / 4
+        north, east = seagraph.raster_axes(self.box, g)
+        import shapely
+
+        simple = shapely.simplify(self.hard.polys, tol)
+        land = seagraph.land_raster(simple, north, east)
+        blocked = seagraph.blocked_cells(land, g, cl, tol)
+        for p in (self.A, self.B):
+            seagraph.free_near(blocked, land, north, east, p, cl + 2 * g + tol)
+        sea = seagraph.sea_route(fld, self.speed, self.A, self.B, north, east, blocked)
+        res = RouteResult(False, self.A, self.B, self.speed, t0=0.0, method="graph", field=fld)
+        res.grid_spacing = g
+        self.clearance = cl
+        notes.append(f"land on the open-sea route: a graph on the sea's cells ({sea.free:,} of {sea.cells:,} "
+                     f"cells of {g:.0f} m free, {sea.edges:,} edges, 16 directions, the current at "
+                     f"departure), its path pulled taut (docs/routing_geo.md); the route keeps {cl:.0f} m off "
+                     "the coastline")
+        if sea.route is None:
+            res.reason = (f"the target is not connected to the start over the sea's cells of {g:.0f} m kept "
+                          f"{cl:.0f} m off land (or the current cannot be stemmed); a finer --grid opens "
+                          "narrower straits")
+            return res
+        r = sea.route
+        res.reachable, res.time_s, res.path = True, float(r.time_s), r
+        res.heading_start, res.heading_end, res.miss_m = r.heading_start, r.heading_end, 0.0
+        res.global_check = {"method": "graph", "time_s": sea.lattice_time,
+                            "rel_diff": (r.time_s - sea.lattice_time) / sea.lattice_time}
+        if not self.current_is_uniform():
+            notes.append("the current is taken at departure along the whole route (the graph is steady)")
+        return res
+
+    def current_is_uniform(self) -> bool:
+        return self.current.grid is None
 
     def _round_land(self, fld, horizon, notes):
         from shipgnc.routing.geo.frontier import reach_round_land
@@ -432,7 +557,8 @@ class GeoProblem:
         if frozen.any():
             notes.append(f"land or shallow water in the route's box ({100 * frozen.mean():.0f} % of the "
                          f"level-set cells): the level set with land cells frozen, φ clipped to a band "
-                         f"(docs/routing_geo.md), grid {self.h:.0f} m")
+                         f"(docs/routing_geo.md), grid {self.h:.0f} m; the router keeps {self.clearance:.0f} m "
+                         "(one level-set cell) off land")
         else:
             notes.append(f"gridded current: the level set (global method), grid {self.h:.0f} m")
         if ls.arrival is None:
