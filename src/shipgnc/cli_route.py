@@ -219,9 +219,9 @@ def _check_memory(need, limit: float | None) -> None:
     if need.total <= have:
         return
     what = f"{format_bytes(have)} is available" if limit is None else f"--max-memory is {format_bytes(have)}"
-    hint = {"level set": "use a coarser --grid, a shorter --horizon or --method pmp",
-            "graph": "use a coarser --grid or another --method",
-            "sweep": "use --method levelset"}.get(need.largest(), "")
+    hint = (need.advice(have) if callable(need.advice) else need.advice) or {"level set": "use a coarser --grid, a shorter --horizon or --method pmp",
+                           "graph": "use a coarser --grid or another --method",
+                           "sweep": "use --method levelset"}.get(need.largest(), "")
     raise ConfigError(f"route: needs about {format_bytes(need.total)} ({need.describe()}) but {what}; "
                       f"{hint + ', or ' if hint else ''}raise --max-memory")
 
@@ -280,20 +280,14 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
 
         offset, iso_depart = 0.0, parse_iso(depart)
     problem = GeoProblem(a, b, speed, current=current, land=land, depth=depth, draft=draft, ukc=ukc,
-                         grid=None if grid is None else grid * length, xte_m=xte_m)
+                         grid=None if grid is None else grid * length, xte_m=xte_m,
+                         budget=lambda need: _check_memory(need, limit))
     if iso_depart is None and problem.current.times is None and offset:
         raise ConfigError(f"--depart = {depart!r}: the current has no time axis; give an ISO 8601 UTC time")
     t_dep = problem.departure(iso_depart, offset)
-    from shipgnc.routing.memory import levelset_memory, route_memory_estimate
-
     t_h = None if horizon is None else horizon * tscale
     fld = problem.field_from(t_dep)
-    if problem.router_obstacles or (problem.current.grid is not None and method in ("auto", "levelset")):
-        need = levelset_memory(fld, speed, problem.A, problem.B, problem.box, problem.h, horizon=t_h,
-                               r0=1.2 * problem.h, n_rays=360, ray_steps=20)  # routing.geo.frontier
-    else:
-        need = route_memory_estimate(fld, speed, problem.A, problem.B, method=method, grid_spacing=problem.h,
-                                     domain=problem.box, horizon=t_h)
+    need = problem.memory_estimate(fld, method=method, horizon=t_h, unit=(length, "nm" if length > 1 else "m"))
     _check_memory(need, limit)
     with _progress() as progress:
         res = problem.solve(t_dep, method=method, horizon=t_h, progress=progress)

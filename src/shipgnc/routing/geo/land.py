@@ -20,6 +20,18 @@ import numpy as np
 from shipgnc.errors import ConfigError
 
 
+#: memory the GSHHG polygons hold once loaded (measured: 558 MiB of resident memory for its 180 496
+#: polygons, 9.46·10⁶ points, from roaring-landmask's WKB), rounded up
+GSHHG_BYTES = 600 * 2**20
+#: memory per GSHHG point in the route's box while it is clipped and projected (its lon/lat copy, its plane
+#: copy, make_valid's): measured 38–66 MiB for 1.7–4.1·10⁶ points, 23 bytes a point, doubled
+COORD_BYTES = 48
+
+
+def gshhg_loaded() -> bool:
+    return _gshhg.cache_info().currsize > 0
+
+
 @lru_cache(maxsize=1)
 def _gshhg():
     import shapely
@@ -40,11 +52,11 @@ def coastline(lon0, lat0, lon1, lat1) -> list:
 
     geoms, tree = _gshhg()
     box = shapely.box(lon0, lat0, lon1, lat1)
-    out = []
-    for k in tree.query(box, predicate="intersects"):
-        g = shapely.intersection(geoms[k], box)
-        out.extend(p for p in shapely.get_parts(g) if p.geom_type == "Polygon" and p.area > 0)
-    return out
+    sel = geoms[tree.query(box, predicate="intersects")]
+    inside = shapely.within(sel, box)  # whole islands kept as they are; the rest clipped
+    parts = shapely.get_parts(np.concatenate([sel[inside], shapely.intersection(sel[~inside], box)]))
+    keep = (shapely.get_type_id(parts) == 3) & (shapely.area(parts) > 0)
+    return list(parts[keep])
 
 
 def load_land(path) -> list:

@@ -171,7 +171,7 @@ class GeoProblem:
     for one departure, as often as wanted (a departure scan)."""
 
     def __init__(self, start, target, speed, *, current=None, land="default", depth=None, draft=0.0,
-                 ukc=0.0, grid=None, margin=None, xte_m=XTE_M, clearance=None):
+                 ukc=0.0, grid=None, margin=None, xte_m=XTE_M, clearance=None, budget=None):
         from shipgnc.routing.geo import cf
 
         for name, p in (("--start", start), ("--target", target)):
@@ -199,6 +199,7 @@ class GeoProblem:
         self.clearance = self.h if clearance is None else float(clearance)
         self._grid = None if grid is None else float(grid)
         self._clearance = None if clearance is None else float(clearance)
+        self._budget, self.held_bytes = budget, 0
         # ---- the current
         if current is None:
             current = GeoCurrent(uniform=(0.0, 0.0))
@@ -309,6 +310,7 @@ class GeoProblem:
         elif land in (None, "none"):
             pass
         elif land == "default":
+            self._coastline_budget()
             groups.append(("on land", "GSHHG full-resolution coastline (roaring-landmask)",
                            coastline(*self.geo_box), None))
         else:
@@ -334,16 +336,16 @@ class GeoProblem:
             groups.append((f"on a NaN (land) cell of {self.current.grid.path} or outside it",
                            f"NaN cells and the outside of {self.current.grid.path}", None, nan_polys))
         geo_box = shapely.box(*self.geo_box)
-        self.land_geo = [p for g in groups if g[2] for p in g[2] if p.intersects(geo_box)]
+        groups = [(what, kind, None if geo is None else _meeting(geo, geo_box), plane)
+                  for what, kind, geo, plane in groups]
+        self.land_geo = [p for g in groups if g[2] is not None for p in g[2]]
         self.land_kinds = [g[1] for g in groups]
         box = shapely.box(n0, e0, n1, e1).buffer(4 * self.clearance)
         parts = []
         for what, kind, geo_polys, plane_polys in groups:
-            plane = plane_polys if plane_polys is not None else self._to_plane_geoms(
-                [p for p in geo_polys if p.intersects(geo_box)])
-            plane = [q for p in plane for q in shapely.get_parts(shapely.intersection(p, box))
-                     if q.geom_type == "Polygon" and q.area > 0]
-            if not plane:
+            plane = plane_polys if plane_polys is not None else self._to_plane_geoms(geo_polys)
+            plane = _meeting(plane, box) if len(plane) else []
+            if not len(plane):
                 continue
             here = PlaneLand(plane)
             for name, p, q in (("start", self.A, self.start), ("target", self.B, self.target)):
@@ -356,6 +358,27 @@ class GeoProblem:
             self._router_obstacles = []
             return
         self.notes.append(f"land/shallow water: {'; '.join(self.land_kinds)}")
+
+    def _coastline_budget(self):
+        """The coastline's memory checked by ``budget`` before it is loaded, then before the box's part is
+        clipped and projected (:data:`.land.GSHHG_BYTES`, :data:`.land.COORD_BYTES` per coordinate)."""
+        from shipgnc.routing.geo.land import COORD_BYTES, GSHHG_BYTES, coastline_size, gshhg_loaded
+        from shipgnc.routing.memory import RouteMemory
+
+        loaded = gshhg_loaded()
+        if self._budget is not None and not loaded:
+            self._budget(RouteMemory(items={"coastline: GSHHG polygons": GSHHG_BYTES},
+                                     phases={"coastline (GSHHG, roaring-landmask)": GSHHG_BYTES},
+                                     advice="give --land none (open sea) or your own --land FILE"))
+        n_poly, n_xy = coastline_size(*self.geo_box)
+        self.held_bytes = GSHHG_BYTES
+        if self._budget is not None:
+            work = COORD_BYTES * n_xy
+            self._budget(RouteMemory(
+                items={"coastline: GSHHG polygons": GSHHG_BYTES, "coastline: the box's part": work},
+                phases={f"coastline ({n_poly:,} polygons, {n_xy:,} points in the route's box)":
+                        GSHHG_BYTES + work},
+                advice="give --land none (open sea) or your own --land FILE"))
 
     @property
     def router_obstacles(self) -> list:
@@ -387,8 +410,7 @@ class GeoProblem:
             n, e = self.projection.to_plane(xy[:, 1], xy[:, 0])
             return np.column_stack([n, e])
 
-        out = shapely.make_valid(shapely.transform(np.array(geoms, dtype=object), f))
-        return [q for g in out for q in shapely.get_parts(g) if q.geom_type == "Polygon" and q.area > 0]
+        return _polygons(shapely.make_valid(shapely.transform(np.asarray(geoms, dtype=object), f)))
 
     # ------------------------------------------------------------------ solving
     def departure(self, depart_s=None, offset_s=0.0):
@@ -436,7 +458,18 @@ class GeoProblem:
         (n0, n1), (e0, e1) = self.box
         return max(n1 - n0, e1 - e0) / 800.0
 
-    def memory_estimate(self, fld, method="auto", horizon=None):
+    def sea_fraction(self) -> float:
+        """The share of the route's box that is not land (the land polygons' area; at most one, plus 0.05
+        for the cells along the coast): the sea graph's nodes and edges scale with it."""
+        import shapely
+
+        (n0, n1), (e0, e1) = self.box
+        box = shapely.box(n0, e0, n1, e1)
+        land = float(np.sum(shapely.area(shapely.intersection(self.hard.polys, box)))) if len(
+            self.hard.polys) else 0.0
+        return min(1.0, max(0.0, 1.0 - land / box.area) + 0.05)
+
+    def memory_estimate(self, fld, method="auto", horizon=None, unit=(1.0, "m")):
         """The :class:`~shipgnc.routing.memory.RouteMemory` of :meth:`solve` with this ``method``, before
         any work: the level set's arrays (:func:`~shipgnc.routing.memory.levelset_memory`), the sea graph's
         raster and edges (:mod:`.seagraph`: ``CELL_BYTES`` per cell, ``EDGE_BYTES`` per edge, 16 per free
@@ -446,20 +479,45 @@ class GeoProblem:
 
         plan = self.plan(method)
         if plan == "levelset":
-            return levelset_memory(fld, self.speed, self.A, self.B, self.box, self.h, horizon=horizon,
-                                   r0=1.2 * self.h, n_rays=360, ray_steps=20)  # routing.geo.frontier
-        out = route_memory_estimate(fld, self.speed, self.A, self.B, method="pmp" if plan == "sea graph"
-                                    else method, grid_spacing=self.h, domain=self.box, horizon=horizon)
+            out = levelset_memory(fld, self.speed, self.A, self.B, self.box, self.h, horizon=horizon,
+                                  r0=1.2 * self.h, n_rays=360, ray_steps=20)  # routing.geo.frontier
+        else:
+            out = route_memory_estimate(fld, self.speed, self.A, self.B, method="pmp" if plan == "sea graph"
+                                        else method, grid_spacing=self.h, domain=self.box, horizon=horizon)
         if plan == "sea graph":
             g = self.sea_spacing()
             cells = seagraph.raster_cells(self.box, g)
-            edges = seagraph.DIRECTIONS * cells
+            fits = math.sqrt(cells / seagraph.MAX_CELLS) * g
+            require(cells <= seagraph.MAX_CELLS, "--grid", float(f"{g / unit[0]:.6g}"),
+                    f"gives {cells:,} cells of the sea graph over the route's box; at most "
+                    f"{seagraph.MAX_CELLS:,}: use --grid {_length(1.01 * fits, unit)} or coarser")
+
+            sea = self.sea_fraction()
+            per_cell = seagraph.CELL_BYTES + seagraph.EDGE_BYTES * seagraph.DIRECTIONS * sea
             out.items["sea graph: raster"] = seagraph.CELL_BYTES * cells
-            out.items["sea graph: edges"] = seagraph.EDGE_BYTES * edges
-            out.phases["graph"] = out.items["sea graph: raster"] + out.items["sea graph: edges"]
-            out.graph_edges = edges
-            out.grid = (cells, 1)
-        return out if out.phases else RouteMemory()
+            out.items["sea graph: edges (16 per sea cell)"] = int(seagraph.EDGE_BYTES * seagraph.DIRECTIONS
+                                                                  * sea * cells)
+            out.phases["graph"] = int(per_cell * cells)
+            out.graph_edges = int(seagraph.DIRECTIONS * sea * cells)
+
+            def advice(have):
+                """The --grid that fits ``have`` bytes (cells fall as 1/g²)."""
+                room = (have - self.held_bytes) / per_cell
+                if room < 1000:
+                    return "no --grid fits beside the coastline; give --land none or your own --land FILE"
+                fit = g * math.sqrt(cells / room) * 1.02
+                return f"use --grid {_length(fit, unit)} or coarser (now {_length(g, unit)})"
+
+            out.advice = advice
+        if plan == "levelset":
+            out.advice = "use a coarser --grid, a shorter --horizon" + (
+                " or --method graph" if not self.hard.is_empty else "")
+        out = out if out.phases else RouteMemory()
+        for k in out.phases:  # the coastline stays loaded while the route is solved
+            out.phases[k] += self.held_bytes
+        if self.held_bytes:
+            out.items["coastline held (GSHHG polygons)"] = self.held_bytes
+        return out
 
     def solve(self, depart_s=None, *, method="auto", horizon=None, global_check=None, **kw) -> GeoRoute:
         """The route for a departure [s since epoch, or None without a clock], by the method of
@@ -475,12 +533,14 @@ class GeoProblem:
             if method not in ("auto", "levelset"):
                 notes.append(f"--method {method}: land in the route's box; the level set is used")
             res = self._round_land(fld, horizon, notes)
+        elif plan == "sea graph":  # the open sea's optimum first (closed form in a uniform current)
+            open_sea = None if method == "graph" else solve_route(
+                fld, self.speed, self.A, self.B, t0=0.0, method="pmp", horizon=horizon, grid_spacing=self.h,
+                domain=self.box, global_check=False, **kw)
+            res = self._sea_graph(fld, open_sea, method, notes)
         else:
-            res = solve_route(fld, self.speed, self.A, self.B, t0=0.0, method="auto" if method == "graph"
-                              else method, horizon=horizon, grid_spacing=self.h, domain=self.box,
-                              global_check=global_check, **kw)
-            if plan == "sea graph":
-                res = self._sea_graph(fld, res, method, notes)
+            res = solve_route(fld, self.speed, self.A, self.B, t0=0.0, method=method, horizon=horizon,
+                              grid_spacing=self.h, domain=self.box, global_check=global_check, **kw)
         out = GeoRoute(res, self, False, depart_s=depart_s, notes=notes)
         if not res.reachable:
             out.notes.append(f"unreachable: {res.reason}")
@@ -488,14 +548,14 @@ class GeoProblem:
         self._finish(out)
         return out
 
-    def _open_sea_clear(self, res) -> bool:
-        """Does the open-sea route's plane track (2000 points) miss every land polygon?"""
+    def _open_sea_clear(self, res, clearance) -> bool:
+        """Does the open-sea route's plane track (2000 points) keep ``clearance`` off every land polygon?"""
         import shapely
 
         if not res.reachable:
             return False
         _t, north, east, _ = res.sample(2000)
-        return not self.hard.intersects(shapely.LineString(np.column_stack([north, east])))
+        return self.hard.distance(shapely.LineString(np.column_stack([north, east]))) >= clearance
 
     def _sea_graph(self, fld, open_sea, method, notes):
         """Land in the box: the open-sea route when it misses the land (the optimum without land is a lower
@@ -503,15 +563,16 @@ class GeoProblem:
         from shipgnc.routing.geo import seagraph
         from shipgnc.routing.result import RouteResult
 
-        if method != "graph" and self._open_sea_clear(open_sea):
-            notes.append("land in the route's box, none on the open-sea route: the open-sea optimum is the "
-                         "route (no shorter route exists round the land)")
+        g = self.sea_spacing()
+        cl = self._clearance if self._clearance is not None else g / 2
+        if open_sea is not None and self._open_sea_clear(open_sea, cl):
+            self.clearance = cl
+            notes.append(f"land in the route's box, none within {cl:.0f} m of the open-sea route: the open-sea "
+                         "optimum is the route (no route round the land is faster)")
             return open_sea
         if method == "pmp":
             raise ConfigError("--method pmp: the extremals' route meets land; --method auto or graph goes "
                               "round it")
-        g = self.sea_spacing()
-        cl = self._clearance if self._clearance is not None else g
         tol = g / 4
         north, east = seagraph.raster_axes(self.box, g)
         import shapely
@@ -649,6 +710,32 @@ class GeoProblem:
             if self.hard.intersects(shapely.LineString(np.column_stack([n, e]))):
                 return False
         return True
+
+
+def _length(metres, unit) -> str:
+    """A length in the user's unit ``(metres per unit, name)``: whole metres, or 3 digits of nm."""
+    scale, name = unit
+    return f"{metres:.0f} m" if name == "m" else f"{metres / scale:.3g} {name}"
+
+
+def _polygons(geoms) -> list:
+    """The polygons of area > 0 among the parts of ``geoms``."""
+    import shapely
+
+    parts = shapely.get_parts(np.asarray(geoms, dtype=object))
+    return list(parts[(shapely.get_type_id(parts) == 3) & (shapely.area(parts) > 0)])
+
+
+def _meeting(polys, box) -> list:
+    """The polygons' parts inside ``box`` (those within it kept whole, the rest clipped)."""
+    import shapely
+
+    arr = np.asarray(polys, dtype=object)
+    if not arr.size:
+        return []
+    arr = arr[shapely.intersects(arr, box)]
+    inside = shapely.within(arr, box)
+    return _polygons(np.concatenate([arr[inside], shapely.intersection(arr[~inside], box)]))
 
 
 def np_thin(xy, tol, leg_ok):
