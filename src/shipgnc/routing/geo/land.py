@@ -101,7 +101,25 @@ def load_land(path) -> list:
         if not (-180 <= x0 <= x1 <= 360 and -90 <= y0 <= y1 <= 90):
             raise ConfigError(f"--land = {name!r}: coordinates must be [lon, lat] in degrees; found bounds "
                               f"{g.bounds}")
-    return polys
+    return normalise_longitudes(polys)
+
+
+def normalise_longitudes(polys) -> list:
+    """Polygons with longitudes in 0..360 (east of 180°) moved to −180..180, the routes' convention: a part
+    east of 180° is shifted by −360°, a polygon across 180° cut there (both longitude conventions of CF
+    and GeoJSON files read alike)."""
+    import shapely
+
+    out = []
+    west, east = shapely.box(-180.0, -90.0, 180.0, 90.0), shapely.box(180.0, -90.0, 360.0, 90.0)
+    for g in polys:
+        if g.bounds[2] <= 180.0:
+            out.append(g)
+            continue
+        parts = [shapely.intersection(g, west),
+                 shapely.transform(shapely.intersection(g, east), lambda xy: xy - np.array([360.0, 0.0]))]
+        out.extend(p for q in parts for p in shapely.get_parts(q) if p.geom_type == "Polygon" and p.area > 0)
+    return out
 
 
 def region_polygons(x, y, value, level: float) -> list:

@@ -142,6 +142,44 @@ def pull_string(n, visible, faster):
     return keep
 
 
+def tighten(xy, sees, time, rounds=8):
+    """The pulled path's corners slid taut: each interior vertex moves toward its neighbours' chord or
+    along either of its legs (bisection, 12 halvings; the quickest of the three) as far as both its legs
+    stay in sight (``sees(p, q)``) and the pair of legs gets no slower (``time(p, q)``); the corners then
+    rest against the blocked cells, not on lattice nodes. Vertices that become needless (their neighbours
+    see each other, no slower) are dropped first."""
+    xy = [np.asarray(p, float) for p in xy]
+    for _ in range(rounds):
+        moved = 0.0
+        k = 1
+        while k < len(xy) - 1:
+            a, v, b = xy[k - 1], xy[k], xy[k + 1]
+            if sees(a, b) and time(a, b) <= time(a, v) + time(v, b):
+                del xy[k]
+                continue
+            ab = b - a
+            lam = float(np.clip(np.dot(v - a, ab) / max(np.dot(ab, ab), 1e-300), 0.0, 1.0))
+            best, w = time(a, v) + time(v, b), v
+            for goal in (a + lam * ab, a, b):  # toward the chord, or along either leg
+                lo, hi = 0.0, 1.0
+                for _ in range(12):
+                    mid = 0.5 * (lo + hi)
+                    u = v + mid * (goal - v)
+                    if sees(a, u) and sees(u, b) and time(a, u) + time(u, b) <= best:
+                        lo = mid
+                    else:
+                        hi = mid
+                u = v + lo * (goal - v)
+                if lo > 0 and time(a, u) + time(u, b) <= best:
+                    best, w = time(a, u) + time(u, b), u
+            moved = max(moved, float(np.hypot(*(w - v))))
+            xy[k] = w
+            k += 1
+        if moved < 1.0:
+            break
+    return np.array(xy)
+
+
 class SeaRoute:
     """The result of :func:`sea_route`: a :class:`~shipgnc.routing.graph.GraphRoute` (``xy``, ``t``,
     ``headings``), the raster spacing and the lattice path's time (before the string was pulled)."""
@@ -215,7 +253,8 @@ def sea_route(field, speed, start, target, north, east, blocked, *, piece=None):
         return leg_time(field, speed, xy[i], xy[j], piece) <= times[j] - times[i] + 1e-9 * times[-1]
 
     keep = pull_string(len(xy), visible, faster)
-    xy = xy[keep]
+    xy = tighten(xy[keep], lambda p, q: _visible(blocked, north, east, p, q),
+                 lambda p, q: leg_time(field, speed, p, q, piece))
     seg_t = np.array([leg_time(field, speed, xy[k], xy[k + 1], piece) for k in range(len(xy) - 1)])
     _, heads = _crab(field, speed, 0.0, xy[:-1], xy[1:])
     times = np.concatenate([[0.0], np.cumsum(seg_t)])
