@@ -65,7 +65,7 @@ def test_a_wall_in_0_360_longitudes_is_gone_round_as_in_minus_180_180(walls):
         assert not any(leg.intersects(wall) for leg in legs(r))
     assert r360.distance_m == pytest.approx(r180.distance_m, rel=1e-12)
     d = r180.distance_m / 1852.0
-    x0, y0, x1, y1 = WALL
+    x0, _, x1, y1 = WALL
     shortest = geodesic_nm([A, (y1, x0), (y1, x1), B])
     g = r180.plane.grid_spacing
     dlat, dlon = 3 * g / 111_000.0, 3 * g / (111_000.0 * np.cos(np.radians(50.0)))

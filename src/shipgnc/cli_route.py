@@ -219,9 +219,10 @@ def _check_memory(need, limit: float | None) -> None:
     if need.total <= have:
         return
     what = f"{format_bytes(have)} is available" if limit is None else f"--max-memory is {format_bytes(have)}"
-    hint = (need.advice(have) if callable(need.advice) else need.advice) or {"level set": "use a coarser --grid, a shorter --horizon or --method pmp",
-                           "graph": "use a coarser --grid or another --method",
-                           "sweep": "use --method levelset"}.get(need.largest(), "")
+    hint = (need.advice(have) if callable(need.advice) else need.advice) or {
+        "level set": "use a coarser --grid, a shorter --horizon or --method pmp",
+        "graph": "use a coarser --grid or another --method",
+        "sweep": "use --method levelset"}.get(need.largest(), "")
     raise ConfigError(f"route: needs about {format_bytes(need.total)} ({need.describe()}) but {what}; "
                       f"{hint + ', or ' if hint else ''}raise --max-memory")
 
@@ -287,7 +288,8 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     t_dep = problem.departure(iso_depart, offset)
     t_h = None if horizon is None else horizon * tscale
     fld = problem.field_from(t_dep)
-    need = problem.memory_estimate(fld, method=method, horizon=t_h, unit=(length, "nm" if length > 1 else "m"))
+    need = problem.memory_estimate(fld, method=method, horizon=t_h,
+                                   unit=(length, "nm" if length > 1 else "m"))
     _check_memory(need, limit)
     with _progress() as progress:
         res = problem.solve(t_dep, method=method, horizon=t_h, progress=progress)

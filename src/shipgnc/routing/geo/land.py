@@ -19,7 +19,6 @@ import numpy as np
 
 from shipgnc.errors import ConfigError
 
-
 #: memory the GSHHG polygons hold once loaded (measured: 558 MiB of resident memory for its 180 496
 #: polygons, 9.46·10⁶ points, from roaring-landmask's WKB), rounded up
 GSHHG_BYTES = 600 * 2**20

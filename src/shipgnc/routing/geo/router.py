@@ -567,8 +567,8 @@ class GeoProblem:
         cl = self._clearance if self._clearance is not None else g / 2
         if open_sea is not None and self._open_sea_clear(open_sea, cl):
             self.clearance = cl
-            notes.append(f"land in the route's box, none within {cl:.0f} m of the open-sea route: the open-sea "
-                         "optimum is the route (no route round the land is faster)")
+            notes.append(f"land in the route's box, none within {cl:.0f} m of the open-sea route: the "
+                         "open-sea optimum is the route (no route round the land is faster)")
             return open_sea
         if method == "pmp":
             raise ConfigError("--method pmp: the extremals' route meets land; --method auto or graph goes "
@@ -586,10 +586,10 @@ class GeoProblem:
         res = RouteResult(False, self.A, self.B, self.speed, t0=0.0, method="graph", field=fld)
         res.grid_spacing = g
         self.clearance = cl
-        notes.append(f"land on the open-sea route: a graph on the sea's cells ({sea.free:,} of {sea.cells:,} "
-                     f"cells of {g:.0f} m free, {sea.edges:,} edges, 16 directions, the current at "
-                     f"departure), its path pulled taut (docs/routing_geo.md); the route keeps {cl:.0f} m off "
-                     "the coastline")
+        notes.append(f"land on the open-sea route: a graph on the sea's cells ({sea.free:,} of "
+                     f"{sea.cells:,} cells of {g:.0f} m free, {sea.edges:,} edges, 16 directions, the current "
+                     f"at departure), its path pulled taut (docs/routing_geo.md); the route keeps {cl:.0f} m "
+                     "off the coastline")
         if sea.route is None:
             res.reason = (f"the target is not connected to the start over the sea's cells of {g:.0f} m kept "
                           f"{cl:.0f} m off land (or the current cannot be stemmed); a finer --grid opens "
@@ -618,8 +618,8 @@ class GeoProblem:
         if frozen.any():
             notes.append(f"land or shallow water in the route's box ({100 * frozen.mean():.0f} % of the "
                          f"level-set cells): the level set with land cells frozen, φ clipped to a band "
-                         f"(docs/routing_geo.md), grid {self.h:.0f} m; the router keeps {self.clearance:.0f} m "
-                         "(one level-set cell) off land")
+                         f"(docs/routing_geo.md), grid {self.h:.0f} m; the router keeps "
+                         f"{self.clearance:.0f} m (one level-set cell) off land")
         else:
             notes.append(f"gridded current: the level set (global method), grid {self.h:.0f} m")
         if ls.arrival is None:

@@ -49,8 +49,8 @@ DIRECTIONS = 16
 def raster_axes(box, spacing):
     """(north, east) node axes [m] of the raster over the plane box ((n0, n1), (e0, e1))."""
     (n0, n1), (e0, e1) = box
-    nn = n0 + spacing * np.arange(int(math.floor((n1 - n0) / spacing)) + 1)
-    ee = e0 + spacing * np.arange(int(math.floor((e1 - e0) / spacing)) + 1)
+    nn = n0 + spacing * np.arange(math.floor((n1 - n0) / spacing) + 1)
+    ee = e0 + spacing * np.arange(math.floor((e1 - e0) / spacing) + 1)
     return nn, ee
 
 
@@ -107,7 +107,7 @@ def free_near(blocked, land, north, east, p, radius):
 def _visible(blocked, north, east, p, q):
     """Does the segment p→q, sampled every half cell, stay on free cells (nearest cell)?"""
     g = float(north[1] - north[0])
-    n = max(2, int(math.ceil(math.hypot(*(q - p)) / (0.5 * g))) + 1)
+    n = max(2, math.ceil(math.hypot(*(q - p)) / (0.5 * g)) + 1)
     s = np.linspace(0.0, 1.0, n)
     pts = p[None] + s[:, None] * (q - p)[None]
     i = np.clip(np.rint((pts[:, 0] - north[0]) / g).astype(int), 0, north.size - 1)
@@ -120,7 +120,7 @@ def leg_time(field, speed, p, q, piece):
     each with the crab triangle in the current at its middle (inf where it cannot be held)."""
     from shipgnc.routing.graph import _crab
 
-    n = max(1, int(math.ceil(math.hypot(*(q - p)) / piece)))
+    n = max(1, math.ceil(math.hypot(*(q - p)) / piece))
     s = np.linspace(0.0, 1.0, n + 1)[:, None]
     pts = p[None] + s * (q - p)[None]
     t, _ = _crab(field, speed, 0.0, pts[:-1], pts[1:])
@@ -185,7 +185,8 @@ class SeaRoute:
     ``headings``), the raster spacing and the lattice path's time (before the string was pulled)."""
 
     def __init__(self, route, lattice_time, cells, free, edges):
-        self.route, self.lattice_time, self.cells, self.free, self.edges = route, lattice_time, cells, free, edges
+        self.route, self.lattice_time = route, lattice_time
+        self.cells, self.free, self.edges = cells, free, edges
 
 
 def sea_route(field, speed, start, target, north, east, blocked, *, piece=None):
