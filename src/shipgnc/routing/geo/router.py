@@ -587,9 +587,9 @@ class GeoProblem:
         res.grid_spacing = g
         self.clearance = cl
         notes.append(f"land on the open-sea route: a graph on the sea's cells ({sea.free:,} of "
-                     f"{sea.cells:,} cells of {g:.0f} m free, {sea.edges:,} edges, 16 directions, the current "
-                     f"at departure), its path pulled taut (docs/routing_geo.md); the route keeps {cl:.0f} m "
-                     "off the coastline")
+                     f"{sea.cells:,} cells of {g:.0f} m free, {sea.edges:,} edges, 16 directions, the "
+                     f"current at departure), its path pulled taut (docs/routing_geo.md); the route keeps "
+                     f"{cl:.0f} m off the coastline")
         if sea.route is None:
             res.reason = (f"the target is not connected to the start over the sea's cells of {g:.0f} m kept "
                           f"{cl:.0f} m off land (or the current cannot be stemmed); a finer --grid opens "
