@@ -252,10 +252,25 @@ def _progress():
         yield update
 
 
-def _geo_route(start, target, speed, field, method, obstacles, units, json_, out, horizon, radius, depart,
-               grid, land, depth, draft, ukc, xte_m, length, tscale, sail=False, sail_vessel="auto",
-               limit=None) -> None:
-    """``route --geo`` (docs/routing_geo.md)."""
+def _geo_route(*args, **kw) -> None:
+    """``route --geo`` (docs/routing_geo.md), the warnings of the libraries it calls (numpy, shapely,
+    pyshp, ...) caught: none is printed before a one-line error; after a route they are its notes."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _geo_route_run(*args, **kw, caught=caught)
+
+
+def _warning_notes(caught) -> list[str]:
+    seen = dict.fromkeys(f"warning ({w.category.__name__}): {' '.join(str(w.message).split())}"
+                         for w in caught)
+    return list(seen)
+
+
+def _geo_route_run(start, target, speed, field, method, obstacles, units, json_, out, horizon, radius,
+                   depart, grid, land, depth, draft, ukc, xte_m, length, tscale, sail=False,
+                   sail_vessel="auto", limit=None, caught=()) -> None:
     from shipgnc.cli import stderr, stdout
     from shipgnc.errors import require
     from shipgnc.routing.geo.router import GeoProblem
@@ -294,6 +309,7 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
     with _progress() as progress:
         res = problem.solve(t_dep, method=method, horizon=t_h, progress=progress)
     payload = res.to_json()
+    payload["notes"].extend(_warning_notes(caught))
     if sail and res.reachable:
         from shipgnc.routing.geo.sail import sail_check
 
@@ -386,7 +402,7 @@ def _print_geo(console, js) -> None:
         row("global check by level set (plane)", f"{gc['time_s']:.0f} s ({gc['rel_diff']:+.2e})")
     console.print(table)
     for note in js["notes"]:
-        console.print(f"note: {note}", soft_wrap=True)
+        console.print(f"note: {escape(note)}", soft_wrap=True)
 
 
 def _jsonable(x):

@@ -65,8 +65,12 @@ def load_land(path) -> list:
 
     name = str(path)
     p = Path(name)
-    if not p.is_file():
+    if not p.exists():
         raise ConfigError(f"--land = {name!r}: no such file")
+    if not p.is_file():
+        what = "a directory" if p.is_dir() else "not a regular file (a device, pipe or socket)"
+        raise ConfigError(f"--land = {name!r}: {what}; give a GeoJSON file (.geojson/.json) or a shapefile "
+                          "(.shp), or default, or none")
     if p.suffix.lower() == ".shp":
         try:
             import shapefile  # pyshp

@@ -181,6 +181,9 @@ class GeoProblem:
         require(math.isfinite(xte_m) and xte_m > 0, "--xte-m", xte_m, "must be a cross-track tolerance > 0 m")
         require(math.isfinite(draft) and draft >= 0, "--draft", draft, "must be >= 0 m")
         require(math.isfinite(ukc) and ukc >= 0, "--ukc", ukc, "must be >= 0 m")
+        for name, value in (("--draft", draft), ("--ukc", ukc)):
+            require(depth is not None or value == 0, name, value,
+                    "needs --depth (a bathymetry CF-NetCDF file): without it no depth is checked")
         self.start, self.target = (float(start[0]), float(start[1])), (float(target[0]), float(target[1]))
         self.speed, self.xte_m, self.notes = float(speed), float(xte_m), []
         proj = self.projection = RouteProjection(self.start, self.target)
@@ -314,7 +317,9 @@ class GeoProblem:
             groups.append(("on land", "GSHHG full-resolution coastline (roaring-landmask)",
                            coastline(*self.geo_box), None))
         else:
-            groups.append(("on land", f"land from {land}", load_land(land), None))
+            polys = load_land(land)
+            self._swapped_note(land, polys)
+            groups.append(("on land", f"land from {land}", polys, None))
         if depth is not None:
             dg = cf.read_depth(depth)
             self.notes.extend(dg.notes)
@@ -358,6 +363,23 @@ class GeoProblem:
             self._router_obstacles = []
             return
         self.notes.append(f"land/shallow water: {'; '.join(self.land_kinds)}")
+
+    def _swapped_note(self, name, polys):
+        """A note when none of a land file's polygons lies in the route's box but some would with each
+        pair read the other way round ([lat, lon] written where GeoJSON wants [lon, lat], RFC 7946
+        §3.1.1)."""
+        import shapely
+
+        box = shapely.box(*self.geo_box)
+        arr = np.asarray(polys, dtype=object)
+        if not arr.size or shapely.intersects(arr, box).any():
+            return
+        swapped = shapely.transform(arr, lambda xy: xy[:, ::-1])
+        hits = int(np.sum(shapely.intersects(swapped, box)))
+        if hits:
+            self.notes.append(f"--land {name}: none of its {arr.size} polygons lies in the route's box, but "
+                              f"{hits} would with latitude and longitude swapped: GeoJSON and shapefiles "
+                              "give [lon, lat] (RFC 7946 §3.1.1); is the file [lat, lon]?")
 
     def _coastline_budget(self):
         """The coastline's memory checked by ``budget`` before it is loaded, then before the box's part is
@@ -415,11 +437,16 @@ class GeoProblem:
     # ------------------------------------------------------------------ solving
     def departure(self, depart_s=None, offset_s=0.0):
         """The absolute departure [s since epoch] or None; a time axis bounds it (errors name the file)."""
+        from shipgnc.routing.geo.timefmt import in_range
+
         times = self.current.times
         if depart_s is None:
             if times is None:
                 return None
             depart_s = float(times[0]) + float(offset_s)
+        if not in_range(depart_s):
+            raise ConfigError(f"--depart: the departure {iso(depart_s)} lies beyond the years 1–9999; give "
+                              "an ISO 8601 UTC time or an offset within the current file's times")
         if times is not None and times.size > 1 and not times[0] <= depart_s <= times[-1]:
             raise ConfigError(f"{self.current.grid.path}: the departure {iso(depart_s)} lies outside the "
                               f"file's time coverage {self.current.grid.time_extent()}")
@@ -452,22 +479,35 @@ class GeoProblem:
         return "sea graph"
 
     def sea_spacing(self) -> float:
-        """The sea graph's raster spacing g [m]: ``--grid`` when given, else the box's larger side / 800."""
+        """The coarse pass's raster spacing g₁ [m]: the box's larger side / 800, at least ``--grid``."""
+        (n0, n1), (e0, e1) = self.box
+        return max(max(n1 - n0, e1 - e0) / 800.0, self._grid or 0.0)
+
+    def fine_spacing(self, corridor_area=None) -> float:
+        """The fine pass's raster spacing g₂ [m]: ``--grid`` when given, else g₁/4 and no finer than
+        :data:`.seagraph.FINE_CELLS` cells over the corridor's box (``corridor_area`` [m²], the route's
+        box before the coarse pass)."""
         if self._grid is not None:
             return float(self._grid)
-        (n0, n1), (e0, e1) = self.box
-        return max(n1 - n0, e1 - e0) / 800.0
+        if corridor_area is None:
+            (n0, n1), (e0, e1) = self.box
+            corridor_area = (n1 - n0) * (e1 - e0)
+        from shipgnc.routing.geo.seagraph import FINE_CELLS
+
+        return max(self.sea_spacing() / 4, math.sqrt(corridor_area / FINE_CELLS))
 
     def sea_fraction(self) -> float:
         """The share of the route's box that is not land (the land polygons' area; at most one, plus 0.05
         for the cells along the coast): the sea graph's nodes and edges scale with it."""
         import shapely
 
-        (n0, n1), (e0, e1) = self.box
-        box = shapely.box(n0, e0, n1, e1)
-        land = float(np.sum(shapely.area(shapely.intersection(self.hard.polys, box)))) if len(
-            self.hard.polys) else 0.0
-        return min(1.0, max(0.0, 1.0 - land / box.area) + 0.05)
+        if getattr(self, "_sea_fraction", None) is None:
+            (n0, n1), (e0, e1) = self.box
+            box = shapely.box(n0, e0, n1, e1)
+            land = float(np.sum(shapely.area(shapely.intersection(self.hard.polys, box)))) if len(
+                self.hard.polys) else 0.0
+            self._sea_fraction = min(1.0, max(0.0, 1.0 - land / box.area) + 0.05)
+        return self._sea_fraction
 
     def memory_estimate(self, fld, method="auto", horizon=None, unit=(1.0, "m")):
         """The :class:`~shipgnc.routing.memory.RouteMemory` of :meth:`solve` with this ``method``, before
@@ -485,28 +525,26 @@ class GeoProblem:
             out = route_memory_estimate(fld, self.speed, self.A, self.B, method="pmp" if plan == "sea graph"
                                         else method, grid_spacing=self.h, domain=self.box, horizon=horizon)
         if plan == "sea graph":
-            g = self.sea_spacing()
-            cells = seagraph.raster_cells(self.box, g)
-            fits = math.sqrt(cells / seagraph.MAX_CELLS) * g
-            require(cells <= seagraph.MAX_CELLS, "--grid", float(f"{g / unit[0]:.6g}"),
-                    f"gives {cells:,} cells of the sea graph over the route's box; at most "
-                    f"{seagraph.MAX_CELLS:,}: use --grid {_length(1.01 * fits, unit)} or coarser")
-
-            sea = self.sea_fraction()
-            per_cell = seagraph.CELL_BYTES + seagraph.EDGE_BYTES * seagraph.DIRECTIONS * sea
-            out.items["sea graph: raster"] = seagraph.CELL_BYTES * cells
-            out.items["sea graph: edges (16 per sea cell)"] = int(seagraph.EDGE_BYTES * seagraph.DIRECTIONS
-                                                                  * sea * cells)
-            out.phases["graph"] = int(per_cell * cells)
-            out.graph_edges = int(seagraph.DIRECTIONS * sea * cells)
+            coarse, fine, edges, fine_cells = self._sea_graph_bytes(self._grid)
+            g2 = self.fine_spacing()
+            require(fine_cells <= seagraph.MAX_CELLS, "--grid", float(f"{g2 / unit[0]:.6g}"),
+                    f"gives up to {fine_cells:,} cells of the sea graph's fine pass; at most "
+                    f"{seagraph.MAX_CELLS:,}: use --grid "
+                    f"{_length(1.01 * g2 * math.sqrt(fine_cells / seagraph.MAX_CELLS), unit)} or coarser")
+            out.items["sea graph: coarse pass, raster and edges (16 per sea cell)"] = coarse
+            out.items["sea graph: fine pass in the corridor, raster and edges"] = fine
+            out.phases["graph"] = max(coarse, fine)
+            out.graph_edges = edges
 
             def advice(have):
-                """The --grid that fits ``have`` bytes (cells fall as 1/g²)."""
-                room = (have - self.held_bytes) / per_cell
-                if room < 1000:
-                    return "no --grid fits beside the coastline; give --land none or your own --land FILE"
-                fit = g * math.sqrt(cells / room) * 1.02
-                return f"use --grid {_length(fit, unit)} or coarser (now {_length(g, unit)})"
+                """The finest --grid (5 % steps) whose passes fit ``have`` bytes beside the coastline."""
+                grid = g2
+                for _ in range(200):
+                    grid *= 1.05
+                    c, f, _, _ = self._sea_graph_bytes(grid)
+                    if max(c, f) + self.held_bytes <= have:
+                        return f"use --grid {_length(grid, unit)} or coarser (now {_length(g2, unit)})"
+                return "no --grid fits beside the coastline; give --land none or your own --land FILE"
 
             out.advice = advice
         if plan == "levelset":
@@ -518,6 +556,27 @@ class GeoProblem:
         if self.held_bytes:
             out.items["coastline held (GSHHG polygons)"] = self.held_bytes
         return out
+
+    def _sea_graph_bytes(self, grid):
+        """(coarse pass, fine pass [bytes], edges, fine cells) of the sea graph with ``--grid`` = ``grid``
+        (None: the defaults): the coarse pass's raster over the box and 16 edges per sea cell
+        (:meth:`sea_fraction`); the fine pass's raster over the corridor's box (at most the route's box,
+        :data:`.seagraph.FINE_CELLS` cells without --grid) and its edges in a corridor along a route 30 %
+        longer than A→B."""
+        from shipgnc.routing.geo import seagraph
+
+        (n0, n1), (e0, e1) = self.box
+        g1 = max(max(n1 - n0, e1 - e0) / 800.0, grid or 0.0)
+        g2 = float(grid) if grid is not None else self.fine_spacing()
+        cells = seagraph.raster_cells(self.box, g1)
+        sea = self.sea_fraction()
+        coarse = int((seagraph.CELL_BYTES + seagraph.EDGE_BYTES * seagraph.DIRECTIONS * sea) * cells)
+        band = 2 * seagraph.BAND_CELLS * g1 * 1.3 * float(np.hypot(*(self.B - self.A))) / g2**2
+        fine_cells = seagraph.raster_cells(self.box, g2)
+        if grid is None:
+            fine_cells = min(fine_cells, seagraph.FINE_CELLS)
+        fine = int(seagraph.CELL_BYTES * fine_cells + seagraph.EDGE_BYTES * seagraph.DIRECTIONS * band)
+        return coarse, fine, int(seagraph.DIRECTIONS * max(sea * cells, band)), fine_cells
 
     def solve(self, depart_s=None, *, method="auto", horizon=None, global_check=None, **kw) -> GeoRoute:
         """The route for a departure [s since epoch, or None without a clock], by the method of
@@ -558,42 +617,83 @@ class GeoProblem:
         return self.hard.distance(shapely.LineString(np.column_stack([north, east]))) >= clearance
 
     def _sea_graph(self, fld, open_sea, method, notes):
-        """Land in the box: the open-sea route when it misses the land (the optimum without land is a lower
-        bound, reached), else the graph route of :mod:`.seagraph` on the sea's cells."""
+        """Land in the box: the open-sea route when it keeps the clearance off the land (the optimum without
+        land is a lower bound, reached), else the graph route of :mod:`.seagraph` in two passes: a coarse
+        path over the whole box, pulled taut (cells of g₁ whose centre is on land blocked, no clearance: a
+        strait wider than a cell stays open), then the fine graph, its path pulled taut, in the corridor of
+        :data:`.seagraph.BAND_CELLS` coarse cells either side of it (cells of g₂ kept the clearance off
+        the land)."""
+        import shapely
+
         from shipgnc.routing.geo import seagraph
+        from shipgnc.routing.memory import RouteMemory
         from shipgnc.routing.result import RouteResult
 
-        g = self.sea_spacing()
-        cl = self._clearance if self._clearance is not None else g / 2
-        if open_sea is not None and self._open_sea_clear(open_sea, cl):
-            self.clearance = cl
-            notes.append(f"land in the route's box, none within {cl:.0f} m of the open-sea route: the "
+        g1 = self.sea_spacing()
+        cl0 = self._clearance if self._clearance is not None else self.fine_spacing() / 2
+        if open_sea is not None and self._open_sea_clear(open_sea, cl0):
+            self.clearance = cl0
+            notes.append(f"land in the route's box, none within {cl0:.0f} m of the open-sea route: the "
                          "open-sea optimum is the route (no route round the land is faster)")
             return open_sea
         if method == "pmp":
             raise ConfigError("--method pmp: the extremals' route meets land; --method auto or graph goes "
                               "round it")
-        tol = g / 4
-        north, east = seagraph.raster_axes(self.box, g)
-        import shapely
-
-        simple = shapely.simplify(self.hard.polys, tol)
-        land = seagraph.land_raster(simple, north, east)
-        blocked = seagraph.blocked_cells(land, g, cl, tol)
-        for p in (self.A, self.B):
-            seagraph.free_near(blocked, land, north, east, p, cl + 2 * g + tol)
-        sea = seagraph.sea_route(fld, self.speed, self.A, self.B, north, east, blocked)
         res = RouteResult(False, self.A, self.B, self.speed, t0=0.0, method="graph", field=fld)
-        res.grid_spacing = g
+        polys = self.hard.polys
+        # ---- coarse pass: the whole box, optimistic land
+        north, east = seagraph.raster_axes(self.box, g1)
+        land = seagraph.land_raster(shapely.simplify(polys, g1 / 4), north, east, outline=False)
+        blocked = land.copy()
+        for p in (self.A, self.B):
+            seagraph.free_near(blocked, np.zeros_like(land), north, east, p, 2 * g1)
+        coarse = seagraph.sea_route(fld, self.speed, self.A, self.B, north, east, blocked)
+        del land, blocked
+        if coarse.route is None:
+            res.grid_spacing = g1
+            res.reason = (f"the target is not connected to the start over the sea's cells of {g1:.0f} m in "
+                          "the route's box (or the current cannot be stemmed)")
+            return res
+        # ---- fine pass: the corridor round the coarse path
+        path, half = coarse.route.xy, seagraph.BAND_CELLS * g1
+        (n0, n1), (e0, e1) = self.box
+        pad = half + 4 * g1
+        sub = ((max(n0, path[:, 0].min() - pad), min(n1, path[:, 0].max() + pad)),
+               (max(e0, path[:, 1].min() - pad), min(e1, path[:, 1].max() + pad)))
+        g2 = self.fine_spacing((sub[0][1] - sub[0][0]) * (sub[1][1] - sub[1][0]))
+        cl = self._clearance if self._clearance is not None else g2 / 2
+        tol = g2 / 4
+        cells = seagraph.raster_cells(sub, g2)
+        length = float(np.sum(np.hypot(*np.diff(path, axis=0).T)))
+        band = 2 * half * length / g2**2
+        if self._budget is not None:  # checked again before the fine pass, on the corridor it has
+            work = int(seagraph.CELL_BYTES * cells + seagraph.EDGE_BYTES * seagraph.DIRECTIONS * band)
+            self._budget(RouteMemory(
+                items={"sea graph: fine pass": work, "coastline held": self.held_bytes},
+                phases={f"sea graph's fine pass, {cells:,} cells of {g2:.0f} m": work + self.held_bytes},
+                advice="use a coarser --grid"))
+        require(cells <= seagraph.MAX_CELLS, "--grid", g2, f"gives {cells:,} cells in the corridor of the "
+                f"coarse route; at most {seagraph.MAX_CELLS:,}: use a coarser --grid")
+        north, east = seagraph.raster_axes(sub, g2)
+        sub_box = shapely.box(sub[0][0], sub[1][0], sub[0][1], sub[1][1])
+        near = polys[self.hard.tree.query(sub_box, predicate="intersects")]
+        land = seagraph.land_raster(shapely.simplify(near, tol), north, east)
+        blocked = seagraph.blocked_cells(land, g2, cl, tol) | ~seagraph.band_mask(path, north, east, half)
+        for p in (self.A, self.B):
+            seagraph.free_near(blocked, land, north, east, p, cl + 2 * g2 + tol)
+        sea = seagraph.sea_route(fld, self.speed, self.A, self.B, north, east, blocked)
+        res.grid_spacing = g2
         self.clearance = cl
-        notes.append(f"land on the open-sea route: a graph on the sea's cells ({sea.free:,} of "
-                     f"{sea.cells:,} cells of {g:.0f} m free, {sea.edges:,} edges, 16 directions, the "
-                     f"current at departure), its path pulled taut (docs/routing_geo.md); the route keeps "
-                     f"{cl:.0f} m off the coastline")
+        notes.append(f"land on the open-sea route: a graph on the sea's cells, a coarse pass "
+                     f"({coarse.free:,} of {coarse.cells:,} cells of {g1:.0f} m) then a fine one in its "
+                     f"corridor ({sea.free:,} cells of {g2:.0f} m within {half / 1000:.0f} km of it, "
+                     f"{sea.edges:,} edges), 16 "
+                     "directions, the current at departure, the path pulled taut (docs/routing_geo.md); the "
+                     f"route keeps {cl:.0f} m off the coastline")
         if sea.route is None:
-            res.reason = (f"the target is not connected to the start over the sea's cells of {g:.0f} m kept "
-                          f"{cl:.0f} m off land (or the current cannot be stemmed); a finer --grid opens "
-                          "narrower straits")
+            res.reason = (f"the corridor of the coarse route is closed on the fine cells of {g2:.0f} m kept "
+                          f"{cl:.0f} m off land (a strait narrower than about "
+                          f"{2 * (cl + 1.7 * g2 + tol) / 1000:.1f} km on the way); a finer --grid opens it")
             return res
         r = sea.route
         res.reachable, res.time_s, res.path = True, float(r.time_s), r
@@ -623,7 +723,8 @@ class GeoProblem:
         else:
             notes.append(f"gridded current: the level set (global method), grid {self.h:.0f} m")
         if ls.arrival is None:
-            res.reason = (f"target not reachable round the land within {horizon:.0f} s "
+            res.reason = (f"target not reachable{'' if self.hard.is_empty else ' round the land'} within "
+                          f"{horizon:.0f} s "
                           f"({horizon / 3600:.1f} h) at {self.speed:.3f} m/s: the front's closest approach "
                           f"is {ls.closest_approach:.0f} m")
             res.closest_approach_m = ls.closest_approach

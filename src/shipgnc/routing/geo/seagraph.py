@@ -42,6 +42,10 @@ CELL_BYTES = 39
 EDGE_BYTES = 64
 #: the most raster cells the sea graph takes (effort: Dijkstra over ≈ 16 edges a cell, a few seconds at 4·10⁶)
 MAX_CELLS = 4_000_000
+#: the fine pass's cells at most over the box of the coarse route's corridor (when --grid is not given)
+FINE_CELLS = 3_000_000
+#: half-width of that corridor in coarse cells
+BAND_CELLS = 5
 #: the 16-direction stencil (graph.stencil(16))
 DIRECTIONS = 16
 
@@ -59,10 +63,12 @@ def raster_cells(box, spacing) -> int:
     return (int((n1 - n0) // spacing) + 1) * (int((e1 - e0) // spacing) + 1)
 
 
-def land_raster(polys, north, east) -> np.ndarray:
+def land_raster(polys, north, east, outline=True) -> np.ndarray:
     """Boolean (len(north), len(east)): the cells a land polygon (plane, (north, east) m) covers, filled
     with Pillow's polygon scan conversion (outline pixels included, so a sliver narrower than a cell
-    still marks its cells). Holes (lakes) are left land: water a ship cannot reach counts as land."""
+    still marks its cells; ``outline=False``: only the cells whose centre is inside, the coarse pass's
+    optimistic land that leaves a strait wider than a cell open). Holes (lakes) are left land: water a
+    ship cannot reach counts as land."""
     import shapely
     from PIL import Image, ImageDraw
 
@@ -78,7 +84,8 @@ def land_raster(polys, north, east) -> np.ndarray:
             rows = (xy[:, 0] - north[0]) / g
             if len(xy) < 3:
                 continue
-            draw.polygon(list(zip(cols.tolist(), rows.tolist(), strict=True)), fill=1, outline=1)
+            draw.polygon(list(zip(cols.tolist(), rows.tolist(), strict=True)), fill=1,
+                         outline=1 if outline else None)
     return np.asarray(img, bool)
 
 
@@ -90,6 +97,20 @@ def blocked_cells(land, spacing, clearance, tol):
         return land.copy()
     dist = ndimage.distance_transform_edt(~land) * spacing
     return dist < clearance + 1.7 * spacing + tol
+
+
+def band_mask(path, north, east, half_width) -> np.ndarray:
+    """Cells within ``half_width`` [m] of the polyline ``path`` ((n, 2) plane points): the corridor the
+    fine pass searches (the polyline drawn with Pillow, then the Euclidean distance transform)."""
+    from PIL import Image, ImageDraw
+    from scipy import ndimage
+
+    g = float(north[1] - north[0])
+    img = Image.new("1", (east.size, north.size), 0)
+    cols, rows = (path[:, 1] - east[0]) / g, (path[:, 0] - north[0]) / g
+    ImageDraw.Draw(img).line(list(zip(cols.tolist(), rows.tolist(), strict=True)), fill=1, width=1)
+    on = np.asarray(img, bool)
+    return ndimage.distance_transform_edt(~on) * g <= half_width
 
 
 def free_near(blocked, land, north, east, p, radius):
@@ -189,10 +210,11 @@ class SeaRoute:
         self.cells, self.free, self.edges = cells, free, edges
 
 
-def sea_route(field, speed, start, target, north, east, blocked, *, piece=None):
+def sea_route(field, speed, start, target, north, east, blocked, *, piece=None, pull=True):
     """The graph route of the module docstring from ``start`` to ``target`` (plane points [m]) over the
     free cells of ``blocked`` (north × east): a :class:`SeaRoute` whose ``route`` is None when the target
-    is not connected to the start over the free cells (or no edge can be held against the current)."""
+    is not connected to the start over the free cells (or no edge can be held against the current).
+    ``pull=False`` keeps the lattice path (the coarse pass of the corridor, :func:`band_mask`)."""
     from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import dijkstra
 
@@ -246,6 +268,10 @@ def sea_route(field, speed, start, target, north, east, blocked, *, piece=None):
         return SeaRoute(None, None, blocked.size, n_free, edges)
     times = np.concatenate([[0.0], np.cumsum(seg_t)])
     lattice_time = float(times[-1])
+    if not pull:
+        _, heads = _crab(field, speed, 0.0, xy[:-1], xy[1:])
+        route = GraphRoute(lattice_time, g, DIRECTIONS, xy, times, heads, 0.0, 0.0)
+        return SeaRoute(route, lattice_time, blocked.size, n_free, edges)
 
     def visible(i, j):
         return _visible(blocked, north, east, xy[i], xy[j])
