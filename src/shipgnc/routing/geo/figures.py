@@ -30,7 +30,6 @@ def geo_route_figure(route, path, *, gpx_path=None, title=None, ax=None):
         fig, ax = plt.subplots(figsize=(10, min(9.0, max(3.2, 8.4 * ratio + 1.2))), constrained_layout=True)
     ax.set_facecolor("#e8f1f8")
     import shapely
-
     from matplotlib.collections import PolyCollection
 
     clip = shapely.box(*box)
