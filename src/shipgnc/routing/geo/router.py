@@ -9,8 +9,10 @@ document 002 (:func:`~shipgnc.routing.router.solve_route`):
    time axis (linear in time); NaN cells and cells outside the file are land;
 2. land (the GSHHG coastline, or ``land=`` polygons), shallow water (depth < draft + UKC) and the current's
    NaN cells are polygons in the plane; the router keeps one level-set cell ``clearance`` off them;
-3. in open water the extremals (PMP) with the level-set global check; with land in the box, the level set
-   (frozen land cells) — the method that goes round any coastline;
+3. in open water the extremals (PMP) with the level-set global check; with a gridded current, the level set
+   (frozen land cells) — the method that goes round any coastline; with land and a uniform current (or
+   ``method="graph"``), the open-sea optimum when it keeps the clearance off the land, else the graph on the
+   sea's cells pulled taut (:mod:`.seagraph`), whose cost follows the sea, not the box;
 4. the optimal track is thinned to waypoints within ``xte_m`` of it (Douglas–Peucker, no leg across land)
    and the waypoint route is re-timed on the ellipsoid: along each geodesic leg (Karney 2013) the ship
    holds the leg's course with the crab angle of the true current, ground speed
@@ -589,8 +591,6 @@ class GeoProblem:
             horizon = 4.0 * float(np.hypot(*(self.B - self.A))) / self.speed
         plan = self.plan(method)
         if plan == "levelset":
-            if method not in ("auto", "levelset"):
-                notes.append(f"--method {method}: land in the route's box; the level set is used")
             res = self._round_land(fld, horizon, notes)
         elif plan == "sea graph":  # the open sea's optimum first (closed form in a uniform current)
             open_sea = None if method == "graph" else solve_route(
