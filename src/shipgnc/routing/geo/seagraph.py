@@ -14,14 +14,21 @@ once, and goes round the coastline at any scale:
 2. **graph** (:func:`sea_route`): Dijkstra (scipy.sparse.csgraph) over the free cells with the 16-direction
    stencil of :mod:`~shipgnc.routing.graph`; each edge sailed at constant course through the current at
    its middle (the crab triangle, :func:`~shipgnc.routing.graph._crab`), the current taken at departure;
-   the 16-direction lattice path is at most 1/cos(π/16)/… ≈ 2.7 % longer than the straight one
-   (Nash & Koenig 2013, *AI Magazine* 34(4), 85–107, "Any-angle path planning");
+   a lattice path is at most sec(α/2) − 1 ≈ 2.7 % longer than the straight one, α = 26.6° the widest angle
+   between neighbouring directions (Nash & Koenig 2013, *AI Magazine* 34(4), 85–107, "Any-angle path
+   planning");
 3. **taut string**: the lattice path is shortened by string pulling (the any-angle post-smoothing of
    Nash & Koenig §3): from each kept vertex the farthest later vertex in sight is joined by a straight
    leg, accepted only when the leg is no slower than the lattice path it replaces. In a uniform current
    the time-optimal track between two points in open water is the straight line (constant heading,
    Zermelo 1931), so the taut string through coastline corners is the optimum of its homotopy class, as
-   in still water (Lozano-Pérez & Wesley 1979, *Comm. ACM* 22(10), 560–570).
+   in still water (Lozano-Pérez & Wesley 1979, *Comm. ACM* 22(10), 560–570); :func:`tighten` then slides
+   the corners, left on lattice nodes, against the blocked cells.
+
+The geo router (:meth:`~.router.GeoProblem.solve`) runs this twice: over the whole box on coarse cells with
+optimistic land (a strait wider than a cell open), then on fine cells kept the clearance off land in the
+corridor of :data:`BAND_CELLS` coarse cells round the coarse route (:func:`band_mask`): the memory follows
+the corridor, not the box.
 
 Distances are plane metres (north, east) of the route's oblique Mercator (:mod:`.projection`); times in
 seconds since departure.
