@@ -221,9 +221,10 @@ def _check_memory(need, limit: float | None) -> None:
     if need.total <= have:
         return
     what = f"{format_bytes(have)} is available" if limit is None else f"--max-memory is {format_bytes(have)}"
-    hint = {"level set": "use a coarser --grid, a shorter --horizon or --method pmp",
-            "graph": "use a coarser --grid or another --method",
-            "sweep": "use --method levelset"}.get(need.largest(), "")
+    hint = (need.advice(have) if callable(need.advice) else need.advice) or {
+        "level set": "use a coarser --grid, a shorter --horizon or --method pmp",
+        "graph": "use a coarser --grid or another --method",
+        "sweep": "use --method levelset"}.get(need.largest(), "")
     raise ConfigError(f"route: needs about {format_bytes(need.total)} ({need.describe()}) but {what}; "
                       f"{hint + ', or ' if hint else ''}raise --max-memory")
 
@@ -253,10 +254,25 @@ def _progress():
         yield update
 
 
-def _geo_route(start, target, speed, field, method, obstacles, units, json_, out, horizon, radius, depart,
-               grid, land, depth, draft, ukc, xte_m, length, tscale, sail=False, sail_vessel="auto",
-               limit=None) -> None:
-    """``route --geo`` (docs/routing_geo.md)."""
+def _geo_route(*args, **kw) -> None:
+    """``route --geo`` (docs/routing_geo.md), the warnings of the libraries it calls (numpy, shapely,
+    pyshp, ...) caught: none is printed before a one-line error; after a route they are its notes."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _geo_route_run(*args, **kw, caught=caught)
+
+
+def _warning_notes(caught) -> list[str]:
+    seen = dict.fromkeys(f"warning ({w.category.__name__}): {' '.join(str(w.message).split())}"
+                         for w in caught)
+    return list(seen)
+
+
+def _geo_route_run(start, target, speed, field, method, obstacles, units, json_, out, horizon, radius,
+                   depart, grid, land, depth, draft, ukc, xte_m, length, tscale, sail=False,
+                   sail_vessel="auto", limit=None, caught=()) -> None:
     from shipgnc.cli import stderr, stdout
     from shipgnc.errors import require
     from shipgnc.routing.geo.router import GeoProblem
@@ -291,24 +307,20 @@ def _geo_route(start, target, speed, field, method, obstacles, units, json_, out
 
         offset, iso_depart = 0.0, parse_iso(depart)
     problem = GeoProblem(a, b, speed, current=current, land=land, depth=depth, draft=draft, ukc=ukc,
-                         grid=None if grid is None else grid * length, xte_m=xte_m)
+                         grid=None if grid is None else grid * length, xte_m=xte_m,
+                         budget=lambda need: _check_memory(need, limit))
     if iso_depart is None and problem.current.times is None and offset:
         raise ConfigError(f"--depart = {depart!r}: the current has no time axis; give an ISO 8601 UTC time")
     t_dep = problem.departure(iso_depart, offset)
-    from shipgnc.routing.memory import levelset_memory, route_memory_estimate
-
     t_h = None if horizon is None else horizon * tscale
     fld = problem.field_from(t_dep)
-    if problem.router_obstacles or (problem.current.grid is not None and method in ("auto", "levelset")):
-        need = levelset_memory(fld, speed, problem.A, problem.B, problem.box, problem.h, horizon=t_h,
-                               r0=1.2 * problem.h, n_rays=360, ray_steps=20)  # routing.geo.frontier
-    else:
-        need = route_memory_estimate(fld, speed, problem.A, problem.B, method=method, grid_spacing=problem.h,
-                                     domain=problem.box, horizon=t_h)
+    need = problem.memory_estimate(fld, method=method, horizon=t_h,
+                                   unit=(length, "nm" if length > 1 else "m"))
     _check_memory(need, limit)
     with _progress() as progress:
         res = problem.solve(t_dep, method=method, horizon=t_h, progress=progress)
     payload = res.to_json()
+    payload["notes"].extend(_warning_notes(caught))
     if sail and res.reachable:
         from shipgnc.routing.geo.sail import sail_check
 
@@ -401,7 +413,7 @@ def _print_geo(console, js) -> None:
         row("global check by level set (plane)", f"{gc['time_s']:.0f} s ({gc['rel_diff']:+.2e})")
     console.print(table)
     for note in js["notes"]:
-        console.print(f"note: {note}", soft_wrap=True)
+        console.print(f"note: {escape(note)}", soft_wrap=True)
 
 
 def _jsonable(x):

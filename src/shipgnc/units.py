@@ -35,10 +35,28 @@ def nautical_text(text: str) -> str:
     kn, 1/h, nm²/h), so that an error speaks the units of its input."""
     def convert(match: re.Match) -> str:
         unit, factor = _TO_NAUTICAL[match.group(3)]
-        values = [f"{float(v) * factor:.{_significant(v)}g}" for v in match.groups()[:2] if v is not None]
+        values = [_restate(v, factor) for v in match.groups()[:2] if v is not None]
         return f"{'…'.join(values)} {unit}"
 
     return _SI_QUANTITY.sub(convert, text)
+
+
+def _restate(number: str, factor: float) -> str:
+    """``number`` (as printed) × ``factor`` in the fewest significant digits that stay within half a unit
+    of the printed number's last digit (scaled): 0.5144 m/s, a printed 1 kn, reads "1", not "0.9999"."""
+    x = float(number)
+    y = x * factor
+    digits = _significant(number)
+    if x == 0 or not math.isfinite(y):
+        return f"{y:.{digits}g}"
+    tol = 0.5 * 10 ** (math.floor(math.log10(abs(x))) - digits + 1) * abs(factor)
+    for k in range(1, digits + 1):
+        text = f"{y:.{k}g}"
+        if abs(float(text) - y) <= tol:
+            if "e" in text and 1e-4 <= abs(y) < 1e15:  # "1e+01" → "10"
+                text = f"{float(text):f}".rstrip("0").rstrip(".")
+            return text
+    return f"{y:.{digits}g}"
 
 
 def _significant(number: str) -> int:

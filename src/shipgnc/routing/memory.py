@@ -58,6 +58,8 @@ class RouteMemory:
     snapshots: int = 0  #: level-set fronts stored up to the horizon
     family: tuple[int, int] | None = None  #: sweep table (n_steps + 1, admissible angles)
     graph_edges: int = 0
+    #: the option that fits, in the caller's words, or a callable (bytes available) -> those words
+    advice: object = ""
 
     @property
     def total(self) -> int:

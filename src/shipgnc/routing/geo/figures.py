@@ -30,14 +30,15 @@ def geo_route_figure(route, path, *, gpx_path=None, title=None, ax=None):
         fig, ax = plt.subplots(figsize=(10, min(9.0, max(3.2, 8.4 * ratio + 1.2))), constrained_layout=True)
     ax.set_facecolor("#e8f1f8")
     import shapely
+    from matplotlib.collections import PolyCollection
 
     clip = shapely.box(*box)
-    for poly in pr.land_geo:
-        g = poly.intersection(clip)
-        for p in shapely.get_parts(g):
-            if p.geom_type == "Polygon" and not p.is_empty:
-                x, y = p.exterior.xy
-                ax.fill(x, y, color="#c9c2b0", ec="#8a8170", lw=0.4, zorder=1)
+    land = np.asarray(pr.land_geo, dtype=object)
+    if land.size:  # one collection for the thousands of islands of a sea-scale box
+        parts = shapely.get_parts(shapely.intersection(land[shapely.intersects(land, clip)], clip))
+        parts = parts[(shapely.get_type_id(parts) == 3) & ~shapely.is_empty(parts)]
+        rings = [np.asarray(p.exterior.coords) for p in parts]
+        ax.add_collection(PolyCollection(rings, facecolor="#c9c2b0", edgecolor="#8a8170", lw=0.4, zorder=1))
     # the current at departure
     t = route.depart_s if route.depart_s is not None else 0.0
     la = np.linspace(box[1], box[3], 22)

@@ -39,6 +39,11 @@ class RouteProjection:
             alpha -= 180.0
         if alpha <= -90.0:
             alpha += 180.0
+        if abs(latm) > 89.999:
+            pole = "North" if latm > 0 else "South"
+            raise ConfigError(f"--start {a[0]:g},{a[1]:g} → --target {b[0]:g},{b[1]:g}: the geodesic "
+                              f"passes over the {pole} Pole (its middle at {latm:.3f}°), where the route's "
+                              "oblique Mercator has no central line; route to a waypoint off the pole first")
         self.centre = (float(latm), float(lonm))
         self.alpha = float(alpha)
         self.proj4 = (f"+proj=omerc +lat_0={latm:.10f} +lonc={lonm:.10f} +alpha={alpha:.10f} +k_0=1 "
@@ -48,8 +53,10 @@ class RouteProjection:
             self._fwd = Transformer.from_crs("EPSG:4326", crs, always_xy=True)
             self._inv = Transformer.from_crs(crs, "EPSG:4326", always_xy=True)
             self._proj = Proj(crs)
-        except Exception as exc:  # pragma: no cover - PROJ refuses only degenerate lines
-            raise ConfigError(f"projection {self.proj4!r}: {exc}") from None
+        except Exception:  # pragma: no cover - PROJ refuses only degenerate lines
+            raise ConfigError(f"--start {a[0]:g},{a[1]:g} → --target {b[0]:g},{b[1]:g}: no oblique "
+                              f"Mercator centred on this route (middle {latm:.4f}°, {lonm:.4f}°, azimuth "
+                              f"{alpha:.2f}°); route via a waypoint") from None
         self.geodesic_m = float(dist)
 
     def describe(self) -> str:

@@ -9,8 +9,10 @@ document 002 (:func:`~shipgnc.routing.router.solve_route`):
    time axis (linear in time); NaN cells and cells outside the file are land;
 2. land (the GSHHG coastline, or ``land=`` polygons), shallow water (depth < draft + UKC) and the current's
    NaN cells are polygons in the plane; the router keeps one level-set cell ``clearance`` off them;
-3. in open water the extremals (PMP) with the level-set global check; with land in the box, the level set
-   (frozen land cells) — the method that goes round any coastline;
+3. in open water the extremals (PMP) with the level-set global check; with a gridded current, the level set
+   (frozen land cells) — the method that goes round any coastline; with land and a uniform current (or
+   ``method="graph"``), the open-sea optimum when it keeps the clearance off the land, else the graph on the
+   sea's cells pulled taut (:mod:`.seagraph`), whose cost follows the sea, not the box;
 4. the optimal track is thinned to waypoints within ``xte_m`` of it (Douglas–Peucker, no leg across land)
    and the waypoint route is re-timed on the ellipsoid: along each geodesic leg (Karney 2013) the ship
    holds the leg's course with the crab angle of the true current, ground speed
@@ -176,7 +178,7 @@ class GeoProblem:
     for one departure, as often as wanted (a departure scan)."""
 
     def __init__(self, start, target, speed, *, current=None, land="default", depth=None, draft=0.0,
-                 ukc=0.0, grid=None, margin=None, xte_m=XTE_M, clearance=None):
+                 ukc=0.0, grid=None, margin=None, xte_m=XTE_M, clearance=None, budget=None):
         from shipgnc.routing.geo import cf
 
         for name, p in (("--start", start), ("--target", target)):
@@ -186,6 +188,9 @@ class GeoProblem:
         require(math.isfinite(xte_m) and xte_m > 0, "--xte-m", xte_m, "must be a cross-track tolerance > 0 m")
         require(math.isfinite(draft) and draft >= 0, "--draft", draft, "must be >= 0 m")
         require(math.isfinite(ukc) and ukc >= 0, "--ukc", ukc, "must be >= 0 m")
+        for name, value in (("--draft", draft), ("--ukc", ukc)):
+            require(depth is not None or value == 0, name, value,
+                    "needs --depth (a bathymetry CF-NetCDF file): without it no depth is checked")
         self.start, self.target = (float(start[0]), float(start[1])), (float(target[0]), float(target[1]))
         self.speed, self.xte_m, self.notes = float(speed), float(xte_m), []
         proj = self.projection = RouteProjection(self.start, self.target)
@@ -202,6 +207,9 @@ class GeoProblem:
         self.h = float(grid) if grid is not None else size / 200.0
         require(math.isfinite(self.h) and self.h > 0, "--grid", grid, "must be a spacing > 0")
         self.clearance = self.h if clearance is None else float(clearance)
+        self._grid = None if grid is None else float(grid)
+        self._clearance = None if clearance is None else float(clearance)
+        self._budget, self.held_bytes = budget, 0
         # ---- the current
         if current is None:
             current = GeoCurrent(uniform=(0.0, 0.0))
@@ -295,7 +303,7 @@ class GeoProblem:
         import shapely
 
         from shipgnc.routing.geo import cf
-        from shipgnc.routing.geo.land import coastline, load_land, region_polygons
+        from shipgnc.routing.geo.land import PlaneLand, coastline, load_land, region_polygons
 
         proj = self.projection
         (n0, n1), (e0, e1) = self.box
@@ -312,10 +320,13 @@ class GeoProblem:
         elif land in (None, "none"):
             pass
         elif land == "default":
+            self._coastline_budget()
             groups.append(("on land", "GSHHG full-resolution coastline (roaring-landmask)",
                            coastline(*self.geo_box), None))
         else:
-            groups.append(("on land", f"land from {land}", load_land(land), None))
+            polys = load_land(land)
+            self._swapped_note(land, polys)
+            groups.append(("on land", f"land from {land}", polys, None))
         if depth is not None:
             dg = cf.read_depth(depth)
             self.notes.extend(dg.notes)
@@ -337,53 +348,112 @@ class GeoProblem:
             groups.append((f"on a NaN (land) cell of {self.current.grid.path} or outside it",
                            f"NaN cells and the outside of {self.current.grid.path}", None, nan_polys))
         geo_box = shapely.box(*self.geo_box)
-        self.land_geo = [p for g in groups if g[2] for p in g[2] if p.intersects(geo_box)]
+        groups = [(what, kind, None if geo is None else _meeting(geo, geo_box), plane)
+                  for what, kind, geo, plane in groups]
+        self.land_geo = [p for g in groups if g[2] is not None for p in g[2]]
         self.land_kinds = [g[1] for g in groups]
-        box = shapely.box(n0, e0, n1, e1)
+        box = shapely.box(n0, e0, n1, e1).buffer(4 * self.clearance)
         parts = []
         for what, kind, geo_polys, plane_polys in groups:
-            plane = plane_polys if plane_polys is not None else [
-                self._to_plane_geom(p) for p in geo_polys if p.intersects(geo_box)]
-            if not plane:
+            plane = plane_polys if plane_polys is not None else self._to_plane_geoms(geo_polys)
+            plane = _meeting(plane, box) if len(plane) else []
+            if not len(plane):
                 continue
-            u = shapely.intersection(shapely.union_all([shapely.make_valid(p) for p in plane]),
-                                     box.buffer(4 * self.clearance))
+            here = PlaneLand(plane)
             for name, p, q in (("start", self.A, self.start), ("target", self.B, self.target)):
-                if u.contains(shapely.Point(p)):
+                if here.contains(shapely.Point(p)):
                     raise ConfigError(f"--{name} = {q[0]:.5f},{q[1]:.5f}: {what} ({kind})")
-            parts.append(u)
-        self.hard = shapely.union_all(parts) if parts else shapely.Polygon()  # (north, east) m
-        shapely.prepare(self.hard)
-        kinds = self.land_kinds
+            parts.extend(plane)
+        self.hard = PlaneLand(parts)  # (north, east) m, every polygon apart (no union)
+        self._router_obstacles = None
         if self.hard.is_empty:
-            self.router_obstacles = []
+            self._router_obstacles = []
             return
-        soft = self.hard.simplify(self.clearance / 10).buffer(self.clearance, quad_segs=2)
-        soft = soft.difference(shapely.Point(self.A).buffer(1.5 * self.clearance))
-        soft = soft.difference(shapely.Point(self.B).buffer(1.5 * self.clearance))
-        soft = shapely.intersection(soft, box).simplify(self.clearance / 8)
-        self.router_obstacles = [g for g in shapely.get_parts(soft)
-                                 if g.geom_type == "Polygon" and g.area > 0 and g.is_valid]
-        self.notes.append(f"land/shallow water: {'; '.join(kinds)}; the router keeps {self.clearance:.0f} m "
-                          "(one level-set cell) off it")
+        self.notes.append(f"land/shallow water: {'; '.join(self.land_kinds)}")
 
-    def _to_plane_geom(self, geom):
+    def _swapped_note(self, name, polys):
+        """A note when none of a land file's polygons lies in the route's box but some would with each
+        pair read the other way round ([lat, lon] written where GeoJSON wants [lon, lat], RFC 7946
+        §3.1.1)."""
         import shapely
+
+        box = shapely.box(*self.geo_box)
+        arr = np.asarray(polys, dtype=object)
+        if not arr.size or shapely.intersects(arr, box).any():
+            return
+        swapped = shapely.transform(arr, lambda xy: xy[:, ::-1])
+        hits = int(np.sum(shapely.intersects(swapped, box)))
+        if hits:
+            self.notes.append(f"--land {name}: none of its {arr.size} polygons lies in the route's box, but "
+                              f"{hits} would with latitude and longitude swapped: GeoJSON and shapefiles "
+                              "give [lon, lat] (RFC 7946 §3.1.1); is the file [lat, lon]?")
+
+    def _coastline_budget(self):
+        """The coastline's memory checked by ``budget`` before it is loaded, then before the box's part is
+        clipped and projected (:data:`.land.GSHHG_BYTES`, :data:`.land.COORD_BYTES` per coordinate)."""
+        from shipgnc.routing.geo.land import COORD_BYTES, GSHHG_BYTES, coastline_size, gshhg_loaded
+        from shipgnc.routing.memory import RouteMemory
+
+        loaded = gshhg_loaded()
+        if self._budget is not None and not loaded:
+            self._budget(RouteMemory(items={"coastline: GSHHG polygons": GSHHG_BYTES},
+                                     phases={"coastline (GSHHG, roaring-landmask)": GSHHG_BYTES},
+                                     advice="give --land none (open sea) or your own --land FILE"))
+        n_poly, n_xy = coastline_size(*self.geo_box)
+        self.held_bytes = GSHHG_BYTES
+        if self._budget is not None:
+            work = COORD_BYTES * n_xy
+            self._budget(RouteMemory(
+                items={"coastline: GSHHG polygons": GSHHG_BYTES, "coastline: the box's part": work},
+                phases={f"coastline ({n_poly:,} polygons, {n_xy:,} points in the route's box)":
+                        GSHHG_BYTES + work},
+                advice="give --land none (open sea) or your own --land FILE"))
+
+    @property
+    def router_obstacles(self) -> list:
+        """The land the level set freezes: every polygon simplified within clearance/10 and grown by the
+        clearance (one level-set cell), the disc of 1.5 clearances about A and B left open; built on
+        first use (only the level set needs it)."""
+        if self._router_obstacles is None:
+            import shapely
+
+            cl = self.clearance
+            (n0, n1), (e0, e1) = self.box
+            grown = shapely.buffer(shapely.simplify(self.hard.polys, cl / 10), cl, quad_segs=2)
+            soft = shapely.union_all(grown)
+            soft = soft.difference(shapely.Point(self.A).buffer(1.5 * cl))
+            soft = soft.difference(shapely.Point(self.B).buffer(1.5 * cl))
+            soft = shapely.intersection(soft, shapely.box(n0, e0, n1, e1)).simplify(cl / 8)
+            self._router_obstacles = [g for g in shapely.get_parts(soft)
+                                      if g.geom_type == "Polygon" and g.area > 0 and g.is_valid]
+        return self._router_obstacles
+
+    def _to_plane_geoms(self, geoms) -> list:
+        """Lon/lat polygons in the plane ((north, east) m), all in one projection call."""
+        import shapely
+
+        if not geoms:
+            return []
 
         def f(xy):
             n, e = self.projection.to_plane(xy[:, 1], xy[:, 0])
             return np.column_stack([n, e])
 
-        return shapely.make_valid(shapely.transform(geom, f))
+        return _polygons(shapely.make_valid(shapely.transform(np.asarray(geoms, dtype=object), f)))
 
     # ------------------------------------------------------------------ solving
     def departure(self, depart_s=None, offset_s=0.0):
         """The absolute departure [s since epoch] or None; a time axis bounds it (errors name the file)."""
+        from shipgnc.routing.geo.timefmt import in_range
+
         times = self.current.times
         if depart_s is None:
             if times is None:
                 return None
             depart_s = float(times[0]) + float(offset_s)
+        if not in_range(depart_s):
+            raise ConfigError(f"--depart: the departure {iso(depart_s)} lies beyond the years 1–9999; give "
+                              "an ISO 8601 UTC time or an offset within the current file's times")
         if times is not None and times.size > 1 and not times[0] <= depart_s <= times[-1]:
             raise ConfigError(f"{self.current.grid.path}: the departure {iso(depart_s)} lies outside the "
                               f"file's time coverage {self.current.grid.time_extent()}")
@@ -401,10 +471,123 @@ class GeoProblem:
         fld.times = self.field.times - float(depart_s)
         return fld
 
+    def plan(self, method="auto") -> str:
+        """The method :meth:`solve` runs: ``open sea`` (no land in the box: the plane router,
+        ``method``), ``levelset`` (the level set round land over the box: a gridded current with
+        ``method`` auto/levelset, or ``method`` levelset), or ``sea graph`` (land in the box, a uniform
+        current or ``method`` graph: the open-sea route when it is clear of land, else the graph on the
+        sea's cells and its taut string, :mod:`.seagraph`). ``method`` pmp with land: the open-sea
+        extremal, refused when it meets land."""
+        gridded = self.current.grid is not None
+        if self.hard.is_empty:
+            return "levelset" if gridded and method in ("auto", "levelset") else "open sea"
+        if method == "levelset" or (gridded and method == "auto"):
+            return "levelset"
+        return "sea graph"
+
+    def sea_spacing(self) -> float:
+        """The coarse pass's raster spacing g₁ [m]: the box's larger side / 800, at least ``--grid``."""
+        (n0, n1), (e0, e1) = self.box
+        return max(max(n1 - n0, e1 - e0) / 800.0, self._grid or 0.0)
+
+    def fine_spacing(self, corridor_area=None) -> float:
+        """The fine pass's raster spacing g₂ [m]: ``--grid`` when given, else g₁/4 and no finer than
+        :data:`.seagraph.FINE_CELLS` cells over the corridor's box (``corridor_area`` [m²], the route's
+        box before the coarse pass)."""
+        if self._grid is not None:
+            return float(self._grid)
+        if corridor_area is None:
+            (n0, n1), (e0, e1) = self.box
+            corridor_area = (n1 - n0) * (e1 - e0)
+        from shipgnc.routing.geo.seagraph import FINE_CELLS
+
+        return max(self.sea_spacing() / 4, math.sqrt(corridor_area / FINE_CELLS))
+
+    def sea_fraction(self) -> float:
+        """The share of the route's box that is not land (the land polygons' area; at most one, plus 0.05
+        for the cells along the coast): the sea graph's nodes and edges scale with it."""
+        import shapely
+
+        if getattr(self, "_sea_fraction", None) is None:
+            (n0, n1), (e0, e1) = self.box
+            box = shapely.box(n0, e0, n1, e1)
+            land = float(np.sum(shapely.area(shapely.intersection(self.hard.polys, box)))) if len(
+                self.hard.polys) else 0.0
+            self._sea_fraction = min(1.0, max(0.0, 1.0 - land / box.area) + 0.05)
+        return self._sea_fraction
+
+    def memory_estimate(self, fld, method="auto", horizon=None, unit=(1.0, "m")):
+        """The :class:`~shipgnc.routing.memory.RouteMemory` of :meth:`solve` with this ``method``, before
+        any work: the level set's arrays (:func:`~shipgnc.routing.memory.levelset_memory`), the sea graph's
+        raster and edges (:mod:`.seagraph`: ``CELL_BYTES`` per cell, ``EDGE_BYTES`` per edge, 16 per free
+        cell at most), or the plane router's (:func:`~shipgnc.routing.memory.route_memory_estimate`)."""
+        from shipgnc.routing.geo import seagraph
+        from shipgnc.routing.memory import RouteMemory, levelset_memory, route_memory_estimate
+
+        plan = self.plan(method)
+        if plan == "levelset":
+            out = levelset_memory(fld, self.speed, self.A, self.B, self.box, self.h, horizon=horizon,
+                                  r0=1.2 * self.h, n_rays=360, ray_steps=20)  # routing.geo.frontier
+        else:
+            out = route_memory_estimate(fld, self.speed, self.A, self.B, method="pmp" if plan == "sea graph"
+                                        else method, grid_spacing=self.h, domain=self.box, horizon=horizon)
+        if plan == "sea graph":
+            coarse, fine, edges, fine_cells = self._sea_graph_bytes(self._grid)
+            g2 = self.fine_spacing()
+            require(fine_cells <= seagraph.MAX_CELLS, "--grid", float(f"{g2 / unit[0]:.6g}"),
+                    f"gives up to {fine_cells:,} cells of the sea graph's fine pass; at most "
+                    f"{seagraph.MAX_CELLS:,}: use --grid "
+                    f"{_length(1.01 * g2 * math.sqrt(fine_cells / seagraph.MAX_CELLS), unit)} or coarser")
+            out.items["sea graph: coarse pass, raster and edges (16 per sea cell)"] = coarse
+            out.items["sea graph: fine pass in the corridor, raster and edges"] = fine
+            out.phases["graph"] = max(coarse, fine)
+            out.graph_edges = edges
+
+            def advice(have):
+                """The finest --grid (5 % steps) whose passes fit ``have`` bytes beside the coastline."""
+                grid = g2
+                for _ in range(200):
+                    grid *= 1.05
+                    c, f, _, _ = self._sea_graph_bytes(grid)
+                    if max(c, f) + self.held_bytes <= have:
+                        return f"use --grid {_length(grid, unit)} or coarser (now {_length(g2, unit)})"
+                return "no --grid fits beside the coastline; give --land none or your own --land FILE"
+
+            out.advice = advice
+        if plan == "levelset":
+            out.advice = "use a coarser --grid, a shorter --horizon" + (
+                " or --method graph" if not self.hard.is_empty else "")
+        out = out if out.phases else RouteMemory()
+        for k in out.phases:  # the coastline stays loaded while the route is solved
+            out.phases[k] += self.held_bytes
+        if self.held_bytes:
+            out.items["coastline held (GSHHG polygons)"] = self.held_bytes
+        return out
+
+    def _sea_graph_bytes(self, grid):
+        """(coarse pass, fine pass [bytes], edges, fine cells) of the sea graph with ``--grid`` = ``grid``
+        (None: the defaults): the coarse pass's raster over the box and 16 edges per sea cell
+        (:meth:`sea_fraction`); the fine pass's raster over the corridor's box (at most the route's box,
+        :data:`.seagraph.FINE_CELLS` cells without --grid) and its edges in a corridor along a route 30 %
+        longer than A→B."""
+        from shipgnc.routing.geo import seagraph
+
+        (n0, n1), (e0, e1) = self.box
+        g1 = max(max(n1 - n0, e1 - e0) / 800.0, grid or 0.0)
+        g2 = float(grid) if grid is not None else self.fine_spacing()
+        cells = seagraph.raster_cells(self.box, g1)
+        sea = self.sea_fraction()
+        coarse = int((seagraph.CELL_BYTES + seagraph.EDGE_BYTES * seagraph.DIRECTIONS * sea) * cells)
+        band = 2 * seagraph.BAND_CELLS * g1 * 1.3 * float(np.hypot(*(self.B - self.A))) / g2**2
+        fine_cells = seagraph.raster_cells(self.box, g2)
+        if grid is None:
+            fine_cells = min(fine_cells, seagraph.FINE_CELLS)
+        fine = int(seagraph.CELL_BYTES * fine_cells + seagraph.EDGE_BYTES * seagraph.DIRECTIONS * band)
+        return coarse, fine, int(seagraph.DIRECTIONS * max(sea * cells, band)), fine_cells
+
     def solve(self, depart_s=None, *, method="auto", horizon=None, global_check=None, **kw) -> GeoRoute:
-        """The route for a departure [s since epoch, or None without a clock]. With land in the box, or a
-        gridded current (``method`` auto/levelset), the level set of :mod:`.frontier` (the global method);
-        otherwise :func:`~shipgnc.routing.router.solve_route` (``method``; ``kw`` passed on)."""
+        """The route for a departure [s since epoch, or None without a clock], by the method of
+        :meth:`plan`; ``kw`` passed on to :func:`~shipgnc.routing.router.solve_route`."""
         from shipgnc.routing.router import solve_route
 
         fld = self.field_from(depart_s)
@@ -412,11 +595,14 @@ class GeoProblem:
         limit = horizon  # a horizon given limits the route sailed along its waypoints too
         if horizon is None:
             horizon = 4.0 * float(np.hypot(*(self.B - self.A))) / self.speed
-        gridded = self.current.grid is not None
-        if self.router_obstacles or (gridded and method in ("auto", "levelset")):
-            if method not in ("auto", "levelset"):
-                notes.append(f"--method {method}: land in the route's box; the level set is used")
+        plan = self.plan(method)
+        if plan == "levelset":
             res = self._round_land(fld, horizon, notes)
+        elif plan == "sea graph":  # the open sea's optimum first (closed form in a uniform current)
+            open_sea = None if method == "graph" else solve_route(
+                fld, self.speed, self.A, self.B, t0=0.0, method="pmp", horizon=horizon, grid_spacing=self.h,
+                domain=self.box, global_check=False, **kw)
+            res = self._sea_graph(fld, open_sea, method, notes)
         else:
             res = solve_route(fld, self.speed, self.A, self.B, t0=0.0, method=method, horizon=horizon,
                               grid_spacing=self.h, domain=self.box, global_check=global_check, **kw)
@@ -433,6 +619,106 @@ class GeoProblem:
             out.reachable, out.time_s = False, None
         return out
 
+    def _open_sea_clear(self, res, clearance) -> bool:
+        """Does the open-sea route's plane track (2000 points) keep ``clearance`` off every land polygon?"""
+        import shapely
+
+        if not res.reachable:
+            return False
+        _t, north, east, _ = res.sample(2000)
+        return self.hard.distance(shapely.LineString(np.column_stack([north, east]))) >= clearance
+
+    def _sea_graph(self, fld, open_sea, method, notes):
+        """Land in the box: the open-sea route when it keeps the clearance off the land (the optimum without
+        land is a lower bound, reached), else the graph route of :mod:`.seagraph` in two passes: a coarse
+        path over the whole box, pulled taut (cells of g₁ whose centre is on land blocked, no clearance: a
+        strait wider than a cell stays open), then the fine graph, its path pulled taut, in the corridor of
+        :data:`.seagraph.BAND_CELLS` coarse cells either side of it (cells of g₂ kept the clearance off
+        the land)."""
+        import shapely
+
+        from shipgnc.routing.geo import seagraph
+        from shipgnc.routing.memory import RouteMemory
+        from shipgnc.routing.result import RouteResult
+
+        g1 = self.sea_spacing()
+        cl0 = self._clearance if self._clearance is not None else self.fine_spacing() / 2
+        if open_sea is not None and self._open_sea_clear(open_sea, cl0):
+            self.clearance = cl0
+            notes.append(f"land in the route's box, none within {cl0:.0f} m of the open-sea route: the "
+                         "open-sea optimum is the route (no route round the land is faster)")
+            return open_sea
+        if method == "pmp":
+            raise ConfigError("--method pmp: the extremals' route meets land; --method auto or graph goes "
+                              "round it")
+        res = RouteResult(False, self.A, self.B, self.speed, t0=0.0, method="graph", field=fld)
+        polys = self.hard.polys
+        # ---- coarse pass: the whole box, optimistic land
+        north, east = seagraph.raster_axes(self.box, g1)
+        land = seagraph.land_raster(shapely.simplify(polys, g1 / 4), north, east, outline=False)
+        blocked = land.copy()
+        for p in (self.A, self.B):
+            seagraph.free_near(blocked, np.zeros_like(land), north, east, p, 2 * g1)
+        coarse = seagraph.sea_route(fld, self.speed, self.A, self.B, north, east, blocked)
+        del land, blocked
+        if coarse.route is None:
+            res.grid_spacing = g1
+            res.reason = (f"the target is not connected to the start over the sea's cells of {g1:.0f} m in "
+                          "the route's box (or the current cannot be stemmed)")
+            return res
+        # ---- fine pass: the corridor round the coarse path
+        path, half = coarse.route.xy, seagraph.BAND_CELLS * g1
+        (n0, n1), (e0, e1) = self.box
+        pad = half + 4 * g1
+        sub = ((max(n0, path[:, 0].min() - pad), min(n1, path[:, 0].max() + pad)),
+               (max(e0, path[:, 1].min() - pad), min(e1, path[:, 1].max() + pad)))
+        g2 = self.fine_spacing((sub[0][1] - sub[0][0]) * (sub[1][1] - sub[1][0]))
+        cl = self._clearance if self._clearance is not None else g2 / 2
+        tol = g2 / 4
+        cells = seagraph.raster_cells(sub, g2)
+        length = float(np.sum(np.hypot(*np.diff(path, axis=0).T)))
+        band = 2 * half * length / g2**2
+        if self._budget is not None:  # checked again before the fine pass, on the corridor it has
+            work = int(seagraph.CELL_BYTES * cells + seagraph.EDGE_BYTES * seagraph.DIRECTIONS * band)
+            self._budget(RouteMemory(
+                items={"sea graph: fine pass": work, "coastline held": self.held_bytes},
+                phases={f"sea graph's fine pass, {cells:,} cells of {g2:.0f} m": work + self.held_bytes},
+                advice="use a coarser --grid"))
+        require(cells <= seagraph.MAX_CELLS, "--grid", g2, f"gives {cells:,} cells in the corridor of the "
+                f"coarse route; at most {seagraph.MAX_CELLS:,}: use a coarser --grid")
+        north, east = seagraph.raster_axes(sub, g2)
+        sub_box = shapely.box(sub[0][0], sub[1][0], sub[0][1], sub[1][1])
+        near = polys[self.hard.tree.query(sub_box, predicate="intersects")]
+        land = seagraph.land_raster(shapely.simplify(near, tol), north, east)
+        blocked = seagraph.blocked_cells(land, g2, cl, tol) | ~seagraph.band_mask(path, north, east, half)
+        for p in (self.A, self.B):
+            seagraph.free_near(blocked, land, north, east, p, cl + 2 * g2 + tol)
+        sea = seagraph.sea_route(fld, self.speed, self.A, self.B, north, east, blocked)
+        res.grid_spacing = g2
+        self.clearance = cl
+        notes.append(f"land on the open-sea route: a graph on the sea's cells, a coarse pass "
+                     f"({coarse.free:,} of {coarse.cells:,} cells of {g1:.0f} m) then a fine one in its "
+                     f"corridor ({sea.free:,} cells of {g2:.0f} m within {half / 1000:.0f} km of it, "
+                     f"{sea.edges:,} edges), 16 "
+                     "directions, the current at departure, the path pulled taut (docs/routing_geo.md); the "
+                     f"route keeps {cl:.0f} m off the coastline")
+        if sea.route is None:
+            res.reason = (f"the corridor of the coarse route is closed on the fine cells of {g2:.0f} m kept "
+                          f"{cl:.0f} m off land (a strait narrower than about "
+                          f"{2 * (cl + 1.7 * g2 + tol) / 1000:.1f} km on the way); a finer --grid opens it")
+            return res
+        r = sea.route
+        res.reachable, res.time_s, res.path = True, float(r.time_s), r
+        res.heading_start, res.heading_end, res.miss_m = r.heading_start, r.heading_end, 0.0
+        res.global_check = {"method": "graph", "time_s": sea.lattice_time,
+                            "rel_diff": (r.time_s - sea.lattice_time) / sea.lattice_time}
+        if not self.current_is_uniform():
+            notes.append("the current is taken at departure along the whole route (the graph is steady)")
+        return res
+
+    def current_is_uniform(self) -> bool:
+        return self.current.grid is None
+
     def _round_land(self, fld, horizon, notes):
         from shipgnc.routing.geo.frontier import reach_round_land
         from shipgnc.routing.result import RouteResult
@@ -444,11 +730,13 @@ class GeoProblem:
         if frozen.any():
             notes.append(f"land or shallow water in the route's box ({100 * frozen.mean():.0f} % of the "
                          f"level-set cells): the level set with land cells frozen, φ clipped to a band "
-                         f"(docs/routing_geo.md), grid {self.h:.0f} m")
+                         f"(docs/routing_geo.md), grid {self.h:.0f} m; the router keeps "
+                         f"{self.clearance:.0f} m (one level-set cell) off land")
         else:
             notes.append(f"gridded current: the level set (global method), grid {self.h:.0f} m")
         if ls.arrival is None:
-            res.reason = (f"target not reachable round the land within {horizon:.0f} s "
+            res.reason = (f"target not reachable{'' if self.hard.is_empty else ' round the land'} within "
+                          f"{horizon:.0f} s "
                           f"({horizon / 3600:.1f} h) at {self.speed:.3f} m/s: the front's closest approach "
                           f"is {ls.closest_approach:.0f} m")
             res.closest_approach_m = ls.closest_approach
@@ -535,6 +823,32 @@ class GeoProblem:
             if self.hard.intersects(shapely.LineString(np.column_stack([n, e]))):
                 return False
         return True
+
+
+def _length(metres, unit) -> str:
+    """A length in the user's unit ``(metres per unit, name)``: whole metres, or 3 digits of nm."""
+    scale, name = unit
+    return f"{metres:.0f} m" if name == "m" else f"{metres / scale:.3g} {name}"
+
+
+def _polygons(geoms) -> list:
+    """The polygons of area > 0 among the parts of ``geoms``."""
+    import shapely
+
+    parts = shapely.get_parts(np.asarray(geoms, dtype=object))
+    return list(parts[(shapely.get_type_id(parts) == 3) & (shapely.area(parts) > 0)])
+
+
+def _meeting(polys, box) -> list:
+    """The polygons' parts inside ``box`` (those within it kept whole, the rest clipped)."""
+    import shapely
+
+    arr = np.asarray(polys, dtype=object)
+    if not arr.size:
+        return []
+    arr = arr[shapely.intersects(arr, box)]
+    inside = shapely.within(arr, box)
+    return _polygons(np.concatenate([arr[inside], shapely.intersection(arr[~inside], box)]))
 
 
 def np_thin(xy, tol, leg_ok):

@@ -2,8 +2,9 @@
 
 * GPX 1.1 (Topografix, https://www.topografix.com/GPX/1/1/) — one ``<rte>`` whose ``<rtept>`` carry each
   waypoint's ETA in ``<time>``; written with ``gpxpy``.
-* GeoJSON (RFC 7946) — a LineString through the waypoints and one Point feature per waypoint with its
-  ETA, course and speed over ground of the leg that leaves it.
+* GeoJSON (RFC 7946) — a LineString through the waypoints (a MultiLineString cut at the antimeridian when
+  the route crosses it, §3.1.9) and one Point feature per waypoint with its ETA, course and speed over
+  ground of the leg that leaves it.
 * RTZ 1.1 (IEC 61174:2015 Annex S, namespace ``http://www.cirm.org/RTZ/1/1``) — ``routeInfo``,
   ``waypoints/waypoint`` with ``position`` and ``leg`` (the leg arriving at the waypoint: ``starboardXTD``,
   ``portsideXTD`` [nm], ``geometryType``; a leg carries no speed in RTZ), and a
@@ -19,6 +20,7 @@ A waypoint is a dict with ``lat``, ``lon`` [deg], ``eta_s`` [s since the epoch, 
 
 from __future__ import annotations
 
+import itertools
 import json
 import xml.etree.ElementTree as ET
 
@@ -51,10 +53,36 @@ def write_gpx(path, waypoints, name="shipgnc time-optimal route", description=""
         fh.write(gpx.to_xml(version="1.1"))
 
 
+def antimeridian_parts(coords) -> list:
+    """The [lon, lat] line cut where a leg crosses the antimeridian (RFC 7946 §3.1.9): each part stays on
+    one side, the cut at ±180° on the leg's geodesic (WGS84, pyproj.Geod: the latitude where the leg's
+    longitude passes 180°, by bisection along it)."""
+    from pyproj import Geod
+
+    g = Geod(ellps="WGS84")
+    parts = [[list(coords[0])]]
+    for (lo0, la0), (lo1, la1) in itertools.pairwise(coords):
+        if abs(lo1 - lo0) > 180.0:
+            az, _, dist = g.inv(lo0, la0, lo1, la1)
+            east = lo0 > 0  # leaving the eastern hemisphere eastward, or the western westward
+            a, b = 0.0, dist
+            for _ in range(60):
+                mid = 0.5 * (a + b)
+                lon, _, _ = g.fwd(lo0, la0, az, mid)
+                a, b = (mid, b) if (lon > 0) == east else (a, mid)
+            _, lat, _ = g.fwd(lo0, la0, az, 0.5 * (a + b))
+            side = 180.0 if east else -180.0
+            parts[-1].append([side, float(lat)])
+            parts.append([[-side, float(lat)]])
+        parts[-1].append([lo1, la1])
+    return parts
+
+
 def geojson(waypoints, properties=None) -> dict:
-    line = {"type": "Feature", "geometry": {"type": "LineString",
-                                            "coordinates": [[w["lon"], w["lat"]] for w in waypoints]},
-            "properties": {"kind": "route", **(properties or {})}}
+    parts = antimeridian_parts([[w["lon"], w["lat"]] for w in waypoints])
+    geometry = ({"type": "LineString", "coordinates": parts[0]} if len(parts) == 1
+                else {"type": "MultiLineString", "coordinates": parts})
+    line = {"type": "Feature", "geometry": geometry, "properties": {"kind": "route", **(properties or {})}}
     feats = [line]
     for w in waypoints:
         feats.append({"type": "Feature", "geometry": {"type": "Point", "coordinates": [w["lon"], w["lat"]]},
