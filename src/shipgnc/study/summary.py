@@ -98,6 +98,7 @@ def spread_figure(ds, path: Path, *, max_metrics: int = 6) -> Path:
     (one line per value of the other grid keys and controllers); a histogram without a grid. The
     members' drawn plant parameters and initial states (``param_*``, ``initial_state_*``) are
     inputs, not metrics: left out."""
+    from shipgnc.units import axis_label, metric_label
     from shipgnc.viz.style import DPI, new_figure
 
     names = [n for n in metric_names(ds) if n != "diverged" and not n.startswith(DRAWN_PREFIXES)
@@ -113,9 +114,12 @@ def spread_figure(ds, path: Path, *, max_metrics: int = 6) -> Path:
         da = ds[name]
         if not grid_dims:
             _histograms(ax, da)
+            ax.set_xlabel(axis_label(name))
         else:
             _bands(ax, da, grid_dims[0])
-        ax.set_title(name)
+            ax.set_ylabel(axis_label(name))
+        title = metric_label(name)[0]
+        ax.set_title(title[:1].upper() + title[1:])
     for ax in axes[len(names):]:
         ax.set_visible(False)
     title = f"{ds.attrs.get('scenario', 'study')}: {ds.sizes.get('member', 1)} members per point"
@@ -162,6 +166,8 @@ def _bands(ax, da, x_dim: str) -> None:
 
 
 def _histograms(ax, da) -> None:
+    from matplotlib.ticker import MaxNLocator
+
     from shipgnc.viz.style import LEGEND
 
     for label, sel in _others(da, ["member"]):
@@ -170,5 +176,6 @@ def _histograms(ax, da) -> None:
         if finite.size:
             ax.hist(finite, bins=min(40, max(5, finite.size // 5)), alpha=0.6, label=label or None)
     ax.set_ylabel("members")
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     if len(_others(da, ["member"])) > 1:
         ax.legend(**LEGEND)
