@@ -4,6 +4,8 @@ course comparison keeps its labels inside the figure and names its one controlle
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -86,3 +88,52 @@ def test_course_comparison_keeps_its_labels_inside_and_names_the_law():
     for text in [*labels, *(ax.title for ax in fig.axes if ax.get_title())]:
         extent = text.get_window_extent(renderer)
         assert extent.x0 >= box.x0 and extent.x1 <= box.x1 and extent.y1 <= box.y1, text.get_text()
+
+
+#: one built-in scenario per kind of figure a run writes (dashboard, stern-kick close-up, course
+#: comparison of one and of several controllers, path tracking, catamaran), shortened
+FIGURE_SCENARIOS = [("boat-stern-kick", 20), ("boat-los-gnss", 30), ("cybership-calm", 60),
+                    ("mariner-cst-heading", 100), ("mariner-lqr", 600), ("catamaran-turn", 30),
+                    ("catamaran-compare", 30)]
+UNIT = re.compile(r"\[[^\]]+\]")
+
+
+def _label(ax, axis: str) -> str:
+    """The axis' label, or that of an axis it shares this axis with (a shared axis is labelled
+    once, on the outer row or column)."""
+    group = ax.get_shared_x_axes() if axis == "x" else ax.get_shared_y_axes()
+    for other in [ax, *group.get_siblings(ax)]:
+        text = other.get_xlabel() if axis == "x" else other.get_ylabel()
+        if text:
+            return text
+    return ""
+
+
+@pytest.mark.parametrize(("scenario", "t_end"), FIGURE_SCENARIOS)
+def test_every_axis_of_a_run_s_figures_has_labels_with_units(scenario, t_end, tmp_path, monkeypatch):
+    """The figures ``shipgnc run`` writes, opened as matplotlib artists: every axis that draws data
+    has an x and a y label (its own or its shared row's / column's), each with a unit in
+    brackets (every quantity these figures draw has one: time, position, speed, angle, rate,
+    force)."""
+    import shipgnc.viz.dashboard as dashboard
+    from shipgnc.scenarios.runner import run_scenario
+    from shipgnc.scenarios.write import write_outputs
+
+    monkeypatch.setenv("SHIPGNC_FIGURE_PROCESS", "0")  # drawn here, so that they can be opened
+    figures = []
+    save = dashboard.save_figure
+    monkeypatch.setattr(dashboard, "save_figure",
+                        lambda fig, path, *a, **k: figures.append((path.name, fig)) or save(fig, path, *a, **k))
+    run = run_scenario(scenario, overrides=[f"simulation.t_end={t_end}"])
+    write_outputs(run, tmp_path / "out", figures=True)
+    assert figures
+    bad = []
+    for name, fig in figures:
+        for ax in fig.axes:
+            if not ax.get_visible() or not (ax.lines or ax.collections or ax.patches or ax.images):
+                continue
+            for axis in ("x", "y"):
+                text = _label(ax, axis)
+                if not UNIT.search(text):
+                    bad.append(f"{name}: {axis} label {text!r} (panel {ax.get_title()!r})")
+    assert not bad, "\n".join(bad)
