@@ -42,30 +42,73 @@ autodoc_inherit_docstrings = False
 
 # Docstrings write mathematics in plain text (|x| for an absolute value, N_|r|r for a coefficient,
 # (*batch, n) for a shape), which reStructuredText would read as substitutions, references and
-# emphasis: escape them outside
-# ``literals`` and :roles:`...` before autodoc parses them.
-_LITERAL = re.compile(r"(``.*?``|:[a-z:]+:`[^`]*`)")
-
-
+# emphasis: escape them before autodoc parses them, in running text only. A paragraph is
+# scanned whole (a ``literal`` or a :role:`...` may run over a line break); ``literals``,
+# :roles:`...`, literal blocks (after ``::``), directives' bodies (``.. math::``) and doctest
+# blocks are left as written (there an escape would be printed as it is).
+_LITERAL = re.compile(r"(``.+?``|:[a-z:]+:`[^`]*`)", re.S)
 _SHAPE_STAR = re.compile(r"(\(|, )\*(?=[A-Za-z_])")  # (*batch, *t.shape)
-
-
-# ``bias_std``² : a literal glued to a letter needs an escaped space after it
-_LITERAL_GLUED = re.compile(r"(``[^`]+``)(?=[^\s.,;:!?)\]}'\"/\\–—-])")
 _LONE_STRONG = re.compile(r"\*\*(?=[A-Za-z_])")                               # **params in a signature
+#: what may follow a literal or a role without an escaped space (``bias_std``² needs one)
+_AFTER_INLINE = set(" \t\n.,;:!?)]}'\"/\\–—-")
+
+
+_DIRECTIVE = re.compile(r"\.\. ([a-z-]+)::")
+#: directives whose body is shown as written (any other's body is running text)
+_VERBATIM_DIRECTIVES = {"math", "code", "code-block", "sourcecode", "doctest", "testcode"}
+
+
+def _indent(line):
+    return len(line) - len(line.lstrip())
+
+
+def _verbatim(lines):
+    """Indices of the lines shown as written: literal blocks (the lines indented under a line
+    ending in ``::``), the bodies of :data:`_VERBATIM_DIRECTIVES` and doctest blocks."""
+    out, i = set(), 0
+    while i < len(lines):
+        text = lines[i].strip()
+        directive = _DIRECTIVE.match(text)
+        if directive.group(1) in _VERBATIM_DIRECTIVES if directive else text.endswith("::"):
+            base, i = _indent(lines[i]), i + 1
+            while i < len(lines) and (not lines[i].strip() or _indent(lines[i]) > base):
+                out.add(i)
+                i += 1
+            continue
+        if text.startswith(">>>"):
+            while i < len(lines) and lines[i].strip():
+                out.add(i)
+                i += 1
+            continue
+        i += 1
+    return out
+
+
+def _escape_text(text):
+    """One paragraph of running text, escaped outside its literals and roles."""
+    parts = _LITERAL.split(text)
+    for j in range(0, len(parts), 2):
+        part = _SHAPE_STAR.sub(r"\1\\*", parts[j].replace("|", "\\|")).replace("_\\|", "\\_\\|")
+        if part.count("**") % 2:                                           # not bold: **kwargs
+            part = _LONE_STRONG.sub(r"\\*\\*", part)
+        if j > 0 and part and part[0] not in _AFTER_INLINE:             # ``x``² → ``x``\ ²
+            part = "\\ " + part
+        parts[j] = part
+    return "".join(parts)
 
 
 def _escape_plain_maths(app, what, name, obj, options, lines):
-    for i, line in enumerate(lines):
-        parts = _LITERAL.split(line)
-        out = []
-        for j, part in enumerate(parts):
-            if j % 2 == 0:
-                part = _SHAPE_STAR.sub(r"\1\\*", part.replace("|", "\\|")).replace("_\\|", "\\_\\|")
-                if part.count("**") % 2:                                   # not bold: **kwargs
-                    part = _LONE_STRONG.sub(r"\\*\\*", part)
-            out.append(part)
-        lines[i] = _LITERAL_GLUED.sub(r"\1\\ ", "".join(out))
+    verbatim = _verbatim(lines)
+    i = 0
+    while i < len(lines):
+        if i in verbatim or not lines[i].strip():
+            i += 1
+            continue
+        j = i
+        while j < len(lines) and j not in verbatim and lines[j].strip():
+            j += 1
+        lines[i:j] = _escape_text("\n".join(lines[i:j])).split("\n")
+        i = j
 
 
 def setup(app):

@@ -223,3 +223,52 @@ def test_ships_with_different_kernel_functions_have_no_kernel():
     assert "is not ship 0's" in model.kernel_reason()
     with pytest.raises(ConfigError, match="input limits differ"):
         PerShipModel((VectoredThrustBoat(), with_params(VectoredThrustBoat(), T_max=100.0)))
+
+
+COASTER = """\
+name: coaster-course
+metrics: course-quality
+vessel: {model: linear-3dof, speed_mps: 5.14, L: 60.0, B: 8.0, T: 3.5, Cb: 0.45}
+simulation: {dt: 0.1, t_end: 120.0, initial_state: {north: 0.0, east: 0.0, psi_deg: 0.0, u: null}}
+controller: {type: course, variant: pd, Kp: 1.0, Kd: 20.0}
+guidance:
+  type: course-schedule
+  schedule: [{t: 0.0, psi_deg: 0.0}, {t: 20.0, psi_deg: 30.0}]
+"""
+
+
+def test_a_catalogue_vessel_from_main_dimensions_takes_a_parameter_of_its_file(tmp_path):
+    """``--perturb vessel.params.Cb=normal:10%`` on a vessel file built from main dimensions: each
+    member is the vessel rebuilt with its drawn C_b (Clarke 1983's regression), and sweep.nc
+    records every drawn value, the initial heading too. Member by member the sweep equals a single
+    run with ``--set vessel.Cb=<draw> --set simulation.initial_state.psi_deg=<draw>`` (the course
+    PD has no model in its design, so the member's plant is the whole difference)."""
+    scenario = tmp_path / "coaster.yaml"
+    scenario.write_text(COASTER)
+    res = runner.invoke(app, ["sweep", str(scenario), "--mc", "3", "--perturb",
+                              "vessel.params.Cb=normal:10%", "--perturb", "psi_deg=normal:5",
+                              "--out", str(tmp_path / "out"), "--no-figures"])
+    assert res.exit_code == 0, res.output
+    from shipgnc.study.summary import load_dataset
+
+    ds = load_dataset(tmp_path / "out" / "sweep.nc")
+    cb, psi = ds["param_Cb"].values, ds["initial_state_psi_deg"].values
+    assert len(np.unique(cb)) == 3 and np.all(np.abs(cb / 0.45 - 1.0) < 0.5)
+    assert len(np.unique(psi)) == 3 and np.all(np.abs(psi) < 25.0)
+    assert ds["initial_state_psi_deg"].attrs["units"] == "deg"
+    assert len(np.unique(ds["psi_E"].values)) == 3
+    for member in range(3):
+        run = run_scenario(str(scenario), overrides=[f"vessel.Cb={float(cb[member])!r}",
+                                                      f"simulation.initial_state.psi_deg={float(psi[member])!r}"])
+        for key, value in numeric_metrics(run.metrics).items():
+            np.testing.assert_allclose(float(ds[key].sel(member=member)), value, rtol=1e-6,
+                                       atol=1e-9, err_msg=f"member {member}: {key}")
+
+
+def test_a_catalogue_vessel_refuses_a_parameter_its_file_does_not_give(tmp_path):
+    scenario = tmp_path / "coaster.yaml"
+    scenario.write_text(COASTER)
+    bad = runner.invoke(app, ["sweep", str(scenario), "--perturb", "vessel.params.m=normal:1",
+                              "--out", str(tmp_path / "out")])
+    assert bad.exit_code == 2 and "perturbable: B, Cb, L, T" in bad.output, bad.output
+    assert "Traceback" not in bad.output

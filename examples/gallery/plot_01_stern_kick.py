@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from shipgnc.scenarios.runner import run_scenario
+from shipgnc.viz.style import show_example
 
 run = run_scenario("boat-stern-kick")
 res = run.result                                   # xarray.Dataset, dims (time,)
@@ -30,3 +31,4 @@ ax_kick.annotate(f"{100 * res.east.values[i]:.1f} cm at {t[i]:.2f} s", (t[i], 10
                  xytext=(6.2, -2.5), arrowprops={"arrowstyle": "->"})
 ax_kick.set(xlabel="time [s]", ylabel="east of the CG [cm]", title="the kick: first to port")
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from shipgnc import HeadingSpeedAutopilot, ReferenceSchedule, VectoredThrustBoat, simulate
+from shipgnc.viz.style import show_example
 
 light = VectoredThrustBoat()                                   # preset "otter" (note 001-1.6)
 heavy = VectoredThrustBoat(light.params.with_(m=120.0, I_z=21.7))
@@ -28,3 +29,4 @@ ax.step([0, 10, 40, 70], [0, 45, -30, -30], where="post", color="k", ls=":", lab
 ax.set(xlabel="time [s]", ylabel="heading [deg]", title="same design rule, two boats")
 ax.legend()
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from shipgnc import HeadingSpeedAutopilot, LOSGuidance, VectoredThrustBoat, WaypointPath, simulate
+from shipgnc.viz.style import show_example
 
 boat = VectoredThrustBoat()
 path = WaypointPath(np.array([[0.0, 0.0], [60.0, 0.0], [60.0, 60.0], [0.0, 60.0]]))   # north, east [m]
@@ -26,3 +27,4 @@ for lookahead in (4.0, 12.0):
 ax.set(xlabel="east [m]", ylabel="north [m]", aspect="equal", title="LOS guidance, boat of document 001")
 ax.legend(loc="center")
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

@@ -16,6 +16,7 @@ import numpy as np
 
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import run_scenario
+from shipgnc.viz.style import show_example
 
 NM = 1852.0
 scenario = load_scenario("mariner-compare", ["simulation.t_end=1800", "simulation.dt=0.6",
@@ -37,3 +38,4 @@ ax_track.set(xlabel="east [nm]", ylabel="north [nm]", aspect="equal", title="tra
 ax_y.set(xlabel="time [min]", ylabel="heading [deg]", title="heading: crabbed into the current")
 ax_track.legend()
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

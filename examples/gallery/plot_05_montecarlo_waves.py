@@ -11,6 +11,7 @@ document's step), and draws the cross-track error of every ship with their media
 import matplotlib.pyplot as plt
 
 from shipgnc.scenarios.runner import run_scenario
+from shipgnc.viz.style import show_example
 
 NM = 1852.0
 run = run_scenario("mariner-montecarlo", overrides=["montecarlo.runs=20", "simulation.t_end=1500",
@@ -31,3 +32,4 @@ for ax, name in zip(axes, res.controller.values, strict=True):
 axes[0].set_ylabel("cross-track error [nm]")
 axes[0].legend()
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

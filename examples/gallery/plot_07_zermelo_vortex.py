@@ -14,6 +14,7 @@ import numpy as np
 
 from shipgnc.routing.fields import LambOseenVortex
 from shipgnc.routing.router import solve_route
+from shipgnc.viz.style import show_example
 
 NM, KN, H = 1852.0, 1852.0 / 3600.0, 3600.0
 start, target = np.array([-1.86, 3.66]) * NM, np.zeros(2)
@@ -37,3 +38,4 @@ ax.plot(*target[::-1] / NM, "k*", ms=12)
 ax.set(xlabel="east [nm]", ylabel="north [nm]", aspect="equal", title="Lamb–Oseen vortex: routes A → B")
 ax.legend(loc="lower left")
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from shipgnc.scenarios.runner import run_scenario
+from shipgnc.viz.style import show_example
 
 run = run_scenario("catamaran-turn", overrides=["simulation.t_end=120", "simulation.backend=numpy"])
 res = run.result
@@ -33,3 +34,4 @@ axes[1].set(xlabel="time [s]", ylabel="yaw rate [rad/s]", title="yaw rate vs ω*
 axes[2].set(xlabel="time [s]", ylabel="thruster angle δ [deg]", title="thrusters")
 axes[1].legend()
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

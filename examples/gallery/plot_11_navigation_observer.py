@@ -17,6 +17,7 @@ import numpy as np
 
 from shipgnc import HeadingSpeedAutopilot, LOSGuidance, VectoredThrustBoat, WaypointPath, simulate
 from shipgnc.navigation import GNSS, Compass, ExtendedKalmanFilter, Navigation, RateGyro
+from shipgnc.viz.style import show_example
 
 boat = VectoredThrustBoat()
 path = WaypointPath(np.array([[0.0, 0.0], [60.0, 0.0], [60.0, 60.0]]))
@@ -43,3 +44,4 @@ ax2.axvspan(20, 30, color="0.9", label="GNSS dropout")
 ax2.set(xlabel="time [s]", ylabel="|position error| [m]", yscale="log", title="estimate vs truth")
 ax2.legend()
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

@@ -14,6 +14,7 @@ import numpy as np
 
 from shipgnc.trials import turning_circle
 from shipgnc.trials.zigzag import zigzag
+from shipgnc.viz.style import show_example
 
 turn = turning_circle("mariner-cst", 35.0)              # both sides, one batch
 zz = zigzag("mariner-cst", 20.0, 20.0, sides=("starboard",))
@@ -35,3 +36,4 @@ ax_zz.plot(hz.time, np.degrees(hz.rudder[:, 0]), label="rudder")
 ax_zz.set(xlabel="time [s]", ylabel="[deg]", title="20°/20° zig-zag, starboard first")
 ax_zz.legend()
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

@@ -14,6 +14,7 @@ import numpy as np
 
 from shipgnc.identify import identify_nomoto1
 from shipgnc.trials.zigzag import zigzag
+from shipgnc.viz.style import show_example
 
 zz = zigzag("frigate", 20.0, 20.0, sides=("starboard",), speed_mps=9.0)
 hist = zz["_history"]
@@ -33,3 +34,4 @@ ax.axvline(fit.t[fit.split], color="grey", ls=":", label="held out from here")
 ax.set(xlabel="time [s]", ylabel="yaw rate [deg/s]", title="frigate 20°/20° zig-zag")
 ax.legend()
 fig.tight_layout()
+show_example()   # run as a script: saves the figure (and shows it where there is a display)

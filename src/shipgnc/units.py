@@ -63,3 +63,28 @@ def _significant(number: str) -> int:
     """The significant digits a number was printed with (at least 3): its conversion keeps them."""
     mantissa = number.lstrip("+-").lower().split("e")[0].replace(".", "").lstrip("0")
     return max(3, len(mantissa))
+
+
+#: a metric name's unit suffix → the unit it is reported in (the project's naming rule: a metric
+#: whose name carries a unit is in that unit), longest suffixes first
+METRIC_SUFFIX_UNITS = (("_per_min", "1/min"), ("_deg_s", "deg/s"), ("_rad_s", "rad/s"),
+                       ("_mps", "m/s"), ("_kn", "kn"), ("_deg", "deg"), ("_rad", "rad"),
+                       ("_min", "min"), ("_nm", "nm"), ("_pct", "%"), ("_hz", "Hz"), ("_s", "s"),
+                       ("_m", "m"), ("_h", "h"), ("_n", "N"))
+
+
+def metric_label(name: str) -> tuple[str, str | None]:
+    """A metric key as a human title and its unit from its suffix: ``"settling_time_s"`` →
+    ``("settling time", "s")``, ``"crosstrack_rms_after_leg1_nm"`` → ``("crosstrack rms after
+    leg1", "nm")``; ``(name with spaces, None)`` for a key without a unit (a count, a fraction,
+    a flag, or a figure of document 003 such as ``psi_E``)."""
+    for suffix, unit in METRIC_SUFFIX_UNITS:
+        if name.endswith(suffix) and len(name) > len(suffix):
+            return name[: -len(suffix)].replace("_", " "), unit
+    return name.replace("_", " "), None
+
+
+def axis_label(name: str) -> str:
+    """``"settling time [s]"`` for ``settling_time_s``; the title alone without a unit."""
+    title, unit = metric_label(name)
+    return f"{title} [{unit}]" if unit else title

@@ -555,9 +555,10 @@ class YawRateFSM:
         """:meth:`law` for the composed loop (:func:`yaw_rate_fsm_step`, sampled or continuous).
 
         Parameters ``[law 20?, T_u, h, h L T_v, J, ω_max?, ω_max, freeze?, δ_f, clamp?, δ_max,
-        inverse?, T_a, k_a, 0, 0, model (:func:`~shipgnc.models.catamaran.kernel_params`), ω*
-        source]``; per-ship state ``[calls, first call (3), time (3), value (3), ω*, u, source
-        state (3)]`` (events in the order the law checks them: ω_max, 90°, clamp).
+        inverse?, T_a, k_a, 0, 0, model, ω* source]`` (``model``: the plant's parameters as
+        :func:`~shipgnc.models.catamaran.kernel_params` orders them); per-ship state ``[calls,
+        first call (3), time (3), value (3), ω*, u, source state (3)]`` (events in the order the law
+        checks them: ω_max, 90°, clamp).
         """
         reason = self.kernel_reason()
         if reason:

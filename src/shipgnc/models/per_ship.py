@@ -31,10 +31,23 @@ from shipgnc.kernels import Kernel, NotCompiled
 from shipgnc.models.base import names
 
 
+def plant_params(model) -> dict:
+    """The parameters a study may change in ``model`` by name: its parameter class's fields, or for
+    a catalogue vessel the numeric parameters of its ``vessel:`` section (e.g. ``Cb`` of a vessel
+    built from main dimensions, which the built matrices no longer name)."""
+    config = getattr(model, "vessel_config", None)
+    return config.scalar_params() if config is not None else model.params.as_dict()
+
+
 def with_params(model, **changes: float):
     """``model`` with some parameters changed, validated by ``model.params.with_`` (a ConfigError
     for an unknown name or a value outside the model's range). A model that is its own parameter
-    set (the Nomoto models) is changed itself; any other is copied with new ``params``."""
+    set (the Nomoto models) is changed itself; a catalogue vessel is rebuilt from its ``vessel:``
+    section with the changes (:meth:`~shipgnc.vessels.config.CatalogueVesselConfig.with_params`);
+    any other is copied with new ``params``."""
+    config = getattr(model, "vessel_config", None)
+    if config is not None:
+        return config.with_params(**changes)
     params = model.params
     changed = params.with_(**changes)
     if params is model:

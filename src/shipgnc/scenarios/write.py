@@ -114,7 +114,9 @@ def figure_job(run: ScenarioRun, out: Path):
     if not isinstance(model, VectoredThrustBoat):
         from shipgnc.viz.comparison import course_series
 
-        return FigureJob(result={name: course_series(run.result, name) for name in names},
+        single = run.setups is None and run.scenario.controller is not None
+        return FigureJob(result={controller_title(run.scenario.controller) if single else name:
+                                 course_series(run.result, name) for name in names},
                          out=out, title=run.scenario.name, kind="course-comparison",
                          limits=limits)
     from shipgnc.viz.series import result_series
@@ -126,6 +128,16 @@ def figure_job(run: ScenarioRun, out: Path):
                      waypoints=list(g.waypoints) if g is not None and g.type == "los" else None,
                      limits=limits, outline=(model.length, model.beam), lever_arm=model.params.L_m,
                      closeup=closeup)
+
+
+def controller_title(cfg) -> str:
+    """A one-controller run's column title: the law and its set numbers, e.g. "course autopilot
+    pd: Kp = 1, Kd = 40" (a comparison's columns keep their controllers' names)."""
+    data = cfg.model_dump(exclude={"type", "variant", "sees"})
+    numbers = ", ".join(f"{k} = {v:g}" for k, v in data.items()
+                        if isinstance(v, (int, float)) and not isinstance(v, bool))
+    law = f"{cfg.type} autopilot" + (f" {cfg.variant}" if getattr(cfg, "variant", None) else "")
+    return f"{law}: {numbers}" if numbers else law
 
 
 def figure_title(run: ScenarioRun) -> str:

@@ -130,6 +130,21 @@ def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> 
     return batch
 
 
+def initial_state_variables(study: Study, x0: np.ndarray, model) -> dict:
+    """Each member's start value of every perturbed initial-state field, as Dataset variables
+    ``initial_state_<FIELD>`` over ``member`` in the field's own unit (``psi_deg`` in degrees):
+    the scenario's value plus the member's draw, from ``x0`` of :func:`member_initial_states`."""
+    state_names = names(model.states)
+    out = {}
+    for p in study.offsets:
+        state, scale = PERTURBABLE[p.field]
+        values = np.asarray(x0, dtype=float)[:, state_names.index(state)] / scale
+        out[f"initial_state_{p.field}"] = ("member", values, {
+            "long_name": f"initial_state.{p.field} of the member (scenario's value + its draw)",
+            "units": PERTURB_UNITS[p.field], "perturb": str(p)})
+    return out
+
+
 def numeric_metrics(metrics: dict) -> dict[str, float]:
     """The scalar figures of a metrics dict as floats (None → NaN; lists and events left out)."""
     out = {}
@@ -279,6 +294,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     # log alive until the study ends (≈ 190 MB per 1 000 boats of boat-autopilot)
     data = {k: ("member", np.array(v, dtype=float)) for k, v in arrays.items()}
     data.update(param_variables(study, drawn))
+    data.update(initial_state_variables(study, x0, setup.model))
     out = xr.Dataset(data, coords={"member": np.arange(chunk.start, chunk.stop)},
                      attrs={"backend": ", ".join(sorted(str(b) for b in ran_on))})
     if study.series:

@@ -19,7 +19,7 @@ import numpy as np
 
 from shipgnc.errors import ConfigError
 from shipgnc.kernels import NotCompiled
-from shipgnc.models.per_ship import PerShipModel, with_params
+from shipgnc.models.per_ship import PerShipModel, plant_params, with_params
 from shipgnc.study.spec import PARAM_PREFIX, Perturbation, Study
 
 
@@ -61,7 +61,7 @@ def _enters_equations(model, name: str, value: float) -> bool | None:
 def perturbable_params(model) -> list[str]:
     """The numeric parameters of ``model`` that enter its equations of motion (sorted)."""
     out = []
-    for name, value in model.params.as_dict().items():
+    for name, value in plant_params(model).items():
         if _numeric(value) and math.isfinite(value) and _enters_equations(model, name, float(value)):
             out.append(name)
     return sorted(out)
@@ -75,7 +75,7 @@ def check_plant(perturb, model, flag: str = "--perturb") -> None:
     if not plant:
         return
     kind = type(model).__name__
-    nominal = model.params.as_dict()
+    nominal = plant_params(model)
     allowed = perturbable_params(model)
     for p in plant:
         if p.param not in allowed:
@@ -109,7 +109,7 @@ def member_params(study: Study, model, start: int, stop: int) -> dict[str, np.nd
     plant = study.plant
     if not plant:
         return {}
-    nominal = model.params.as_dict()
+    nominal = plant_params(model)
     values = {p.param: np.empty(stop - start) for p in plant}
     for row, member in enumerate(range(start, stop)):
         rng = np.random.default_rng(study.member_stream(member, 2))

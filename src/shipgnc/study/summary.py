@@ -14,9 +14,13 @@ ZARR_MIN_BYTES = 2 * 1024**3
 QUANTILES = {"median": 0.5, "p5": 0.05, "p95": 0.95}
 
 
+#: prefixes of a member's drawn inputs (plant parameters, initial-state fields), not metrics
+DRAWN_PREFIXES = ("param_", "initial_state_")
+
+
 def metric_names(ds) -> list[str]:
-    """The per-member summary metrics (every variable but the ``series_*`` time series; a plant
-    perturbation's draws ``param_*`` are among them, so the summary shows their spread)."""
+    """The per-member summary metrics (every variable but the ``series_*`` time series; the drawn
+    ``param_*`` and ``initial_state_*`` are among them, so the summary shows their spread)."""
     return [str(k) for k in ds.data_vars if not str(k).startswith("series_")]
 
 
@@ -24,8 +28,8 @@ def summary_rows(ds) -> list[dict]:
     """Median, p5 and p95 over the members of each metric, one row per grid point (and controller);
     NaN members (a figure that does not exist, e.g. a run that never settles) are left out and
     counted in ``<metric>_missing``. Members that diverged are left out of every metric's figures
-    (their figures are those of a partial run; ``diverged`` itself and the drawn ``param_*`` keep
-    every member) and counted in ``diverged_members``."""
+    (their figures are those of a partial run; ``diverged`` itself and the drawn ``param_*`` and
+    ``initial_state_*`` keep every member) and counted in ``diverged_members``."""
     cell_dims = [d for d in ds[metric_names(ds)[0]].dims if d != "member"] if metric_names(ds) else []
     stacked = ds[metric_names(ds)]
     if cell_dims:
@@ -42,7 +46,7 @@ def summary_rows(ds) -> list[dict]:
         row["diverged_members"] = int(np.sum(diverged))
         for name in metric_names(ds):
             values = np.asarray(cell[name].values, dtype=float)
-            if name != "diverged" and not name.startswith("param_") and values.shape == diverged.shape:
+            if name != "diverged" and not name.startswith(DRAWN_PREFIXES) and values.shape == diverged.shape:
                 values = values[~diverged]
             finite = values[np.isfinite(values)]
             for label, q in QUANTILES.items():
@@ -92,10 +96,12 @@ def load_dataset(path: str | Path):
 def spread_figure(ds, path: Path, *, max_metrics: int = 6) -> Path:
     """Each metric against the first grid key: the median line and the p5–p95 band of the members
     (one line per value of the other grid keys and controllers); a histogram without a grid. The
-    members' drawn plant parameters (``param_*``) are inputs, not metrics: left out."""
+    members' drawn plant parameters and initial states (``param_*``, ``initial_state_*``) are
+    inputs, not metrics: left out."""
+    from shipgnc.units import axis_label, metric_label
     from shipgnc.viz.style import DPI, new_figure
 
-    names = [n for n in metric_names(ds) if n != "diverged" and not n.startswith("param_")
+    names = [n for n in metric_names(ds) if n != "diverged" and not n.startswith(DRAWN_PREFIXES)
              and np.isfinite(np.asarray(ds[n].values, dtype=float)).any()][:max_metrics]
     if not names:
         names = ["diverged"]
@@ -108,9 +114,12 @@ def spread_figure(ds, path: Path, *, max_metrics: int = 6) -> Path:
         da = ds[name]
         if not grid_dims:
             _histograms(ax, da)
+            ax.set_xlabel(axis_label(name))
         else:
             _bands(ax, da, grid_dims[0])
-        ax.set_title(name)
+            ax.set_ylabel(axis_label(name))
+        title = metric_label(name)[0]
+        ax.set_title(title[:1].upper() + title[1:])
     for ax in axes[len(names):]:
         ax.set_visible(False)
     title = f"{ds.attrs.get('scenario', 'study')}: {ds.sizes.get('member', 1)} members per point"
@@ -157,6 +166,8 @@ def _bands(ax, da, x_dim: str) -> None:
 
 
 def _histograms(ax, da) -> None:
+    from matplotlib.ticker import MaxNLocator
+
     from shipgnc.viz.style import LEGEND
 
     for label, sel in _others(da, ["member"]):
@@ -165,5 +176,6 @@ def _histograms(ax, da) -> None:
         if finite.size:
             ax.hist(finite, bins=min(40, max(5, finite.size // 5)), alpha=0.6, label=label or None)
     ax.set_ylabel("members")
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     if len(_others(da, ["member"])) > 1:
         ax.legend(**LEGEND)

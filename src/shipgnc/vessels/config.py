@@ -61,10 +61,38 @@ class CatalogueVesselConfig(Strict):
         return float(self.build().straight_state()[3])
 
     def build(self):
-        """The model (:meth:`shipgnc.vessels.VesselEntry.build`)."""
+        """The model (:meth:`shipgnc.vessels.VesselEntry.build`); it keeps this section as
+        ``vessel_config``, so a study can rebuild it with a parameter changed
+        (:meth:`with_params`)."""
         from shipgnc.vessels.catalogue import get_vessel
 
-        return get_vessel(self.model).build(self.speed_mps, **self.params())
+        model = get_vessel(self.model).build(self.speed_mps, **self.params())
+        object.__setattr__(model, "vessel_config", self)  # frozen dataclass: set once, here
+        return model
+
+    def scalar_params(self) -> dict[str, float]:
+        """The section's numeric parameters given (the matrices and ``speed_mps`` left out): what
+        a study may perturb as ``vessel.params.NAME``, e.g. ``Cb`` of a vessel built from its
+        main dimensions."""
+        return {k: float(v) for k, v in self.params().items() if isinstance(v, (int, float))}
+
+    def with_params(self, **changes: float):
+        """The model rebuilt with some of :meth:`scalar_params` changed, validated as the file
+        would be (a one-line ConfigError naming the field and its rule)."""
+        from pydantic import ValidationError
+
+        from shipgnc.config_types import format_validation_error
+
+        allowed = self.scalar_params()
+        for key in changes:
+            if key not in allowed:
+                raise ConfigError(f"vessel.params.{key}: not a parameter given in the {self.model} "
+                                  f"vessel section; allowed: {', '.join(sorted(allowed))}")
+        try:
+            config = type(self).model_validate({**self.model_dump(exclude_none=True), **changes})
+        except ValidationError as exc:
+            raise ConfigError(format_validation_error(exc, "vessel").removeprefix("scenario ")) from None
+        return config.build()
 
     @model_validator(mode="after")
     def _builds(self) -> CatalogueVesselConfig:

@@ -33,7 +33,7 @@ def course_comparison(series: Mapping[str, Mapping[str, np.ndarray]], *, title: 
     if not series:
         raise ConfigError("course_comparison: no controller series to draw")
     names = list(series)
-    fig = Figure(figsize=(4.2 * len(names) + 1.0, 7.5))
+    fig = Figure(figsize=(4.2 * len(names) + 1.0, 7.5), layout="constrained")  # room for labels
     axes = fig.subplots(3, len(names), sharex=True, sharey="row", squeeze=False)
     for col, name in enumerate(names):
         data = series[name]
@@ -64,5 +64,4 @@ def course_comparison(series: Mapping[str, Mapping[str, np.ndarray]], *, title: 
     axes[2, 0].set_ylabel("δ [deg]", fontsize=style.LABEL_SIZE)
     if title:
         fig.suptitle(title, fontsize=style.LABEL_SIZE + 1)
-    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.08, top=0.9, hspace=0.12, wspace=0.08)
     return fig

@@ -134,3 +134,24 @@ def _non_interactive_backends() -> list[str]:
         from matplotlib import rcsetup
 
         return list(rcsetup.non_interactive_bk)
+
+
+def show_example() -> list[str]:
+    """End of a gallery example: save every open figure as ``<script's stem>.png``
+    (``_2.png``, ... for more) in the current directory, print where, and ``plt.show()`` where
+    matplotlib has a window. Under sphinx-gallery, which draws the figures into the page itself,
+    nothing is saved. Returns the paths written."""
+    import matplotlib.pyplot as plt
+
+    written = []
+    if "sphinx_gallery" not in sys.modules:
+        stem = os.path.splitext(os.path.basename(sys.argv[0] or ""))[0] or "figure"
+        for i, number in enumerate(plt.get_fignums(), start=1):
+            path = f"{stem}.png" if i == 1 else f"{stem}_{i}.png"
+            plt.figure(number).savefig(path, dpi=DPI)
+            written.append(path)
+        if written:
+            print("saved", ", ".join(written))
+    if is_interactive_backend():
+        plt.show()
+    return written
