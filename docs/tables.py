@@ -88,8 +88,11 @@ class Quote:
     overrides: tuple[str, ...] = ()
 
 
-def _options(text: str) -> tuple[list[str] | None, list[str], str | None]:
-    keys, overrides, layout = None, [], None
+def _options(text: str) -> tuple[list[str] | None, list[str], str | None, dict[str, float]]:
+    """A table's options: ``keys=a,b``, ``set=KEY=VALUE`` (repeatable), ``layout=NAME`` and
+    ``rtol=COLUMN:FRACTION,...`` (``*`` for every column): the columns whose figures round-off
+    decides, checked to that relative tolerance instead of one unit in the last digit."""
+    keys, overrides, layout, rtol = None, [], None, {}
     for item in text.split():
         name, _, value = item.partition("=")
         if name == "keys":
@@ -98,9 +101,17 @@ def _options(text: str) -> tuple[list[str] | None, list[str], str | None]:
             overrides.append(value)
         elif name == "layout":
             layout = value
+        elif name == "rtol":
+            for part in value.split(","):
+                column, _, fraction = part.partition(":")
+                try:
+                    rtol[column.strip("`")] = float(fraction)
+                except ValueError:
+                    raise ValueError(f"table option {item!r}: expected rtol=COLUMN:FRACTION,...") from None
         else:
-            raise ValueError(f"table option {item!r}: expected keys=a,b, set=KEY=VALUE or layout=NAME")
-    return keys, overrides, layout
+            raise ValueError(f"table option {item!r}: expected keys=a,b, set=KEY=VALUE, layout=NAME "
+                             f"or rtol=COLUMN:FRACTION")
+    return keys, overrides, layout, rtol
 
 
 def _scalar(value) -> bool:
@@ -166,20 +177,22 @@ def _last_digit(text: str) -> float:
     return 10.0 ** (-decimals + (int(exponent) if exponent else 0))
 
 
-def _close(documented: str, run: str) -> bool:
-    """``run`` equals the ``documented`` number within one unit in its last printed digit."""
+def _close(documented: str, run: str, rtol: float = 0.0) -> bool:
+    """``run`` equals the ``documented`` number within one unit in its last printed digit, or
+    within ``rtol`` of it."""
     x, y = _number(documented), _number(run)
-    return x is not None and y is not None and abs(x - y) <= _last_digit(documented) * (1 + 1e-9)
+    return x is not None and y is not None and abs(x - y) <= max(
+        _last_digit(documented) * (1 + 1e-9), rtol * abs(x))
 
 
-def _same(documented: str, run: str) -> bool:
+def _same(documented: str, run: str, rtol: float = 0.0) -> bool:
     """Two cells say the same: equal text around their numbers, each number within one unit in
-    the documented number's last digit."""
+    the documented number's last digit (or within ``rtol`` of it)."""
     if documented == run:
         return True
     a, b = NUMBERS.split(documented), NUMBERS.split(run)
     return (len(a) == len(b) and a[::2] == b[::2]
-            and all(_close(x, y) for x, y in zip(a[1::2], b[1::2], strict=True)))
+            and all(_close(x, y, rtol) for x, y in zip(a[1::2], b[1::2], strict=True)))
 
 
 def fmt(value, spec: str = "") -> str:
@@ -270,14 +283,17 @@ def _cells(body: str) -> dict[tuple[str, str], str]:
     return {(row[0], header[j]): cell for row in split[2:] for j, cell in enumerate(row) if j}
 
 
-def drifts(documented: str, generated: str, page: str, table: str) -> list[Drift]:
-    """The cells of ``documented`` that differ from ``generated`` beyond a rounding flip (and
-    rows or columns that appeared or vanished)."""
+def drifts(documented: str, generated: str, page: str, table: str,
+           rtol: dict[str, float] | None = None) -> list[Drift]:
+    """The cells of ``documented`` that differ from ``generated`` beyond a rounding flip, or
+    beyond ``rtol[column]`` (``rtol["*"]`` for every column) where given (and rows or columns
+    that appeared or vanished)."""
     old, new = _cells(documented), _cells(generated)
+    rtol = rtol or {}
     found = []
     for key in dict.fromkeys([*old, *new]):
         a, b = old.get(key, "(absent)"), new.get(key, "(absent)")
-        if not _same(a, b):
+        if not _same(a, b, rtol.get(key[1].strip("`"), rtol.get("*", 0.0))):
             found.append(Drift(page, table, key[0], key[1], a, b))
     return found
 
@@ -290,9 +306,9 @@ def update(page: Path, *, check: bool = False) -> list[Drift]:
     found: list[Drift] = []
 
     def replace(match: re.Match) -> str:
-        keys, overrides, layout = _options(match["options"])
+        keys, overrides, layout, rtol = _options(match["options"])
         table = render(match["name"], keys, overrides, layout)
-        found.extend(drifts(match["body"], table, page.name, match["name"]))
+        found.extend(drifts(match["body"], table, page.name, match["name"], rtol))
         return match["open"] + table + match["close"]
 
     new = _quotes(page, BLOCK.sub(replace, text), found)

@@ -99,3 +99,17 @@ def test_cells_compare_the_text_and_each_number_at_its_printed_precision(tables)
     assert tables.fmt(-2.0861e-6, ".2x") == "−2.09·10⁻⁶"
     assert tables.fmt(2497.8, "_.0f") == "2 498" and tables.fmt(-9.166, ".2fm") == "−9.17"
     assert tables.sig(58.025) == "58.0" and tables.sig(145.8) == "146" and tables.sig(0.0) == "0"
+
+
+def test_a_column_round_off_decides_is_held_to_its_stated_tolerance(tables):
+    """``rtol=COLUMN:FRACTION`` (a chattering law, a rate limit flipping on round-off): within the
+    fraction is no drift, beyond it is; the other columns keep one unit in the last digit."""
+    documented = "| metric | `a` | `b` |\n|---|---:|---:|\n| `J` | 100.0 | 50.0 |\n"
+    within = "| metric | `a` | `b` |\n|---|---:|---:|\n| `J` | 104.0 | 50.1 |\n"
+    assert [d.column for d in tables.drifts(documented, within, "p", "t", {"a": 0.05})] == ["`b`"]
+    assert tables.drifts(documented, within, "p", "t", {"*": 0.05}) == []
+    beyond = within.replace("104.0", "106.0")
+    assert [d.column for d in tables.drifts(documented, beyond, "p", "t", {"*": 0.05})] == ["`a`"]
+    assert tables._options("keys=J rtol=a:0.05,`b`:0.1")[3] == {"a": 0.05, "b": 0.1}
+    with pytest.raises(ValueError, match="rtol"):
+        tables._options("rtol=a")
