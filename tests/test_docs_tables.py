@@ -105,9 +105,10 @@ def test_a_column_round_off_decides_is_held_to_its_stated_tolerance(tables):
     """``rtol=COLUMN:FRACTION`` (a chattering law, a rate limit flipping on round-off): within the
     fraction is no drift, beyond it is; the other columns keep one unit in the last digit."""
     documented = "| metric | `a` | `b` |\n|---|---:|---:|\n| `J` | 100.0 | 50.0 |\n"
-    within = "| metric | `a` | `b` |\n|---|---:|---:|\n| `J` | 104.0 | 50.1 |\n"
+    within = "| metric | `a` | `b` |\n|---|---:|---:|\n| `J` | 104.0 | 50.3 |\n"
     assert [d.column for d in tables.drifts(documented, within, "p", "t", {"a": 0.05})] == ["`b`"]
     assert tables.drifts(documented, within, "p", "t", {"*": 0.05}) == []
+    assert len(tables.drifts(documented, within, "p", "t")) == 2  # no tolerance: both drift
     beyond = within.replace("104.0", "106.0")
     assert [d.column for d in tables.drifts(documented, beyond, "p", "t", {"*": 0.05})] == ["`a`"]
     assert tables._options("keys=J rtol=a:0.05,`b`:0.1")[3] == {"a": 0.05, "b": 0.1}
