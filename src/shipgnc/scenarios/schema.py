@@ -11,7 +11,7 @@ allowed (:func:`format_validation_error`).
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal, Union
+from typing import Annotated, ClassVar, Literal, Union
 
 from pydantic import Discriminator, Field, Tag, ValidationError, field_validator, model_validator
 
@@ -67,6 +67,8 @@ MetricSet = Literal[tuple(C.METRICS)]
 
 class Scenario(Strict):
     """A complete, runnable scenario: one ``controller``, or ``controllers`` to compare by name."""
+
+    field_units: ClassVar[dict[str, str]] = {"document_figures": "each metric's (its key's suffix)"}
 
     name: Annotated[str, Field(min_length=1, pattern=r"^[A-Za-z0-9_.\-]+$")]
     description: str = ""

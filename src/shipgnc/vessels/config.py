@@ -4,7 +4,7 @@ writes."""
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
@@ -23,6 +23,13 @@ class CatalogueVesselConfig(Strict):
     the steering machine ``rudder_max_deg``, ``rudder_rate_deg_s``, ``rudder_time_constant_s``.
     The vessel starts in its steady straight run at that speed (``initial_state`` sets position,
     heading and yaw rate)."""
+
+    field_units: ClassVar[dict[str, str]] = {"K": "1/s",
+        "T": "s (nomoto: time constant) or m (linear-3dof: draught)", "T1": "s", "T2": "s",
+        "T3": "s", "a0": "rad/s", "a1": "1", "a2": "s/rad", "a3": "s²/rad²",
+        "M": "kg, kg·m, kg·m² (SI)", "N": "kg/s, kg·m/s, kg·m²/s (SI)",
+        "B": "m (linear-3dof beam) or N/rad, N·m/rad (input matrix)", "L": "m", "Cb": "1",
+        "R66": "m", "xg": "m", "T_surge": "s", "T_n": "s"}
 
     model: Literal["mariner-cst", "frigate", "kvlcc2", "kvlcc2-l7", "linear-3dof", "nomoto",
                    "nomoto2"]
@@ -55,6 +62,22 @@ class CatalogueVesselConfig(Strict):
         """The entry's parameters given (None left out)."""
         return {k: v for k, v in self.model_dump(exclude={"model", "speed_mps"}).items()
                 if v is not None}
+
+    def optional_fields(self) -> tuple[str, ...]:
+        """The fields this model may take beside those given: ``speed_mps``, the entry's
+        parameters and the steering machine (:data:`~shipgnc.vessels.catalogue.STEERING_PARAMS`);
+        a ``linear-3dof`` from main dimensions does not list the matrices, nor one from matrices
+        the dimensions."""
+        from shipgnc.vessels.catalogue import STEERING_PARAMS, get_vessel
+
+        names = ("speed_mps", *get_vessel(self.model).param_names, *STEERING_PARAMS)
+        given = set(self.params())
+        if self.model == "linear-3dof":
+            exclusive = ({"M", "N"} if given & {"L", "T", "Cb"}
+                         else {"L", "T", "Cb", "R66", "xg", "T_surge"} if given & {"M", "N"}
+                         else set())
+            names = tuple(n for n in names if n not in exclusive)
+        return tuple(n for n in names if n not in given)
 
     def surge_equilibrium(self) -> float:
         """The steady straight run's surge speed [m/s] (``initial_state.u: null``)."""
