@@ -61,3 +61,39 @@ def test_show_lists_a_catalogue_vessels_optional_fields_commented_out():
     from shipgnc.scenarios.schema import validate
 
     assert validate(edited, "edited").vessel.rudder_rate_deg_s == 15
+
+
+def _make_reference():
+    import importlib.util
+    from pathlib import Path
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    spec = importlib.util.spec_from_file_location("make_reference", docs / "make_reference.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return docs / "reference", module
+
+
+def test_reference_pages_are_the_ones_the_schema_writes():
+    """The committed pages cannot drift from the schema: regenerate with
+    ``python docs/make_reference.py``."""
+    where, module = _make_reference()
+    for name, page in module.pages().items():
+        assert (where / name).read_text(encoding="utf-8") == page, \
+            f"docs/reference/{name} is stale: run python docs/make_reference.py"
+
+
+def test_reference_pages_list_every_field_with_its_unit():
+    where, _ = _make_reference()
+    fields = (where / "scenario-fields.md").read_text(encoding="utf-8")
+    vessel = (where / "vessel-file.md").read_text(encoding="utf-8")
+    for cls in sections(Scenario):
+        assert f"\n## {cls.__name__}\n" in fields
+        for name in cls.model_fields:
+            unit = field_unit(cls, name) or ""
+            assert f"| `{name}` |" in fields, (cls.__name__, name)
+            if unit:
+                assert any(line.startswith(f"| `{name}` |") and f"| {unit} |" in line
+                           for line in fields.splitlines()), (cls.__name__, name, unit)
+    assert "| `rudder_rate_deg_s` | number > 0 | `null` | deg/s |" in vessel
+    assert "| `lookahead` | number > 0 | `8.0` | m |" in fields
