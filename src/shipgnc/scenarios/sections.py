@@ -195,9 +195,13 @@ class ActuatorConfig(Strict):
     field_units: ClassVar[dict[str, str]] = {"thrust_time_constant": "s", "thrust_rate": "N/s",
         "angle_time_constant": "s"}
 
+    #: first-order lag of the thrust behind its command (0: none)
     thrust_time_constant: NonNegative = 0.0
+    #: thrust rate limit; null: none
     thrust_rate: Positive | None = None
+    #: first-order lag of the thruster angle behind its command (0: none)
     angle_time_constant: NonNegative = 0.0
+    #: thruster angle rate limit; null: none
     angle_rate_deg_s: Positive | None = None
 
 
@@ -209,11 +213,17 @@ class InitialState(Strict):
 
     field_units: ClassVar[dict[str, str]] = {"north": "m", "east": "m", "u": "m/s", "v": "m/s"}
 
+    #: position north of the origin
     north: Finite = 0.0
+    #: position east of the origin
     east: Finite = 0.0
+    #: heading, clockwise from north
     psi_deg: Finite = 0.0
+    #: surge speed; null: the straight-run equilibrium
     u: Finite | None = 0.0
+    #: sway speed
     v: Finite = 0.0
+    #: yaw rate
     r_deg_s: Finite = 0.0
 
 
@@ -223,16 +233,26 @@ class SimulationConfig(Strict):
     field_units: ClassVar[dict[str, str]] = {"dt": "s", "t_end": "s", "rtol": "1",
         "atol": "SI units of each state", "log_every": "samples"}
 
+    #: integration and control step
     dt: Positive = 0.05
+    #: duration (a whole number of steps)
     t_end: Positive
+    #: fixed-step ``rk4`` or scipy's adaptive ``solve_ivp``
     integrator: Literal["rk4", "solve_ivp"] = "rk4"
+    #: the ``solve_ivp`` method
     method: Literal["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"] = "RK45"
+    #: ``solve_ivp`` relative tolerance
     rtol: Positive = 1e-3
+    #: ``solve_ivp`` absolute tolerance
     atol: Positive = 1e-6
+    #: seed of every random draw (noise, waves, Monte Carlo); null: a fresh one each run,
+    #: recorded in the result
     seed: Annotated[int, Field(ge=0, lt=2**63)] | None = None  # an int64: what NetCDF stores
+    #: the loop: ``numpy``, ``compiled`` (numba), or ``auto`` (compiled where it can)
     backend: Literal["auto", "numpy", "compiled"] = "auto"
     #: keep every n-th sample in the result (large batches); metrics use the kept samples
     log_every: Annotated[int, Field(ge=1)] = 1
+    #: the state at t = 0
     initial_state: InitialState = Field(default_factory=InitialState)
 
     @model_validator(mode="after")
@@ -282,9 +302,13 @@ class HeadingSpeedConfig(Navigated):
 
     type: Literal["heading-speed"]
     Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
+    #: bandwidth of the heading reference model
     omega_ref: Positive = 1.0
+    #: closed-loop heading bandwidth (pole placement)
     omega: Positive = 1.0
+    #: closed-loop speed bandwidth
     omega_u: Positive = 1.0
+    #: feed the reference's nonlinear yaw damping N_rr·|r|·r forward
     yaw_feedforward: bool = True
 
 
@@ -454,10 +478,15 @@ class LOSConfig(Strict):
         "adaptive_gain": "rad/m²"}
 
     type: Literal["los"]
+    #: ``[[north, east], ...]``, sailed in order
     waypoints: Annotated[list[tuple[Finite, Finite]], Field(min_length=2)]
+    #: lookahead distance Δ along the leg
     lookahead: Positive = 8.0
+    #: speed reference
     speed: Positive = 1.5
+    #: switch to the next leg within this distance of the waypoint
     switch_radius: NonNegative = 5.0
+    #: the cross-track metrics score each leg from this far along it (the turn onto it left out)
     capture_distance: NonNegative = 20.0
     #: σ of integral LOS against currents and steady side forces (0 = plain LOS)
     integral_gain: NonNegative = 0.0
@@ -796,6 +825,7 @@ class MonteCarloConfig(Strict):
     ``heading_offset_deg``; each ship gets its own wave realisation (same ``simulation.seed``,
     same batch). The divergence guard stops the whole batch at the first ship that trips it."""
 
+    #: number of ships in the batch
     runs: Annotated[int, Field(ge=1, le=100_000)] = 1000
     east_offset_nm: tuple[OffsetNm, OffsetNm] = (-1.0, 1.0)
     heading_offset_deg: tuple[OffsetDeg, OffsetDeg] = (-20.0, 20.0)
