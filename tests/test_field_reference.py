@@ -43,6 +43,8 @@ def test_show_prints_units_as_comments_and_reads_back():
     assert "  dt: 0.05  # s\n" in result.stdout
     assert "  waypoints:  # m\n" in result.stdout
     assert yaml.safe_load(result.stdout)["guidance"]["lookahead"] == 8.0
+    nautical = CliRunner().invoke(app, ["show", "zermelo-paper"]).stdout
+    assert "  speed: 0.5  # kn\n" in nautical  # a route in units: nautical
 
 
 def test_show_lists_a_catalogue_vessels_optional_fields_commented_out():
@@ -56,6 +58,7 @@ def test_show_lists_a_catalogue_vessels_optional_fields_commented_out():
     assert "  # R66: null  # m, optional\n" in text
     assert "# M: null" not in text  # matrices or main dimensions, not both
     assert "  L: 12.0  # m\n" in text
+    assert "  T: 1.2  # m\n" in text  # a draught here, a Nomoto time constant [s] elsewhere
     # uncommented with a value, the line is a field the vessel takes
     edited = yaml.safe_load(text.replace("# rudder_rate_deg_s: null", "rudder_rate_deg_s: 15"))
     from shipgnc.scenarios.schema import validate

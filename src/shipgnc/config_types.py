@@ -72,6 +72,15 @@ def _location(loc: tuple) -> str:
     return ".".join(parts)
 
 
+def value_unit(section: BaseModel, name: str) -> str | None:
+    """The unit of field ``name`` as this section reads it: its ``unit_of(name)`` where the unit
+    depends on another field (a catalogue vessel's ``T``: a time constant or a draught), else
+    :func:`field_unit`."""
+    unit_of = getattr(section, "unit_of", None)
+    unit = unit_of(name) if unit_of is not None else None
+    return unit if unit is not None else field_unit(type(section), name)
+
+
 def sections(root: type[BaseModel]) -> list[type[BaseModel]]:
     """``root`` and every model its fields hold, nested (through unions, lists, dicts), in the
     order of the fields: the sections of a schema, for its reference page and its checks."""

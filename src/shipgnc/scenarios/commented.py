@@ -8,12 +8,12 @@ from __future__ import annotations
 import yaml
 from pydantic import BaseModel
 
-from shipgnc.config_types import DIMENSIONLESS, field_unit
+from shipgnc.config_types import DIMENSIONLESS, value_unit
 
 
-def unit_comment(model: type, name: str) -> str | None:
-    """``"m"``, ``"dimensionless"`` or None: the comment after field ``name`` of ``model``."""
-    unit = field_unit(model, name)
+def unit_comment(section: BaseModel, name: str) -> str | None:
+    """``"m"``, ``"dimensionless"`` or None: the comment after field ``name`` of ``section``."""
+    unit = value_unit(section, name)
     return "dimensionless" if unit == DIMENSIONLESS else unit
 
 
@@ -42,7 +42,7 @@ def optional_lines(vessel: BaseModel) -> list[str]:
         names = [name for name in names if name in vessel.optional_fields()]
     out = []
     for name in names:
-        unit = unit_comment(type(vessel), name)
+        unit = unit_comment(vessel, name)
         out.append(f"{name}: null  # {unit + ', ' if unit else ''}optional")
     return out
 
@@ -56,7 +56,7 @@ def _walk(node, obj, notes: dict[int, str]) -> None:
             key = key_node.value
             if isinstance(obj, BaseModel):
                 child = getattr(obj, key, None)
-                unit = unit_comment(type(obj), key) if key in type(obj).model_fields else None
+                unit = unit_comment(obj, key) if key in type(obj).model_fields else None
                 line = key_node.start_mark.line
                 if unit and (value_node.start_mark.line > line
                              or value_node.end_mark.line == line):

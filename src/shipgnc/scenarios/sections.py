@@ -780,6 +780,14 @@ class RouteConfig(Strict):
     horizon: Positive | None = None
     grid: Positive | None = None
 
+    def unit_of(self, name: str) -> str | None:
+        """The unit of a length, speed or time field in this route's ``units``."""
+        unit = self.field_units.get(name)
+        if unit is None:
+            return None
+        si, _, nautical = unit.partition(" (")
+        return nautical.split(" with")[0] if self.units == "nautical" else si
+
 
 class SailConfig(Strict):
     """The route sailed by a ship (note 002-2.9.7; :mod:`shipgnc.scenarios.routing`), SI units.

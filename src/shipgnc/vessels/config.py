@@ -86,6 +86,16 @@ class CatalogueVesselConfig(Strict):
         return {k: v for k, v in self.model_dump(exclude={"model", "speed_mps"}).items()
                 if v is not None}
 
+    def unit_of(self, name: str) -> str | None:
+        """The unit of ``T`` and ``B`` for this model: a Nomoto time constant [s] or a draught
+        [m]; a beam [m] or the rudder input matrix (None: the generic :attr:`field_units`)."""
+        dimensions = self.model == "linear-3dof" and self.M is None
+        if name == "T" and self.model in ("nomoto", "linear-3dof"):
+            return "m" if dimensions else "s"
+        if name == "B" and self.model == "linear-3dof":
+            return "m" if dimensions else "N/rad, N·m/rad"
+        return None
+
     def optional_fields(self) -> tuple[str, ...]:
         """The fields this model may take beside those given: ``speed_mps``, the entry's
         parameters and the steering machine (:data:`~shipgnc.vessels.catalogue.STEERING_PARAMS`);
