@@ -58,7 +58,7 @@ def notes(cls: type) -> dict[str, str]:
             trailing = line.partition("  # ")[2].strip()
             if trailing.startswith(("noqa", "type:")):
                 trailing = ""
-            note = " ".join(pending) or trailing
+            note = "\n".join(pending) or trailing
             if note:
                 out[match.group(1)] = note
         pending = [] if not stripped.startswith("#") else pending

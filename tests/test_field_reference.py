@@ -100,3 +100,21 @@ def test_reference_pages_list_every_field_with_its_unit():
                            for line in fields.splitlines()), (cls.__name__, name, unit)
     assert "| `rudder_rate_deg_s` | number > 0 | `null` | deg/s |" in vessel
     assert "| `lookahead` | number > 0 | `8.0` | m |" in fields
+
+
+def test_a_field_note_is_not_read_as_a_type_by_the_api_pages():
+    """A ``#:`` note whose first line holds ``text: more`` is split by napoleon into a type
+    ("text") and a description on the API pages: the notes say ``(null = ...)`` instead."""
+    napoleon = pytest.importorskip("sphinx.ext.napoleon")
+    from sphinx.ext.napoleon.docstring import NumpyDocstring
+
+    _, module = _make_reference()
+    config = napoleon.Config(napoleon_numpy_docstring=True)
+    split = []
+    for root in (Scenario, CatalogueVesselConfig):
+        for cls in sections(root):
+            for name, note in module.notes(cls).items():
+                parsed = str(NumpyDocstring(note.split("\n"), config, what="attribute"))
+                if ":type:" in parsed:
+                    split.append(f"{cls.__name__}.{name}: {note.splitlines()[0]}")
+    assert not split

@@ -19,7 +19,7 @@ class Strict(BaseModel):
     its fields whose name does not carry one (:func:`field_unit`) in ``field_units``."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
-    #: units of fields whose name carries none (or a misleading one): ``{"lookahead": "m"}``;
+    #: units of fields whose name carries none (or a misleading one), e.g. ``{"lookahead": "m"}``;
     #: "1" for a dimensionless number. Subclasses add to their bases' (:func:`field_unit`).
     field_units: ClassVar[dict[str, str]] = {}
 

@@ -84,7 +84,7 @@ class Scenario(Strict):
     quality: QualityConfig = Field(default_factory=QualityConfig)
     montecarlo: MonteCarloConfig | None = None
     #: document 004's case builders (vessel model ``catamaran``), in place of controller(s) and
-    #: guidance: comparisons whose runs differ in reference, plant or duration
+    #: guidance, for comparisons whose runs differ in reference, plant or duration
     case: CatamaranCaseConfig | None = None
     #: document 002's routing problem, and optionally a ship sailing the route
     route: RouteConfig | None = None
@@ -93,7 +93,7 @@ class Scenario(Strict):
     document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
     #: an earth-fixed current on the vessel (:data:`CURRENT_VESSELS`), with any force disturbance
     current: CurrentConfig | None = None
-    #: navigation: the sensors between the true state and the controller, and an
+    #: navigation, the sensors between the true state and the controller, and an
     #: estimator between the sensors and the controller (the controller acts on its estimate)
     sensors: list[SensorConfig] = Field(default_factory=list)
     estimator: EstimatorConfig | None = None

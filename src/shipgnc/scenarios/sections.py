@@ -22,7 +22,7 @@ from shipgnc.errors import ConfigError
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 OffsetNm = Annotated[float, Field(ge=-1000, le=1000, allow_inf_nan=False)]
 OffsetDeg = Annotated[float, Field(ge=-180, le=180, allow_inf_nan=False)]
-#: a commanded heading: up to ten turns either way (beyond that a float's degrees lose meaning)
+#: a commanded heading, up to ten turns either way (beyond that a float's degrees lose meaning)
 HeadingDeg = Annotated[float, Field(ge=-3600, le=3600, allow_inf_nan=False)]
 
 
@@ -82,7 +82,7 @@ class CyberShipVesselConfig(Strict):
     #: 2.32°/s Froude-scaled by √70: 19.4105…°/s (``models.cybership2.DELTA_RATE_DEG_S``; the
     #: indicative figures of note 003-3.8 used it rounded to 19.4)
     rudder_rate_deg_s: Positive | None = CYBERSHIP_RUDDER_RATE_DEG_S
-    #: ``ramp``: the rudder slews linearly within a step; ``hold``: the slewed value is held over
+    #: ``ramp`` — the rudder slews linearly within a step; ``hold`` — the slewed value is held over
     #: the step (a discrete rate limiter, the setting of document 003's indicative figures)
     rudder_rate_mode: Literal["ramp", "hold"] = "ramp"
 
@@ -155,10 +155,10 @@ class CatamaranVesselConfig(Strict):
 
     model: Literal["catamaran"]
     preset: Literal["si-consistent", "si", "paper"] = "si-consistent"
-    #: sway Coriolis sign: the printed model's, or the consistent one (note 004-4.3); None: the
+    #: sway Coriolis sign, the printed model's or the consistent one (note 004-4.3); None means the
     #: preset's (consistent for ``si-consistent``, printed for ``si`` and ``paper``)
     coriolis: Literal["printed", "consistent"] | None = None
-    #: resistance below V_m: the quadratic continuation, or the literal fit (note 004-4.3)
+    #: resistance below V_m, the quadratic continuation or the literal fit (note 004-4.3)
     low_speed: Literal["continued", "literal"] = "continued"
     #: other :class:`CatamaranParams` overrides (SI), e.g. ``{J_zz: 4.0e6, T_v: 18000}``
     params: dict[str, Finite] = Field(default_factory=dict)
@@ -195,13 +195,13 @@ class ActuatorConfig(Strict):
     field_units: ClassVar[dict[str, str]] = {"thrust_time_constant": "s", "thrust_rate": "N/s",
         "angle_time_constant": "s"}
 
-    #: first-order lag of the thrust behind its command (0: none)
+    #: first-order lag of the thrust behind its command (0 = none)
     thrust_time_constant: NonNegative = 0.0
-    #: thrust rate limit; null: none
+    #: thrust rate limit (null = none)
     thrust_rate: Positive | None = None
-    #: first-order lag of the thruster angle behind its command (0: none)
+    #: first-order lag of the thruster angle behind its command (0 = none)
     angle_time_constant: NonNegative = 0.0
-    #: thruster angle rate limit; null: none
+    #: thruster angle rate limit (null = none)
     angle_rate_deg_s: Positive | None = None
 
 
@@ -219,7 +219,7 @@ class InitialState(Strict):
     east: Finite = 0.0
     #: heading, clockwise from north
     psi_deg: Finite = 0.0
-    #: surge speed; null: the straight-run equilibrium
+    #: surge speed (null = the straight-run equilibrium)
     u: Finite | None = 0.0
     #: sway speed
     v: Finite = 0.0
@@ -245,10 +245,10 @@ class SimulationConfig(Strict):
     rtol: Positive = 1e-3
     #: ``solve_ivp`` absolute tolerance
     atol: Positive = 1e-6
-    #: seed of every random draw (noise, waves, Monte Carlo); null: a fresh one each run,
-    #: recorded in the result
+    #: seed of every random draw (noise, waves, Monte Carlo); null draws a fresh one each
+    #: run, recorded in the result
     seed: Annotated[int, Field(ge=0, lt=2**63)] | None = None  # an int64: what NetCDF stores
-    #: the loop: ``numpy``, ``compiled`` (numba), or ``auto`` (compiled where it can)
+    #: the loop, ``numpy``, ``compiled`` (numba), or ``auto`` (compiled where it can)
     backend: Literal["auto", "numpy", "compiled"] = "auto"
     #: keep every n-th sample in the result (large batches); metrics use the kept samples
     log_every: Annotated[int, Field(ge=1)] = 1
@@ -855,7 +855,7 @@ class QualityConfig(Strict):
     lam: NonNegative = 1.0
 
 
-#: the largest sensor noise or bias (in its field's unit): its square is a finite float
+#: the largest sensor noise or bias (in its field's unit), whose square is a finite float
 MAX_SENSOR_ERROR = 1e150
 
 

@@ -34,7 +34,7 @@ class CatalogueVesselConfig(Strict):
     #: the catalogue model (``shipgnc vessels``)
     model: Literal["mariner-cst", "frigate", "kvlcc2", "kvlcc2-l7", "linear-3dof", "nomoto",
                    "nomoto2"]
-    #: the speed the model is built at; null: the model's design speed
+    #: the speed the model is built at (null = the model's design speed)
     speed_mps: Positive | None = None
     #: Nomoto gain (``nomoto``, ``nomoto2``)
     K: Finite | None = None
@@ -66,19 +66,19 @@ class CatalogueVesselConfig(Strict):
     L: Finite | None = None
     #: block coefficient (``linear-3dof`` from main dimensions)
     Cb: Finite | None = None
-    #: yaw radius of gyration; null: 0.27 L above 100 m, else 0.25 L
+    #: yaw radius of gyration (null = 0.27 L above 100 m, else 0.25 L)
     R66: Finite | None = None
-    #: longitudinal centre of gravity from midships (positive forward); null: 0
+    #: longitudinal centre of gravity from midships, positive forward (null = 0)
     xg: Finite | None = None
-    #: surge time constant; null: L in seconds (Fossen's shipClarke83)
+    #: surge time constant (null = L in seconds, as Fossen's shipClarke83)
     T_surge: Finite | None = None
-    #: engine (propeller rate) time constant of the KVLCC2; null: the model's
+    #: engine (propeller rate) time constant of the KVLCC2 (null = the model's)
     T_n: Positive | None = None
-    #: rudder angle limit; null: the model's
+    #: rudder angle limit (null = the model's)
     rudder_max_deg: Annotated[float, Field(gt=0, le=90, allow_inf_nan=False)] | None = None
-    #: rudder rate limit of the steering machine; null: the model's
+    #: rudder rate limit of the steering machine (null = the model's)
     rudder_rate_deg_s: Positive | None = None
-    #: steering machine time constant; null: the model's
+    #: steering machine time constant (null = the model's)
     rudder_time_constant_s: Positive | None = None
 
     def params(self) -> dict:
