@@ -43,9 +43,9 @@ def cell(value: str) -> str:
     return value.replace("|", "\\|").replace("\n", " ")
 
 
-def notes(cls: type) -> dict[str, str]:
-    """The comment beside each field in the class's source: ``#:`` lines above it, or a ``# ...``
-    after it on its line."""
+def notes(cls: type, trailing_comments: bool = True) -> dict[str, str]:
+    """The comment beside each field in the class's source: ``#:`` lines above it (what autodoc
+    shows on the API pages), or a ``# ...`` after it on its line."""
     out: dict[str, str] = {}
     pending: list[str] = []
     for line in inspect.getsource(cls).splitlines():
@@ -55,7 +55,7 @@ def notes(cls: type) -> dict[str, str]:
             continue
         match = _FIELD_LINE.match(line)
         if match and not stripped.startswith(("def ", "@")):
-            trailing = line.partition("  # ")[2].strip()
+            trailing = line.partition("  # ")[2].strip() if trailing_comments else ""
             if trailing.startswith(("noqa", "type:")):
                 trailing = ""
             note = "\n".join(pending) or trailing

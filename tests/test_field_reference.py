@@ -113,8 +113,8 @@ def test_a_field_note_is_not_read_as_a_type_by_the_api_pages():
     split = []
     for root in (Scenario, CatalogueVesselConfig):
         for cls in sections(root):
-            for name, note in module.notes(cls).items():
-                parsed = str(NumpyDocstring(note.split("\n"), config, what="attribute"))
+            for name, note in module.notes(cls, trailing_comments=False).items():
+                parsed = str(NumpyDocstring(note.split("\n"), config, what="attribute", name=name))
                 if ":type:" in parsed:
                     split.append(f"{cls.__name__}.{name}: {note.splitlines()[0]}")
     assert not split
