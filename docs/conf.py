@@ -111,5 +111,21 @@ def _escape_plain_maths(app, what, name, obj, options, lines):
         i = j
 
 
+def _no_pydantic_field_types(app, what, name, obj, options, signature, return_annotation):
+    """A configuration section (a pydantic model) takes its fields as keyword arguments, whose
+    annotations print as ``FieldInfo(...)`` reprs in the parameter list autodoc adds: leave that
+    list out. Its fields are its documented attributes, and reference/scenario-fields.md lists
+    each with type, range, default and unit."""
+    from pydantic import BaseModel
+
+    if what == "class" and isinstance(obj, type) and issubclass(obj, BaseModel):
+        document = getattr(app.env, "current_document", None)
+        annotations = (getattr(document, "autodoc_annotations", None) if document is not None
+                       else app.env.temp_data.get("annotations"))
+        if annotations is not None:
+            annotations.pop(name, None)
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", _escape_plain_maths)
+    app.connect("autodoc-process-signature", _no_pydantic_field_types)

@@ -197,7 +197,7 @@ class CyberShip2Params(Params):
 
     @property
     def sway_yaw_mass(self) -> np.ndarray:
-        """The sway–yaw block of M: [[m − Y_v̇, m x_G − Y_ṙ], [m x_G − N_v̇, I_z − N_ṙ]]."""
+        """The sway–yaw block of the mass matrix M, [[m − Y_v̇, m x_G − Y_ṙ], [m x_G − N_v̇, I_z − N_ṙ]]."""
         mx = self.m * self.x_G
         return np.array([[self.m - self.Y_vdot, mx - self.Y_rdot],
                          [mx - self.N_vdot, self.I_z - self.N_rdot]])

@@ -191,7 +191,11 @@ def scenario_yaml(scenario: Scenario) -> str:
     sections it does not read (:meth:`Scenario.used_sections`: ``actuator`` beyond the boat,
     ``quality`` beyond document 003's index, ``vessel`` of a route) and fields its vessel
     ignores (:meth:`Scenario.ignored_fields`) are left out. A catamaran case's ``options`` list
-    every option of its builder with its default (``t_end`` and ``dt`` come from ``simulation``)."""
+    every option of its builder with its default (``t_end`` and ``dt`` come from ``simulation``).
+    Each field's unit is a comment after it, and the vessel's optional fields not set are listed
+    commented out (:func:`~shipgnc.scenarios.commented.commented_yaml`)."""
+    from shipgnc.scenarios.commented import commented_yaml
+
     data = scenario.model_dump(mode="json")
     _drop_default_nulls(scenario, data)
     used = set(scenario.used_sections())
@@ -209,4 +213,4 @@ def scenario_yaml(scenario: Scenario) -> str:
         defaults = {k: v for k, v in builder_options(scenario.case.builder).items()
                     if k not in ("t_end", "dt")}
         data["case"]["options"] = {**defaults, **data["case"].get("options", {})}
-    return yaml.safe_dump(data, sort_keys=False)
+    return commented_yaml(yaml.safe_dump(data, sort_keys=False), scenario)

@@ -11,7 +11,7 @@ allowed (:func:`format_validation_error`).
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal, Union
+from typing import Annotated, ClassVar, Literal, Union
 
 from pydantic import Discriminator, Field, Tag, ValidationError, field_validator, model_validator
 
@@ -68,6 +68,8 @@ MetricSet = Literal[tuple(C.METRICS)]
 class Scenario(Strict):
     """A complete, runnable scenario: one ``controller``, or ``controllers`` to compare by name."""
 
+    field_units: ClassVar[dict[str, str]] = {"document_figures": "each metric's (its key's suffix)"}
+
     name: Annotated[str, Field(min_length=1, pattern=r"^[A-Za-z0-9_.\-]+$")]
     description: str = ""
     document: str = ""
@@ -82,7 +84,7 @@ class Scenario(Strict):
     quality: QualityConfig = Field(default_factory=QualityConfig)
     montecarlo: MonteCarloConfig | None = None
     #: document 004's case builders (vessel model ``catamaran``), in place of controller(s) and
-    #: guidance: comparisons whose runs differ in reference, plant or duration
+    #: guidance, for comparisons whose runs differ in reference, plant or duration
     case: CatamaranCaseConfig | None = None
     #: document 002's routing problem, and optionally a ship sailing the route
     route: RouteConfig | None = None
@@ -91,7 +93,7 @@ class Scenario(Strict):
     document_figures: dict[str, dict[str, Finite]] = Field(default_factory=dict)
     #: an earth-fixed current on the vessel (:data:`CURRENT_VESSELS`), with any force disturbance
     current: CurrentConfig | None = None
-    #: navigation: the sensors between the true state and the controller, and an
+    #: navigation, the sensors between the true state and the controller, and an
     #: estimator between the sensors and the controller (the controller acts on its estimate)
     sensors: list[SensorConfig] = Field(default_factory=list)
     estimator: EstimatorConfig | None = None

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 from pydantic import AfterValidator, Field, field_validator, model_validator
 
@@ -22,7 +22,7 @@ from shipgnc.errors import ConfigError
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 OffsetNm = Annotated[float, Field(ge=-1000, le=1000, allow_inf_nan=False)]
 OffsetDeg = Annotated[float, Field(ge=-180, le=180, allow_inf_nan=False)]
-#: a commanded heading: up to ten turns either way (beyond that a float's degrees lose meaning)
+#: a commanded heading, up to ten turns either way (beyond that a float's degrees lose meaning)
 HeadingDeg = Annotated[float, Field(ge=-3600, le=3600, allow_inf_nan=False)]
 
 
@@ -47,6 +47,9 @@ BOAT_PARAM_NAMES = ("m", "X_udot", "Y_vdot", "I_z", "N_rdot", "X_u", "Y_v", "N_r
 class VesselConfig(Strict):
     """``vessel`` for document 001's boat: a named parameter preset and overrides."""
 
+    field_units: ClassVar[dict[str, str]] = {
+        "params": "SI, per parameter (alpha_max rad, alpha_max_deg deg)"}
+
     model: Literal["vectored-thrust-boat"] = "vectored-thrust-boat"
     preset: Literal["otter", "doc-eq7", "doc-printed", "otter-munk"] = "otter"
     params: dict[str, Finite] = Field(default_factory=dict)
@@ -69,6 +72,8 @@ CYBERSHIP_RUDDER_RATE_DEG_S = 2.32 * math.sqrt(70.0)
 class CyberShipVesselConfig(Strict):
     """``vessel`` for CyberShip II (document 003): rudder force model, steering machine, propellers."""
 
+    field_units: ClassVar[dict[str, str]] = {"propeller_rps": "1/s"}
+
     model: Literal["cybership2"]
     rudder_model: Literal["table1", "skjetne"] = "table1"
     propeller_rps: Positive = 8.13
@@ -77,7 +82,7 @@ class CyberShipVesselConfig(Strict):
     #: 2.32°/s Froude-scaled by √70: 19.4105…°/s (``models.cybership2.DELTA_RATE_DEG_S``; the
     #: indicative figures of note 003-3.8 used it rounded to 19.4)
     rudder_rate_deg_s: Positive | None = CYBERSHIP_RUDDER_RATE_DEG_S
-    #: ``ramp``: the rudder slews linearly within a step; ``hold``: the slewed value is held over
+    #: ``ramp`` — the rudder slews linearly within a step; ``hold`` — the slewed value is held over
     #: the step (a discrete rate limiter, the setting of document 003's indicative figures)
     rudder_rate_mode: Literal["ramp", "hold"] = "ramp"
 
@@ -99,6 +104,8 @@ class MarinerVesselConfig(Strict):
     e.g. ``{r1: 0.0375}`` for the sign-flipped sway coupling; converted to SI at the model boundary.
     The steering machine: ``rudder_max_deg``, ``rudder_rate_deg_s`` (null: no rate limit).
     """
+
+    field_units: ClassVar[dict[str, str]] = {"params_paper": "the document's units (min, nm, rad)"}
 
     model: Literal["mariner"]
     params_paper: dict[str, Finite] = Field(default_factory=dict)
@@ -144,12 +151,14 @@ class CatamaranVesselConfig(Strict):
     corrected, hull lift [A]); ``si`` (printed Coriolis sign) and ``paper`` (the listing's mixed
     units) are the document's reproductions, flagged in figures and metrics."""
 
+    field_units: ClassVar[dict[str, str]] = {"params": "SI, per parameter"}
+
     model: Literal["catamaran"]
     preset: Literal["si-consistent", "si", "paper"] = "si-consistent"
-    #: sway Coriolis sign: the printed model's, or the consistent one (note 004-4.3); None: the
+    #: sway Coriolis sign, the printed model's or the consistent one (note 004-4.3); None means the
     #: preset's (consistent for ``si-consistent``, printed for ``si`` and ``paper``)
     coriolis: Literal["printed", "consistent"] | None = None
-    #: resistance below V_m: the quadratic continuation, or the literal fit (note 004-4.3)
+    #: resistance below V_m, the quadratic continuation or the literal fit (note 004-4.3)
     low_speed: Literal["continued", "literal"] = "continued"
     #: other :class:`CatamaranParams` overrides (SI), e.g. ``{J_zz: 4.0e6, T_v: 18000}``
     params: dict[str, Finite] = Field(default_factory=dict)
@@ -172,6 +181,8 @@ class CatamaranCaseConfig(Strict):
     """Document 004's case (note 004-4.7): a ``builder`` of :mod:`shipgnc.cases.catamaran` and its
     keyword ``options`` (checked against the builder's signature when the scenario is built)."""
 
+    field_units: ClassVar[dict[str, str]] = {"options": "SI, per option"}
+
     builder: Literal["turn", "steps", "fixed-angle", "sine", "heading", "actuator", "montecarlo",
                      "compare"]
     options: dict[str, Finite | int | bool | str | None] = Field(default_factory=dict)
@@ -181,9 +192,16 @@ class CatamaranCaseConfig(Strict):
 class ActuatorConfig(Strict):
     """``actuator``: dynamics between command and thruster (defaults: none, as in document 001)."""
 
+    field_units: ClassVar[dict[str, str]] = {"thrust_time_constant": "s", "thrust_rate": "N/s",
+        "angle_time_constant": "s"}
+
+    #: first-order lag of the thrust behind its command (0 = none)
     thrust_time_constant: NonNegative = 0.0
+    #: thrust rate limit (null = none)
     thrust_rate: Positive | None = None
+    #: first-order lag of the thruster angle behind its command (0 = none)
     angle_time_constant: NonNegative = 0.0
+    #: thruster angle rate limit (null = none)
     angle_rate_deg_s: Positive | None = None
 
 
@@ -193,27 +211,48 @@ class InitialState(Strict):
     at ``vessel.propeller_rps`` (2T(n, u) = d₁₁(u)u, δ = 0; 0.29583… m/s at 8.13 rps, note 003-3.5), the
     Mariner's U = S/f."""
 
+    field_units: ClassVar[dict[str, str]] = {"north": "m", "east": "m", "u": "m/s", "v": "m/s"}
+
+    #: position north of the origin
     north: Finite = 0.0
+    #: position east of the origin
     east: Finite = 0.0
+    #: heading, clockwise from north
     psi_deg: Finite = 0.0
+    #: surge speed (null = the straight-run equilibrium)
     u: Finite | None = 0.0
+    #: sway speed
     v: Finite = 0.0
+    #: yaw rate
     r_deg_s: Finite = 0.0
 
 
 class SimulationConfig(Strict):
     """``simulation``: step, duration, integrator, seed, initial state."""
 
+    field_units: ClassVar[dict[str, str]] = {"dt": "s", "t_end": "s", "rtol": "1",
+        "atol": "SI units of each state", "log_every": "samples"}
+
+    #: integration and control step
     dt: Positive = 0.05
+    #: duration (a whole number of steps)
     t_end: Positive
+    #: fixed-step ``rk4`` or scipy's adaptive ``solve_ivp``
     integrator: Literal["rk4", "solve_ivp"] = "rk4"
+    #: the ``solve_ivp`` method
     method: Literal["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"] = "RK45"
+    #: ``solve_ivp`` relative tolerance
     rtol: Positive = 1e-3
+    #: ``solve_ivp`` absolute tolerance
     atol: Positive = 1e-6
+    #: seed of every random draw (noise, waves, Monte Carlo); null draws a fresh one each
+    #: run, recorded in the result
     seed: Annotated[int, Field(ge=0, lt=2**63)] | None = None  # an int64: what NetCDF stores
+    #: the loop, ``numpy``, ``compiled`` (numba), or ``auto`` (compiled where it can)
     backend: Literal["auto", "numpy", "compiled"] = "auto"
     #: keep every n-th sample in the result (large batches); metrics use the kept samples
     log_every: Annotated[int, Field(ge=1)] = 1
+    #: the state at t = 0
     initial_state: InitialState = Field(default_factory=InitialState)
 
     @model_validator(mode="after")
@@ -230,6 +269,7 @@ class SimulationConfig(Strict):
 # --------------------------------------------------------------------------- controllers
 
 class CommandEntry(Strict):
+    field_units: ClassVar[dict[str, str]] = {"t": "s", "T": "N"}
     t: NonNegative
     T: Finite
     alpha_deg: Finite
@@ -241,6 +281,8 @@ class Navigated(Strict):
     state, as without navigation), ``measurement`` (the held sensor values) or ``estimate`` (the
     estimator's); default: the estimate when there is an estimator, else the measurement when
     there are sensors, else the truth. A comparison can so set the same law on each."""
+
+    field_units: ClassVar[dict[str, str]] = {"Ts": "s"}
 
     sees: Literal["truth", "measurement", "estimate"] | None = None
 
@@ -255,11 +297,18 @@ class OpenLoopConfig(Strict):
 class HeadingSpeedConfig(Navigated):
     """The boat's heading + speed autopilot (note 001-1.10)."""
 
+    field_units: ClassVar[dict[str, str]] = {"omega_ref": "rad/s", "omega": "rad/s",
+        "omega_u": "rad/s"}
+
     type: Literal["heading-speed"]
     Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
+    #: bandwidth of the heading reference model
     omega_ref: Positive = 1.0
+    #: closed-loop heading bandwidth (pole placement)
     omega: Positive = 1.0
+    #: closed-loop speed bandwidth
     omega_u: Positive = 1.0
+    #: feed the reference's nonlinear yaw damping N_rr·|r|·r forward
     yaw_feedforward: bool = True
 
 
@@ -286,6 +335,10 @@ class CourseControllerConfig(Navigated):
     and settings on the first-order Nomoto model identified from the plant's 20°/20° zig-zag
     (``design_model: identified`` gives that model to the other SMC variants too).
     """
+
+    field_units: ClassVar[dict[str, str]] = {"Kp": "1", "Kd": "s", "lam1": "1/s", "lam2": "1/s",
+        "eta": "unit of σ per s (σ = hᵀx̃, SI)", "eta_rudder": "rad",
+        "phi": "unit of σ (σ = hᵀx̃, SI)", "omega_n": "rad/s", "zeta": "1"}
 
     type: Literal["course"]
     variant: Literal["pd", "smc_printed", "smc_consistent", "smc_tuned", "smc_identified"]
@@ -323,6 +376,9 @@ class PathLQRConfig(Navigated):
     ``K_paper`` = [k_y, k_ψ, k_r, k_e] used as given (min / nm / rad; the print: [3.4, 3.2, 1, 0.45]).
     ``anti_windup``: conditional integration while the rudder saturates (the document has none)."""
 
+    field_units: ClassVar[dict[str, str]] = {"Q": "the document's units (min, nm, rad)", "R": "1",
+        "K_paper": "the document's units (min, nm, rad)"}
+
     type: Literal["lqr"]
     Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
     Q: tuple[NonNegative, NonNegative, NonNegative, NonNegative] | None = None
@@ -343,6 +399,8 @@ class OutputFLConfig(Navigated):
     ``lookahead_nm`` l = 0 is the literal design (``fl_paper``, unstable), 0.1 nm the sound variant;
     gains of (23) in the document's units. ``knows_disturbance``: b_r and d_y known (A13)."""
 
+    field_units: ClassVar[dict[str, str]] = {"k1_per_min2": "1/min²"}
+
     type: Literal["fl"]
     Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
     lookahead_nm: NonNegative = 0.0
@@ -359,6 +417,9 @@ class LOSFLConfig(Navigated):
     ẏ_r comes from successive positions. ``knows_disturbance: true`` is the
     document's oracle: b_r and d_y handed to the law (crab compensation −asin(d_y/u), A13) and
     κ = 0 unless set."""
+
+    field_units: ClassVar[dict[str, str]] = {"kp_per_min2": "1/min²",
+        "integral_gain_nm_min": "nm/min"}
 
     type: Literal["los-fl"]
     Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
@@ -384,6 +445,8 @@ class YawRateFSMConfig(Strict):
     2.5 s for ``si`` and ``si-consistent``, 0.1 s and 0.0625 s for ``paper``); ``Ts`` [s]: a
     sampled law (null: continuous, the document's mode)."""
 
+    field_units: ClassVar[dict[str, str]] = {"T_u": "s", "h": "s", "Ts": "s"}
+
     type: Literal["yaw-rate-fsm"]
     law: Literal[20, 21] = 21
     T_u: Positive | None = None
@@ -394,6 +457,7 @@ class YawRateFSMConfig(Strict):
 # --------------------------------------------------------------------------- guidance
 
 class ReferenceEntry(Strict):
+    field_units: ClassVar[dict[str, str]] = {"t": "s", "u": "m/s"}
     t: NonNegative
     psi_deg: HeadingDeg
     u: Positive
@@ -409,11 +473,20 @@ class ScheduleGuidanceConfig(Strict):
 class LOSConfig(Strict):
     """Lookahead LOS along waypoints ``[[north, east], ...]`` in m."""
 
+    field_units: ClassVar[dict[str, str]] = {"waypoints": "m", "lookahead": "m", "speed": "m/s",
+        "switch_radius": "m", "capture_distance": "m", "integral_gain": "m/s",
+        "adaptive_gain": "rad/m²"}
+
     type: Literal["los"]
+    #: ``[[north, east], ...]``, sailed in order
     waypoints: Annotated[list[tuple[Finite, Finite]], Field(min_length=2)]
+    #: lookahead distance Δ along the leg
     lookahead: Positive = 8.0
+    #: speed reference
     speed: Positive = 1.5
+    #: switch to the next leg within this distance of the waypoint
     switch_radius: NonNegative = 5.0
+    #: the cross-track metrics score each leg from this far along it (the turn onto it left out)
     capture_distance: NonNegative = 20.0
     #: σ of integral LOS against currents and steady side forces (0 = plain LOS)
     integral_gain: NonNegative = 0.0
@@ -429,6 +502,7 @@ class LOSConfig(Strict):
 
 
 class CourseEntry(Strict):
+    field_units: ClassVar[dict[str, str]] = {"t": "s"}
     t: NonNegative
     psi_deg: HeadingDeg
 
@@ -467,6 +541,8 @@ class PathConfig(Strict):
 class YawRateGuidanceConfig(Strict):
     """A constant yaw-rate reference ω* [rad/s] (document 004, S3/S4: 0.08, 0.008, 0.00072)."""
 
+    field_units: ClassVar[dict[str, str]] = {"omega": "rad/s"}
+
     type: Literal["yaw-rate"]
     omega: Finite = 0.08
 
@@ -474,6 +550,8 @@ class YawRateGuidanceConfig(Strict):
 class YawRateSineConfig(Strict):
     """The sine yaw-rate reference of S6, ω* = ``amplitude`` sin(8πt/t_f) with t_f = 1 500 s
     (``reading: pi``, C11) or sin(8t/t_f) (``literal``); ``amplitude`` [rad/s]."""
+
+    field_units: ClassVar[dict[str, str]] = {"amplitude": "rad/s"}
 
     type: Literal["yaw-rate-sine"]
     amplitude: Finite = 0.0072
@@ -484,6 +562,8 @@ class HeadingCaptureConfig(Strict):
     """Heading capture (17) of S7: ω* = ±``omega_c`` [rad/s] until the heading ``psi_target_rad``
     (K*, the document's 0.8 rad) is reached, then 0; ``ramp_s`` > 0 replaces the jump to 0 by a
     ramp of that length (the same area, so the same heading)."""
+
+    field_units: ClassVar[dict[str, str]] = {"omega_c": "rad/s"}
 
     type: Literal["heading-capture"]
     psi_target_rad: Finite = 0.8
@@ -496,6 +576,8 @@ class HeadingCaptureConfig(Strict):
 class ConstantForceConfig(Strict):
     """Constant body-frame force and moment [X N, Y N, N N·m] (a current: the scenario's
     ``current`` section, which combines with it)."""
+
+    field_units: ClassVar[dict[str, str]] = {"values": "N, N, N·m"}
 
     type: Literal["constant"]
     values: tuple[Finite, Finite, Finite]
@@ -514,6 +596,10 @@ class GaussianForceConfig(Strict):
       whose effect scales like √dt (``sigma_per_step: σ`` at dt₀ is ``psd: σ²·dt₀``);
     * ``stationary_std`` with ``time_constant`` [s] — a first-order Gauss–Markov process.
     """
+
+    field_units: ClassVar[dict[str, str]] = {"psd": "N²·s, N²·s, N²·m²·s",
+        "sigma_per_step": "N, N, N·m", "std": "N, N, N·m", "stationary_std": "N, N, N·m",
+        "time_constant": "s", "mean": "N, N, N·m"}
 
     type: Literal["gaussian"]
     psd: Triple | None = None
@@ -596,6 +682,8 @@ class WavesConfig(Strict):
     (RAO) estimate of :meth:`FroudeKrylovWaveLoads.linear_response`, ≈ 0.2°.
     """
 
+    field_units: ClassVar[dict[str, str]] = {"hs": "m", "t0": "s", "gamma": "1", "gains": "1"}
+
     type: Literal["waves"]
     spectrum: Literal["modified-pm", "jonswap", "pm"] = "modified-pm"
     hs: NonNegative = 0.0429
@@ -623,6 +711,9 @@ class MarinerDisturbanceConfig(Strict):
     Any other current (a field, Gauss–Markov, gridded data) is the scenario's ``current`` section
     (:class:`CurrentConfig`); with one, ``d_y_nm_min`` must be 0 and the section may be left out
     (then b_r = 0 and no waves)."""
+
+    field_units: ClassVar[dict[str, str]] = {"b_r_rad_min2": "rad/min²", "d_y_nm_min": "nm/min",
+        "wave_sigma_rad_min2": "rad/min²", "wave_period": "s", "wave_zeta": "1"}
 
     type: Literal["mariner"]
     b_r_rad_min2: Finite = 0.1
@@ -671,6 +762,12 @@ class RouteConfig(Strict):
     in h and the FIELD parameters as the route command reads them (k, ω in 1/h, Γ in nm²/h);
     ``obstacles``: polygons of [north, east] vertices in the same length unit."""
 
+    field_units: ClassVar[dict[str, str]] = {"start": "m (nm with units: nautical)",
+        "target": "m (nm with units: nautical)", "speed": "m/s (kn with units: nautical)",
+        "obstacles": "m (nm with units: nautical)", "radius": "m (nm with units: nautical)",
+        "depart": "s (h with units: nautical)", "horizon": "s (h with units: nautical)",
+        "grid": "m (nm with units: nautical)"}
+
     units: Literal["si", "nautical"] = "si"
     start: tuple[Finite, Finite]
     target: tuple[Finite, Finite]
@@ -682,6 +779,14 @@ class RouteConfig(Strict):
     depart: NonNegative = 0.0
     horizon: Positive | None = None
     grid: Positive | None = None
+
+    def unit_of(self, name: str) -> str | None:
+        """The unit of a length, speed or time field in this route's ``units``."""
+        unit = self.field_units.get(name)
+        if unit is None:
+            return None
+        si, _, nautical = unit.partition(" (")
+        return nautical.split(" with")[0] if self.units == "nautical" else si
 
 
 class SailConfig(Strict):
@@ -696,6 +801,9 @@ class SailConfig(Strict):
     it comes within ``acceptance_radius`` [m] of the target (default ``acceptance_lengths`` vessel
     lengths, Fossen's circle-of-acceptance rule R = 2 L); otherwise the run reports ``arrived:
     false``, no arrival time and its miss distance (closest approach)."""
+
+    field_units: ClassVar[dict[str, str]] = {"dt": "s", "margin": "1", "acceptance_radius": "m",
+        "acceptance_lengths": "vessel lengths", "lookahead": "m", "integral_gain": "m/s"}
 
     vessel: Literal["vectored-thrust-boat", "mariner"] = "vectored-thrust-boat"
     #: the boat's parameter preset (note 001-1.6); unused by the Mariner
@@ -725,6 +833,7 @@ class MonteCarloConfig(Strict):
     ``heading_offset_deg``; each ship gets its own wave realisation (same ``simulation.seed``,
     same batch). The divergence guard stops the whole batch at the first ship that trips it."""
 
+    #: number of ships in the batch
     runs: Annotated[int, Field(ge=1, le=100_000)] = 1000
     east_offset_nm: tuple[OffsetNm, OffsetNm] = (-1.0, 1.0)
     heading_offset_deg: tuple[OffsetDeg, OffsetDeg] = (-20.0, 20.0)
@@ -741,10 +850,12 @@ class MonteCarloConfig(Strict):
 class QualityConfig(Strict):
     """Quality index J = Σ(Δψ² + λδ²) of document 003 eq. (2)."""
 
+    field_units: ClassVar[dict[str, str]] = {"lam": "1"}
+
     lam: NonNegative = 1.0
 
 
-#: the largest sensor noise or bias (in its field's unit): its square is a finite float
+#: the largest sensor noise or bias (in its field's unit), whose square is a finite float
 MAX_SENSOR_ERROR = 1e150
 
 
@@ -752,6 +863,8 @@ class _SensorBase(Strict):
     """Common sensor settings (:mod:`shipgnc.navigation.sensors`): its own sample rate
     (a whole multiple of the control period; default every control sample), a latency in control
     samples, and intervals ``[t0, t1]`` [s] without measurements."""
+
+    field_units: ClassVar[dict[str, str]] = {"latency": "control samples", "dropouts": "s"}
 
     name: str | None = None
     rate_hz: Positive | None = None
@@ -792,6 +905,8 @@ class CompassConfig(_SensorBase):
 class GyroConfig(_SensorBase):
     """Yaw rate: white noise and a bias that walks (``bias_walk_deg_s``: per √s)."""
 
+    field_units: ClassVar[dict[str, str]] = {"bias_walk_deg_s": "deg/s per √s"}
+
     type: Literal["gyro"]
     noise_deg_s: NonNegative = 0.1
     bias_deg_s: Finite = 0.0
@@ -800,6 +915,8 @@ class GyroConfig(_SensorBase):
 
 class SpeedLogConfig(_SensorBase):
     """Speed through the water of one state (``u`` by default): white noise."""
+
+    field_units: ClassVar[dict[str, str]] = {"noise_m_s": "m/s"}
 
     type: Literal["log"]
     noise_m_s: NonNegative = 0.05
@@ -818,6 +935,11 @@ class EKFConfig(Strict):
     density [unit²/s³] of a random-walk bias on that state's derivative (e.g. a current on
     north/east, a yaw-acceleration bias on r); ``sensor_errors``: estimate the sensors' GNSS and
     gyro biases and update with delayed fixes (default), or fold them into white noise."""
+
+    field_units: ClassVar[dict[str, str]] = {"process_psd": "(SI unit of the state)²/s",
+        "P0_std": "SI unit of the state (heading rad)",
+        "x0_offset": "SI unit of the state (heading rad)",
+        "bias_states": "(SI unit of the state)²/s³", "force_psd": "N²·s, N²·s, N²·m²·s"}
 
     type: Literal["ekf"]
     process_psd: dict[str, NonNegative] = Field(default_factory=dict)
@@ -839,6 +961,8 @@ class PassiveObserverConfig(Strict):
     ω₀/10; one for all or [surge, sway, yaw]) and its damping ``zeta_lf`` (default 1), bias time
     constant ``T_b_s``, and the velocity model (``linear``, as published, or the vessel's own
     ``model``). It needs position and heading measurements."""
+
+    field_units: ClassVar[dict[str, str]] = {"zeta": "1", "zeta_notch": "1", "zeta_lf": "1"}
 
     type: Literal["passive-observer"]
     omega0_rad_s: Positive

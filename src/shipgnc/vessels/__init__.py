@@ -1,4 +1,5 @@
-"""The vessel catalogue (``shipgnc vessels``): named manoeuvring models for scenarios and trials.
+"""The vessel catalogue (``shipgnc vessels``): named manoeuvring models for scenarios and trials,
+e.g.::
 
     from shipgnc.vessels import get_vessel, VESSELS, VesselEntry
     model = get_vessel("mariner-cst").build(speed_mps=7.7175)
