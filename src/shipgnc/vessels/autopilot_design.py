@@ -170,6 +170,20 @@ class AutopilotDesign:
     Ki: float
     check: LoopCheck
 
+    def heading_loop(self) -> control.TransferFunction:
+        """ψ/ψ_d of the linearised loop: the derivative acts on r, not on the error (as
+        :class:`~shipgnc.vessels.autopilot.HeadingAutopilot`), ψ/ψ_d = K_P P/(1 + (K_P + K_D s)P),
+        P = (r/δ)/s · 1/(1 + s/ω_δ) (K_I left out)."""
+        s = control.tf("s")
+        P = self.model.r_over_delta / s / (1 + s / self.model.omega_delta)
+        return control.feedback(self.Kp * P, 1 + (self.Kd / self.Kp) * s)
+
+    def settling_time(self, threshold: float = 0.02) -> float:
+        """Time [s] for the linearised loop's heading-step response to stay within ``threshold``
+        of the step (python-control's ``step_info``); no saturation, no rate limit."""
+        return float(control.step_info(self.heading_loop(),
+                                       SettlingTimeThreshold=threshold)["SettlingTime"])
+
     def lines(self) -> list[str]:
         m = self.model
         kind = "course-stable" if m.course_stable else "course-UNSTABLE"
@@ -182,7 +196,8 @@ class AutopilotDesign:
             f"bandwidth ω_b = {self.bandwidth:.4g} rad/s, ζ = {self.zeta:g}, ω_n = "
             f"{self.omega_n:.4g} rad/s",
             f"gains: Kp = {self.Kp:.4g} rad/rad, Kd = {self.Kd:.4g} s, Ki = {self.Ki:.4g} 1/s",
-            f"check: {self.check.describe()}",
+            f"check: {self.check.describe()}; a heading step settles within 2 % in "
+            f"{self.settling_time():.3g} s (linearised, no rudder saturation or rate limit)",
         ]
 
 
