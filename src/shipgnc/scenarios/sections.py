@@ -318,8 +318,8 @@ class CourseControllerConfig(Navigated):
         for name in ("Kp", "Kd", "design_model", "lam1", "lam2", "eta", "eta_rudder", "phi",
                      "omega_n", "zeta"):
             if getattr(self, name) is not None and name not in allowed:
-                raise ValueError(f"{name} does not apply to variant {self.variant!r}; "
-                                 f"its settings: {', '.join(allowed)}")
+                where = "design: auto (gains designed)" if self.design else f"variant {self.variant!r}"
+                raise ValueError(f"{name} does not apply to {where}; its settings: {', '.join(allowed)}")
         return self
 
     def gains(self) -> dict:

@@ -9,11 +9,12 @@ rudder does not reach, e.g. a decoupled surge). The first-order Nomoto model use
 
 keeps r/δ's **dominant pole** p (the rightmost one; T = −1/p, negative for a course-unstable
 ship) and its **high-frequency gain** b = lim s·r/δ (the rudder's yaw acceleration per radian).
-Nomoto's low-frequency reduction T = T₁ + T₂ − T₃ (:func:`shipgnc.models.nomoto_reduction.
-first_order_reduction`) is printed beside it: it is the textbook design model, but it matches r/δ
-at s → 0, not near the crossover; for a small beamy hull (L 12 m, B 4 m, T 1.2 m, C_b 0.5,
-5.14 m/s) it gives b 4 × too small (0.36 against 1.41 1/s²) and Fossen's rule on it lands at a
-crossover 5 × the chosen bandwidth with a phase margin of 10–20°.
+Nomoto's low-frequency reduction T = T₁ + T₂ − T₃
+(:func:`~shipgnc.models.nomoto_reduction.first_order_reduction`) is printed beside it: it is the
+textbook design model, but it matches r/δ at s → 0, not near the crossover; for a small beamy
+hull (L 12 m, B 4 m, T 1.2 m, C_b 0.5, 5.14 m/s) it gives b 4 × too small (0.36 against
+1.41 1/s²), and Fossen's rule on it (with a 20°/s rudder, T_δ = 0.2 s) lands at crossovers
+3–6 × the chosen bandwidth, with phase margins of 3–28° over the allowed bandwidths.
 
 **Steering machine.** The catalogue's servo (:mod:`shipgnc.vessels.base`) is a first-order lag T_δ
 with a rate limit δ̇_max. A sinusoid of amplitude δ_a is followed without rate limiting up to
@@ -22,7 +23,7 @@ rudder, IMO MSC.137(76)) is therefore taken as ω_δ = min(1/T_δ, δ̇_max/δ_a
 checked with the servo as the lag 1/(1 + s/ω_δ).
 
 **Rule** (Fossen 2021, *Handbook of Marine Craft Hydrodynamics and Motion Control*, 2nd ed.,
-§15.3.4, PID pole placement on the Nomoto model): choose the closed-loop bandwidth ω_b with
+§15.3, PID pole placement on the Nomoto model): choose the closed-loop bandwidth ω_b with
 1/|T| < ω_b < ω_δ (above the ship's own yaw dynamics, below the steering machine's); the
 natural frequency follows from ω_b = ω_n √(1 − 2ζ² + √(4ζ⁴ − 4ζ² + 2)) and
 
@@ -58,7 +59,7 @@ DEFAULT_ZETA = 0.8
 
 
 def _bandwidth_factor(zeta: float) -> float:
-    """ω_b/ω_n of the second-order closed loop (Fossen 2021 §15.3.4)."""
+    """ω_b/ω_n of the second-order closed loop (Fossen 2021 §15.3)."""
     return math.sqrt(1 - 2 * zeta**2 + math.sqrt(4 * zeta**4 - 4 * zeta**2 + 2))
 
 
