@@ -151,7 +151,7 @@ fig.tight_layout()
 # ``shipgnc design autopilot`` and a scenario's ``controller: {type: course, design: auto}``):
 # the vessel is linearised at its speed and reduced to ψ/δ = K/(s(1 + Ts)) keeping the dominant
 # pole and the rudder's yaw acceleration; Fossen's pole placement (Handbook 2021, §15.3) gives
-# K_P = Tω_n²/K, K_D = (2ζω_nT − 1)/K, K_I = ω_n K_P/10, for a bandwidth between 1/|T| (the
+# K_P = Tω_n²/K, K_D = (2ζω_nT − 1)/K, K_I = ω_n K_P/10, for a bandwidth between :math:`1/|T|` (the
 # ship's own yaw dynamics) and the steering machine's (its time constant, and its rate limit over
 # 10° of rudder). The loop is then checked on the full linearised model with the steering machine
 # as a lag: its closed-loop poles and margins.
