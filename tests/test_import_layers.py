@@ -33,7 +33,7 @@ LAYERS = [
     ("sim", ("sim",)),
     ("analysis", ("analysis", "identify", "trials", "vessels", "routing")),
     ("studies", ("scenarios", "cases", "study", "rl")),
-    ("front", ("viz", "cli", "cli_identify", "cli_route", "cli_sweep", "cli_trials", "cli_vessels",
+    ("front", ("viz", "cli", "cli_identify", "cli_route", "cli_sweep", "cli_trials", "cli_vessels", "cli_design",
                "__main__", "trials.figures", "identify.report", "routing.figures", "study.summary",
                "scenarios.write")),
 ]

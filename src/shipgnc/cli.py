@@ -182,6 +182,9 @@ def run_command(
                                keep_interrupted=keep_partial)
         if observer is not None:
             observer.finish()  # draw the last samples (a LOS run may end before t_end)
+        controller_notes = run.result.attrs.get("controller_notes") if run.result is not None else None
+        if controller_notes:  # before a divergence error: the note may say why
+            stderr.print(f"note: {controller_notes}", soft_wrap=True)
         diverged = run.result is not None and bool(run.result.attrs.get("diverged"))
         if diverged and not keep_partial:  # a comparison keeps going: its outputs are not written
             stderr.print(f"[bold red]error:[/] {_one_line(divergence_message(run))}; --keep-partial "
@@ -327,6 +330,10 @@ app.command("trial")(_trial)
 from shipgnc.cli_vessels import vessels as _vessels  # noqa: E402  (the vessel catalogue)
 
 app.command("vessels")(_vessels)
+
+from shipgnc.cli_design import app as _design  # noqa: E402  (controllers designed for a vessel)
+
+app.add_typer(_design, name="design")
 
 
 def main() -> None:

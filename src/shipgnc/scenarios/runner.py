@@ -19,7 +19,7 @@ from shipgnc.actuators import Actuator
 from shipgnc.control.heading_speed import HeadingSpeedAutopilot
 from shipgnc.control.open_loop import OpenLoopSchedule
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
-from shipgnc.errors import ConfigError, Interrupted
+from shipgnc.errors import ConfigError, DivergenceError, Interrupted
 from shipgnc.guidance.los import LOSGuidance
 from shipgnc.guidance.schedule import ReferenceSchedule
 from shipgnc.models.fossen3dof import VectoredThrustBoat
@@ -154,6 +154,9 @@ def course_controller(cfg, model, scenario: Scenario):
     from shipgnc.cases import cybership as document
     from shipgnc.control import course
 
+    if cfg.design is not None:
+        raise ConfigError("controller.design = 'auto': designs a catalogue vessel's heading "
+                          "autopilot (shipgnc vessels); give CyberShip II's gains or variant")
     params, propeller_rps = model.params, scenario.vessel.propeller_rps
     gains = cfg.gains()
     common = {"Ts": cfg.Ts, "propeller_rps": propeller_rps}
@@ -500,19 +503,27 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                                   scored=scenario.metrics is not None)
         check_run_memory(setup.model, setup.x0, sim.t_end, sim.dt, every,
                          scored=scenario.metrics is not None)  # before the run, not a MemoryError
-        with interruptible(keep_interrupted) as run:
-            run.result = simulate(
-                setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
-                actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
-                navigation=setup.navigation,
-                u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
-                atol=sim.atol, seed=seed, observer=observer, progress=progress,
-                log_every=every, backend="numpy" if observer is not None else sim.backend,
-                on_divergence="stop" if compare else on_divergence,
-                attrs={"scenario": scenario.name, "controller": name, "seed": seed,
-                       **_vessel_attrs(setup.model, scenario)})
+        try:
+            with interruptible(keep_interrupted) as run:
+                run.result = simulate(
+                    setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
+                    actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
+                    navigation=setup.navigation,
+                    u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
+                    atol=sim.atol, seed=seed, observer=observer, progress=progress,
+                    log_every=every, backend="numpy" if observer is not None else sim.backend,
+                    on_divergence="stop" if compare else on_divergence,
+                    attrs={"scenario": scenario.name, "controller": name, "seed": seed,
+                           **_vessel_attrs(setup.model, scenario)})
+        except DivergenceError as exc:  # a controller's note (e.g. poor margins) may say why
+            if not getattr(setup.controller, "notes", None):
+                raise
+            raise DivergenceError(f"{exc}; note: {'; '.join(setup.controller.notes)}", time=exc.time,
+                                  state=exc.state, value=exc.value, index=exc.index) from None
         if setup.navigation is not None and run.result is not None:
             run.result.attrs["navigation_notes"] = "; ".join(setup.navigation.notes())
+        if getattr(setup.controller, "notes", None) and run.result is not None:
+            run.result.attrs["controller_notes"] = "; ".join(setup.controller.notes)
         all_metrics[name] = run.metrics(lambda r, s=setup: compute_metrics(scenario, r, s))
         results[name], setups[name] = thin(run.result, sim.log_every // every), setup
         if run.interrupted:

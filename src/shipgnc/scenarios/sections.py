@@ -341,7 +341,12 @@ class CourseControllerConfig(Navigated):
         "phi": "unit of σ (σ = hᵀx̃, SI)", "omega_n": "rad/s", "zeta": "1"}
 
     type: Literal["course"]
-    variant: Literal["pd", "smc_printed", "smc_consistent", "smc_tuned", "smc_identified"]
+    variant: Literal["pd", "smc_printed", "smc_consistent", "smc_tuned", "smc_identified"] = "pd"
+    #: ``auto``: a catalogue vessel's PD gains designed from its linearised yaw response
+    #: (:mod:`shipgnc.vessels.autopilot_design`) to ``bandwidth`` [rad/s] (default: the rule's)
+    #: and damping ``zeta``
+    design: Literal["auto"] | None = None
+    bandwidth: Positive | None = None
     Ts: Positive | None = None  # sampling period [s]; None: the simulation's dt
     Kp: Positive | None = None
     Kd: NonNegative | None = None
@@ -357,16 +362,23 @@ class CourseControllerConfig(Navigated):
     @model_validator(mode="after")
     def _gains_fit_the_variant(self) -> CourseControllerConfig:
         allowed = COURSE_GAINS[self.variant]
+        if self.design == "auto":
+            if self.variant != "pd":
+                raise ValueError(f"design: auto designs the pd autopilot, not variant {self.variant!r}")
+            allowed = ("bandwidth", "zeta")
+        elif self.bandwidth is not None:
+            raise ValueError("bandwidth applies to design: auto only")
         for name in ("Kp", "Kd", "design_model", "lam1", "lam2", "eta", "eta_rudder", "phi",
                      "omega_n", "zeta"):
             if getattr(self, name) is not None and name not in allowed:
-                raise ValueError(f"{name} does not apply to variant {self.variant!r}; "
-                                 f"its settings: {', '.join(allowed)}")
+                where = "design: auto (gains designed)" if self.design else f"variant {self.variant!r}"
+                raise ValueError(f"{name} does not apply to {where}; its settings: {', '.join(allowed)}")
         return self
 
     def gains(self) -> dict:
         """The settings given (the rest keep the controller's defaults)."""
-        return {k: v for k, v in self.model_dump(exclude={"type", "variant", "Ts", "sees"}).items()
+        return {k: v for k, v in self.model_dump(exclude={"type", "variant", "Ts", "sees", "design",
+                                                          "bandwidth"}).items()
                 if v is not None}
 
 

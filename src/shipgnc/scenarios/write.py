@@ -137,6 +137,7 @@ def controller_title(cfg) -> str:
     numbers = ", ".join(f"{k} = {v:g}" for k, v in data.items()
                         if isinstance(v, (int, float)) and not isinstance(v, bool))
     law = f"{cfg.type} autopilot" + (f" {cfg.variant}" if getattr(cfg, "variant", None) else "")
+    law += " (designed for the vessel)" if getattr(cfg, "design", None) else ""
     return f"{law}: {numbers}" if numbers else law
 
 
