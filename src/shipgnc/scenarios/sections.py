@@ -338,11 +338,12 @@ class CourseControllerConfig(Navigated):
 
     field_units: ClassVar[dict[str, str]] = {"Kp": "1", "Kd": "s", "lam1": "1/s", "lam2": "1/s",
         "eta": "unit of σ per s (σ = hᵀx̃, SI)", "eta_rudder": "rad",
-        "phi": "unit of σ (σ = hᵀx̃, SI)", "omega_n": "rad/s", "zeta": "1"}
+        "phi": "unit of σ (σ = hᵀx̃, SI)", "omega_n": "rad/s", "zeta": "1",
+        "bandwidth": "rad/s"}
 
     type: Literal["course"]
     variant: Literal["pd", "smc_printed", "smc_consistent", "smc_tuned", "smc_identified"] = "pd"
-    #: ``auto``: a catalogue vessel's PD gains designed from its linearised yaw response
+    #: with ``auto``, a catalogue vessel's PD gains are designed from its linearised yaw response
     #: (:mod:`shipgnc.vessels.autopilot_design`) to ``bandwidth`` [rad/s] (default: the rule's)
     #: and damping ``zeta``
     design: Literal["auto"] | None = None
