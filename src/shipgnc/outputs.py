@@ -229,7 +229,8 @@ def _host() -> str:
     return hashlib.sha1(socket.gethostname().encode()).hexdigest()[:8]
 
 
-def _alive(pid: int) -> bool:
+def process_alive(pid: int) -> bool:
+    """A process of this number runs on this machine (ours or, unsignalable, another user's)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -252,7 +253,7 @@ def remove_stale(parent: Path, name: str) -> list[Path]:
     for path in candidates:
         match = _OWNED.fullmatch(path.name)
         if (match is None or match["out"] != name or match["host"] != host
-                or int(match["pid"]) == os.getpid() or _alive(int(match["pid"]))):
+                or int(match["pid"]) == os.getpid() or process_alive(int(match["pid"]))):
             continue
         shutil.rmtree(path, ignore_errors=True)
         removed.append(path)

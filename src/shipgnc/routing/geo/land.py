@@ -2,7 +2,8 @@
 
 * :func:`coastline` — the default land: GSHHG (Wessel & Smith 1996, *J. Geophys. Res.* 101(B4),
   8741–8743), full resolution, as shipped inside the ``roaring-landmask`` wheel (no download at run time);
-  clipped to the route's box and cached per process.
+  clipped to the route's box and cached per process; its WKB is made once in a child process and
+  kept in the cache folder (:func:`_gshhg_wkb`).
 * :func:`load_land` — the user's own polygons: GeoJSON (RFC 7946, [lon, lat]) or an ESRI shapefile
   (read with ``pyshp`` when installed).
 * :func:`region_polygons` — the region of a grid where a value is below a level (NaN counts as below):
@@ -12,12 +13,17 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
+from shipgnc import interrupts
 from shipgnc.errors import ConfigError
+from shipgnc.outputs import process_alive
 
 #: memory the GSHHG polygons hold once loaded (measured: 558 MiB of resident memory for its 180 496
 #: polygons, 9.46·10⁶ points, from roaring-landmask's WKB), rounded up
@@ -41,8 +47,44 @@ def _gshhg():
         raise ConfigError("the default coastline needs the optional package roaring-landmask (≈ 100 MB): "
                           "pip install 'shipgnc[geo]'; or give your own polygons with --land FILE, or "
                           "--land none for open sea") from None
-    geoms = shapely.get_parts(shapely.from_wkb(rl.Shapes.wkb(rl.LandmaskProvider.Gshhg)))
+    geoms = shapely.get_parts(shapely.from_wkb(_gshhg_wkb(rl)))
     return geoms, shapely.STRtree(geoms)
+
+
+#: the child process that writes GSHHG's WKB to the file named by its argument
+_WRITE_WKB = ("import sys, roaring_landmask as rl; "
+              "open(sys.argv[1], 'wb').write(rl.Shapes.wkb(rl.LandmaskProvider.Gshhg))")
+
+
+def _gshhg_wkb(rl) -> bytes:
+    """GSHHG's polygons as WKB (≈ 150 MB). roaring-landmask makes them in one call into compiled
+    code that holds the interpreter for 1–3 s, during which a Ctrl-C cannot be answered; so the
+    first route makes them in a child process (the parent waits with Ctrl-C live, the child dies
+    with the process group's Ctrl-C) and keeps them in ``<cache>/coastline/`` keyed by the
+    package's version; later routes read the file. Where the cache cannot be written, in process."""
+    from importlib.metadata import version
+
+    from shipgnc.sim.compose import cache_dir
+
+    path = cache_dir().parent / "coastline" / f"gshhg-{version('roaring-landmask')}.wkb"
+    if path.is_file():
+        return path.read_bytes()
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    interrupts.on_hard_exit(id(tmp), lambda: tmp.unlink(missing_ok=True))
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        for stale in path.parent.glob(f"{path.name}.*.tmp"):  # of a process that no longer runs
+            pid = stale.name.split(".")[-2]
+            if not (pid.isdigit() and process_alive(int(pid))):
+                stale.unlink(missing_ok=True)
+        subprocess.run([sys.executable, "-c", _WRITE_WKB, str(tmp)], check=True, capture_output=True)
+        os.replace(tmp, path)
+        return path.read_bytes()
+    except (OSError, subprocess.CalledProcessError):
+        return rl.Shapes.wkb(rl.LandmaskProvider.Gshhg)
+    finally:
+        tmp.unlink(missing_ok=True)
+        interrupts.on_hard_exit(id(tmp), None)
 
 
 def coastline(lon0, lat0, lon1, lat1) -> list:
