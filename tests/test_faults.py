@@ -352,3 +352,29 @@ def test_a_long_thinned_one_ship_run_is_not_told_to_use_fewer_ships():
         run_scenario("boat-autopilot", overrides=["simulation.t_end=4e6", "simulation.log_every=1000"])
     message = str(info.value)
     assert "fewer ships" not in message and "simulation.t_end" in message and "fits" in message
+
+
+def test_figures_out_of_memory_is_one_line_and_the_results_are_written(tmp_path, monkeypatch):
+    """A MemoryError while drawing the figures (after result.nc and metrics.json are written): the
+    results are kept in --out, one ``error:`` line says the figures could not be drawn and the results
+    were written, exit 2; never "internal error"."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+    from shipgnc.viz import background, figures
+
+    def out_of_memory(job):
+        raise MemoryError("Unable to allocate 244. MiB for an array with shape (2, 16000001)")
+
+    monkeypatch.setattr(figures, "render_figures", out_of_memory)  # drawn here, not in a worker
+    monkeypatch.setattr(background.FigureProcess, "submit",
+                        lambda self, fn, *args: background._Pending(None, fn, args))
+    out = tmp_path / "r"
+    r = CliRunner().invoke(app, ["run", "boat-autopilot", "--set", "simulation.t_end=5", "--out", str(out),
+                                 "--json"])
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert r.exit_code == 2, r.output
+    assert len(lines) == 1 and lines[0].startswith("error: the figures could not be drawn"), lines
+    assert "results were written" in lines[0] and "internal error" not in r.stderr
+    assert (out / "result.nc").is_file() and not list(out.glob("*.png"))
+    assert json.loads((out / "metrics.json").read_text()) == json.loads(r.stdout)
