@@ -204,10 +204,14 @@ def run_command(
             stderr.print(f"note: {notes}", soft_wrap=True)
         if no_figures is not None:
             raise no_figures
+        from shipgnc.interrupts import held, say_once
+
+        if held() and not run.interrupted:  # Ctrl-C after the run finished (--keep-partial): kept whole
+            say_once(f"interrupted after the run finished: its complete result was written "
+                     f"({', '.join(p.name for p in written)} to {out_dir})")
+            raise typer.Exit(130)
         stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
         if run.interrupted:
-            from shipgnc.interrupts import say_once
-
             say_once(run.interrupted)
             raise typer.Exit(130)
         if observer is not None and not observer.closed:
