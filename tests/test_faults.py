@@ -352,3 +352,60 @@ def test_a_long_thinned_one_ship_run_is_not_told_to_use_fewer_ships():
         run_scenario("boat-autopilot", overrides=["simulation.t_end=4e6", "simulation.log_every=1000"])
     message = str(info.value)
     assert "fewer ships" not in message and "simulation.t_end" in message and "fits" in message
+
+
+def test_figures_out_of_memory_is_one_line_and_the_results_are_written(tmp_path, monkeypatch):
+    """A MemoryError while drawing the figures (after result.nc and metrics.json are written): the
+    results are kept in --out, one ``error:`` line says the figures could not be drawn and the results
+    were written, exit 2; never "internal error"."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+    from shipgnc.viz import background, figures
+
+    def out_of_memory(job):
+        raise MemoryError("Unable to allocate 244. MiB for an array with shape (2, 16000001)")
+
+    monkeypatch.setattr(figures, "render_figures", out_of_memory)  # drawn here, not in a worker
+    monkeypatch.setattr(background.FigureProcess, "submit",
+                        lambda self, fn, *args: background._Pending(None, fn, args))
+    out = tmp_path / "r"
+    r = CliRunner().invoke(app, ["run", "boat-autopilot", "--set", "simulation.t_end=5", "--out", str(out),
+                                 "--json"])
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert r.exit_code == 2, r.output
+    assert len(lines) == 1 and lines[0].startswith("error: the figures could not be drawn"), lines
+    assert "results were written" in lines[0] and "internal error" not in r.stderr
+    assert (out / "result.nc").is_file() and not list(out.glob("*.png"))
+    assert json.loads((out / "metrics.json").read_text()) == json.loads(r.stdout)
+
+
+def test_keep_partial_keeps_a_run_whose_ctrl_c_came_after_it_finished(tmp_path, monkeypatch):
+    """--keep-partial and a Ctrl-C after the simulation finished (while it is scored): the simulation
+    ran to t_end first, then the Ctrl-C came, and the complete result is written (status complete,
+    the log to t_end), one line says so, exit 130."""
+    from typer.testing import CliRunner
+
+    import shipgnc.scenarios.runner as runner_mod
+    from shipgnc.cli import app
+    from shipgnc.sim.result import load
+
+    events, score = [], runner_mod.compute_metrics
+
+    def ctrl_c_while_scoring(scenario, result, setup):
+        events.append(("scored", float(result["time"].values[-1])))
+        os.kill(os.getpid(), signal.SIGINT)  # the handler runs here, before the next line
+        events.append("after Ctrl-C")
+        return score(scenario, result, setup)
+
+    monkeypatch.setattr(runner_mod, "compute_metrics", ctrl_c_while_scoring)
+    out = tmp_path / "r"
+    r = CliRunner().invoke(app, ["run", "boat-autopilot", "--set", "simulation.t_end=20", "--no-figures",
+                                 "--keep-partial", "--out", str(out)])
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert r.exit_code == 130, r.output
+    assert events == [("scored", 20.0), "after Ctrl-C"]  # the run had finished when the Ctrl-C came
+    assert len(lines) == 1 and "complete result was written" in lines[0], lines
+    assert json.loads((out / ".shipgnc-run").read_text())["status"] == "complete"
+    assert float(load(out / "result.nc")["time"].values[-1]) == 20.0
+    assert "interrupted" not in json.loads((out / "metrics.json").read_text())

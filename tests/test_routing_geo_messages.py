@@ -123,6 +123,20 @@ def test_the_method_asked_for_is_the_method_run_or_refused(tmp_path):
     assert re.search(r"--method pmp: .*meets land.*graph", one_line(r))
 
 
+def test_graph_on_open_sea_says_the_extremal_it_polished_answered():
+    """--method graph with no land: the graph route seeds an extremal (JSON ``method`` pmp); a note says
+    the graph asked for was polished, as --method levelset's does. In still water the time is the
+    WGS84 geodesic over the speed (closed form)."""
+    r = invoke("--start", "50,-4", "--target", "50,-3", "--speed", "6", "--field", "uniform:north=0,east=0",
+               "--land", "none", "--method", "graph", "--json")
+    assert r.exit_code == 0, r.output
+    js = json.loads(r.stdout)
+    assert js["method"] == "pmp"
+    assert any(re.match(r"method graph: polished from the graph route", n) for n in js["notes"]), js["notes"]
+    dist = GEOD.inv(-4, 50, -3, 50)[2]
+    assert js["time_s"] == pytest.approx(dist / 6, rel=1e-6)
+
+
 @pytest.mark.parametrize("flag", ["--draft", "--ukc"])
 def test_draft_or_ukc_without_depth_is_refused(flag):
     r = invoke(*WEST_OF_IRELAND, "--speed", "5", "--field", "still", "--land", "none", flag, "5")

@@ -257,3 +257,47 @@ def test_bad_arguments_name_the_field(open_loop):
 def test_import_shipgnc_does_not_import_matplotlib():
     code = "import sys, shipgnc; sys.exit('matplotlib' in sys.modules)"
     assert subprocess.run([sys.executable, "-c", code], check=False).returncode == 0
+
+
+def _long_turn(n):
+    """A steady turn (ψ = r·t wrapped to (−π, π], closed form) with one spike in u and in T."""
+    t = np.linspace(0.0, 1000.0, n)
+    psi_true = 0.05 * t
+    data = {"time": t, "north": np.cos(psi_true), "east": np.sin(psi_true),
+            "psi": np.angle(np.exp(1j * psi_true)), "u": np.ones(n), "v": np.zeros(n),
+            "r": np.full(n, 0.05), "T": np.sin(t), "alpha": np.cos(3 * t)}
+    data["u"][n // 3 + 7] = 9.0  # a one-sample spike must stay drawn
+    data["T"][2 * n // 3 + 1] = -5.0
+    return data
+
+
+def test_a_long_series_is_drawn_from_its_envelope_at_the_figures_resolution():
+    """decimate_series keeps at most a bounded number of samples, the first and last, every variable's
+    minimum and maximum (the one-sample spikes), and the turn's heading unwrapped as ψ = r·t."""
+    from shipgnc.viz.series import FIGURE_BUCKETS, decimate_series
+
+    n = 400_001
+    data = _long_turn(n)
+    thin = decimate_series(data)
+    kept = thin["time"].size
+    assert kept <= 2 * FIGURE_BUCKETS * (len(data) - 1) + FIGURE_BUCKETS + 2 and kept < n // 10
+    assert thin["time"][0] == data["time"][0] and thin["time"][-1] == data["time"][-1]
+    for key in ("north", "east", "u", "T", "alpha"):
+        assert thin[key].min() == data[key].min() and thin[key].max() == data[key].max(), key
+    psi_deg = style.unwrap_deg(thin["psi"])
+    np.testing.assert_allclose(psi_deg, np.degrees(0.05 * thin["time"]), atol=1e-6)
+    short = {k: v[:1000] for k, v in data.items()}
+    assert decimate_series(short)["time"].size == 1000
+
+
+def test_the_dashboard_draws_a_long_run_from_its_envelope():
+    """The dashboard's time lines carry the decimated series (not the whole log): the u line reaches the
+    spike, and holds far fewer points than the log."""
+    data = _long_turn(400_001)
+    fig = dashboard(data)
+    try:
+        lines = [ln for ax in fig.axes for ln in ax.get_lines() if len(ln.get_xdata()) > 2]
+        assert lines and max(len(ln.get_xdata()) for ln in lines) < 100_000
+        assert max(float(np.nanmax(ln.get_ydata())) for ln in lines) >= 9.0
+    finally:
+        plt.close(fig)

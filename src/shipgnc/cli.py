@@ -158,7 +158,7 @@ def run_command(
             stack.enter_context(keeping())
         from shipgnc.scenarios.registry import load_scenario
         from shipgnc.scenarios.runner import divergence_message, metrics_json, run_scenario
-        from shipgnc.scenarios.write import write_outputs
+        from shipgnc.scenarios.write import FiguresNotDrawn, write_outputs
 
         if realtime is not None and not (realtime > 0 and realtime < float("inf")):
             raise ConfigError(f"--realtime = {realtime}: must be a number > 0 (1.0 = real time)")
@@ -190,8 +190,11 @@ def run_command(
             stderr.print(f"[bold red]error:[/] {_one_line(divergence_message(run))}; --keep-partial "
                          "writes the partial result", soft_wrap=True)
             raise typer.Exit(3)
-        written = write_outputs(run, out_dir, figures=figures, figure_process=figure_process,
-                                overwrite=overwrite)
+        try:
+            written, no_figures = write_outputs(run, out_dir, figures=figures, figure_process=figure_process,
+                                                overwrite=overwrite), None
+        except FiguresNotDrawn as exc:  # the results are written: their metrics, then the one error line
+            written, no_figures = exc.written, exc
         if json_:
             sys.stdout.write(metrics_json(run.metrics) + "\n")
         else:
@@ -199,10 +202,16 @@ def run_command(
         notes = run.result.attrs.get("navigation_notes") if run.result is not None else None
         if notes:
             stderr.print(f"note: {notes}", soft_wrap=True)
+        if no_figures is not None:
+            raise no_figures
+        from shipgnc.interrupts import held, say_once
+
+        if held() and not run.interrupted:  # Ctrl-C after the run finished (--keep-partial): kept whole
+            say_once(f"interrupted after the run finished: its complete result was written "
+                     f"({', '.join(p.name for p in written)} to {out_dir})")
+            raise typer.Exit(130)
         stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
         if run.interrupted:
-            from shipgnc.interrupts import say_once
-
             say_once(run.interrupted)
             raise typer.Exit(130)
         if observer is not None and not observer.closed:

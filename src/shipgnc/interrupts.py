@@ -37,10 +37,38 @@ _latched = False
 _previous_hook = sys.__unraisablehook__
 
 
+_holding = False  # a complete result is being kept (hold()): the first Ctrl-C is held, not raised
+_held = False
+
+
 def _handler(signum, frame) -> None:
     global _latched
     _latched = True
-    raise KeyboardInterrupt
+    if not held_now():
+        raise KeyboardInterrupt
+
+
+def held_now() -> bool:
+    """A Ctrl-C arrives (or was deferred): True when it is held (:func:`hold`), so not to be raised."""
+    global _held
+    if _holding and not _held:
+        _held = True
+        return True
+    return False
+
+
+def hold(on: bool = True) -> None:
+    """From now until the command ends (or ``hold(False)``: the next run starts), a first Ctrl-C is
+    held (latched, :func:`held` says so) instead of raised: a run kept with --keep-partial has
+    finished, and its complete result is written before the command ends as interrupted; a second
+    Ctrl-C still raises."""
+    global _holding
+    _holding = on
+
+
+def held() -> bool:
+    """Whether a Ctrl-C was held since :func:`hold`."""
+    return _held
 
 
 def _unraisable(info) -> None:
@@ -78,12 +106,13 @@ def latched() -> bool:
 def latching() -> Iterator[None]:
     """Ctrl-C latched inside the block, the previous handler restored after it; a block that ends
     normally after a Ctrl-C that something swallowed raises KeyboardInterrupt."""
-    global _latched, _said_flag, _noted
+    global _latched, _said_flag, _noted, _holding, _held
     previous = signal.getsignal(signal.SIGINT) if _main_thread() else None
     hook = sys.unraisablehook
     install()
     if previous is not _handler:  # a command of its own: its one line is still to be said
         _said_flag = False
+        _holding = _held = False
         note("interrupted")
     caught = False
     try:
@@ -97,7 +126,7 @@ def latching() -> Iterator[None]:
         if previous is not None and previous is not _handler:  # this block installed the latch
             signal.signal(signal.SIGINT, previous)
             sys.unraisablehook = hook
-            _latched = False  # a later command, or library call, starts clear
+            _latched = _holding = _held = False  # a later command, or library call, starts clear
     if caught:
         raise KeyboardInterrupt
 

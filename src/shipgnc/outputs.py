@@ -45,7 +45,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from shipgnc.errors import ConfigError, ShipGNCError
-from shipgnc.interrupts import latched, on_hard_exit
+from shipgnc.interrupts import held, held_now, latched, on_hard_exit
 
 #: the marker file written with every run's outputs
 MARKER = ".shipgnc-run"
@@ -203,7 +203,7 @@ def atomic_dir(out: Path, *, overwrite: bool = False, command: str = "run", stat
     on_hard_exit(id(tmp), lambda: shutil.rmtree(tmp, ignore_errors=True))  # Ctrl-C's deadline
     try:
         yield tmp
-        if status == "complete" and latched():  # a Ctrl-C a callback swallowed: not complete
+        if status == "complete" and latched() and not held():  # a Ctrl-C a callback swallowed
             raise KeyboardInterrupt
         marker = {"tool": "shipgnc", "version": _version(), "command": command, "status": status,
                   "files": sorted(p.name for p in tmp.iterdir())}
@@ -338,7 +338,7 @@ def _sigint_deferred():
         yield
     finally:
         signal.signal(signal.SIGINT, previous)
-    if caught:
+    if caught and not held_now():  # held: a complete result kept (--keep-partial) is not undone
         raise KeyboardInterrupt
 
 

@@ -22,6 +22,7 @@ from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNo
 from shipgnc.errors import ConfigError, DivergenceError, Interrupted
 from shipgnc.guidance.los import LOSGuidance
 from shipgnc.guidance.schedule import ReferenceSchedule
+from shipgnc.interrupts import held, hold
 from shipgnc.models.fossen3dof import VectoredThrustBoat
 from shipgnc.paths import WaypointPath
 from shipgnc.scenarios import components as C
@@ -496,13 +497,20 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                                             on_divergence=on_divergence,
                                             keep_interrupted=keep_interrupted)
     results, all_metrics, setups = {}, {}, {}
+    run = _Interruptible()
     for name in scenario.variants:
+        if keep_interrupted and held():  # Ctrl-C after the last run finished: keep those done, no more
+            run.interrupted = True
+            run.message = (f"interrupted after {len(results)} of {len(scenario.variants)} runs "
+                           "(each complete)")
+            break
         setup = build(scenario, name, seed=seed)
         # the metrics see every step: an unthinned record, thinned to log_every once scored
         every = scoring_log_every(setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every,
                                   scored=scenario.metrics is not None)
         check_run_memory(setup.model, setup.x0, sim.t_end, sim.dt, every,
                          scored=scenario.metrics is not None)  # before the run, not a MemoryError
+        hold(False)  # a Ctrl-C during the simulation cuts it short (kept as partial, or raised)
         try:
             with interruptible(keep_interrupted) as run:
                 run.result = simulate(
@@ -515,6 +523,8 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                     on_divergence="stop" if compare else on_divergence,
                     attrs={"scenario": scenario.name, "controller": name, "seed": seed,
                            **_vessel_attrs(setup.model, scenario)})
+                if keep_interrupted:  # finished: a Ctrl-C from now on keeps the complete result
+                    hold()
         except DivergenceError as exc:  # a controller's note (e.g. poor margins) may say why
             if not getattr(setup.controller, "notes", None):
                 raise

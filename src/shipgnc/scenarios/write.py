@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from shipgnc.errors import ShipGNCError
 from shipgnc.models.fossen3dof import VectoredThrustBoat
 from shipgnc.scenarios.routing import sail_label, sail_summary
 from shipgnc.scenarios.runner import ScenarioRun, comparison_table, metrics_json, run_status, write_table
@@ -28,12 +29,28 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
     from shipgnc.outputs import atomic_dir, moved
 
     out = Path(out_dir)
+    failed = []
     with atomic_dir(out, overwrite=overwrite, command="run", status=run_status(run)) as tmp:
-        written = _write_files(run, tmp, figures=figures, figure_process=figure_process)
-    return moved(written, tmp, out)
+        written = _write_files(run, tmp, figures=figures, figure_process=figure_process, failed=failed)
+    written = moved(written, tmp, out)
+    if failed:  # the results are in place; only the figures are missing
+        raise FiguresNotDrawn(f"the figures could not be drawn (out of memory: {failed[0]}); the results "
+                              f"were written: {', '.join(p.name for p in written)} to {out} (--no-figures "
+                              "skips the figures)", written=written)
+    return written
 
 
-def _write_files(run: ScenarioRun, out: Path, *, figures: bool, figure_process) -> list[Path]:
+class FiguresNotDrawn(ShipGNCError):
+    """The run's results were written but its figures ran out of memory (``written``: the paths)."""
+
+    def __init__(self, message: str, *, written: list[Path]):
+        super().__init__(message)
+        self.written = written
+
+
+def _write_files(run: ScenarioRun, out: Path, *, figures: bool, figure_process, failed=None) -> list[Path]:
+    """The files of :func:`write_outputs` in ``out``; a MemoryError while drawing the figures leaves them
+    out and is appended to ``failed`` (a list) when one is given."""
     from shipgnc.sim.result import save
     from shipgnc.viz.figures import render_figures
 
@@ -58,10 +75,15 @@ def _write_files(run: ScenarioRun, out: Path, *, figures: bool, figure_process) 
         if pending is not None:
             pending.cancel()
         raise
-    if pending is not None:
-        written.extend(pending.result())
-    elif figures:
-        written.extend(render_figures(job))
+    try:
+        if pending is not None:
+            written.extend(pending.result())
+        elif figures:
+            written.extend(render_figures(job))
+    except MemoryError as exc:
+        if failed is None:
+            raise
+        failed.append(" ".join(str(exc).split()) or "MemoryError")
     return written
 
 

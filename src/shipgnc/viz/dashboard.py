@@ -27,6 +27,7 @@ from shipgnc.viz.series import (  # noqa: F401  (re-exported)
     INPUT_KEYS,
     REFERENCE_KEYS,
     STATE_KEYS,
+    decimate_series,
     result_series,
     select_ship,
 )
@@ -387,7 +388,7 @@ def dashboard(result, *, title: str = "", waypoints=None, limits: Mapping | None
             layout.add_boat(data["north"][i], data["east"][i], data["psi"][i],
                             data["T"][i] if "T" in data else 0.0,
                             data["alpha"][i] if "alpha" in data else 0.0)
-        layout.update(data)
+        layout.update(decimate_series(data))  # a long run: its envelope at the figure's resolution
         layout.legends()
     except Exception:
         close_figure(fig)

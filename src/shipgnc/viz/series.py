@@ -61,3 +61,48 @@ def result_series(ds) -> dict[str, np.ndarray]:
     if out["time"].size == 0:
         raise ConfigError("result: no samples (empty time axis)")
     return out
+
+
+#: buckets of a long series drawn on a figure: about its width in pixels (a figure of 6–12 in at 100–150 dpi)
+FIGURE_BUCKETS = 1500
+
+
+def decimate_series(data: Mapping[str, np.ndarray], buckets: int = FIGURE_BUCKETS) -> dict[str, np.ndarray]:
+    """A series dict (:func:`result_series`) thinned for drawing: no more than a pixel column's worth of
+    samples per bucket of the time axis, keeping in each bucket its first and last sample and, for every
+    variable, the samples of its minimum and maximum (min/max decimation: the drawn envelope is the full
+    series' envelope, as a line of all the samples would draw it at that width: the M4 aggregation of
+    Jugel et al., PVLDB 7(10), 2014, with buckets of equal sample count).
+    Series of at most ``4 * buckets`` samples are returned as they are. Each bucket's argmin/argmax is
+    taken on a view of the arrays (no copy of a long log); a bucket with a NaN keeps the NaN's sample
+    (a gap stays a gap). ``psi`` is unwrapped first (a turn between kept samples must not fold)."""
+    t = np.asarray(data["time"])
+    n = t.size
+    if n <= 4 * buckets:
+        return dict(data)
+    size = -(-n // buckets)  # samples per bucket
+    whole = (n // size) * size
+    keep = [np.arange(0, n, size), np.arange(size - 1, whole, size), np.array([n - 1])]
+    out = {k: v for k, v in data.items()}
+    if "psi" in out:  # np.unwrap over the finite samples, as style.unwrap_deg does
+        psi = np.asarray(out["psi"], dtype=float)
+        ok = np.isfinite(psi)
+        if ok.any() and not ok.all():
+            psi = psi.copy()
+            psi[ok] = np.unwrap(psi[ok])
+        elif ok.all():
+            psi = np.unwrap(psi)
+        out["psi"] = psi
+    for key, values in out.items():
+        values = np.asarray(values)
+        if key == "time" or values.shape != t.shape:
+            continue
+        blocks = values[:whole].reshape(-1, size)
+        base = np.arange(0, whole, size)
+        keep += [base + np.argmin(blocks, axis=1), base + np.argmax(blocks, axis=1)]
+        tail = values[whole:]
+        if tail.size:
+            keep += [np.array([whole + np.argmin(tail), whole + np.argmax(tail)])]
+    idx = np.unique(np.concatenate(keep))
+    return {k: (np.asarray(v)[idx] if np.shape(v) == t.shape else v) for k, v in out.items()}
+
