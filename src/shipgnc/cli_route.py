@@ -214,8 +214,8 @@ def _check_memory(need, limit: float | None) -> None:
     """A ConfigError (exit 2, one line) when the estimate ``need``
     (:class:`~shipgnc.routing.memory.RouteMemory`) exceeds ``limit`` bytes (default: the memory
     available now, as ``shipgnc sweep`` measures it)."""
+    from shipgnc.memory import available_memory
     from shipgnc.routing.memory import format_bytes
-    from shipgnc.study.execute import available_memory
 
     have = available_memory() if limit is None else limit
     if need.total <= have:

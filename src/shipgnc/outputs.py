@@ -45,7 +45,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from shipgnc.errors import ConfigError, ShipGNCError
-from shipgnc.interrupts import held, held_now, latched, on_hard_exit
+from shipgnc.interrupts import held, held_now, keeping, latched, on_hard_exit
 
 #: the marker file written with every run's outputs
 MARKER = ".shipgnc-run"
@@ -208,7 +208,7 @@ def atomic_dir(out: Path, *, overwrite: bool = False, command: str = "run", stat
         marker = {"tool": "shipgnc", "version": _version(), "command": command, "status": status,
                   "files": sorted(p.name for p in tmp.iterdir())}
         (tmp / MARKER).write_text(json.dumps(marker, indent=2) + "\n", encoding="utf-8")
-        with _sigint_deferred():
+        with keeping(), _sigint_deferred():  # the swap is never cut in half by Ctrl-C's deadline
             _replace(tmp, out.resolve())
     except OSError as exc:
         shutil.rmtree(tmp, ignore_errors=True)

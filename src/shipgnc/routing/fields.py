@@ -32,6 +32,7 @@ import numpy as np
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.kernels import JIT_OPTIONS, NotCompiled, flat, kernel_function
+from shipgnc.units import KNOT
 
 __all__ = [
     "AffineCurrent",
@@ -553,8 +554,7 @@ VELOCITY_UNITS = {"m/s": 1.0, "m s-1": 1.0, "m s^-1": 1.0, "m s**-1": 1.0, "m.s-
                   "metres/second": 1.0, "meters per second": 1.0, "ms-1": 1.0, "m/sec": 1.0,
                   "cm/s": 0.01, "cm s-1": 0.01, "cm s^-1": 0.01, "cm s**-1": 0.01, "cm.s-1": 0.01,
                   "centimeter/second": 0.01, "centimeters/second": 0.01, "centimeter second-1": 0.01,
-                  "kn": 1852.0 / 3600.0, "knot": 1852.0 / 3600.0, "knots": 1852.0 / 3600.0,
-                  "kt": 1852.0 / 3600.0, "kts": 1852.0 / 3600.0}
+                  "kn": KNOT, "knot": KNOT, "knots": KNOT, "kt": KNOT, "kts": KNOT}
 
 
 def velocity_factor(units, where: str) -> float:

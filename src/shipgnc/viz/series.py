@@ -7,6 +7,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from shipgnc.errors import ConfigError
+from shipgnc.viz.style import unwrap_rad
 
 STATE_KEYS = ("north", "east", "psi", "u", "v", "r")
 INPUT_KEYS = ("T_cmd", "alpha_cmd", "T", "alpha")
@@ -83,16 +84,9 @@ def decimate_series(data: Mapping[str, np.ndarray], buckets: int = FIGURE_BUCKET
     size = -(-n // buckets)  # samples per bucket
     whole = (n // size) * size
     keep = [np.arange(0, n, size), np.arange(size - 1, whole, size), np.array([n - 1])]
-    out = {k: v for k, v in data.items()}
-    if "psi" in out:  # np.unwrap over the finite samples, as style.unwrap_deg does
-        psi = np.asarray(out["psi"], dtype=float)
-        ok = np.isfinite(psi)
-        if ok.any() and not ok.all():
-            psi = psi.copy()
-            psi[ok] = np.unwrap(psi[ok])
-        elif ok.all():
-            psi = np.unwrap(psi)
-        out["psi"] = psi
+    out = dict(data)
+    if "psi" in out:  # continuous, so that a turn between kept samples does not fold
+        out["psi"] = unwrap_rad(out["psi"])
     for key, values in out.items():
         values = np.asarray(values)
         if key == "time" or values.shape != t.shape:

@@ -79,14 +79,20 @@ def to_deg(angle):
     return np.degrees(angle)
 
 
-def unwrap_deg(angle):
-    """Continuous angle [deg] from angles [rad] that may jump by 2π (NaNs are kept in place)."""
+def unwrap_rad(angle):
+    """Continuous angle [rad] from angles [rad] that may jump by 2π (non-finite samples become NaN,
+    in place)."""
     angle = np.asarray(angle, dtype=float)
     out = np.full_like(angle, np.nan)
     ok = np.isfinite(angle)
     if ok.any():
         out[ok] = np.unwrap(angle[ok])
-    return np.degrees(out)
+    return out
+
+
+def unwrap_deg(angle):
+    """Continuous angle [deg] from angles [rad] that may jump by 2π (NaNs are kept in place)."""
+    return np.degrees(unwrap_rad(angle))
 
 
 def align_deg(angle, to):

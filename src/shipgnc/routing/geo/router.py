@@ -485,10 +485,11 @@ class GeoProblem:
             return "levelset"
         return "sea graph"
 
-    def sea_spacing(self) -> float:
-        """The coarse pass's raster spacing g₁ [m]: the box's larger side / 800, at least ``--grid``."""
+    def sea_spacing(self, grid=...) -> float:
+        """The coarse pass's raster spacing g₁ [m]: the box's larger side / 800, at least ``grid``
+        (default: ``--grid``)."""
         (n0, n1), (e0, e1) = self.box
-        return max(max(n1 - n0, e1 - e0) / 800.0, self._grid or 0.0)
+        return max(max(n1 - n0, e1 - e0) / 800.0, (self._grid if grid is ... else grid) or 0.0)
 
     def fine_spacing(self, corridor_area=None) -> float:
         """The fine pass's raster spacing g₂ [m]: ``--grid`` when given, else g₁/4 and no finer than
@@ -572,8 +573,7 @@ class GeoProblem:
         longer than A→B."""
         from shipgnc.routing.geo import seagraph
 
-        (n0, n1), (e0, e1) = self.box
-        g1 = max(max(n1 - n0, e1 - e0) / 800.0, grid or 0.0)
+        g1 = self.sea_spacing(grid)
         g2 = float(grid) if grid is not None else self.fine_spacing()
         cells = seagraph.raster_cells(self.box, g1)
         sea = self.sea_fraction()
