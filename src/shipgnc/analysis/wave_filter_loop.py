@@ -36,16 +36,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-
-def _jacobian(f, z0: np.ndarray, h: float = 1e-6) -> np.ndarray:
-    z0 = np.asarray(z0, dtype=float)
-    cols = []
-    for j in range(z0.size):
-        zp, zm = z0.copy(), z0.copy()
-        zp[j] += h
-        zm[j] -= h
-        cols.append((f(zp) - f(zm)) / (2 * h))
-    return np.stack(cols, axis=-1)
+from shipgnc.control.finite_state import numerical_jacobian
 
 
 def linearised_vessel(model, u_cruise: float, propeller_rps: float):
@@ -53,10 +44,10 @@ def linearised_vessel(model, u_cruise: float, propeller_rps: float):
     δ = 0, for the rudder input (the second input, propellers held at ``propeller_rps``)."""
     x0 = np.array([0.0, 0.0, 0.0, u_cruise, 0.0, 0.0])
     u0 = np.array([propeller_rps, 0.0])
-    A = _jacobian(lambda x: model.derivatives(x, u0, None), x0)
-    B = _jacobian(lambda d: model.derivatives(x0, np.array([propeller_rps, d[0]]), None),
-                  np.zeros(1))
-    return A, B
+    A = numerical_jacobian(lambda x: model.derivatives(x, u0, None), x0)
+    B = numerical_jacobian(
+        lambda u: model.derivatives(np.broadcast_to(x0, u.shape[:-1] + x0.shape), u, None), u0)
+    return A, B[:, 1:]
 
 
 def linearised_observer(obs, A: np.ndarray, B: np.ndarray, u_cruise: float):
