@@ -523,16 +523,7 @@ def _grad_at(res: LevelSetResult, k, x):
     if k not in res._grads:
         res._grads[k] = np.gradient(res.snapshots[k].astype(float), h)
     gn, ge = res._grads[k]
-    i = np.clip(np.searchsorted(res.north, x[0]) - 1, 0, res.north.size - 2)
-    j = np.clip(np.searchsorted(res.east, x[1]) - 1, 0, res.east.size - 2)
-    a = np.clip((x[0] - res.north[i]) / h, 0, 1)
-    b = np.clip((x[1] - res.east[j]) / h, 0, 1)
-
-    def bil(g):
-        return ((1 - a) * (1 - b) * g[i, j] + (1 - a) * b * g[i, j + 1] + a * (1 - b) * g[i + 1, j]
-                + a * b * g[i + 1, j + 1])
-
-    return np.array([bil(gn), bil(ge)])
+    return np.array([_bilinear(gn, res.north, res.east, x), _bilinear(ge, res.north, res.east, x)])
 
 
 def _recover(field, speed, start, target, res: LevelSetResult, t0, t_init, ends) -> LevelSetRoute:
