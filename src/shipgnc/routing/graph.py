@@ -78,11 +78,53 @@ def _crab(field, speed, t0, p0, p1):
     return time, np.mod(np.arctan2(heading_vec[..., 1], heading_vec[..., 0]), TWO_PI)
 
 
+def lattice_graph(field, speed, north, east, free, directions, t0=0.0, segment_blocked=None):
+    """The Dijkstra graph over the ``free`` nodes (north × east mask) of a grid: one edge per stencil
+    vector between two free nodes, weighted by its crab-sailing time (module docstring), kept when the
+    edge can be held and ``segment_blocked(p0, p1)`` (optional, (m, 2) end points → bool (m,)) is false.
+    Returns (csr_matrix over the free nodes numbered in grid order, ids: grid → node or −1, fi, fj: the
+    grid indices of each node)."""
+    from scipy.sparse import csr_matrix
+
+    nn_, ne_ = north.size, east.size
+    ids = np.full(free.shape, -1, np.int64)
+    ids[free] = np.arange(int(free.sum()))
+    fi, fj = np.nonzero(free)
+    src_all, dst_all, w_all = [], [], []
+    for a, b in stencil(directions):
+        i2, j2 = fi + a, fj + b
+        ok = (i2 >= 0) & (i2 < nn_) & (j2 >= 0) & (j2 < ne_)
+        i1, j1, i2, j2 = fi[ok], fj[ok], i2[ok], j2[ok]
+        ok = free[i2, j2]
+        i1, j1, i2, j2 = i1[ok], j1[ok], i2[ok], j2[ok]
+        p0 = np.stack([north[i1], east[j1]], axis=-1)
+        p1 = np.stack([north[i2], east[j2]], axis=-1)
+        w, _ = _crab(field, speed, t0, p0, p1)
+        keep = np.isfinite(w)
+        if segment_blocked is not None:
+            idx = np.flatnonzero(keep)
+            if idx.size:
+                keep[idx[segment_blocked(p0[idx], p1[idx])]] = False
+        src_all.append(ids[i1[keep], j1[keep]])
+        dst_all.append(ids[i2[keep], j2[keep]])
+        w_all.append(w[keep])
+    n_free = fi.size
+    src, dst, w = np.concatenate(src_all), np.concatenate(dst_all), np.concatenate(w_all)
+    return csr_matrix((w, (src, dst)), shape=(n_free, n_free)), ids, fi, fj
+
+
+def walk_back(pred, a_node: int, b_node: int) -> np.ndarray:
+    """The nodes of Dijkstra's shortest path from ``a_node`` to ``b_node`` (its predecessor array)."""
+    nodes = [b_node]
+    while nodes[-1] != a_node:
+        nodes.append(int(pred[nodes[-1]]))
+    return np.array(nodes[::-1])
+
+
 def graph_route(field, speed, start, target, domain, spacing, *, directions=80, t0=0.0,
                 obstacles=None, radius=0.0) -> GraphRoute:
     """Dijkstra from the node nearest ``start`` to ``target`` (a node) on a grid of ``spacing`` [m]; with
     ``radius`` > 0 [m] to the nearest-in-time node of the disc |x − B| ≤ radius (B's node included)."""
-    from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import dijkstra
 
     start, target = np.asarray(start, float), np.asarray(target, float)
@@ -103,51 +145,34 @@ def graph_route(field, speed, start, target, domain, spacing, *, directions=80, 
         north, east = north[(north >= b0) & (north <= b1)], east[(east >= c0) & (east <= c1)]
     nn_, ne_ = north.size, east.size
     require_grid(nn_ * ne_ * directions <= 30_000_000, spacing, "too many graph edges; coarsen the grid")
-    ii, jj = np.meshgrid(np.arange(nn_), np.arange(ne_), indexing="ij")
-    src_all, dst_all, w_all = [], [], []
-    blocked = None
+    free = np.ones((nn_, ne_), bool)
+    segment_blocked = None
     if obstacles:
-        from shipgnc.routing.obstacles import inside_any
+        from shipgnc.routing.obstacles import inside_any, segments_hit
 
-        blocked = inside_any(obstacles, *np.meshgrid(north, east, indexing="ij"))
-    for a, b in stencil(directions):
-        i2, j2 = ii + a, jj + b
-        ok = (i2 >= 0) & (i2 < nn_) & (j2 >= 0) & (j2 < ne_)
-        i1, j1, i2, j2 = ii[ok], jj[ok], i2[ok], j2[ok]
-        p0 = np.stack([north[i1], east[j1]], axis=-1)
-        p1 = np.stack([north[i2], east[j2]], axis=-1)
-        w, _ = _crab(field, speed, t0, p0, p1)
-        keep = np.isfinite(w)
-        if obstacles:
-            from shipgnc.routing.obstacles import segments_hit
+        free = ~inside_any(obstacles, *np.meshgrid(north, east, indexing="ij"))
 
-            keep &= ~(blocked[i1, j1] | blocked[i2, j2])
-            idx = np.flatnonzero(keep)
-            if idx.size:
-                keep[idx[segments_hit(obstacles, p0[idx], p1[idx])]] = False
-        src_all.append(i1[keep] * ne_ + j1[keep])
-        dst_all.append(i2[keep] * ne_ + j2[keep])
-        w_all.append(w[keep])
-    src, dst, w = np.concatenate(src_all), np.concatenate(dst_all), np.concatenate(w_all)
-    graph = csr_matrix((w, (src, dst)), shape=(nn_ * ne_, nn_ * ne_))
+        def segment_blocked(p0, p1):
+            return segments_hit(obstacles, p0, p1)
+
+    graph, ids, fi, fj = lattice_graph(field, speed, north, east, free, directions, t0, segment_blocked)
     i_a = int(np.argmin(np.abs(north - start[0])))
     j_a = int(np.argmin(np.abs(east - start[1])))
     i_b = int(np.argmin(np.abs(north - target[0])))
     j_b = int(np.argmin(np.abs(east - target[1])))
-    a_node, b_node = i_a * ne_ + j_a, i_b * ne_ + j_b
+    a_node, b_node = int(ids[i_a, j_a]), int(ids[i_b, j_b])
+    if a_node < 0:  # the start's node is inside an obstacle
+        return GraphRoute(None, float(spacing), directions, t0=t0)
     dist, pred = dijkstra(graph, indices=a_node, return_predecessors=True)
     if radius > 0:  # the disc's node reached first
         nn_g, ee_g = np.meshgrid(north, east, indexing="ij")
-        disc = np.flatnonzero((np.hypot(nn_g - target[0], ee_g - target[1]) <= radius).ravel())
-        disc = np.union1d(disc, [b_node])
-        b_node = int(disc[np.argmin(dist[disc])])
-    if not np.isfinite(dist[b_node]):
+        disc = ids[np.hypot(nn_g - target[0], ee_g - target[1]) <= radius]
+        disc = np.union1d(disc[disc >= 0], np.array([b_node] if b_node >= 0 else [], np.int64))
+        b_node = int(disc[np.argmin(dist[disc])]) if disc.size else -1
+    if b_node < 0 or not np.isfinite(dist[b_node]):
         return GraphRoute(None, float(spacing), directions, t0=t0)
-    nodes = [b_node]
-    while nodes[-1] != a_node:
-        nodes.append(int(pred[nodes[-1]]))
-    nodes = nodes[::-1]
-    xy = np.stack([north[np.array(nodes) // ne_], east[np.array(nodes) % ne_]], axis=-1)
+    nodes = walk_back(pred, a_node, b_node)
+    xy = np.stack([north[fi[nodes]], east[fj[nodes]]], axis=-1)
     # join A to its nearest node by a crab course
     lead = 0.0
     if np.hypot(*(xy[0] - start)) > 1e-9:

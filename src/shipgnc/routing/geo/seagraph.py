@@ -222,37 +222,15 @@ def sea_route(field, speed, start, target, north, east, blocked, *, piece=None, 
     free cells of ``blocked`` (north × east): a :class:`SeaRoute` whose ``route`` is None when the target
     is not connected to the start over the free cells (or no edge can be held against the current).
     ``pull=False`` keeps the lattice path (the coarse pass of the corridor, :func:`band_mask`)."""
-    from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import dijkstra
 
-    from shipgnc.routing.graph import GraphRoute, _crab, stencil
+    from shipgnc.routing.graph import GraphRoute, _crab, lattice_graph, walk_back
 
     start, target = np.asarray(start, float), np.asarray(target, float)
     g = float(north[1] - north[0])
     piece = g if piece is None else piece
-    nn_, ne_ = north.size, east.size
-    free = ~blocked
-    ids = np.full(blocked.shape, -1, np.int64)
-    ids[free] = np.arange(int(free.sum()))
-    fi, fj = np.nonzero(free)
-    src_all, dst_all, w_all = [], [], []
-    for a, b in stencil(DIRECTIONS):
-        i2, j2 = fi + a, fj + b
-        ok = (i2 >= 0) & (i2 < nn_) & (j2 >= 0) & (j2 < ne_)
-        i1, j1, i2, j2 = fi[ok], fj[ok], i2[ok], j2[ok]
-        ok = free[i2, j2]
-        i1, j1, i2, j2 = i1[ok], j1[ok], i2[ok], j2[ok]
-        p0 = np.stack([north[i1], east[j1]], axis=-1)
-        p1 = np.stack([north[i2], east[j2]], axis=-1)
-        w, _ = _crab(field, speed, 0.0, p0, p1)
-        keep = np.isfinite(w)
-        src_all.append(ids[i1[keep], j1[keep]])
-        dst_all.append(ids[i2[keep], j2[keep]])
-        w_all.append(w[keep])
-    src, dst, w = np.concatenate(src_all), np.concatenate(dst_all), np.concatenate(w_all)
-    n_free = int(free.sum())
-    graph = csr_matrix((w, (src, dst)), shape=(n_free, n_free))
-    del src, dst, w, src_all, dst_all, w_all
+    graph, _, fi, fj = lattice_graph(field, speed, north, east, ~blocked, DIRECTIONS)
+    n_free = fi.size
 
     def nearest_free(p):
         d = np.hypot(north[fi] - p[0], east[fj] - p[1])
@@ -264,10 +242,7 @@ def sea_route(field, speed, start, target, north, east, blocked, *, piece=None, 
     edges = graph.nnz
     if not np.isfinite(dist[b_node]):
         return SeaRoute(None, None, blocked.size, n_free, edges)
-    nodes = [b_node]
-    while nodes[-1] != a_node:
-        nodes.append(int(pred[nodes[-1]]))
-    nodes = np.array(nodes[::-1])
+    nodes = walk_back(pred, a_node, b_node)
     xy = np.stack([north[fi[nodes]], east[fj[nodes]]], axis=-1)
     xy = np.vstack([start, xy, target])
     seg_t = np.array([leg_time(field, speed, xy[k], xy[k + 1], piece) for k in range(len(xy) - 1)])
