@@ -17,6 +17,7 @@ Writes ``sweep.nc`` (or ``sweep.zarr`` for a large study with the ``[dist]`` ext
 from __future__ import annotations
 
 import warnings
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Annotated
 
@@ -51,7 +52,10 @@ def sweep(
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write sweep.png.")] = True,
     keep_partial: Annotated[bool, typer.Option(
         "--keep-partial", help="If every member diverges (exit 3), still write the study "
-                               "(the marker file .shipgnc-run says 'diverged').")] = False,
+                               "(the marker file .shipgnc-run says 'diverged'); if Ctrl-C "
+                               "interrupts it (exit 130), write the chunks that finished (the "
+                               "others' members NaN, variable 'finished' 0; the marker says "
+                               "'interrupted').")] = False,
     overwrite: Annotated[bool, typer.Option(
         "--overwrite", help="Write into --out even when it holds files that are not a shipgnc run: "
                             "they are kept, only an earlier run's files are replaced (a directory "
@@ -62,8 +66,12 @@ def sweep(
 
     from shipgnc.cli import friendly_errors, stderr
 
-    with friendly_errors():
+    with friendly_errors(), ExitStack() as stack:
         from shipgnc.errors import ConfigError, ShipGNCWarning
+        from shipgnc.interrupts import keeping, say_once
+
+        if keep_partial:  # Ctrl-C waits for the finished chunks to be written (a second one not)
+            stack.enter_context(keeping())
         from shipgnc.study.spec import Perturbation, Study, parse_grid
 
         if mc < 1:
@@ -80,7 +88,7 @@ def sweep(
                             overwrite=overwrite, inputs=(Path(scenario),))  # before any work
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ShipGNCWarning)
-            run = _run_with_progress(study, workers, scheduler, chunk_size, limit)
+            run = _run_with_progress(study, workers, scheduler, chunk_size, limit, keep_partial)
         for warning in caught:
             if issubclass(warning.category, ShipGNCWarning):
                 stderr.print(f"[yellow]warning:[/] {escape(str(warning.message))}", soft_wrap=True)
@@ -99,11 +107,17 @@ def sweep(
             stderr.print(f"[yellow]warning:[/] {diverged} of {total} members diverged "
                          f"({share:.0%}); the summary leaves them out (diverged_members)",
                          soft_wrap=True)
+        status = ("interrupted" if run.interrupted else
+                  "diverged" if diverged == total else "complete")
         written = write_study(run.dataset, out_dir, figures=figures, overwrite=overwrite,
-                              status="diverged" if diverged == total else "complete")
+                              status=status)
         _print_summary(run)
-        stderr.print(f"{run.chunks} chunks on {run.workers} in {run.seconds:.1f} s; wrote "
-                     f"{', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
+        ran = "" if run.interrupted else f"{run.chunks} chunks on {run.workers} in {run.seconds:.1f} s; "
+        stderr.print(f"{ran}wrote {', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
+        if run.interrupted:
+            say_once(f"{run.interrupted}; kept {run.dataset.attrs['members_finished']} finished "
+                     "members")
+            raise typer.Exit(130)
         if diverged == total:
             raise typer.Exit(3)
 
@@ -134,7 +148,7 @@ def parse_size(text: str, option: str) -> float:
     return float(match.group(1)) * SIZE_UNITS[match.group(2)]
 
 
-def _run_with_progress(study, workers, scheduler, chunk_size, max_memory=None):
+def _run_with_progress(study, workers, scheduler, chunk_size, max_memory=None, keep=False):
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from shipgnc.cli import stderr
@@ -148,7 +162,7 @@ def _run_with_progress(study, workers, scheduler, chunk_size, max_memory=None):
             bar.update(task, completed=done, total=total)
 
         return run_study(study, workers=workers, scheduler=scheduler, chunk_size=chunk_size,
-                         on_chunk=update, max_memory=max_memory)
+                         on_chunk=update, max_memory=max_memory, keep_interrupted=keep)
 
 
 def write_study(ds, out: Path, *, figures: bool = True, overwrite: bool = False,
@@ -185,7 +199,8 @@ def _print_summary(run, max_columns: int = 8) -> None:
     cell_keys = [k for k in rows[0] if not k.endswith(suffixes) and k != "diverged_members"]
     metrics = [k.removesuffix("_median") for k in rows[0] if k.endswith("_median")]
     shown = rows[:max_columns]
-    title = f"{ds.attrs['scenario']}: median [p5, p95] over {ds.attrs['members']} members"
+    members = ds.attrs.get("members_finished", ds.attrs["members"])  # an interrupted study's: those run
+    title = f"{ds.attrs['scenario']}: median [p5, p95] over {members} members"
     if len(rows) > len(shown):
         title += f" (first {len(shown)} of {len(rows)} points; all in summary.csv)"
     columns = {}

@@ -43,6 +43,7 @@ class StudyRun:
     chunks: int
     workers: str
     seconds: float
+    interrupted: str | None = None  #: Ctrl-C's one line when the study kept its finished chunks
 
 
 def variants_of(study: Study) -> list[str] | None:
@@ -125,8 +126,12 @@ def _sigint_ignored():
 
 def run_chunks(study: Study, chunks: list[Chunk], *, client=None,
                on_chunk: Callable[[int, int], None] | None = None) -> list:
-    """The chunks' Datasets in chunk order; ``on_chunk(done, total)`` after each finished chunk."""
+    """The chunks' Datasets in chunk order; ``on_chunk(done, total)`` after each finished chunk.
+
+    Ctrl-C raises :class:`~shipgnc.errors.Interrupted` whose ``partial`` is the list of the chunks'
+    Datasets, None for each chunk that had not finished."""
     total = len(chunks)
+    results: list = [None] * total
     finished = [0]
 
     def counted(done: int, total: int) -> None:
@@ -136,19 +141,20 @@ def run_chunks(study: Study, chunks: list[Chunk], *, client=None,
 
     try:
         if client is None:
-            out = []
             for i, chunk in enumerate(chunks):
-                out.append(run_chunk(study, chunk))
+                results[i] = run_chunk(study, chunk)
                 counted(i + 1, total)
-            return out
-        return _run_on_dask(study, chunks, client, counted)
+        else:
+            _run_on_dask(study, chunks, client, counted, results)
+        return results
     except KeyboardInterrupt:  # Ctrl-C: one line, whatever was running
         message = f"interrupted after {finished[0]} of {total} chunks"
         note(message)  # said at once if closing the cluster would keep the command waiting
-        raise Interrupted(message=message) from None
+        raise Interrupted(message=message, partial=results) from None
 
 
-def _run_on_dask(study: Study, chunks: list[Chunk], client, on_chunk) -> list:
+def _run_on_dask(study: Study, chunks: list[Chunk], client, on_chunk, results: list) -> None:
+    """The chunks on the dask cluster, each Dataset stored in ``results`` (chunk order) as it ends."""
     total = len(chunks)
     from dask.distributed import as_completed
 
@@ -156,7 +162,6 @@ def _run_on_dask(study: Study, chunks: list[Chunk], client, on_chunk) -> list:
     # is returned, not raised, so it is not retried
     futures = [client.submit(chunk_task, study, chunk, pure=False, retries=1) for chunk in chunks]
     index = {f.key: i for i, f in enumerate(futures)}
-    results: list = [None] * total
     for done, future in enumerate(as_completed(futures), start=1):
         part = future.result()
         if isinstance(part, ConfigError):
@@ -165,7 +170,23 @@ def _run_on_dask(study: Study, chunks: list[Chunk], client, on_chunk) -> list:
         results[index[future.key]] = part
         if on_chunk is not None:
             on_chunk(done, total)
-    return results
+
+
+def unfinished_filled(chunks: list[Chunk], parts: list) -> list:
+    """``parts`` with each chunk that did not finish (None) replaced by its members with every
+    variable NaN, so that an interrupted study assembles like a whole one; a variable ``finished``
+    (1 for a member computed, 0 for one left out) tells them apart."""
+    template = next(part for part in parts if part is not None)
+    filled = []
+    for chunk, part in zip(chunks, parts, strict=True):
+        if part is None:
+            part = (template.isel(member=[0] * chunk.size).astype(float) * np.nan).assign_coords(
+                member=np.arange(chunk.start, chunk.stop))
+            part["finished"] = ("member", np.zeros(chunk.size))
+        else:
+            part = part.assign(finished=("member", np.ones(part.sizes["member"])))
+        filled.append(part)
+    return filled
 
 
 def chunk_task(study: Study, chunk: Chunk):
@@ -263,13 +284,15 @@ def check_memory(study: Study, variants: list[str] | None, chunk_size: int,
 def run_study(study: Study, *, workers: str = "local", scheduler: str | None = None,
               chunk_size: int = DEFAULT_CHUNK_SIZE, client=None,
               on_chunk: Callable[[int, int], None] | None = None,
-              max_memory: float | None = None) -> StudyRun:
+              max_memory: float | None = None, keep_interrupted: bool = False) -> StudyRun:
     """Run ``study`` and return its Dataset (see :func:`assemble`).
 
     ``workers``: ``"local"`` or ``"dask"`` (a new LocalCluster); ``scheduler``: an existing dask
     cluster's address (implies dask); ``client``: an existing ``dask.distributed.Client`` (tests).
     ``max_memory``: bytes the study may hold (default: the memory available); checked with
-    :func:`check_memory` before any work.
+    :func:`check_memory` before any work. ``keep_interrupted``: a Ctrl-C returns the chunks that
+    had finished (the others' members NaN, ``finished`` 0; ``attrs["interrupted"] = 1``) instead
+    of raising, when at least one had.
     """
     import time
 
@@ -282,8 +305,13 @@ def run_study(study: Study, *, workers: str = "local", scheduler: str | None = N
     owned = None
     if client is None and (workers == "dask" or scheduler is not None):
         client = owned = connect(scheduler, workers)
+    interrupted = None
     try:
         parts = run_chunks(study, chunks, client=client, on_chunk=on_chunk)
+    except Interrupted as exc:  # --keep-partial: the finished chunks, when there are any
+        if not keep_interrupted or not any(part is not None for part in exc.partial):
+            raise
+        parts, interrupted = unfinished_filled(chunks, exc.partial), str(exc)
     finally:
         if owned is not None:
             cluster = getattr(owned, "cluster", None)
@@ -291,5 +319,8 @@ def run_study(study: Study, *, workers: str = "local", scheduler: str | None = N
             if cluster is not None and scheduler is None:
                 cluster.close()
     ds = assemble(study, chunks, parts, variants)
+    if interrupted is not None:
+        ds.attrs["interrupted"] = 1
+        ds.attrs["members_finished"] = int(ds["finished"].sum())
     how = "local" if client is None else ("scheduler " + scheduler if scheduler else "dask")
-    return StudyRun(ds, len(chunks), how, time.perf_counter() - start)
+    return StudyRun(ds, len(chunks), how, time.perf_counter() - start, interrupted)

@@ -19,9 +19,10 @@ DRAWN_PREFIXES = ("param_", "initial_state_")
 
 
 def metric_names(ds) -> list[str]:
-    """The per-member summary metrics (every variable but the ``series_*`` time series; the drawn
-    ``param_*`` and ``initial_state_*`` are among them, so the summary shows their spread)."""
-    return [str(k) for k in ds.data_vars if not str(k).startswith("series_")]
+    """The per-member summary metrics (every variable but the ``series_*`` time series and an
+    interrupted study's ``finished`` flags; the drawn ``param_*`` and ``initial_state_*`` are among
+    them, so the summary shows their spread)."""
+    return [str(k) for k in ds.data_vars if not str(k).startswith("series_") and k != "finished"]
 
 
 def summary_rows(ds) -> list[dict]:
