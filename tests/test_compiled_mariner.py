@@ -2,7 +2,8 @@
 numpy reference loop.
 
 Each component's kernel equals its numpy form on single ships (the model's eq. (25), the path
-controllers' laws (13), (19)–(23) and LOS + FL, the disturbance of note 000-0.6); and every comparison of a
+frame (guidance), the path controllers' laws (13), (19)–(23) and LOS + FL, the disturbance of note
+000-0.6); and every comparison of a
 whole run goes through ``simulate(..., backend="numpy")`` and ``backend="compiled"`` on fresh
 components and requires the same variables, sample times and attributes, values equal to 1e-9
 relative (round-off of the variable's scale absolute), the same divergence errors and the
@@ -21,6 +22,7 @@ from shipgnc.environment.current import CrossCurrent
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
 from shipgnc.environment.filtered_noise import SecondOrderNoise
 from shipgnc.errors import DivergenceError
+from shipgnc.guidance.path import PathGuidance
 from shipgnc.models.mariner import DOC_B_R, DOC_D_Y, MarinerDisturbance, MarinerWitOppe, rudder
 from shipgnc.paths import WaypointPath
 from shipgnc.sim import compose, simulator
@@ -41,11 +43,11 @@ X0_SHORT = np.array([[0.0, -120.0, 0.0, U, 0.0],
 X0_DOC = np.array([[0.0, -1.5 * NM, 0.0, U, 0.0], [0.0, 0.5 * NM, 0.2, U, 0.0]])
 
 CONTROLLERS = {
-    "lqr": lambda path: PathLQR(K_SI, path, Ts=0.3, anti_windup=False),
-    "lqr_anti_windup": lambda path: PathLQR(K_SI, path, Ts=0.3, anti_windup=True),
-    "fl_paper": lambda path: fl_paper(M.params, path, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y),
-    "fl_lookahead": lambda path: fl_lookahead(M.params, path, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y),
-    "los_fl": lambda path: LOSFL(M.params, path, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y),
+    "lqr": lambda: PathLQR(K_SI, Ts=0.3, anti_windup=False),
+    "lqr_anti_windup": lambda: PathLQR(K_SI, Ts=0.3, anti_windup=True),
+    "fl_paper": lambda: fl_paper(M.params, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y),
+    "fl_lookahead": lambda: fl_lookahead(M.params, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y),
+    "los_fl": lambda: LOSFL(M.params, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y),
 }
 
 
@@ -69,7 +71,8 @@ DISTURBANCES = {
 
 
 def components(ctrl, dist, path, rate_mode="ramp"):
-    return lambda: {"controller": CONTROLLERS[ctrl](path) if ctrl else None,
+    return lambda: {"controller": CONTROLLERS[ctrl]() if ctrl else None,
+                    "guidance": PathGuidance(path) if ctrl else None,
                     "disturbance": DISTURBANCES[dist](path),
                     "actuator": rudder(M.params, rate_mode=rate_mode)}
 
@@ -101,12 +104,16 @@ def assert_same(ref, got, rtol=RTOL):
 
 
 def assert_same_end_state(numpy_parts, compiled_parts):
-    """The controller (active leg, e_I, last signal values) and the current's tracker as the numpy
-    loop leaves them."""
-    a, b = numpy_parts["controller"], compiled_parts["controller"]
+    """The path frame (active leg), the controller (e_I, last signal values) and the current's
+    tracker as the numpy loop leaves them."""
+    a, b = numpy_parts.get("guidance"), compiled_parts.get("guidance")
     if a is not None:
         np.testing.assert_array_equal(b.tracker.leg, a.tracker.leg)
         assert b.tracker.leg.dtype == a.tracker.leg.dtype
+        assert list(b.output_values()) == list(a.output_values())
+        np.testing.assert_array_equal(b.output_values()["leg"], a.output_values()["leg"])
+    a, b = numpy_parts["controller"], compiled_parts["controller"]
+    if a is not None:
         if isinstance(a, PathLQR):
             np.testing.assert_allclose(b.e_I, a.e_I, rtol=RTOL)
         assert list(b.signal_values()) == list(a.signal_values())
@@ -146,42 +153,75 @@ def test_model_kernel_equals_derivatives():
         np.testing.assert_allclose(xdot, M.derivatives(x, u, None), rtol=1e-13, atol=1e-18)
 
 
-@pytest.mark.parametrize("ctrl", [*sorted(CONTROLLERS), "fl_global", "los_global"])
-def test_controller_kernel_equals_step(ctrl):
-    """Command, logged signals and end state (leg, e_I, signal_values) of one ship at a time over
-    a run of samples that switches legs, against the batched numpy ``step``."""
-    make = {**CONTROLLERS,
-            "fl_global": lambda path: OutputFL(M.params, path, Ts=0.3, lookahead=40.0, b_r=DOC_B_R,
-                                               d_y=DOC_D_Y, current_frame="global"),
-            "los_global": lambda path: LOSFL(M.params, path, Ts=0.3, b_r=DOC_B_R, d_y=-DOC_D_Y,
-                                             current_frame="global")}[ctrl]
-    n = 40
-    reference, compiled = make(SHORT_PATH), make(SHORT_PATH)
-    reference.reset((n,))
-    compiled.reset((n,))
-    kernel = compiled.kernel((n,))
-    z = kernel.state_for(n)
+def along_the_legs(n):
+    """States of ``n`` ships sample by sample, northwards along SHORT_PATH's leg 0 then onto legs
+    1 and 2: ``(k, x)`` for 25 samples."""
     x = random_states(n, seed=3)
     x[:, :2] = np.linspace([-100.0, -50.0], [100.0, 40.0], n)
-    names = [s.name for s in reference.signals]
-    legs = set()
     for k in range(25):
-        x[:, 0] += 25.0 + 3.0 * k  # northwards along leg 0, then onto legs 1 and 2
+        x[:, 0] += 25.0 + 3.0 * k
         x[:, 1] += 4.0 * k
         x[:, 2:] += 0.01
-        expected = reference.step(0.3 * k, x, None)
-        logged = reference.signal_values()
-        legs |= set(logged["leg"].tolist())
+        yield k, x.copy()
+
+
+def test_path_guidance_kernel_equals_reference():
+    """References (y_r, ψ_r, π_p), the leg output and the end state (leg) of one ship at a time
+    against the batched numpy ``reference``, over samples that switch legs."""
+    n = 40
+    reference, compiled = PathGuidance(SHORT_PATH), PathGuidance(SHORT_PATH)
+    reference.reset((n,), M)
+    compiled.reset((n,), M)
+    kernel = compiled.kernel((n,))
+    z = kernel.state_for(n)
+    legs = set()
+    for k, x in along_the_legs(n):
+        expected = reference.reference(0.3 * k, x)
+        leg = reference.output_values()["leg"]
+        legs |= set(leg.tolist())
         for i in range(n):
-            cmd, sig = np.empty(1), np.empty(len(names))
-            kernel.function(0.3 * k, x[i], np.zeros(0), z[i], kernel.params, cmd, sig)
-            np.testing.assert_allclose(cmd, expected[i], rtol=1e-12, atol=1e-15)
-            np.testing.assert_allclose(sig, [logged[name][i] for name in names], rtol=1e-12,
-                                       atol=1e-12)
+            ref, out = np.empty(3), np.empty(1)
+            assert not kernel.function(0.3 * k, x[i], z[i], kernel.params, ref, out)
+            # y_r: the kernel's fused multiply-adds round once where numpy rounds twice
+            np.testing.assert_allclose(ref, expected[i], rtol=1e-12, atol=1e-12)
+            assert out[0] == leg[i]
     assert legs == {0.0, 1.0, 2.0}  # the ships switch legs on the way
     kernel.restore(z)
     np.testing.assert_array_equal(compiled.tracker.leg, reference.tracker.leg)
     assert compiled.tracker.leg.dtype == reference.tracker.leg.dtype
+
+
+@pytest.mark.parametrize("ctrl", [*sorted(CONTROLLERS), "fl_global", "los_global"])
+def test_controller_kernel_equals_step(ctrl):
+    """Command, logged signals and end state (e_I, signal_values) of one ship at a time over
+    a run of samples that switches legs, against the batched numpy ``step`` (both reading the
+    path frame's references)."""
+    make = {**CONTROLLERS,
+            "fl_global": lambda: OutputFL(M.params, Ts=0.3, lookahead=40.0, b_r=DOC_B_R,
+                                          d_y=DOC_D_Y, current_frame="global"),
+            "los_global": lambda: LOSFL(M.params, Ts=0.3, b_r=DOC_B_R, d_y=-DOC_D_Y,
+                                        current_frame="global")}[ctrl]
+    n = 40
+    reference, compiled = make(), make()
+    reference.reset((n,))
+    compiled.reset((n,))
+    guidance = PathGuidance(SHORT_PATH)
+    guidance.reset((n,), M)
+    kernel = compiled.kernel((n,))
+    z = kernel.state_for(n)
+    names = [s.name for s in reference.signals]
+    for k, x in along_the_legs(n):
+        ref = guidance.reference(0.3 * k, x)
+        expected = reference.step(0.3 * k, x, ref)
+        logged = reference.signal_values()
+        for i in range(n):
+            cmd, sig = np.empty(1), np.empty(len(names))
+            kernel.function(0.3 * k, x[i], ref[i], z[i], kernel.params, cmd, sig)
+            np.testing.assert_allclose(cmd, expected[i], rtol=1e-12, atol=1e-15)
+            np.testing.assert_allclose(sig, [logged[name][i] for name in names], rtol=1e-12,
+                                       atol=1e-12)
+    assert set(guidance.tracker.leg.tolist()) == {2}  # every ship reached the last leg
+    kernel.restore(z)
     if isinstance(reference, PathLQR):
         np.testing.assert_allclose(compiled.e_I, reference.e_I, rtol=1e-12)
     for name in names:
@@ -288,8 +328,9 @@ def test_sample_time_log_every_progress_and_batch_shape():
     calls = []
 
     def make():
-        return {"controller": LOSFL(M.params, SHORT_PATH, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y,
+        return {"controller": LOSFL(M.params, Ts=0.3, b_r=DOC_B_R, d_y=DOC_D_Y,
                                     current_frame="global"),
+                "guidance": PathGuidance(SHORT_PATH),
                 "disturbance": doc_disturbance(SHORT_PATH, frame="global"),
                 "actuator": rudder(M.params)}
 
@@ -305,7 +346,7 @@ def test_sample_time_log_every_progress_and_batch_shape():
 def test_rudder_lag_is_composed_too():
     """A steering machine with a first-order lag (no twin ever covered it)."""
     def make():
-        return {"controller": PathLQR(K_SI, SHORT_PATH, Ts=0.9),
+        return {"controller": PathLQR(K_SI, Ts=0.9), "guidance": PathGuidance(SHORT_PATH),
                 "disturbance": doc_disturbance(SHORT_PATH),
                 "actuator": Actuator([-0.6], [0.6], rate=[0.07], tau=[2.0], names=("delta",))}
 
@@ -366,11 +407,12 @@ DIVERGING = {  # name: (x0, components, expected signal, ship)
     "state": (far_north, components("lqr", "doc", DOC_PATH), "north", (1,)),
     # b_r = 1 rad/s² spins ship (2,): its speed loss W r² drives u past −100 m/s at t = 11.7 s
     "spin": (lambda: X0_SHORT, lambda: {
-        "controller": PathLQR(K_SI, SHORT_PATH, Ts=0.3),
+        "controller": PathLQR(K_SI, Ts=0.3), "guidance": PathGuidance(SHORT_PATH),
         "disturbance": ConstantDisturbance([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]),
         "actuator": rudder(M.params)}, "u", (2,)),
     "command": (toward_the_path, lambda: {
-        "controller": fl_paper(M.params, SHORT_PATH, Ts=0.3, k1=1e308, b_r=1e308),
+        "controller": fl_paper(M.params, Ts=0.3, k1=1e308, b_r=1e308),
+        "guidance": PathGuidance(SHORT_PATH),
         "actuator": rudder(M.params, rate_mode="hold")}, "delta", (2,)),
 }
 
@@ -407,8 +449,8 @@ def test_divergence_stop_keeps_the_same_partial_result(case):
 # ----------------------------------------------------------------------------------------------
 
 def setup_of(**kw):
-    base = dict(t_end=3.0, dt=0.3, controller=PathLQR(K_SI, DOC_PATH, Ts=0.3),
-                actuator=rudder(M.params), guidance=None, disturbance=None, u0=None,
+    base = dict(t_end=3.0, dt=0.3, controller=PathLQR(K_SI, Ts=0.3),
+                actuator=rudder(M.params), guidance=PathGuidance(DOC_PATH), disturbance=None, u0=None,
                 integrator="rk4", method="RK45", rtol=1e-3, atol=1e-6, seed=None,
                 on_divergence="raise", observer=None, progress=None, log_every=1)
     return _validate(M, X0_DOC, **{**base, **kw})
@@ -421,7 +463,8 @@ def test_unsupported_reasons():
 
     reason = compose.unsupported_reason
     assert reason(setup_of()) is None
-    assert reason(setup_of(disturbance=doc_disturbance(DOC_PATH), controller=None)) is None
+    assert reason(setup_of(disturbance=doc_disturbance(DOC_PATH), controller=None,
+                           guidance=None)) is None
     cases = {
         "current GriddedCurrent has no kernel": {
             "disturbance": MarinerDisturbance(current=gridded)},
@@ -440,7 +483,8 @@ def test_wave_noise_runs_compiled_with_the_same_sea():
 
     def make():
         made.append(MarinerDisturbance(DOC_B_R, waves=waves()))
-        return {"controller": PathLQR(K_SI, DOC_PATH, Ts=0.3), "disturbance": made[-1]}
+        return {"controller": PathLQR(K_SI, Ts=0.3), "guidance": PathGuidance(DOC_PATH),
+                "disturbance": made[-1]}
 
     x0 = np.repeat(X0_DOC[:1], 5, axis=0)
     ref = simulate(M, x0, t_end=300.0, dt=0.3, backend="numpy", seed=4, **make())

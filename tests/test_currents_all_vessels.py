@@ -24,7 +24,6 @@ from shipgnc.models.catamaran import EAST, NORTH, U, V
 from shipgnc.models.mariner import MarinerParams, MarinerWitOppe, MarinerYawDisturbance
 from shipgnc.routing.fields import SumField, UniformCurrent
 from shipgnc.scenarios import catamaran as SC
-from shipgnc.scenarios import mariner as SM
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build, run_scenario
 from shipgnc.scenarios.schema import CURRENT_VESSELS
@@ -192,7 +191,7 @@ def test_mariner_turn_drifts_by_current_times_time(backend):
     current = UniformCurrent(VN, VE)
     calm, drift = (simulate(model, x0, t_end=1800.0, dt=0.3, u0=[math.radians(10.0)],
                             disturbance=d, backend=backend)
-                   for d in (None, SM.disturbance(None, None, current=current)))
+                   for d in (None, CurrentDisturbance(current, n_force=1)))
     assert drift.attrs["backend"] == backend
     for k in ("u", "r", "psi"):
         np.testing.assert_array_equal(drift[k].values, calm[k].values, err_msg=k)

@@ -37,6 +37,8 @@ from shipgnc.control.lqr import (
 )
 from shipgnc.errors import ConfigError
 from shipgnc.frames import wrap_angle
+from shipgnc.guidance.path import PathGuidance
+from shipgnc.models.mariner import MarinerWitOppe
 from shipgnc.paths import LegTracker, WaypointPath
 from shipgnc.sim.integrators import rk4_step
 from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
@@ -65,31 +67,48 @@ D_Y = 0.04 * NM / MIN  # m/s
 A_PAPER, C_PAPER, U_PAPER = 1.084, 3.553, 0.25  # /min, /min², nm/min
 DELTA_MAX, RUDDER_RATE = deg(35.0), deg(3.8)  # rad, rad/s
 STRAIGHT = WaypointPath(np.array([[0.0, 0.0], [20.0, 0.0]]) * NM)  # along north, then a half-line
+PATH_NAMES = ("cross_track_error", "heading_error", "path_course")
 
 
-def closed_loop(ctrl, x0, *, t_end, dt, b_r=0.0, d_y=0.0, delta_max=DELTA_MAX, rate=RUDDER_RATE, p=P):
-    """Run ``ctrl`` on the local W–O plant (25): ideal servo (saturation, ramp rate limit), Ts = dt.
+def on_path(path, batch_shape) -> PathGuidance:
+    """The path frame of ``path`` (the references y_r, ψ_r, π_p the laws read), reset for a batch
+    of states [north, east, ψ, u, r]."""
+    guidance = PathGuidance(path)
+    guidance.reset(batch_shape, MarinerWitOppe)
+    return guidance
 
-    The cross current d_y acts along Y_r of the controller's active leg (A10). Returns the time
-    [s] and the logged y_r [m], ψ_r [rad], applied δ [rad] (shape (time, *batch)).
+
+def refs(path, x) -> np.ndarray:
+    """The path references of the states ``x`` on ``path`` (from leg 0)."""
+    return on_path(path, np.shape(x)[:-1]).reference(0.0, x)
+
+
+def closed_loop(ctrl, x0, *, t_end, dt, b_r=0.0, d_y=0.0, delta_max=DELTA_MAX, rate=RUDDER_RATE, p=P,
+                path=STRAIGHT):
+    """Run ``ctrl`` on the local W–O plant (25) along ``path``'s frame: ideal servo (saturation,
+    ramp rate limit), Ts = dt.
+
+    The cross current d_y acts along Y_r of the active leg (A10). Returns the time
+    [s] and the y_r [m], ψ_r [rad] the law read, applied δ [rad] (shape (time, *batch)).
     """
     x = np.array(x0, dtype=float)
     ctrl.reset(x.shape[:-1])
+    guidance = on_path(path, x.shape[:-1])
     delta = np.zeros(x.shape[:-1])
     n = round(t_end / dt)
     y_log, psi_log, d_log = [], [], []
     for k in range(n + 1):
-        command = ctrl.step(k * dt, x, np.zeros((*x.shape[:-1], 0)))
+        ref = guidance.reference(k * dt, x)
+        command = ctrl.step(k * dt, x, ref)
         assert command.shape == (*x.shape[:-1], 1)
-        logged = ctrl.signal_values()
-        y_log.append(logged["cross_track_error"])
-        psi_log.append(logged["heading_error"])
+        y_log.append(ref[..., 0])
+        psi_log.append(ref[..., 1])
         d_log.append(delta)
         if k == n:
             break
         start = delta
         end = delta + np.clip(np.clip(command[..., 0], -delta_max, delta_max) - delta, -rate * dt, rate * dt)
-        angle = ctrl.path.leg_angles[ctrl.tracker.leg]
+        angle = ref[..., 2]
         cur_n, cur_e = -np.sin(angle) * d_y, np.cos(angle) * d_y
         t0 = k * dt
 
@@ -183,11 +202,13 @@ def test_design_errors():
     with pytest.raises(ConfigError, match=r"params\.a"):
         design_lqr(object())
     with pytest.raises(ConfigError, match="K_si"):
-        PathLQR([1.0, 2.0], STRAIGHT, Ts=1.0)
+        PathLQR([1.0, 2.0], Ts=1.0)
     with pytest.raises(ConfigError, match="Ts"):
-        PathLQR(gain_to_si(PAPER_LQR_GAIN), STRAIGHT, Ts=0.0)
+        PathLQR(gain_to_si(PAPER_LQR_GAIN), Ts=0.0)
+    with pytest.raises(ConfigError, match=r"guidance=PathGuidance\(path\)"):  # the former form
+        PathLQR(gain_to_si(PAPER_LQR_GAIN), STRAIGHT, Ts=1.0)
     with pytest.raises(ConfigError, match="path"):
-        PathLQR(gain_to_si(PAPER_LQR_GAIN), [[0, 0], [1, 0]], Ts=1.0)
+        PathGuidance([[0, 0], [1, 0]])
 
 
 # ------------------------------------------------------------------------------ PathLQR plumbing
@@ -195,30 +216,35 @@ def test_design_errors():
 def test_path_lqr_law_shapes_and_reset():
     K = gain_to_si(PAPER_LQR_GAIN)
     path = WaypointPath(np.array([[0.0, 0.0], [1000.0, 1000.0], [1000.0, 3000.0]]))
-    ctrl = PathLQR(K, path, Ts=2.0, delta_max=10.0)  # wide limit: the law unclipped
-    assert ctrl.reference_names == ()
-    assert {s.name for s in ctrl.signals} >= {"cross_track_error", "heading_error", "leg"}
+    ctrl = PathLQR(K, Ts=2.0, delta_max=10.0)  # wide limit: the law unclipped
+    assert ctrl.reference_names == PATH_NAMES
+    assert [s.name for s in ctrl.signals] == ["integral_error"]
     rng = np.random.default_rng(1)
     x = np.stack([rng.uniform(0, 500, (2, 3)), rng.uniform(0, 500, (2, 3)), rng.uniform(-1, 1, (2, 3)),
                   np.full((2, 3), U), rng.uniform(-0.01, 0.01, (2, 3))], axis=-1)
     ctrl.reset((2, 3))
-    delta = ctrl.step(0.0, x, np.zeros((2, 3, 0)))
+    guidance = on_path(path, (2, 3))
+    ref = guidance.reference(0.0, x)
+    delta = ctrl.step(0.0, x, ref)
     assert delta.shape == (2, 3, 1)
     angle = math.atan2(1000.0, 1000.0)
     y_r = -x[..., 0] * math.sin(angle) + x[..., 1] * math.cos(angle)
     psi_r = wrap_angle(x[..., 2] - angle)
     np.testing.assert_allclose(delta[..., 0], -(K[0] * y_r + K[1] * psi_r + K[2] * x[..., 4]), rtol=1e-12)
-    np.testing.assert_allclose(ctrl.signal_values()["cross_track_error"], y_r)
+    np.testing.assert_allclose(ref[..., 0], y_r)
     np.testing.assert_allclose(ctrl.e_I, 2.0 * y_r)  # forward Euler: e_I += Ts·y_r
     # batched equals one ship at a time (second sample: the integrator enters)
-    batched = ctrl.step(2.0, x, None)
+    batched = ctrl.step(2.0, x, guidance.reference(2.0, x))
     for i, j in np.ndindex(2, 3):
-        single = PathLQR(K, path, Ts=2.0, delta_max=10.0)
+        single = PathLQR(K, Ts=2.0, delta_max=10.0)
         single.reset(())
-        assert single.step(0.0, x[i, j], np.zeros(0)).shape == (1,)
-        np.testing.assert_allclose(single.step(2.0, x[i, j], np.zeros(0)), batched[i, j], rtol=1e-12)
+        one = on_path(path, ())
+        assert single.step(0.0, x[i, j], one.reference(0.0, x[i, j])).shape == (1,)
+        np.testing.assert_allclose(single.step(2.0, x[i, j], one.reference(2.0, x[i, j])),
+                                   batched[i, j], rtol=1e-12)
     ctrl.reset((4,))
-    assert ctrl.e_I.shape == (4,) and np.all(ctrl.e_I == 0) and np.all(ctrl.tracker.leg == 0)
+    guidance.reset((4,), MarinerWitOppe)
+    assert ctrl.e_I.shape == (4,) and np.all(ctrl.e_I == 0) and np.all(guidance.tracker.leg == 0)
 
 
 def test_leg_switching_and_integrator_kept():
@@ -237,15 +263,17 @@ def test_leg_switching_and_integrator_kept():
     _, y_r, _ = tracker.update(np.array([0.0, 9000.0, 0.0]), east)  # last leg: a half-line
     np.testing.assert_array_equal(tracker.leg, [0, 2, 2])
 
-    ctrl = PathLQR(gain_to_si(PAPER_LQR_GAIN), path, Ts=1.0)
+    ctrl = PathLQR(gain_to_si(PAPER_LQR_GAIN), Ts=1.0)
     ctrl.reset(())
+    guidance = on_path(path, ())
     state = np.array([500.0, 20.0, 0.0, U, 0.0])
     for k in range(3):
-        ctrl.step(float(k), state, None)
+        ctrl.step(float(k), state, guidance.reference(float(k), state))
     e_before = float(ctrl.e_I)
     assert e_before == pytest.approx(60.0)
-    ctrl.step(3.0, np.array([1000.0, 12.0, 0.0, U, 0.0]), None)
-    assert int(ctrl.tracker.leg) == 2 and ctrl.signal_values()["leg"] == 2.0
+    state = np.array([1000.0, 12.0, 0.0, U, 0.0])
+    ctrl.step(3.0, state, guidance.reference(3.0, state))
+    assert int(guidance.tracker.leg) == 2 and guidance.output_values()["leg"] == 2.0
     assert ctrl.signal_values()["integral_error"] == pytest.approx(e_before)  # A7: not reset
     assert float(ctrl.e_I) == pytest.approx(e_before + 2.0)
 
@@ -254,16 +282,17 @@ def test_anti_windup_holds_the_integrator_only_when_it_deepens_saturation():
     K = gain_to_si(PAPER_LQR_GAIN)
     far = np.array([[0.0, 1.5 * NM, 0.0, U, 0.0]])  # δ = −k_y y_r ≈ −5.1 rad: saturated
     for anti_windup, expected in ((True, 0.0), (False, 1.5 * NM)):
-        ctrl = PathLQR(K, STRAIGHT, Ts=1.0, anti_windup=anti_windup)
+        ctrl = PathLQR(K, Ts=1.0, anti_windup=anti_windup)
         ctrl.reset((1,))
-        delta = ctrl.step(0.0, far, None)
+        delta = ctrl.step(0.0, far, refs(STRAIGHT, far))
         assert delta[0, 0] == pytest.approx(-deg(35.0))
         assert ctrl.e_I[0] == pytest.approx(expected)
     # saturated, but integrating y_r winds the law back: integrate
-    ctrl = PathLQR(K, STRAIGHT, Ts=1.0)
+    ctrl = PathLQR(K, Ts=1.0)
     ctrl.reset((1,))
     ctrl.e_I = np.array([-1e6])  # −k_e e_I ≈ +4 rad
-    ctrl.step(0.0, np.array([[0.0, 100.0, 0.0, U, 0.0]]), None)
+    near = np.array([[0.0, 100.0, 0.0, U, 0.0]])
+    ctrl.step(0.0, near, refs(STRAIGHT, near))
     assert ctrl.e_I[0] == pytest.approx(-1e6 + 100.0)
 
 
@@ -307,9 +336,10 @@ def test_fl_law_cancels_the_nonlinearity(lookahead):
     north = along * math.cos(angle) - y_r * math.sin(angle)
     east = along * math.sin(angle) + y_r * math.cos(angle)
     x = np.stack([north, east, psi_r + angle, u, r], axis=-1)
-    ctrl = OutputFL(P, path, Ts=1.0, lookahead=lookahead, delta_max=1e9, b_r=B_R, d_y=D_Y)
+    ctrl = OutputFL(P, Ts=1.0, lookahead=lookahead, delta_max=1e9, b_r=B_R, d_y=D_Y)
     ctrl.reset((n,))
-    delta = ctrl.step(0.0, x, None)[..., 0]
+    ref = refs(path, x)
+    delta = ctrl.step(0.0, x, ref)[..., 0]
     r_dot = -P.a * r - P.b * r**3 + P.c * delta + B_R
     h_psi, h_r = 1e-6, 1e-8
     d_psi = (ydot_plain(psi_r + h_psi, r, u, lookahead, D_Y) - ydot_plain(psi_r - h_psi, r, u, lookahead, D_Y))
@@ -319,7 +349,8 @@ def test_fl_law_cancels_the_nonlinearity(lookahead):
     nu = -(K1_PAPER / 3600) * z - (K2_PAPER / 60) * ydot_plain(psi_r, r, u, lookahead, D_Y)
     np.testing.assert_allclose(z_ddot, nu, rtol=1e-5, atol=1e-9 * np.abs(nu).max())
     np.testing.assert_allclose(ctrl.signal_values()["fl_output"], z, rtol=1e-9, atol=1e-6)
-    np.testing.assert_allclose(ctrl.signal_values()["cross_track_error"], y_r, atol=1e-6)
+    np.testing.assert_allclose(ref[..., 0], y_r, atol=1e-6)  # the path frame's y_r
+    np.testing.assert_allclose(ref[..., 1], psi_r, atol=1e-12)
 
 
 def test_los_fl_law():
@@ -329,9 +360,9 @@ def test_los_fl_law():
     y_r, psi_r = rng.uniform(-2 * NM, 2 * NM, n), rng.uniform(-1.0, 1.0, n)
     r, u = rng.uniform(-0.01, 0.01, n), rng.uniform(5.0, 8.0, n)
     x = np.stack([rng.uniform(0, NM, n), y_r, psi_r, u, r], axis=-1)  # STRAIGHT runs north
-    ctrl = LOSFL(P, STRAIGHT, Ts=1.0, delta_max=1e9, b_r=B_R, d_y=D_Y)
+    ctrl = LOSFL(P, Ts=1.0, delta_max=1e9, b_r=B_R, d_y=D_Y)
     ctrl.reset((n,))
-    delta = ctrl.step(0.0, x, None)[..., 0]
+    delta = ctrl.step(0.0, x, refs(STRAIGHT, x))[..., 0]
     y_dot = ydot_plain(psi_r, r, u, 0.0, D_Y)
     psi_d = -np.arctan(y_r / LOS_DELTA) - np.arcsin(D_Y / u)
     psi_d_dot = -(y_dot / LOS_DELTA) / (1 + (y_r / LOS_DELTA) ** 2)
@@ -343,40 +374,44 @@ def test_los_fl_law():
 
 def test_fl_controllers_shapes_clipping_and_errors():
     x = np.array([0.0, 100.0, math.pi / 2, U, 0.0])  # ψ_r = 90°: g = 0 for the literal law
-    for ctrl in (fl_paper(P, STRAIGHT, Ts=1.0), fl_lookahead(P, STRAIGHT, Ts=1.0), LOSFL(P, STRAIGHT, Ts=1.0)):
-        assert ctrl.reference_names == () and ctrl.Ts == 1.0
-        assert {"cross_track_error", "heading_error", "leg"} <= {s.name for s in ctrl.signals}
+    for ctrl in (fl_paper(P, Ts=1.0), fl_lookahead(P, Ts=1.0), LOSFL(P, Ts=1.0)):
+        assert ctrl.reference_names == PATH_NAMES and ctrl.Ts == 1.0
+        assert not {"cross_track_error", "heading_error", "leg"} & {s.name for s in ctrl.signals}
         ctrl.reset(())
-        delta = ctrl.step(0.0, x, None)
+        delta = ctrl.step(0.0, x, refs(STRAIGHT, x))
         assert delta.shape == (1,) and np.isfinite(delta).all() and abs(delta[0]) <= deg(35.0)
         batch = np.broadcast_to(x, (2, 3, 5)).copy()
         batch[..., 1] = np.linspace(-500, 500, 6).reshape(2, 3)
         ctrl.reset((2, 3))
-        out = ctrl.step(0.0, batch, None)
+        out = ctrl.step(0.0, batch, refs(STRAIGHT, batch))
         assert out.shape == (2, 3, 1)
         for i, j in np.ndindex(2, 3):
             ctrl.reset(())
-            assert ctrl.step(0.0, batch[i, j], None)[0] == pytest.approx(out[i, j, 0], rel=1e-12)
+            one = ctrl.step(0.0, batch[i, j], refs(STRAIGHT, batch[i, j]))
+            assert one[0] == pytest.approx(out[i, j, 0], rel=1e-12)
     with pytest.raises(ConfigError, match="lookahead"):
-        OutputFL(P, STRAIGHT, Ts=1.0, lookahead=-1.0)
+        OutputFL(P, Ts=1.0, lookahead=-1.0)
     with pytest.raises(ConfigError, match="pivot"):
-        OutputFL(P, STRAIGHT, Ts=1.0, lookahead=-P.r1)
+        OutputFL(P, Ts=1.0, lookahead=-P.r1)
     with pytest.raises(ConfigError, match="current_frame"):
-        LOSFL(P, STRAIGHT, Ts=1.0, current_frame="body")
+        LOSFL(P, Ts=1.0, current_frame="body")
     with pytest.raises(ConfigError, match=r"params\.a"):
-        fl_paper(object(), STRAIGHT, Ts=1.0)
+        fl_paper(object(), Ts=1.0)
+    for law in (fl_paper, fl_lookahead, LOSFL):  # the former call form: a clear error
+        with pytest.raises(ConfigError, match=r"guidance=PathGuidance\(path\)"):
+            law(P, STRAIGHT, Ts=1.0)
 
 
 def test_global_current_frame():
     """A global current along east has the cross-track component d_y cos ψ_r0 on each leg."""
     path = WaypointPath(np.array([[0.0, 0.0], [0.0, 5000.0]]))  # leg along east: no cross component
     x = np.array([[100.0, 300.0, math.pi / 2, U, 0.0]])
-    ctrl = LOSFL(P, path, Ts=1.0, d_y=D_Y, current_frame="global")
+    ctrl = LOSFL(P, Ts=1.0, d_y=D_Y, current_frame="global")
     ctrl.reset((1,))
-    ctrl.step(0.0, x, None)
-    calm = LOSFL(P, path, Ts=1.0)
+    ctrl.step(0.0, x, refs(path, x))
+    calm = LOSFL(P, Ts=1.0)
     calm.reset((1,))
-    calm.step(0.0, x, None)
+    calm.step(0.0, x, refs(path, x))
     np.testing.assert_allclose(ctrl.signal_values()["los_heading"], calm.signal_values()["los_heading"],
                                atol=1e-12)
 
@@ -385,9 +420,9 @@ def test_global_current_frame():
 
 def test_lqr_and_lookahead_fl_converge_to_a_straight_leg():
     x0 = np.array([[0.0, -1.5 * NM, 0.0, U, 0.0], [0.0, 0.8 * NM, 0.3, U, 0.0]])
-    for ctrl in (PathLQR(design_lqr(P).K_si, STRAIGHT, Ts=2.0),
-                 PathLQR(gain_to_si(PAPER_LQR_GAIN), STRAIGHT, Ts=2.0),
-                 fl_lookahead(P, STRAIGHT, Ts=2.0)):
+    for ctrl in (PathLQR(design_lqr(P).K_si, Ts=2.0),
+                 PathLQR(gain_to_si(PAPER_LQR_GAIN), Ts=2.0),
+                 fl_lookahead(P, Ts=2.0)):
         t, y, psi, _ = closed_loop(ctrl, x0, t_end=60 * MIN, dt=2.0)
         # never (beyond the few metres of the non-minimum-phase start) past the initial offsets
         assert np.all(np.abs(y).max(axis=0) < [1.51 * NM, 0.86 * NM])
@@ -398,7 +433,7 @@ def test_lqr_and_lookahead_fl_converge_to_a_straight_leg():
 
 def test_literal_fl_diverges():
     """From 1 m off the path the literal FL turns away; |y_r| passes several nm (zero dynamics)."""
-    t, y, psi, delta = closed_loop(fl_paper(P, STRAIGHT, Ts=2.0), [[0.0, 1.0, 0.0, U, 0.0]],
+    t, y, psi, delta = closed_loop(fl_paper(P, Ts=2.0), [[0.0, 1.0, 0.0, U, 0.0]],
                                    t_end=25 * MIN, dt=2.0)
     assert np.abs(y).max() > 3 * NM
     assert np.abs(psi).max() > deg(90.0)  # past the singularity g = 0
@@ -409,7 +444,7 @@ def test_literal_fl_works_with_the_sign_flipped_sway_coupling():
     """Note 000-0.5: with r₁ = +0.0375 nm/rad in plant and controller the zero dynamics are stable."""
     flipped = WO(r1=+0.0375 * NM)
     assert zero_dynamics_pole(flipped)[0] == pytest.approx(-6.6667, rel=1e-4)
-    t, y, psi, _ = closed_loop(fl_paper(flipped, STRAIGHT, Ts=2.0), [[0.0, -1.5 * NM, 0.0, U, 0.0]],
+    t, y, psi, _ = closed_loop(fl_paper(flipped, Ts=2.0), [[0.0, -1.5 * NM, 0.0, U, 0.0]],
                                t_end=40 * MIN, dt=2.0, p=flipped)
     assert np.abs(y).max() < 1.51 * NM
     assert np.abs(y[t >= 30 * MIN]).max() < 0.005 * NM and np.abs(psi[t >= 30 * MIN]).max() < deg(0.5)
@@ -417,7 +452,7 @@ def test_literal_fl_works_with_the_sign_flipped_sway_coupling():
 
 def test_lqr_steady_state_under_disturbances():
     """On a straight leg with b_r and d_y: ψ_r → −asin(d_y/U), δ → −b_r/c, y_r → 0 (note 000-0.4)."""
-    t, y, psi, delta = closed_loop(PathLQR(design_lqr(P).K_si, STRAIGHT, Ts=2.0),
+    t, y, psi, delta = closed_loop(PathLQR(design_lqr(P).K_si, Ts=2.0),
                                    [[0.0, 0.0, 0.0, U, 0.0]], t_end=120 * MIN, dt=2.0, b_r=B_R, d_y=D_Y)
     last = t >= 110 * MIN
     assert np.abs(y[last]).max() < 1.0  # m
@@ -436,7 +471,8 @@ def test_parameters_of_the_toolkit_mariner_model_fit():
     assert zero_dynamics_pole(params) == pytest.approx(zero_dynamics_pole(P), rel=1e-9)
     x = np.array([[10.0, -300.0, 0.2, U, 0.001]])
     for make in (fl_paper, fl_lookahead, LOSFL):
-        a, b = make(params, STRAIGHT, Ts=1.0, b_r=B_R, d_y=D_Y), make(P, STRAIGHT, Ts=1.0, b_r=B_R, d_y=D_Y)
+        a, b = make(params, Ts=1.0, b_r=B_R, d_y=D_Y), make(P, Ts=1.0, b_r=B_R, d_y=D_Y)
         a.reset((1,))
         b.reset((1,))
-        np.testing.assert_allclose(a.step(0.0, x, None), b.step(0.0, x, None), rtol=1e-9)
+        np.testing.assert_allclose(a.step(0.0, x, refs(STRAIGHT, x)), b.step(0.0, x, refs(STRAIGHT, x)),
+                                   rtol=1e-9)

@@ -110,6 +110,47 @@ def test_path_readings(reading, expected):
     np.testing.assert_allclose(mariner_path(s.guidance).waypoints, np.array(expected) * NM)
 
 
+@pytest.mark.parametrize(("name", "law"), [("mariner-lqr", "PathLQR"),
+                                         ("mariner-fl-lookahead", "OutputFL"),
+                                         ("mariner-los-fl", "LOSFL")])
+def test_the_registry_builds_the_mariner_like_any_vessel(name, law):
+    """No set-up hook of its own: the path frame is the ``path`` guidance's builder, each law the
+    controller entry's, the disturbance its entry's; the law holds no path and reads the path
+    frame's references by name."""
+    from shipgnc.guidance.path import PathGuidance
+    from shipgnc.scenarios.components import CONTROLLERS, DISTURBANCES, GUIDANCE, VESSEL_KINDS
+
+    assert VESSEL_KINDS["mariner"].setup is None
+    assert GUIDANCE["path"].build is not None and DISTURBANCES["mariner"].build is not None
+    assert all(CONTROLLERS[t].build is not None for t in ("lqr", "fl", "los-fl"))
+    setup = build(load_scenario(name))
+    assert type(setup.controller).__name__ == law and not hasattr(setup.controller, "path")
+    assert isinstance(setup.guidance, PathGuidance)
+    assert set(setup.controller.reference_names) <= {s.name for s in setup.guidance.references}
+
+
+def test_path_guidance_cross_track_is_the_distance_to_the_leg():
+    """At (11, 3) nm, past the end of leg 0 (north 10 nm), the active leg is leg 1 from A = (10, 0)
+    to B = (12, 4) nm (A6) and y_r is the point-to-line distance |AB × AP|/|AB| = |2·3 − 4·1|/√20 nm
+    = 0.4472 nm, positive: AP·n > 0 for the starboard normal n = (−sin π_p, cos π_p) of the leg's
+    course π_p = atan2(4, 2) (east of north)."""
+    setup = build(load_scenario("mariner-lqr"))
+    guidance, model = setup.guidance, setup.model
+    x = np.array([11.0 * NM, 3.0 * NM, math.radians(70.0), 7.7, 0.0])
+    guidance.reset((), model)
+    ref = dict(zip((s.name for s in guidance.references), guidance.reference(0.0, x), strict=True))
+    course = math.atan2(4.0, 2.0)
+    assert guidance.output_values()["leg"] == 1.0
+    assert ref["cross_track_error"] == pytest.approx(abs(2 * 3 - 4 * 1) / math.sqrt(20) * NM,
+                                                     rel=1e-12)
+    assert ref["path_course"] == pytest.approx(course, rel=1e-15)
+    assert ref["heading_error"] == pytest.approx(math.radians(70.0) - course, rel=1e-12)
+    port = x.copy()
+    port[:2] = [11.0 * NM, 1.0 * NM]  # the line's other side: AP = (1, 1), |AB × AP| = |2 − 4|
+    guidance.reset((), model)
+    assert guidance.reference(0.0, port)[0] == pytest.approx(-2 / math.sqrt(20) * NM, rel=1e-12)
+
+
 def test_every_parameter_is_settable():
     s = load_scenario("mariner-compare", [
         "simulation.dt=0.6", "simulation.t_end=1200", "simulation.seed=7",

@@ -35,6 +35,7 @@ _LAZY = {
     "HeadingSpeedAutopilot": "shipgnc.control.heading_speed",
     "OpenLoopSchedule": "shipgnc.control.open_loop",
     "LOSGuidance": "shipgnc.guidance.los",
+    "PathGuidance": "shipgnc.guidance.path",
     "ReferenceSchedule": "shipgnc.guidance.schedule",
     "WaypointPath": "shipgnc.paths",
     "load_scenario": "shipgnc.scenarios.registry",

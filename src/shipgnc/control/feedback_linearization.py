@@ -7,8 +7,8 @@ Design model (14): a Norrbin yaw equation with the path-frame kinematics, x = [y
 
 Three controllers, each with the conventions of :mod:`shipgnc.control` (``Ts``, ``signals``,
 ``reset(batch_shape)``, ``step`` → ``(..., 1)``, batched) and the path geometry of
-:class:`~shipgnc.control.lqr.PathLQR` (their own :class:`~shipgnc.paths.LegTracker`, leg
-switching A6, ``reference_names = ()``):
+:class:`~shipgnc.control.lqr.PathLQR`: they read y_r, ψ_r and the active leg's course π_p as
+references from :class:`~shipgnc.guidance.path.PathGuidance`, which switches the legs (A6):
 
 * :class:`OutputFL` with ``lookahead = 0`` — ``fl_paper``, the literal design (19)–(23) on
   y = y_r. Differentiating twice (u̇ neglected, A13)::
@@ -58,11 +58,15 @@ from shipgnc.control.lqr import (
     I_PSI,
     I_R,
     I_U,
-    PATH_SIGNALS,
+    PATH_REFERENCE_NAMES,
+    R_COURSE,
+    R_PSI,
+    R_Y,
     check_controller_args,
     nominal_speed,
     path_state,
     plant_coefficient,
+    refuse_path,
     restore_path_state,
 )
 from shipgnc.environment.current import CURRENT_FRAMES
@@ -70,16 +74,6 @@ from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
 from shipgnc.kernels import Kernel, clip, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
-from shipgnc.paths import (
-    LEG_ANGLE,
-    LEG_COS,
-    LEG_SIN,
-    LegTracker,
-    WaypointPath,
-    leg_table,
-    leg_value,
-    track_leg,
-)
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 
 #: gains of (23) printed in the document [1/min², 1/min]
@@ -127,13 +121,14 @@ def zero_dynamics_pole(params, *, lookahead: float = 0.0, U: float | None = None
 
 
 class _PathFL:
-    """Shared plumbing: plant coefficients, known disturbances, path geometry, clipping, logging."""
+    """Shared plumbing: plant coefficients, known disturbances, the path references, clipping,
+    logging."""
 
     continuous = False
-    reference_names = ()
+    reference_names = PATH_REFERENCE_NAMES
 
-    def __init__(self, params, path: WaypointPath, *, Ts: float, delta_max: float, b_r: float,
-                 d_y: float, current_frame: str):
+    def __init__(self, params, *, Ts: float, delta_max: float, b_r: float, d_y: float,
+                 current_frame: str):
         check_controller_args(Ts, delta_max)
         for name, value in (("b_r", b_r), ("d_y", d_y)):
             require(isinstance(value, (int, float, np.floating)) and np.isfinite(value),
@@ -145,8 +140,6 @@ class _PathFL:
         self.r2 = float(getattr(params, "r2", 0.0) or 0.0)
         require(self.c != 0, "controller.params.c", self.c, "the rudder must act on the yaw rate")
         self.params = params
-        self.tracker = LegTracker(path)
-        self.path = path
         self.Ts = float(Ts)
         self.delta_max = float(delta_max)
         self.b_r, self.d_y = float(b_r), float(d_y)
@@ -154,7 +147,6 @@ class _PathFL:
         self._logged: dict[str, np.ndarray] = {}
 
     def reset(self, batch_shape) -> None:
-        self.tracker.reset(batch_shape)
         self._logged = {}
 
     def signal_values(self) -> dict[str, np.ndarray]:
@@ -164,31 +156,29 @@ class _PathFL:
         """Norrbin manoeuvring characteristic H_N(r) = a r + b r³ [rad/s²] (eq. (16))."""
         return self.a * r + self.b * r**3
 
-    def kinematics(self, measurement: np.ndarray) -> dict[str, np.ndarray]:
-        """Path-frame quantities of the active leg: y_r, ψ_r, u, r, v, ẏ_r ("measured"), leg angle."""
-        x = np.asarray(measurement, dtype=float)
-        _, y_r, angle = self.tracker.update(x[..., I_NORTH], x[..., I_EAST])
-        psi_r = wrap_angle(x[..., I_PSI] - angle)
+    def kinematics(self, measurement: np.ndarray, reference: np.ndarray) -> dict[str, np.ndarray]:
+        """Path-frame quantities of the active leg: y_r, ψ_r and its course π_p (the references,
+        by name), u, r, v, ẏ_r ("measured")."""
+        x, ref = np.asarray(measurement, dtype=float), np.asarray(reference, dtype=float)
+        y_r, psi_r, course = ref[..., R_Y], ref[..., R_PSI], ref[..., R_COURSE]
         u, r = x[..., I_U], x[..., I_R]
         v = self.r1 * r + self.r2 * r**3
-        d_cross = self.d_y if self.current_frame == "path" else self.d_y * np.cos(angle)
+        d_cross = self.d_y if self.current_frame == "path" else self.d_y * np.cos(course)
         y_dot = u * np.sin(psi_r) + v * np.cos(psi_r) + d_cross
-        return {"y_r": y_r, "psi_r": psi_r, "u": u, "r": r, "v": v, "y_dot": y_dot,
-                "d_cross": d_cross + np.zeros_like(y_r)}
+        return {"y_r": y_r, "psi_r": psi_r, "course": course, "u": u, "r": r, "v": v,
+                "y_dot": y_dot, "d_cross": d_cross + np.zeros_like(y_r)}
 
     def _kernel(self, function, batch_shape, *specific) -> Kernel:
         """The kernel of a path FL controller: ``p`` = [δ_max, a, b, c, r₁, r₂, b_r, d_y, global
-        frame, *specific (7 numbers), leg table]; per-ship state of
-        :func:`~shipgnc.control.lqr.path_state`."""
+        frame, *specific]; per-ship state of :func:`~shipgnc.control.lqr.path_state`."""
         params = flat(self.delta_max, self.a, self.b, self.c, self.r1, self.r2, self.b_r, self.d_y,
-                      float(self.current_frame == "global"), *specific, leg_table(self.path))
+                      float(self.current_frame == "global"), *specific)
         return Kernel(function, params, path_state(self, batch_shape),
                       restore=lambda z: restore_path_state(self, batch_shape, z))
 
-    def _finish(self, raw: np.ndarray, k: dict[str, np.ndarray], **extra) -> np.ndarray:
+    def _finish(self, raw: np.ndarray, **logged) -> np.ndarray:
         delta = np.clip(raw, -self.delta_max, self.delta_max)
-        self._logged = {"cross_track_error": k["y_r"], "heading_error": k["psi_r"],
-                        "leg": self.tracker.leg.astype(float), **extra}
+        self._logged = logged
         return delta[..., None]
 
 
@@ -201,16 +191,17 @@ class OutputFL(_PathFL):
         δ = (ν − f)/g,   ν = −k₁ z − k₂ ż
 
     (l = 0, r₂ = 0: exactly (20)–(23)). Gains in SI: ``k1`` [1/s²] = 0.18/60², ``k2`` [1/s] = 0.7/60
-    by default; ``lookahead`` l [m]. Logged besides the path errors: ``fl_output`` z [m].
+    by default; ``lookahead`` l [m]. Logged: ``fl_output`` z [m].
     """
 
-    signals = (*PATH_SIGNALS, Signal("fl_output", "m", "linearised output z = y_r + l sin(psi_r)"))
+    signals = (Signal("fl_output", "m", "linearised output z = y_r + l sin(psi_r)"),)
 
-    def __init__(self, params, path: WaypointPath, *, Ts: float, lookahead: float = 0.0,
+    def __init__(self, params, path=None, *, Ts: float, lookahead: float = 0.0,
                  k1: float = K1_PAPER / MINUTE**2, k2: float = K2_PAPER / MINUTE,
                  delta_max: float = DELTA_MAX, b_r: float = 0.0, d_y: float = 0.0,
                  current_frame: str = "path"):
-        super().__init__(params, path, Ts=Ts, delta_max=delta_max, b_r=b_r, d_y=d_y,
+        refuse_path(type(self), path)
+        super().__init__(params, Ts=Ts, delta_max=delta_max, b_r=b_r, d_y=d_y,
                          current_frame=current_frame)
         require(isinstance(lookahead, (int, float, np.floating)) and np.isfinite(lookahead)
                 and lookahead >= 0, "controller.lookahead", lookahead, "must be a finite length >= 0 m")
@@ -236,27 +227,27 @@ class OutputFL(_PathFL):
         return z, z_dot, f, g
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        k = self.kinematics(measurement)
+        k = self.kinematics(measurement, reference)
         z, z_dot, f, g = self.linearization(k)
         nu = -self.k1 * z - self.k2 * z_dot
         # g = 0 only at ψ_r = ±90° (or r on the pivot point): saturate there instead of dividing
         tiny = 1e-12 * abs(self.c) * (abs(self.r1) + self.lookahead + NAUTICAL_MILE)
         g_safe = np.where(np.abs(g) < tiny, np.where(g < 0, -tiny, tiny), g)
-        return self._finish((nu - f) / g_safe, k, fl_output=z)
+        return self._finish((nu - f) / g_safe, fl_output=z)
 
     def kernel(self, batch_shape) -> Kernel:
         """:meth:`step` for the composed loop (:func:`output_fl_step`), after ``reset``."""
         tiny = 1e-12 * abs(self.c) * (abs(self.r1) + self.lookahead + NAUTICAL_MILE)
         return self._kernel(output_fl_step, batch_shape, self.lookahead, self.k1, self.k2, tiny,
-                            3.0 * self.r2, 0.0, 0.0)
+                            3.0 * self.r2)
 
 
-def fl_paper(params, path: WaypointPath, *, Ts: float, **options) -> OutputFL:
+def fl_paper(params, path=None, *, Ts: float, **options) -> OutputFL:
     """``fl_paper``: the literal FL (19)–(23) on y_r, k₁ = 0.18 /min², k₂ = 0.7 /min (unstable)."""
     return OutputFL(params, path, Ts=Ts, lookahead=0.0, **options)
 
 
-def fl_lookahead(params, path: WaypointPath, *, Ts: float, lookahead: float = LOOKAHEAD,
+def fl_lookahead(params, path=None, *, Ts: float, lookahead: float = LOOKAHEAD,
                  **options) -> OutputFL:
     """``fl_lookahead``: the same law on y_r + l sin ψ_r, l = 0.1 nm by default (stable for l > −r₁)."""
     return OutputFL(params, path, Ts=Ts, lookahead=lookahead, **options)
@@ -288,19 +279,20 @@ class LOSFL(_PathFL):
     from the known current; the first sample uses the latter.
 
     SI arguments: ``delta_los`` Δ [m] (0.5 nm), ``kp`` [1/s²] = 1/60², ``kd`` [1/s] = 2/60,
-    ``integral_gain`` κ [m/s] (0 = plain LOS). Logged besides the path errors: ``los_heading``
-    ψ_d,r [rad] (relative to the leg).
+    ``integral_gain`` κ [m/s] (0 = plain LOS). Logged: ``los_heading`` ψ_d,r [rad] (relative to
+    the leg).
     """
 
-    signals = (*PATH_SIGNALS,
-               Signal("los_heading", "rad", "LOS desired heading relative to the leg psi_d,r", angle=True))
+    signals = (Signal("los_heading", "rad", "LOS desired heading relative to the leg psi_d,r",
+                      angle=True),)
 
-    def __init__(self, params, path: WaypointPath, *, Ts: float, delta_los: float = LOS_DELTA,
+    def __init__(self, params, path=None, *, Ts: float, delta_los: float = LOS_DELTA,
                  kp: float = KP_PAPER / MINUTE**2, kd: float = KD_PAPER / MINUTE,
                  delta_max: float = DELTA_MAX, b_r: float = 0.0, d_y: float = 0.0,
                  current_frame: str = "path", integral_gain: float = 0.0,
                  rate_from_positions: bool = False):
-        super().__init__(params, path, Ts=Ts, delta_max=delta_max, b_r=b_r, d_y=d_y,
+        refuse_path(LOSFL, path)
+        super().__init__(params, Ts=Ts, delta_max=delta_max, b_r=b_r, d_y=d_y,
                          current_frame=current_frame)
         for name, value in (("delta_los", delta_los), ("kp", kp), ("kd", kd)):
             require(isinstance(value, (int, float, np.floating)) and np.isfinite(value) and value > 0,
@@ -311,7 +303,6 @@ class LOSFL(_PathFL):
         self.delta_los, self.kp, self.kd = float(delta_los), float(kp), float(kd)
         self.integral_gain = float(integral_gain)
         self.rate_from_positions = bool(rate_from_positions)
-        self._cos, self._sin = np.cos(path.leg_angles), np.sin(path.leg_angles)
         self.y_int: np.ndarray | None = None
         self._prev: tuple | None = None  # (t, north, east, ẏ_int) of the last sample
 
@@ -322,7 +313,7 @@ class LOSFL(_PathFL):
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
         x = np.asarray(measurement, dtype=float)
-        k = self.kinematics(x)
+        k = self.kinematics(x, reference)
         D, y_r, kappa = self.delta_los, k["y_r"], self.integral_gain
         y_dot = k["y_dot"]
         if self._prev is not None:
@@ -330,9 +321,9 @@ class LOSFL(_PathFL):
             h = t - t0
             self.y_int = self.y_int + h * rate0  # forward Euler: y_int(t_k)
             if self.rate_from_positions:
-                leg = self.tracker.leg
-                y_dot = ((x[..., I_NORTH] - n0) * -self._sin[leg]
-                         + (x[..., I_EAST] - e0) * self._cos[leg]) / h
+                course = k["course"]
+                y_dot = ((x[..., I_NORTH] - n0) * -np.sin(course)
+                         + (x[..., I_EAST] - e0) * np.cos(course)) / h
         rho = y_r + kappa * self.y_int
         den = D**2 + rho * rho
         rate = D * y_r / den
@@ -343,7 +334,7 @@ class LOSFL(_PathFL):
         nu = -self.kp * e - self.kd * (k["r"] - psi_d_dot)
         raw = (nu + self.H_N(k["r"]) - self.b_r) / self.c
         self._prev = (t, x[..., I_NORTH], x[..., I_EAST], rate)
-        return self._finish(raw, k, los_heading=psi_d)
+        return self._finish(raw, los_heading=psi_d)
 
     def kernel(self, batch_shape) -> Kernel:
         """:meth:`step` for the composed loop (:func:`los_fl_step`), after ``reset``; per-ship
@@ -359,8 +350,7 @@ class LOSFL(_PathFL):
         z = np.concatenate([path_state(self, shape), own], axis=-1)
         params = flat(self.delta_max, self.a, self.b, self.c, self.r1, self.r2, self.b_r, self.d_y,
                       float(self.current_frame == "global"), self.delta_los, self.kp, self.kd,
-                      self.delta_los**2, 0.0, self.integral_gain, float(self.rate_from_positions),
-                      leg_table(self.path))
+                      self.delta_los**2, self.integral_gain, float(self.rate_from_positions))
 
         def restore(zf: np.ndarray) -> None:
             zf = zf.reshape(*shape, zf.shape[-1])
@@ -378,46 +368,41 @@ class LOSFL(_PathFL):
 # kernels (shipgnc.kernels): one ship's step, operation for operation as the numpy methods
 # ----------------------------------------------------------------------------------------------
 
-#: where the FL kernels find the leg table in their parameters (9 common + 7 specific numbers)
-_FL_LEGS = 16
-#: where :func:`los_fl_step` finds its own per-ship state (after :func:`path_state`'s 6 numbers)
-_LOS_OWN = 6
+#: where :func:`los_fl_step` finds its own per-ship state (after :func:`path_state`'s 2 numbers)
+_LOS_OWN = 2
 
 
 @kernel_function
-def path_kinematics(x, z, p):
-    """:meth:`_PathFL.kinematics` for one ship (its leg tracker in ``z[0]``, updated):
-    ``(leg, y_r, ψ_r, u, r, v, ẏ_r, d_cross, sin ψ_r, cos ψ_r)``, with v = r₁ r + r₂ r³ and the
-    "measured" ẏ_r = u sin ψ_r + v cos ψ_r + d_cross (d_cross = d_y, or d_y cos ψ_r0 in the
+def path_kinematics(x, ref, p):
+    """:meth:`_PathFL.kinematics` for one ship: ``(y_r, ψ_r, π_p, u, r, v, ẏ_r, d_cross, sin ψ_r,
+    cos ψ_r)`` from the path references (by name) and the state, with v = r₁ r + r₂ r³ and the
+    "measured" ẏ_r = u sin ψ_r + v cos ψ_r + d_cross (d_cross = d_y, or d_y cos π_p in the
     global frame)."""
     r1, r2, d_y, frame_global = p[4], p[5], p[7], p[8]
-    leg, _, y_r = track_leg(x[I_NORTH], x[I_EAST], int(z[0]), p, _FL_LEGS)
-    z[0] = leg
-    psi_r = wrap(x[I_PSI] - leg_value(p, _FL_LEGS, LEG_ANGLE, leg))
+    y_r, psi_r, course = ref[R_Y], ref[R_PSI], ref[R_COURSE]
     u, r = x[I_U], x[I_R]
     v = r1 * r + r2 * r * r * r
-    d_cross = d_y * leg_value(p, _FL_LEGS, LEG_COS, leg) if frame_global != 0.0 else d_y
+    d_cross = d_y * math.cos(course) if frame_global != 0.0 else d_y
     s, c = math.sin(psi_r), math.cos(psi_r)
     y_dot = u * s + v * c + d_cross
-    return leg, y_r, psi_r, u, r, v, y_dot, d_cross, s, c
+    return y_r, psi_r, course, u, r, v, y_dot, d_cross, s, c
 
 
 @kernel_function
-def _log_path(z, sig, y_r, psi_r, leg, extra):
-    """The logged signals [y_r, ψ_r, leg, extra], also kept in ``z`` for ``signal_values``."""
-    sig[0], sig[1], sig[2], sig[3] = y_r, psi_r, float(leg), extra
-    z[1], z[2], z[3], z[4], z[5] = y_r, psi_r, float(leg), extra, 1.0
+def _log_path(z, sig, extra):
+    """The logged signal ``extra``, also kept in ``z`` for ``signal_values``."""
+    sig[0] = extra
+    z[0], z[1] = extra, 1.0
 
 
 @kernel_function
 def output_fl_step(t, x, ref, z, p, cmd, sig):
     """One :meth:`OutputFL.step` for one ship: z = y_r + l sin ψ_r, ż, f, g of
     :meth:`OutputFL.linearization` ((19)–(20) with r₁ → r₁ + l + 3r₂r²), δ = clip((ν − f)/g) with
-    ν = −k₁ z − k₂ ż ((21)–(23)) and |g| kept ≥ tiny. ``p`` = [common 9, l, k₁, k₂, tiny, 3r₂,
-    0, 0, leg table]."""
+    ν = −k₁ z − k₂ ż ((21)–(23)) and |g| kept ≥ tiny. ``p`` = [common 9, l, k₁, k₂, tiny, 3r₂]."""
     delta_max, a, b, c_rudder, r1, b_r = p[0], p[1], p[2], p[3], p[4], p[6]
     l, k1, k2, tiny, r2_3 = p[9], p[10], p[11], p[12], p[13]
-    leg, y_r, psi_r, u, r, v, y_dot, _, s, c = path_kinematics(x, z, p)
+    y_r, _, _, u, r, v, y_dot, _, s, c = path_kinematics(x, ref, p)
     lateral = v + l * r
     out = y_r + l * s
     out_dot = y_dot + l * r * c
@@ -427,7 +412,7 @@ def output_fl_step(t, x, ref, z, p, cmd, sig):
     nu = -k1 * out - k2 * out_dot
     if abs(g) < tiny:  # the g_safe guard of OutputFL.step (NaN passes through)
         g = -tiny if g < 0.0 else tiny
-    _log_path(z, sig, y_r, psi_r, leg, out)
+    _log_path(z, sig, out)
     cmd[0] = clip((nu - f) / g, -delta_max, delta_max)
 
 
@@ -437,18 +422,18 @@ def los_fl_step(t, x, ref, z, p, cmd, sig):
     ẏ_int = Δ y_r/(Δ² + ρ²), ψ_d,r = −atan(ρ/Δ) − asin(clip(d_cross/max(u, 1e-6))),
     ψ̇_d,r = −Δ (ẏ_r + κ ẏ_int)/(Δ² + ρ²) (ẏ_r from the last two positions when asked),
     e = wrap(ψ_r − ψ_d,r), ν = −k_p e − k_d (r − ψ̇_d,r), δ = clip((ν + H_N(r) − b_r)/c)
-    (note 000-0.5). ``p`` = [common 9, Δ, k_p, k_d, Δ², 0, κ, rate from positions, leg table];
-    ``z`` = [path_state 6, y_int, ẏ_int, t, north, east, has previous]."""
+    (note 000-0.5). ``p`` = [common 9, Δ, k_p, k_d, Δ², κ, rate from positions];
+    ``z`` = [path_state 2, y_int, ẏ_int, t, north, east, has previous]."""
     delta_max, a, b, c_rudder, b_r = p[0], p[1], p[2], p[3], p[6]
-    D, kp, kd, D2, kappa, from_positions = p[9], p[10], p[11], p[12], p[14], p[15]
-    leg, y_r, psi_r, u, r, _, y_dot, d_cross, _, _ = path_kinematics(x, z, p)
+    D, kp, kd, D2, kappa, from_positions = p[9], p[10], p[11], p[12], p[13], p[14]
+    y_r, psi_r, course, u, r, _, y_dot, d_cross, _, _ = path_kinematics(x, ref, p)
     o = _LOS_OWN
     if z[o + 5] != 0.0:
         h = t - z[o + 2]
         z[o] = z[o] + h * z[o + 1]
         if from_positions != 0.0:
-            y_dot = ((x[I_NORTH] - z[o + 3]) * -leg_value(p, _FL_LEGS, LEG_SIN, leg)
-                     + (x[I_EAST] - z[o + 4]) * leg_value(p, _FL_LEGS, LEG_COS, leg)) / h
+            y_dot = ((x[I_NORTH] - z[o + 3]) * -math.sin(course)
+                     + (x[I_EAST] - z[o + 4]) * math.cos(course)) / h
     rho = y_r + kappa * z[o]
     den = D2 + rho * rho
     rate = D * y_r / den
@@ -460,7 +445,7 @@ def los_fl_step(t, x, ref, z, p, cmd, sig):
     e = wrap(psi_r - psi_d)
     nu = -kp * e - kd * (r - psi_d_dot)
     raw = (nu + (a * r + b * r * r * r) - b_r) / c_rudder
-    _log_path(z, sig, y_r, psi_r, leg, psi_d)
+    _log_path(z, sig, psi_d)
     cmd[0] = clip(raw, -delta_max, delta_max)
 
 

@@ -19,13 +19,12 @@ The printed gain :data:`PAPER_LQR_GAIN` = [3.4, 3.2, 1, 0.45] is reproduced with
 (A12), not with the stated R = 1, which gives [2.4455, 2.3244, 0.8788, 0.3162]
 (k_e = √(ρ_e/R) in every unit system).
 
-**Controller.** :class:`PathLQR` does its own path geometry (``reference_names = ()``): the LQR
-state *is* the path-frame error (y_r, ψ_r) of the active leg plus an integrator whose bookkeeping
-is tied to the leg (it is not reset at a switch, A7), so it takes the
-:class:`~shipgnc.paths.WaypointPath` directly instead of a heading reference from a
-guidance object (the simulator's references are set-points for one state each, which y_r, ψ_r
-and e_I are not). Leg switching (A6, :class:`LegTracker`): leg i+1 becomes active once the
-along-track distance x_r on leg i reaches its length; the last leg is a half-line.
+**Controller.** :class:`PathLQR` reads the path-frame errors y_r, ψ_r of the active leg as
+references (``reference_names``: ``cross_track_error``, ``heading_error``, ``path_course``, each
+found by name) from :class:`~shipgnc.guidance.path.PathGuidance`, which holds the
+:class:`~shipgnc.paths.WaypointPath` and switches the legs (A6: leg i+1 becomes active once the
+along-track distance x_r on leg i reaches its length; the last leg is a half-line). The law keeps
+only its integrator e_I, which is not reset at a switch (A7).
 """
 
 from __future__ import annotations
@@ -37,18 +36,10 @@ import numpy as np
 
 from shipgnc.batchmath import row_dot
 from shipgnc.errors import ConfigError, require
-from shipgnc.frames import wrap_angle
-from shipgnc.kernels import Kernel, clip, flat, kernel_function, sign, wrap
+from shipgnc.guidance.path import PATH_REFERENCES
+from shipgnc.kernels import Kernel, clip, flat, kernel_function, sign
 from shipgnc.models.base import Signal, state_index
 from shipgnc.models.mariner import MarinerWitOppe, tracking_model  # the design model (8)/(9)
-from shipgnc.paths import (
-    LEG_ANGLE,
-    LegTracker,
-    WaypointPath,
-    leg_table,
-    leg_value,
-    track_leg,
-)
 from shipgnc.units import MINUTE, NAUTICAL_MILE, deg
 
 #: K = [k_y, k_ψ, k_r, k_e] printed in the document (min / nm / rad, state order [y_r, ψ_r, r, e_I])
@@ -191,11 +182,18 @@ def check_controller_args(Ts: float, delta_max: float) -> None:
                 f"controller.{name}", value, "must be a finite number > 0")
 
 
-PATH_SIGNALS = (
-    Signal("cross_track_error", "m", "cross-track error y_r of the active leg, positive to starboard"),
-    Signal("heading_error", "rad", "heading error psi_r = psi - leg angle", angle=True),
-    Signal("leg", "1", "active leg index (0-based)"),
-)
+#: the references a path law reads (:class:`~shipgnc.guidance.path.PathGuidance`'s, by name)
+PATH_REFERENCE_NAMES = tuple(s.name for s in PATH_REFERENCES)
+#: where each of them is in the reference vector
+R_Y, R_PSI, R_COURSE = (PATH_REFERENCE_NAMES.index(name)
+                        for name in ("cross_track_error", "heading_error", "path_course"))
+
+
+def refuse_path(cls: type, path) -> None:
+    """A clear error for the former call form ``Law(..., path, ...)``: the path is guidance now."""
+    if path is not None:
+        raise ConfigError(f"{cls.__name__}: the path is no longer the controller's; give it as "
+                          f"guidance=PathGuidance(path) (shipgnc.guidance.path) and leave it out here")
 
 
 class PathLQR:
@@ -203,8 +201,10 @@ class PathLQR:
 
     ``K_si``: [k_y, k_ψ, k_r, k_e] in s / m / rad (:func:`gain_to_si` of a paper-unit gain, or
     ``design_lqr(...).K_si``). Measurement: the Mariner state ``[north, east, psi, u, r]`` (SI);
-    command ``[delta]`` [rad], clipped to ±``delta_max`` (the actuator's limit; the rate limit
-    stays the actuator's).
+    references: y_r and ψ_r of the active leg (``cross_track_error``, ``heading_error``:
+    :class:`~shipgnc.guidance.path.PathGuidance`, which also switches the legs, A6); command
+    ``[delta]`` [rad], clipped to ±``delta_max`` (the actuator's limit; the rate limit stays the
+    actuator's).
 
     The integrator e_I = ∫ y_r dt is a forward-Euler sum over the samples (the command at t_k
     uses e_I(t_k), then e_I += Ts·y_r(t_k)); it starts at 0 and is **not** reset at a leg switch
@@ -215,20 +215,18 @@ class PathLQR:
     note 000-0.8 figures for ``lqr``/``lqr_paper`` (settling 25.9 min, overshoot 0.63 nm) are those of
     ``anti_windup=False``; with it the 1.5 nm capture of note 000-0.6 settles in 25.46 min with a
     0.486 nm overshoot (25.93 min, 0.635 nm without), and the steady state (e_I absorbs b_r,
-    d_y) is the same. Logged:
-    ``cross_track_error``, ``heading_error``, ``leg``, ``integral_error`` (e_I, before the update).
+    d_y) is the same. Logged: ``integral_error`` (e_I, before the update).
     """
 
     continuous = False
-    reference_names = ()
-    signals = (*PATH_SIGNALS, Signal("integral_error", "m s", "integral of the cross-track error e_I"))
+    reference_names = PATH_REFERENCE_NAMES
+    signals = (Signal("integral_error", "m s", "integral of the cross-track error e_I"),)
 
-    def __init__(self, K_si, path: WaypointPath, *, Ts: float, delta_max: float = DELTA_MAX,
+    def __init__(self, K_si, path=None, *, Ts: float, delta_max: float = DELTA_MAX,
                  anti_windup: bool = False):
+        refuse_path(PathLQR, path)
         check_controller_args(Ts, delta_max)
         self.K = _gain_vector(K_si, "K_si")
-        self.tracker = LegTracker(path)
-        self.path = path
         self.Ts = float(Ts)
         self.delta_max = float(delta_max)
         self.anti_windup = bool(anti_windup)
@@ -241,21 +239,19 @@ class PathLQR:
         return gain_to_paper(self.K)
 
     def reset(self, batch_shape) -> None:
-        self.tracker.reset(batch_shape)
         self.e_I = np.zeros(tuple(batch_shape))
         self._logged = {}
 
-    def state(self, measurement: np.ndarray) -> np.ndarray:
-        """The LQR state [y_r, ψ_r, r, e_I] (SI, shape (..., 4)); updates the active leg."""
-        x = np.asarray(measurement, dtype=float)
-        _, y_r, angle = self.tracker.update(x[..., I_NORTH], x[..., I_EAST])
-        psi_r = wrap_angle(x[..., I_PSI] - angle)
+    def state(self, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        """The LQR state [y_r, ψ_r, r, e_I] (SI, shape (..., 4))."""
+        x, ref = np.asarray(measurement, dtype=float), np.asarray(reference, dtype=float)
+        y_r, psi_r = ref[..., R_Y], ref[..., R_PSI]
         e_I = np.broadcast_to(self.e_I, y_r.shape)
         return np.stack([y_r, psi_r, x[..., I_R], e_I], axis=-1)
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        xs = self.state(measurement)
-        y_r, psi_r = xs[..., 0], xs[..., 1]
+        xs = self.state(measurement, reference)
+        y_r = xs[..., 0]
         raw = -row_dot(xs, self.K)
         delta = np.clip(raw, -self.delta_max, self.delta_max)
         integrate = np.ones(raw.shape, dtype=bool)
@@ -264,8 +260,7 @@ class PathLQR:
             deepens = np.sign(-self.K[3] * y_r) == np.sign(raw)
             integrate = (np.abs(raw) <= self.delta_max) | ~deepens
         self.e_I = np.where(integrate, xs[..., 3] + self.Ts * y_r, xs[..., 3])
-        self._logged = {"cross_track_error": y_r, "heading_error": psi_r,
-                        "leg": self.tracker.leg.astype(float), "integral_error": xs[..., 3]}
+        self._logged = {"integral_error": xs[..., 3]}
         return delta[..., None]
 
     def signal_values(self) -> dict[str, np.ndarray]:
@@ -273,54 +268,49 @@ class PathLQR:
 
     def kernel(self, batch_shape) -> Kernel:
         """:meth:`step` for the composed loop (:func:`path_lqr_step`), after ``reset``; per-ship
-        state ``[leg, e_I, logged signals (4), logged]`` (see :func:`path_state`)."""
-        params = flat(self.K, self.delta_max, self.Ts, float(self.anti_windup),
-                      leg_table(self.path))
+        state ``[e_I, logged e_I, logged]`` (see :func:`path_state`)."""
+        params = flat(self.K, self.delta_max, self.Ts, float(self.anti_windup))
         state = path_state(self, batch_shape, self.e_I)
-        return Kernel(path_lqr_step, params, state,
-                      restore=lambda z: restore_path_state(self, batch_shape, z, e_I=True))
+        shape = tuple(batch_shape)
+
+        def restore(z: np.ndarray) -> None:
+            self.e_I = restore_path_state(self, shape, z, n_own=1)[..., 0].copy()
+
+        return Kernel(path_lqr_step, params, state, restore=restore)
 
 
-def path_state(ctrl, batch_shape, *extra) -> np.ndarray:
-    """Initial per-ship state of a path controller's kernel: ``[leg, *extra, signals, logged]``
-    (its tracker's leg, e.g. PathLQR's e_I, the last logged signal values and a flag: 1 once
-    ``step`` has run, as ``signal_values()`` is empty before)."""
+def path_state(ctrl, batch_shape, *own) -> np.ndarray:
+    """Initial per-ship state of a path law's kernel: ``[*own, signals, logged]`` (its own
+    numbers, e.g. PathLQR's e_I, the last logged signal values and a flag: 1 once ``step`` has
+    run, as ``signal_values()`` is empty before)."""
     shape = tuple(batch_shape)
-    parts = [ctrl.tracker.leg, *extra]
     logged = ctrl.signal_values()
-    parts += [logged.get(s.name, np.zeros(shape)) for s in ctrl.signals]
-    parts.append(np.full(shape, float(bool(logged))))
+    parts = [*own, *(logged.get(s.name, np.zeros(shape)) for s in ctrl.signals),
+             np.full(shape, float(bool(logged)))]
     return np.stack([np.broadcast_to(np.asarray(v, dtype=float), shape) for v in parts], axis=-1)
 
 
-def restore_path_state(ctrl, batch_shape, z: np.ndarray, *, e_I: bool = False) -> None:
-    """Leave a path controller as its numpy ``step`` would: the tracker's leg, e_I (PathLQR) and
-    the logged signal values, from the final per-ship state of :func:`path_state`."""
+def restore_path_state(ctrl, batch_shape, z: np.ndarray, *, n_own: int = 0) -> np.ndarray:
+    """Leave a path law's logged signal values as its numpy ``step`` would, from the final
+    per-ship state of :func:`path_state` (its ``n_own`` own numbers first); returns that state
+    shaped ``(*batch_shape, n_z)``."""
     z = z.reshape(*tuple(batch_shape), z.shape[-1])
-    ctrl.tracker.leg = z[..., 0].astype(int)
-    first = 1
-    if e_I:
-        ctrl.e_I = z[..., 1].copy()
-        first = 2
-    if np.all(z[..., -1] > 0):
-        ctrl._logged = {s.name: z[..., first + j].copy() for j, s in enumerate(ctrl.signals)}
-
-
-#: where :func:`path_lqr_step` finds the leg table in its parameters
-_LQR_LEGS = 7
+    n_sig = len(ctrl.signals)
+    if np.all(z[..., n_own + n_sig] > 0):
+        ctrl._logged = {s.name: z[..., n_own + j].copy() for j, s in enumerate(ctrl.signals)}
+    return z
 
 
 @kernel_function
 def path_lqr_step(t, x, ref, z, p, cmd, sig):
     """One :meth:`PathLQR.step` for one ship, operation for operation: law (13)
     δ = clip(−K·[y_r, ψ_r, r, e_I]) (the sum left to right, as :func:`~shipgnc.batchmath.row_dot`),
-    then e_I += Ts·y_r (held by the anti-windup). ``p`` = [K (4), δ_max, Ts, anti-windup, leg
-    table]; ``z`` = [leg, e_I, y_r, ψ_r, leg, e_I logged, logged]."""
+    then e_I += Ts·y_r (held by the anti-windup). ``p`` = [K (4), δ_max, Ts, anti-windup];
+    ``ref`` = the path references (y_r, ψ_r by name); ``z`` = [e_I, e_I logged, logged]."""
     k_y, k_psi, k_r, k_e = p[0], p[1], p[2], p[3]
     delta_max, Ts, anti_windup = p[4], p[5], p[6]
-    leg, _, y_r = track_leg(x[I_NORTH], x[I_EAST], int(z[0]), p, _LQR_LEGS)
-    psi_r = wrap(x[I_PSI] - leg_value(p, _LQR_LEGS, LEG_ANGLE, leg))
-    e_I = z[1]
+    y_r, psi_r = ref[R_Y], ref[R_PSI]
+    e_I = z[0]
     raw = -(y_r * k_y + psi_r * k_psi + x[I_R] * k_r + e_I * k_e)
     delta = clip(raw, -delta_max, delta_max)
     integrate = True
@@ -328,8 +318,7 @@ def path_lqr_step(t, x, ref, z, p, cmd, sig):
         deepens = sign(-k_e * y_r) == sign(raw)
         integrate = abs(raw) <= delta_max or not deepens
     if integrate:
-        z[1] = e_I + Ts * y_r
-    z[0] = leg
-    sig[0], sig[1], sig[2], sig[3] = y_r, psi_r, float(leg), e_I
-    z[2], z[3], z[4], z[5], z[6] = y_r, psi_r, float(leg), e_I, 1.0
+        z[0] = e_I + Ts * y_r
+    sig[0] = e_I
+    z[1], z[2] = e_I, 1.0
     cmd[0] = delta

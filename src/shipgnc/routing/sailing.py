@@ -271,7 +271,7 @@ class ShiftedField:
 
 
 def mariner_sail(route, field, heading, *, dt: float, t_end: float, seed: int = 0,
-                 backend: str = "auto", model=None, controller=None):
+                 backend: str = "auto", model=None, controller=None, guidance=None):
     """Simulate document 000's Mariner steering ``heading(t)`` [rad] from the route's start through
     ``field`` (module docstring).
 
@@ -280,8 +280,9 @@ def mariner_sail(route, field, heading, *, dt: float, t_end: float, seed: int = 
     the route's target and that distance (an arrival is judged by the acceptance radius instead,
     :func:`arrival`). ``backend`` as :func:`~shipgnc.sim.simulator.simulate`'s. ``model``: a
     :class:`~shipgnc.models.mariner.MarinerWitOppe` (default the document's, U = 15 kn; the ship starts at
-    its U on the heading ``heading(t0)``). ``controller``: a path controller with its own path (e.g.
-    :class:`~shipgnc.control.feedback_linearization.LOSFL` through waypoints, as
+    its U on the heading ``heading(t0)``). ``controller`` and ``guidance``: a path controller and the
+    path it follows (e.g. :class:`~shipgnc.control.feedback_linearization.LOSFL` on a
+    :class:`~shipgnc.guidance.path.PathGuidance` through waypoints, as
     :func:`shipgnc.routing.geo.sail.sail_check` sails a chart's route) instead of
     :class:`~shipgnc.control.feedback_linearization.HeadingFL` on ``heading``, which then only gives the
     initial heading.
@@ -289,7 +290,7 @@ def mariner_sail(route, field, heading, *, dt: float, t_end: float, seed: int = 
     from shipgnc.sim.simulator import simulate
 
     run = mariner_sail_run(route, field, heading, dt=dt, t_end=t_end, model=model,
-                           controller=controller)
+                           controller=controller, guidance=guidance)
     ds = simulate(run.model, run.x0, **run.options, seed=seed, backend=backend)
     distance = np.hypot(ds["north"].values - route.target[0], ds["east"].values - route.target[1])
     k = int(np.argmin(distance))
@@ -297,7 +298,7 @@ def mariner_sail(route, field, heading, *, dt: float, t_end: float, seed: int = 
 
 
 def mariner_sail_run(route, field, heading, *, dt: float, t_end: float, model=None,
-                     controller=None) -> SailRun:
+                     controller=None, guidance=None) -> SailRun:
     """The run :func:`mariner_sail` simulates (its arguments), not yet simulated."""
     from shipgnc.control.feedback_linearization import HeadingFL
     from shipgnc.guidance.schedule import HeadingProfile
@@ -310,8 +311,8 @@ def mariner_sail_run(route, field, heading, *, dt: float, t_end: float, model=No
     steps = max(1, math.ceil(t_end / dt))
     # the autopilot samples every step (Ts = dt): the programme's table for the compiled loop
     samples = np.arange(steps + 1) * dt
-    guidance = None if controller is not None else \
-        HeadingProfile(lambda t: heading(t0 + t), samples=samples)
+    if controller is None:
+        guidance = HeadingProfile(lambda t: heading(t0 + t), samples=samples)
     return SailRun(model, x0, {
         "t_end": steps * dt, "dt": dt,
         "controller": HeadingFL(p, Ts=dt) if controller is None else controller,

@@ -41,7 +41,7 @@ class VesselKind:
     one is refused, ``shipgnc show`` leaves it out); ``comparisons``: takes a ``controllers``
     mapping. Optional hooks, each
     ``"module:function"``: ``setup(scenario, variant, seed) -> Setup`` (a vessel whose whole set-up
-    is its own, e.g. document 000's path-frame controllers), ``run(scenario, seed=, progress=,
+    is its own, e.g. document 004's cases), ``run(scenario, seed=, progress=,
     on_divergence=, keep_interrupted=) -> ScenarioRun`` (a vessel whose runs are its own),
     ``controller(cfg, model, scenario)`` (its own controller builder), ``initial_state(scenario,
     seed) -> x0``, ``check(scenario)`` (rules of its own, raising ValueError). ``cases``: also
@@ -81,7 +81,7 @@ class ControllerKind:
 @dataclass(frozen=True)
 class GuidanceKind:
     """A ``guidance.type``: its section, its builder ``(cfg) -> guidance`` (None: the vessel's
-    set-up reads it, e.g. document 000's path) and the vessel models it serves (None: any)."""
+    set-up reads it, e.g. document 004's references) and the vessel models it serves (None: any)."""
 
     type: str
     config: type
@@ -119,9 +119,12 @@ CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
                    build="shipgnc.scenarios.runner:heading_speed_controller"),
     ControllerKind("course", S.CourseControllerConfig, guidance=("course-schedule",),
                    build="shipgnc.scenarios.runner:course_controller"),
-    ControllerKind("lqr", S.PathLQRConfig, guidance=("path",)),
-    ControllerKind("fl", S.OutputFLConfig, guidance=("path",)),
-    ControllerKind("los-fl", S.LOSFLConfig, guidance=("path",)),
+    ControllerKind("lqr", S.PathLQRConfig, guidance=("path",),
+                   build="shipgnc.scenarios.mariner:lqr_controller"),
+    ControllerKind("fl", S.OutputFLConfig, guidance=("path",),
+                   build="shipgnc.scenarios.mariner:fl_controller"),
+    ControllerKind("los-fl", S.LOSFLConfig, guidance=("path",),
+                   build="shipgnc.scenarios.mariner:los_fl_controller"),
     ControllerKind("yaw-rate-fsm", S.YawRateFSMConfig,
                    guidance=("yaw-rate", "yaw-rate-sine", "heading-capture")),
 )}
@@ -130,7 +133,8 @@ GUIDANCE: dict[str, GuidanceKind] = {k.type: k for k in (
     GuidanceKind("schedule", S.ScheduleGuidanceConfig, build="shipgnc.scenarios.runner:reference_schedule"),
     GuidanceKind("los", S.LOSConfig, build="shipgnc.scenarios.runner:los_guidance"),
     GuidanceKind("course-schedule", S.CourseScheduleConfig, build="shipgnc.scenarios.runner:course_schedule"),
-    GuidanceKind("path", S.PathConfig, vessels=("mariner",)),
+    GuidanceKind("path", S.PathConfig, build="shipgnc.scenarios.mariner:path_guidance",
+                 vessels=("mariner",)),
     # document 004's references: the law holds its reference (evaluated at every RK stage in
     # continuous mode), so the catamaran's set-up builds them with the controller
     GuidanceKind("yaw-rate", S.YawRateGuidanceConfig, vessels=("catamaran",)),
@@ -142,7 +146,8 @@ DISTURBANCES: dict[str, DisturbanceKind] = {k.type: k for k in (
     DisturbanceKind("constant", S.ConstantForceConfig, build="shipgnc.scenarios.runner:constant_force"),
     DisturbanceKind("gaussian", S.GaussianForceConfig, build="shipgnc.scenarios.runner:gaussian_force"),
     DisturbanceKind("waves", S.WavesConfig, build="shipgnc.scenarios.runner:wave_loads"),
-    DisturbanceKind("mariner", S.MarinerDisturbanceConfig),
+    DisturbanceKind("mariner", S.MarinerDisturbanceConfig,
+                    build="shipgnc.scenarios.mariner:disturbance_section"),
 )}
 
 METRICS: dict[str, MetricKind] = {k.name: k for k in (
@@ -166,7 +171,6 @@ VESSEL_KINDS: dict[str, VesselKind] = {k.model: k for k in (
     VesselKind("mariner", S.MarinerVesselConfig, "shipgnc.scenarios.mariner:vessel",
                controllers=("lqr", "fl", "los-fl"), disturbances=("mariner",),
                navigation=True, current=True, sections=("montecarlo",),
-               setup="shipgnc.scenarios.mariner:setup",
                initial_state="shipgnc.scenarios.mariner:initial_states",
                check="shipgnc.scenarios.mariner:check"),
     VesselKind("catamaran", S.CatamaranVesselConfig, "shipgnc.scenarios.catamaran:vessel_parts",

@@ -1,5 +1,7 @@
-"""Document 000's scenario pieces: the Mariner, its path (note 000-A4), controllers and
-disturbances built from a validated :class:`~shipgnc.scenarios.schema.Scenario`.
+"""Document 000's scenario pieces: the builders of the Mariner, its path frame (note 000-A4, a
+guidance), its path controllers and disturbances, named by the component registry
+(:mod:`shipgnc.scenarios.components`) and called by :func:`shipgnc.scenarios.runner.build` like any
+vessel's, from a validated :class:`~shipgnc.scenarios.schema.Scenario`.
 
 The scenario file keeps the document's units where it names them (``*_nm``, ``*_rad_min2``,
 ``*_per_min``); everything is converted to SI here, at the boundary.
@@ -40,63 +42,85 @@ def mariner_path(g) -> WaypointPath:
     return WaypointPath(north_east * NAUTICAL_MILE)
 
 
-def controller(cfg, model, path: WaypointPath, scenario: Scenario):
-    """Document 000's path controllers (notes 000-0.4–000-0.5) with the scenario's settings."""
-    from shipgnc.control import feedback_linearization as fl
+def path_guidance(g):
+    """The path frame of note 000-A4's path (:class:`~shipgnc.guidance.path.PathGuidance`): the
+    references y_r, ψ_r, π_p the path controllers read."""
+    from shipgnc.guidance.path import PathGuidance
+
+    return PathGuidance(mariner_path(g))
+
+
+def lqr_controller(cfg, model, scenario: Scenario):
+    """Document 000's LQR (note 000-0.4): the printed gain ``K_paper``, or designed from Q, R."""
     from shipgnc.control.lqr import PAPER_Q, PAPER_R, PathLQR, design_lqr, gain_to_si
 
     p = model.params
-    if cfg.type == "lqr":
-        if cfg.K_paper is not None:
-            K = gain_to_si(cfg.K_paper)
-        else:
-            Q = PAPER_Q if cfg.Q is None else cfg.Q
-            K = design_lqr(p, Q=Q, R=PAPER_R if cfg.R is None else cfg.R).K_si
-        return PathLQR(K, path, Ts=cfg.Ts, delta_max=p.delta_max, anti_windup=cfg.anti_windup)
+    if cfg.K_paper is not None:
+        K = gain_to_si(cfg.K_paper)
+    else:
+        Q = PAPER_Q if cfg.Q is None else cfg.Q
+        K = design_lqr(p, Q=Q, R=PAPER_R if cfg.R is None else cfg.R).K_si
+    return PathLQR(K, Ts=cfg.Ts, delta_max=p.delta_max, anti_windup=cfg.anti_windup)
+
+
+def _known_disturbance(cfg, scenario: Scenario) -> dict:
+    """b_r, d_y and the current's frame handed to a law that ``knows_disturbance`` (A13)."""
     d = scenario.disturbance
-    known = {}
-    if cfg.knows_disturbance and d is not None:
-        known = {"b_r": d.b_r, "d_y": d.d_y, "current_frame": d.current_frame}
-    if cfg.type == "fl":
-        return fl.OutputFL(p, path, Ts=cfg.Ts, lookahead=cfg.lookahead_nm * NAUTICAL_MILE,
-                           k1=cfg.k1_per_min2 / MINUTE**2, k2=cfg.k2_per_min / MINUTE,
-                           delta_max=p.delta_max, **known)
-    return fl.LOSFL(p, path, Ts=cfg.Ts, delta_los=cfg.delta_nm * NAUTICAL_MILE,
-                    kp=cfg.kp_per_min2 / MINUTE**2, kd=cfg.kd_per_min / MINUTE,
-                    delta_max=p.delta_max,
-                    integral_gain=cfg.integral_gain * NAUTICAL_MILE / MINUTE,
-                    rate_from_positions=not cfg.knows_disturbance, **known)
+    if not cfg.knows_disturbance or d is None:
+        return {}
+    return {"b_r": d.b_r, "d_y": d.d_y, "current_frame": d.current_frame}
+
+
+def fl_controller(cfg, model, scenario: Scenario):
+    """Document 000's output feedback linearisation (note 000-0.5), l = ``lookahead_nm``."""
+    from shipgnc.control.feedback_linearization import OutputFL
+
+    p = model.params
+    return OutputFL(p, Ts=cfg.Ts, lookahead=cfg.lookahead_nm * NAUTICAL_MILE,
+                    k1=cfg.k1_per_min2 / MINUTE**2, k2=cfg.k2_per_min / MINUTE,
+                    delta_max=p.delta_max, **_known_disturbance(cfg, scenario))
+
+
+def los_fl_controller(cfg, model, scenario: Scenario):
+    """Document 000's (integral) LOS feeding a feedback-linearised yaw loop (note 000-0.5)."""
+    from shipgnc.control.feedback_linearization import LOSFL
+
+    p = model.params
+    return LOSFL(p, Ts=cfg.Ts, delta_los=cfg.delta_nm * NAUTICAL_MILE,
+                 kp=cfg.kp_per_min2 / MINUTE**2, kd=cfg.kd_per_min / MINUTE,
+                 delta_max=p.delta_max,
+                 integral_gain=cfg.integral_gain * NAUTICAL_MILE / MINUTE,
+                 rate_from_positions=not cfg.knows_disturbance, **_known_disturbance(cfg, scenario))
 
 
 def disturbance(d, path: WaypointPath, current=None):
-    """b_r, the current and the optional wave noise of note 000-0.6 (A9–A11), in SI.
-
-    The current is the scenario's ``current`` section when it has one (``current``): an earth-fixed
-    field object
-    (uniform, Gauss–Markov, gridded) in :class:`~shipgnc.environment.current_field.CurrentDisturbance`
-    beside the yaw channel (:class:`~shipgnc.models.mariner.MarinerYawDisturbance`), as on the other
-    vessels; else document 000's cross current d_y (:class:`~shipgnc.environment.current.CrossCurrent`,
-    across the active leg or along east). ``d`` None: no b_r and no waves (None without a
-    current)."""
+    """The force part of note 000-0.6's disturbance (A9–A11), in SI: b_r and the optional wave
+    noise on ṙ, with document 000's cross current d_y
+    (:class:`~shipgnc.environment.current.CrossCurrent`, across the active leg of ``path`` or
+    along east) — :class:`~shipgnc.models.mariner.MarinerDisturbance` — or, when the scenario has
+    a ``current`` section (``current`` not None: an earth-fixed field, composed beside this part by
+    :class:`~shipgnc.environment.current_field.CurrentDisturbance` as on the other vessels), the
+    yaw channel alone (:class:`~shipgnc.models.mariner.MarinerYawDisturbance`; d_y must be 0)."""
     from shipgnc.environment.current import CrossCurrent
-    from shipgnc.environment.current_field import CurrentDisturbance
     from shipgnc.environment.filtered_noise import SecondOrderNoise
     from shipgnc.errors import require
     from shipgnc.models.mariner import MarinerDisturbance, MarinerYawDisturbance
 
     waves = None
-    if d is not None and d.wave_sigma > 0:  # the literal σ_w, or calibrated to a heading RMS
+    if d.wave_sigma > 0:  # the literal σ_w, or calibrated to a heading RMS
         waves = SecondOrderNoise(d.wave_sigma, d.wave_period, d.wave_zeta)
-    b_r = 0.0 if d is None else d.b_r
     if current is not None:
-        require(d is None or d.d_y_nm_min == 0.0, "disturbance.d_y_nm_min", d and d.d_y_nm_min,
+        require(d.d_y_nm_min == 0.0, "disturbance.d_y_nm_min", d.d_y_nm_min,
                 "must be 0 with a current section (give the current once)")
-        field = current.build() if hasattr(current, "build") else current
-        return CurrentDisturbance(field, MarinerYawDisturbance(b_r, waves), n_force=1)
-    if d is None:
-        return None
-    return MarinerDisturbance(b_r, current=CrossCurrent(d.d_y, path, frame=d.current_frame),
+        return MarinerYawDisturbance(d.b_r, waves)
+    return MarinerDisturbance(d.b_r, current=CrossCurrent(d.d_y, path, frame=d.current_frame),
                               waves=waves)
+
+
+def disturbance_section(d, scenario: Scenario):
+    """The ``disturbance: {type: mariner}`` section's builder: :func:`disturbance` on the
+    scenario's path (its ``guidance`` section) and ``current`` section."""
+    return disturbance(d, mariner_path(scenario.guidance), scenario.current)
 
 
 def check(scenario: Scenario) -> None:
@@ -133,18 +157,3 @@ def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
     batch[:, 1] += rng.uniform(*mc.east_offset_nm, size=mc.runs) * NAUTICAL_MILE
     batch[:, 2] += deg(rng.uniform(*mc.heading_offset_deg, size=mc.runs))
     return batch
-
-
-def setup(scenario: Scenario, name: str, seed: int):
-    """The :class:`~shipgnc.scenarios.runner.Setup` of controller ``name``: the path-frame
-    controllers track the path themselves (no guidance object); the disturbance needs the path."""
-    from shipgnc.scenarios.runner import Setup, navigation, sampled
-
-    model, actuator, _ = vessel(scenario)
-    cfg = scenario.variants[name]
-    path = mariner_path(scenario.guidance)
-    d, current = scenario.disturbance, scenario.current
-    dist = None if d is None and current is None else disturbance(d, path, current)
-    return Setup(model, initial_states(scenario, seed), actuator,
-                 controller(sampled(cfg, scenario), model, path, scenario), None, dist, path=path,
-                 navigation=navigation(scenario, cfg))

@@ -42,8 +42,6 @@ class Setup:
     guidance: object | None
     disturbance: object | None
     u0: np.ndarray | None = None
-    #: the waypoint path of document 000's path-frame controllers (they track it themselves)
-    path: WaypointPath | None = None
     #: the run's own record for its metrics: document 004's case (a
     #: :class:`~shipgnc.cases.catamaran.CatamaranCase`), or document 002's sailed run
     #: (``(SailPlan, run key)`` of :mod:`shipgnc.scenarios.routing`)
@@ -206,9 +204,11 @@ def guidance_of(g):
     return C.resolve(build)(g)
 
 
-def disturbance_of(d, scenario: Scenario):
+def disturbance_of(d, scenario: Scenario, model=None):
     """The force disturbance ``d`` and the scenario's ``current`` composed once
-    (:class:`~shipgnc.environment.current_field.CurrentDisturbance`), or the force alone."""
+    (:class:`~shipgnc.environment.current_field.CurrentDisturbance`: ``model``'s disturbance
+    channels before its two current channels are the force's; 3 without a model), or the force
+    alone."""
     force = None
     if d is not None:
         build = C.DISTURBANCES[d.type].build
@@ -220,7 +220,8 @@ def disturbance_of(d, scenario: Scenario):
         return force
     from shipgnc.environment.current_field import CurrentDisturbance
 
-    return CurrentDisturbance(current.build(), force)
+    n_force = 3 if model is None else len(model.disturbances) - 2
+    return CurrentDisturbance(current.build(), force, n_force=n_force)
 
 
 def constant_force(d, scenario: Scenario):
@@ -275,9 +276,8 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
 
     ``seed`` draws a Monte Carlo batch's initial offsets (default: ``simulation.seed`` or 0).
     A catamaran scenario's ``variant`` is a run key: a controller's name, or a run of its case
-    builder (see :func:`shipgnc.scenarios.catamaran.setup`); a vessel whose registry entry has a ``setup`` of
-    its own (the Mariner's path-frame controllers) is set up by it; a route scenario's is a
-    sailed run (:func:`shipgnc.scenarios.routing.sail_setup`)."""
+    builder (see :func:`shipgnc.scenarios.catamaran.setup`); a route scenario's is a sailed run
+    (:func:`shipgnc.scenarios.routing.sail_setup`)."""
     if scenario.route is not None:
         from shipgnc.scenarios import routing
 
@@ -296,7 +296,8 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
     cfg = variants[name]
     return Setup(model, initial_states(scenario, seed), actuator,
                  controller_of(sampled(cfg, scenario), model, scenario),
-                 guidance_of(scenario.guidance), disturbance_of(scenario.disturbance, scenario), u0,
+                 guidance_of(scenario.guidance),
+                 disturbance_of(scenario.disturbance, scenario, model), u0,
                  navigation=navigation(scenario, cfg))
 
 

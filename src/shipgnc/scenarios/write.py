@@ -119,10 +119,10 @@ def figure_job(run: ScenarioRun, out: Path):
                    "laws": {k: getattr(s.controller, "law_number", None) for k, s in setups.items()}}
         return FigureJob(result=runs, out=out, title=run.scenario.name, kind="catamaran",
                          options=options)
-    if run.setup.path is not None:
+    if g is not None and g.type == "path":  # document 000's path frame
         from shipgnc.viz import path_tracking as pt
 
-        waypoints = run.setup.path.waypoints.tolist()
+        waypoints = run.setup.guidance.path.waypoints.tolist()
         if run.scenario.montecarlo is not None:
             return FigureJob(result={n: pt.montecarlo_series(run.result, n) for n in names}, out=out,
                              title=run.scenario.name, kind="montecarlo", waypoints=waypoints)

@@ -133,18 +133,20 @@ def sail_check(route, *, vessel: str = "auto", preset: str = "otter", dt: float 
         name = f"vectored-thrust boat ({preset}, {length:g} m), LOS through the waypoints"
     else:
         from shipgnc.control.feedback_linearization import LOS_DELTA, LOSFL
+        from shipgnc.guidance.path import PathGuidance
         from shipgnc.models.mariner import MarinerWitOppe
         from shipgnc.paths import WaypointPath
         from shipgnc.routing.sailing import mariner_sail, route_waypoints
 
         model = MarinerWitOppe()
         p, length = model.params, model.length
-        controller = LOSFL(p, WaypointPath(route_waypoints(adapter, len(adapter.xy))), Ts=dt,
-                           delta_los=LOS_DELTA if lookahead is None else lookahead, delta_max=p.delta_max,
+        controller = LOSFL(p, Ts=dt, delta_los=LOS_DELTA if lookahead is None else lookahead,
+                           delta_max=p.delta_max,
                            integral_gain=p.U / 4.0 if integral_gain is None else integral_gain,
                            rate_from_positions=True)
+        guidance = PathGuidance(WaypointPath(route_waypoints(adapter, len(adapter.xy))))
         ds = mariner_sail(adapter, route.plane.field, adapter.heading, dt=dt, t_end=t_end, backend=backend,
-                          model=model, controller=controller)[0]
+                          model=model, controller=controller, guidance=guidance)[0]
         name = (f"Mariner (document 000, {length:g} m, {p.U / KNOT:.4g} kn), integral LOS through the "
                 "waypoints")
     radius = ACCEPTANCE_LENGTHS * length
