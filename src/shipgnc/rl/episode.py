@@ -79,7 +79,7 @@ class BatchedEpisode:
             runs = run_kind(sc)
             self.reward_kind = CATAMARAN_REWARDS.get(runs)
             if self.reward_kind is None:
-                raise ConfigError(f"scenario {sc.name!r}: its runs ({runs}) have no per-sample "
+                raise ConfigError(f"scenario {sc.name!r} ({runs} runs) has no per-sample "
                                   f"reward; catamaran environments take one plant tracking one "
                                   f"yaw-rate or heading reference (a yaw-rate-fsm law with guidance "
                                   f"yaw-rate, yaw-rate-sine or heading-capture, e.g. scenarios "

@@ -144,6 +144,35 @@ class MarinerVesselConfig(Strict):
         return MarinerParams.from_paper_units(**self.params_paper).U
 
 
+class CatamaranThrusterConfig(Strict):
+    """``vessel.thruster``: the thruster lag (22) of document 004, T_t δ̇ = k_t v_a − δ (S8)."""
+
+    field_units: ClassVar[dict[str, str]] = {"T_t": "s", "k_t": "1"}
+
+    #: true lag time constant
+    T_t: Positive = 2.0
+    #: true gain
+    k_t: Positive = 1.0
+
+
+class CatamaranSpreadConfig(Strict):
+    """``vessel.spread``: ``n`` plants drawn from ``seed`` (S10, check 16), each factor uniform in
+    its [low, high] range, drawn in the order J, m_x, m_y."""
+
+    field_units: ClassVar[dict[str, str]] = {"J_factor": "1", "m_x_factor": "1", "m_y_factor": "1"}
+
+    #: number of ships (one batched run)
+    n: Annotated[int, Field(ge=1)] = 40
+    #: seed of the draws
+    seed: Annotated[int, Field(ge=0, lt=2**63)] = 10
+    #: range of the multiplier of J (yaw inertia)
+    J_factor: tuple[Positive, Positive] = (0.7, 1.3)
+    #: range of the multiplier of m_x
+    m_x_factor: tuple[Positive, Positive] = (0.9, 1.1)
+    #: range of the multiplier of m_y
+    m_y_factor: tuple[Positive, Positive] = (0.9, 1.1)
+
+
 class CatamaranVesselConfig(Strict):
     """``vessel`` for document 004's twin-azimuth catamaran: parameter preset (note 004-4.4).
 
@@ -178,35 +207,6 @@ class CatamaranVesselConfig(Strict):
         if self.low_speed != "continued":
             out["low_speed"] = self.low_speed
         return out
-
-
-class CatamaranThrusterConfig(Strict):
-    """``vessel.thruster``: the thruster lag (22) of document 004, T_t δ̇ = k_t v_a − δ (S8)."""
-
-    field_units: ClassVar[dict[str, str]] = {"T_t": "s", "k_t": "1"}
-
-    #: true lag time constant
-    T_t: Positive = 2.0
-    #: true gain
-    k_t: Positive = 1.0
-
-
-class CatamaranSpreadConfig(Strict):
-    """``vessel.spread``: ``n`` plants drawn from ``seed`` (S10, check 16), each factor uniform in
-    its [low, high] range, drawn in the order J, m_x, m_y."""
-
-    field_units: ClassVar[dict[str, str]] = {"J_factor": "1", "m_x_factor": "1", "m_y_factor": "1"}
-
-    #: number of ships (one batched run)
-    n: Annotated[int, Field(ge=1)] = 40
-    #: seed of the draws
-    seed: Annotated[int, Field(ge=0, lt=2**63)] = 10
-    #: range of the multiplier of J (yaw inertia)
-    J_factor: tuple[Positive, Positive] = (0.7, 1.3)
-    #: range of the multiplier of m_x
-    m_x_factor: tuple[Positive, Positive] = (0.9, 1.1)
-    #: range of the multiplier of m_y
-    m_y_factor: tuple[Positive, Positive] = (0.9, 1.1)
 
 
 CATAMARAN_BUILDERS = ("turn", "steps", "fixed-angle", "sine", "heading", "actuator", "montecarlo",
@@ -502,9 +502,10 @@ class YawRateFSMConfig(Strict):
     T_u: Positive | None = None
     h: Positive | None = None
     Ts: Positive | None = None
-    #: the thruster the law assumes, through the actuator inverse (23): lag time constant (null:
-    #: none, the law commands δ̇) and gain (null: 1)
+    #: the thruster lag the law assumes, through the actuator inverse (23) (null: none, the law
+    #: commands δ̇)
     T_a: Positive | None = None
+    #: the thruster gain the law assumes with ``T_a`` (null: 1)
     k_a: Positive | None = None
 
 

@@ -65,14 +65,15 @@ def check_sweepable(scenario) -> None:
                           "sweep catamaran-turn with --mc and --perturb instead")
     if scenario.runs is not None:  # a study runs every member of every run for simulation.t_end
         sim = scenario.simulation
-        for name, run in scenario.run_scenarios().items():
-            if (run.simulation.t_end, run.simulation.dt) != (sim.t_end, sim.dt):
-                raise ConfigError(f"scenario {scenario.name!r}: run {name!r} lasts "
-                                  f"{run.simulation.t_end:g} s at dt = {run.simulation.dt:g} s, the "
-                                  f"scenario simulation.t_end = {sim.t_end:g} s at dt = {sim.dt:g} s, "
-                                  "and a study runs every member for one duration: --set "
-                                  f"runs.{name}.simulation.t_end={sim.t_end:g} (and the same for "
-                                  "the other runs of their own duration) to sweep it")
+        own = {name: run.simulation for name, run in scenario.run_scenarios().items()
+               if (run.simulation.t_end, run.simulation.dt) != (sim.t_end, sim.dt)}
+        if own:
+            name, first = next(iter(own.items()))
+            fix = " ".join(f"--set runs.{n}.simulation.t_end={sim.t_end:g}" for n in own)
+            raise ConfigError(f"scenario {scenario.name!r}: run {name!r} lasts {first.t_end:g} s at "
+                              f"dt = {first.dt:g} s, the scenario simulation.t_end = {sim.t_end:g} s "
+                              f"at dt = {sim.dt:g} s, and a study runs every member for one "
+                              f"duration: {fix} to sweep it")
     if scenario.montecarlo is not None:
         raise ConfigError(f"scenario {scenario.name!r} has its own montecarlo section; sweep the "
                           "single-run scenario with --mc and --perturb instead")
