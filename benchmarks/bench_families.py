@@ -56,17 +56,10 @@ def family_setup(scenario_name: str):
     from shipgnc.scenarios.registry import load_scenario
 
     scenario = load_scenario(scenario_name)
-    sim = scenario.simulation
-    if scenario.vessel.model == "catamaran":
-        from shipgnc.scenarios.catamaran import cases
-
-        case = next(iter(cases(scenario).values()))
-        x0 = np.asarray(case.x0, dtype=float)
-        steps = round(case.t_end / case.dt)
-        return case.model, x0.reshape(-1, x0.shape[-1])[0], case.simulate_kwargs(), steps
-    from shipgnc.scenarios.runner import build
+    from shipgnc.scenarios.runner import build, simulation_of
 
     setup = build(scenario)
+    sim = simulation_of(scenario, setup)
     x0 = np.asarray(setup.x0, dtype=float)
     kwargs = {"dt": sim.dt, "controller": setup.controller, "actuator": setup.actuator,
               "guidance": setup.guidance, "disturbance": setup.disturbance, "u0": setup.u0}

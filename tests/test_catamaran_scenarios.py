@@ -20,7 +20,8 @@ KEYS = ("final_yaw_rate_rad_s", "final_delta_deg", "final_speed_mps", "turning_d
         "yaw_rate_settling_s", "yaw_rate_overshoot_pct", "max_delta_rate_deg_s", "events", "stable")
 
 
-#: the scenarios written as controller(s) and guidance; the others name a case builder
+#: the scenarios written as controller(s) and guidance; the others also as runs (or, the
+#: Monte Carlo batch, a vessel spread)
 CONTROLLED = ("catamaran-turn", "catamaran-sine", "catamaran-heading")
 
 
@@ -28,8 +29,10 @@ def test_every_scenario_is_built_in_and_shows():
     assert set(NAMES) <= set(builtin_names())
     for name in NAMES:
         result = CliRunner().invoke(app, ["show", name])
-        shown = ("controllers:", "guidance:") if name in CONTROLLED else ("builder:",)
+        shown = (("controllers:", "guidance:") if name in CONTROLLED
+                 else ("spread:", "controller:") if name == "catamaran-montecarlo" else ("runs:",))
         assert result.exit_code == 0 and all(s in result.stdout for s in shown), name
+        assert "builder:" not in result.stdout, name
 
 
 @pytest.mark.parametrize(("name", "builder", "options"), [
@@ -38,14 +41,14 @@ def test_every_scenario_is_built_in_and_shows():
     ("catamaran-heading", "heading", "{law: 21, psi_target: 0.8, omega_c: 0.0022}"),
 ])
 def test_controlled_scenarios_run_the_case_builders_runs(name, builder, options):
-    """A scenario of controller(s) and guidance runs what the case builder of the same runs runs:
-    the same runs, keys and metrics, and the same time series to the bit (document 004's laws,
-    references and gains, note 004-4.7)."""
+    """A scenario of controller(s) and guidance runs what the older ``case`` spelling of the same
+    runs runs (read as runs when loaded): the same runs, keys and metrics, and the same time
+    series to the bit (document 004's laws, references and gains, note 004-4.7)."""
     short = ["simulation.t_end=150"]
     controlled = run_scenario(name, overrides=short)
     as_case = ["controllers=null", "guidance=null", f"case={{builder: {builder}, options: {options}}}"]
     built = run_scenario(name, overrides=[*short, *as_case])
-    assert controlled.scenario.shape == "controlled" and built.scenario.shape == "case"
+    assert controlled.scenario.shape == built.scenario.shape == "controlled"
     assert controlled.metrics == built.metrics
     for var in ("r", "psi", "delta", "u"):
         assert (controlled.result[var].values == built.result[var].values).all(), var
@@ -85,18 +88,18 @@ def test_settings_reach_the_runs():
 
 
 def test_montecarlo_is_one_batch():
-    run = run_scenario("catamaran-montecarlo", overrides=["case.options.n=50", "simulation.t_end=120"])
+    run = run_scenario("catamaran-montecarlo", overrides=["vessel.spread.n=50", "simulation.t_end=120"])
     assert run.result.sizes["ship"] == 50
     assert run.metrics["runs"] == 50
     assert run.metrics["final_yaw_rate_max_error_rad_s"] < 1e-3  # every perturbed plant tracks ω*
 
 
 @pytest.mark.parametrize(("scenario", "overrides", "words"), [
-    ("catamaran-actuator", ["case.options.omegaa=0.1"], ["case.options.omegaa", "allowed", "omega"]),
-    ("catamaran-actuator", ["case.options.omega=fast"], ["case.options.omega", "number"]),
-    ("catamaran-actuator", ["case.builder=spin"], ["case.builder", "spin"]),
-    ("catamaran-actuator", ["controller={type: yaw-rate-fsm}"], ["controller", "does not use"]),
-    ("catamaran-steps", ["simulation.dt=0.1"], ["simulation.dt"]),
+    ("catamaran-actuator", ["runs.ideal.name=x"], ["runs.ideal.name", "a run overrides"]),
+    ("catamaran-actuator", ["runs.ideal.controller.law=22"], ["runs.ideal", "law", "22"]),
+    ("catamaran-actuator", ["runs={}"], ["runs", "empty"]),
+    ("catamaran-steps", ["simulation.dt=0.07"], ["simulation", "dt = 0.07"]),
+    ("boat-autopilot", ["case={builder: turn}"], ["case", "does not use"]),
     ("catamaran-turn", ["vessel.preset=navy"], ["vessel.preset", "navy"]),
     ("catamaran-turn", ["guidance.omega=fast"], ["guidance", "omega"]),
     ("catamaran-turn", ["guidance.omegaa=0.1"], ["guidance", "omegaa"]),

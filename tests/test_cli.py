@@ -186,7 +186,7 @@ def test_times_are_clean_numbers(tmp_path):
     (["show", "zermelo-paper", "--set", "simulation.t_end=5"], "simulation", "route, sail"),
     (["run", "zermelo-paper", "--set", "simulation.t_end=5", "--no-figures"], "simulation", "route"),
     (["show", "boat-los", "--set", "quality.lam=2"], "quality", "actuator"),
-    (["show", "catamaran-steps", "--set", "guidance.lookahead=5"], "guidance", "case"),
+    (["show", "catamaran-steps", "--set", "quality.lam=2"], "quality", "runs"),
     (["show", "cybership-calm", "--set", "montecarlo.runs=5"], "montecarlo", "quality"),
 ])
 def test_a_setting_the_scenario_does_not_use_is_refused(args, section, reads, tmp_path):

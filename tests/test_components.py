@@ -113,13 +113,15 @@ def test_a_metric_set_of_another_shape_is_refused():
 
 
 def test_a_catamaran_case_refuses_what_its_builder_sets_naming_where_it_goes():
-    for section, value, message in (
-            ("actuator", {"thrust_time_constant": 1.0}, r"actuator: the catamaran's thruster is set "
-                                                         r"in case\.options"),
+    for section, value, message in (  # the older spelling: a case builder's runs
+            ("actuator", {"thrust_time_constant": 1.0}, r"runs\.ideal: actuator: applies to vessel "
+                                                         r"model vectored-thrust-boat"),
             ("montecarlo", {"runs": 3}, r"montecarlo: a scenario with a case section takes its runs "
                                         r"from the case builder \(set them in case\.options\)"),
             ("guidance", {"type": "yaw-rate"}, r"guidance: a scenario with a case section")):
         data, source = raw_scenario("catamaran-actuator")
+        del data["runs"], data["guidance"]
+        data["case"] = {"builder": "actuator"}
         data[section] = value
         with pytest.raises(ConfigError, match=message):
             validate(data, source)
@@ -162,24 +164,23 @@ def test_the_runner_dispatches_by_the_registry():
 
 
 def test_show_of_a_catamaran_scenario_lists_what_a_set_can_change():
-    """``shipgnc show`` prints the fields that act on the run: a case's every builder option
-    (with its default); a scenario of controllers and guidance its sections' fields; neither the
-    initial state and integrator the runs do not read; a ``--set`` into one of those is refused
-    instead of being ignored."""
-    import inspect
-
+    """``shipgnc show`` prints the fields that act on the run: a scenario's runs as given; a
+    scenario of controllers and guidance its sections' fields; neither the initial state and
+    integrator the runs do not read; a ``--set`` into one of those is refused instead of being
+    ignored."""
     import yaml
 
-    from shipgnc.cases import catamaran as cases
+    from shipgnc.cases.catamaran import ACTUATOR_RUNS
     from shipgnc.scenarios.registry import load_scenario, scenario_yaml
 
     shown = yaml.safe_load(scenario_yaml(load_scenario("catamaran-actuator")))
     assert "initial_state" not in shown["simulation"] and "integrator" not in shown["simulation"]
     assert "sensors" not in shown and "actuator" not in shown and "controllers" not in shown
-    signature = inspect.signature(cases.actuator).parameters
-    expected = {k for k in signature if k not in ("preset_name", "vessel", "t_end", "dt")}
-    assert set(shown["case"]["options"]) == expected
-    assert shown["case"]["options"]["T_a"] == signature["T_a"].default
+    assert list(shown["runs"]) == ["ideal", *ACTUATOR_RUNS]  # S8's runs (note 004-4.7)
+    for key, (T_t, k_t) in ACTUATOR_RUNS.items():
+        assert shown["runs"][key]["vessel"]["thruster"] == {"T_t": T_t, "k_t": k_t}
+        assert shown["runs"][key]["controller"]["T_a"] == 2.0  # the law assumes T_a = 2 s, k_a = 1
+    assert "case" not in shown
     shown = yaml.safe_load(scenario_yaml(load_scenario("catamaran-heading")))
     assert "initial_state" not in shown["simulation"] and "case" not in shown
     assert shown["guidance"] == {"type": "heading-capture", "psi_target_rad": 0.8, "omega_c": 0.0022,

@@ -23,7 +23,6 @@ from shipgnc.errors import ConfigError
 from shipgnc.models.catamaran import EAST, NORTH, U, V
 from shipgnc.models.mariner import MarinerParams, MarinerWitOppe, MarinerYawDisturbance
 from shipgnc.routing.fields import SumField, UniformCurrent
-from shipgnc.scenarios import catamaran as SC
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build, run_scenario
 from shipgnc.scenarios.schema import CURRENT_VESSELS
@@ -49,15 +48,19 @@ def test_current_section_on_catamaran_and_mariner():
     assert set(CURRENT_VESSELS) == {"vectored-thrust-boat", "cybership2", "catamaran", "mariner"}
     cat = load_scenario("catamaran-turn", [f"current={UNIFORM}"])
     assert cat.current.field == UNIFORM
-    for case in SC.cases(cat).values():  # every run of the case, each with its own object
-        assert isinstance(case.disturbance, CurrentDisturbance)
-        case.disturbance.bind_model(case.model)  # as the simulator does at the run's start
-        assert case.disturbance.position_index == (NORTH, EAST)  # found by name
+    disturbances = [build(cat, name).disturbance for name in cat.variants]
+    assert len({id(d) for d in disturbances}) == 2  # every run with its own object
+    for name in cat.variants:
+        setup = build(cat, name)
+        assert isinstance(setup.disturbance, CurrentDisturbance)
+        setup.disturbance.bind_model(setup.model)  # as the simulator does at the run's start
+        assert setup.disturbance.position_index == (NORTH, EAST)  # found by name
     setup = build(cat)
     assert setup.disturbance is not None
     np.testing.assert_array_equal(setup.disturbance(0.0, setup.x0), [0, 0, 0, VN, VE])
     # without the section the catamaran's runs stay in calm water
-    assert all(c.disturbance is None for c in SC.cases(load_scenario("catamaran-turn")).values())
+    calm = load_scenario("catamaran-turn")
+    assert all(build(calm, name).disturbance is None for name in calm.variants)
 
     mar = load_scenario("mariner-los-fl", ["disturbance.d_y_nm_min=0", f"current={UNIFORM}"])
     d = build(mar).disturbance
@@ -164,8 +167,10 @@ def test_catamaran_turning_circle_drifts_by_current_times_time():
     ground, so the two agree to RK4's truncation error, O(dt⁴): halving dt divides it by ≈ 16."""
     def fixed(current):
         extra = [] if current is None else [f"current={current}"]
-        return SC.cases(load_scenario("catamaran-fixed-angle", ["simulation.t_end=300", *extra]))[
-            "fixed"]
+        scenario = load_scenario("catamaran-fixed-angle", ["simulation.t_end=300", *extra])
+        setup = build(scenario, "fixed")
+        return C.CatamaranCase("fixed", setup.model, setup.x0, setup.controller, setup.guidance,
+                               t_end=300.0, disturbance=setup.disturbance)
 
     errors = []
     for dt in (C.DT, C.DT / 2):

@@ -170,12 +170,10 @@ def fixed_angle(preset_name: str = DEFAULT_PRESET, t_end: float = T_END, delta: 
     ``delta`` [rad]: the document's 0.6 rad for the printed-sign presets; on a hull with the
     consistent sign (no steady turn at 0.6 rad) the angle of the steady turn at r = 0.036434 rad/s,
     the 0.6 rad run's rate in ``si``."""
-    from shipgnc.models.steady_turn import steady_state_at_angle, steady_turn
+    from shipgnc.models.steady_turn import steady_state_at_angle
 
     model = Catamaran.from_preset(preset_name, **(vessel or {}))
-    if delta is None:
-        delta = (FIXED_ANGLE if model.params.coriolis == "printed"
-                 else steady_turn(model, FIXED_ANGLE_RATE_SI).delta)
+    delta = fixed_angle_of(model, delta)
     same = steady_state_at_angle(model, delta).r
     return {
         "fixed": CatamaranCase("catamaran-fixed-angle/fixed", model, initial_state(delta0=delta), None,
@@ -185,6 +183,18 @@ def fixed_angle(preset_name: str = DEFAULT_PRESET, t_end: float = T_END, delta: 
         "law20@0.00072": yaw_rate_case("catamaran-fixed-angle/law20@0.00072", preset_name, 20, 0.00072,
                                        t_end=t_end, vessel=vessel),
     }
+
+
+def fixed_angle_of(model: Catamaran, delta: float | None = None) -> float:
+    """S5's thruster angle [rad] on ``model``: ``delta`` when given, else the document's 0.6 rad
+    on a printed-sign hull, and on the consistent hull (no steady turn at 0.6 rad) the angle of
+    the steady turn at r = 0.036434 rad/s, the 0.6 rad run's rate in ``si``."""
+    from shipgnc.models.steady_turn import steady_turn
+
+    if delta is not None:
+        return delta
+    return (FIXED_ANGLE if model.params.coriolis == "printed"
+            else steady_turn(model, FIXED_ANGLE_RATE_SI).delta)
 
 
 def sine(preset_name: str = DEFAULT_PRESET, law: int = 21, reading: str = "pi", t_end: float = T_END,

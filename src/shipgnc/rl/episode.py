@@ -53,9 +53,9 @@ REWARDS = ("heading-steps", "course-quality", "waypoints")
 BACKENDS = ("auto", "numpy", "compiled")
 #: an event that makes the compiled loop skip a member (one already done stays frozen)
 _SKIP = np.iinfo(np.int64).max
-#: document 004's runs an environment takes (:func:`~shipgnc.scenarios.catamaran.run_kind`: a
-#: case builder, or the builder a guidance type matches), with the kind of their per-sample reward
-#: (one plant and one reference for every run: the agent replaces the law)
+#: document 004's runs an environment takes (:func:`~shipgnc.scenarios.catamaran.run_kind`, by
+#: the guidance type), with the kind of their per-sample reward (one plant and one reference for
+#: every run: the agent replaces the law)
 CATAMARAN_REWARDS = {"turn": "yaw-rate", "sine": "yaw-rate", "heading": "heading"}
 
 
@@ -79,11 +79,11 @@ class BatchedEpisode:
             runs = run_kind(sc)
             self.reward_kind = CATAMARAN_REWARDS.get(runs)
             if self.reward_kind is None:
-                raise ConfigError(f"scenario {sc.name!r}: case builder {runs!r} has no per-sample "
-                                  f"reward; catamaran environments take a yaw-rate-fsm law with "
-                                  f"guidance yaw-rate, yaw-rate-sine or heading-capture, or case "
-                                  f"builders {', '.join(CATAMARAN_REWARDS)} (one plant tracking one "
-                                  "yaw-rate or heading reference)")
+                raise ConfigError(f"scenario {sc.name!r} ({runs} runs) has no per-sample "
+                                  f"reward; catamaran environments take one plant tracking one "
+                                  f"yaw-rate or heading reference (a yaw-rate-fsm law with guidance "
+                                  f"yaw-rate, yaw-rate-sine or heading-capture, e.g. scenarios "
+                                  f"catamaran-turn, catamaran-sine, catamaran-heading)")
         else:
             self.reward_kind = sc.metrics
         if not catamaran and sc.metrics not in REWARDS:
@@ -138,7 +138,9 @@ class BatchedEpisode:
         #: (index of psi, K*) of a catamaran heading case: K* and wrap(psi - K*) join the observation
         self._target = None
         if self.reward_kind == "heading":
-            self._target = (state_names.index("psi"), float(setup.case.heading_target))
+            from shipgnc.scenarios.catamaran import heading_target
+
+            self._target = (state_names.index("psi"), float(heading_target(setup)))
         self._i_delta = names(self.model.inputs).index("delta") if self.lam else None
         lower, upper = self.model.input_limits()
         self.action_low, self.action_high = np.asarray(lower, float), np.asarray(upper, float)

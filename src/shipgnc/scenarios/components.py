@@ -39,14 +39,9 @@ class VesselKind:
     takes a ``current`` section; ``sections``: other top-level sections it reads (e.g. the boat's
     ``actuator``); ``ignores``: dotted fields of those sections it does not read (a ``--set`` into
     one is refused, ``shipgnc show`` leaves it out); ``comparisons``: takes a ``controllers``
-    mapping. Optional hooks, each
-    ``"module:function"``: ``setup(scenario, variant, seed) -> Setup`` (a vessel whose whole set-up
-    is its own, e.g. document 004's cases), ``run(scenario, seed=, progress=,
-    on_divergence=, keep_interrupted=) -> ScenarioRun`` (a vessel whose runs are its own),
-    ``controller(cfg, model, scenario)`` (its own controller builder), ``initial_state(scenario,
-    seed) -> x0``, ``check(scenario)`` (rules of its own, raising ValueError). ``cases``: also
-    takes a ``case`` section (document 004's case builders: comparisons whose runs differ in
-    reference, plant or duration) in place of controller(s) and guidance."""
+    mapping. Optional hooks, each ``"module:function"``: ``controller(cfg, model, scenario)``
+    (its own controller builder), ``initial_state(scenario, seed) -> x0``, ``check(scenario)``
+    (rules of its own, raising ValueError)."""
 
     model: str
     config: type
@@ -58,9 +53,6 @@ class VesselKind:
     sections: tuple[str, ...] = ()
     ignores: tuple[str, ...] = ()
     comparisons: bool = True
-    cases: bool = False
-    setup: str | None = None
-    run: str | None = None
     controller: str | None = None
     initial_state: str | None = None
     check: str | None = None
@@ -69,24 +61,28 @@ class VesselKind:
 @dataclass(frozen=True)
 class ControllerKind:
     """A ``controller.type``: its section, the guidance types it needs (one of them; empty: none)
-    and its builder ``(cfg, model, scenario)`` (None: the vessel's own, :attr:`VesselKind.controller`
-    or :attr:`VesselKind.setup`)."""
+    and its builder ``(cfg, model, scenario)`` (None: the vessel's own, :attr:`VesselKind.controller`). ``continuous``: ``Ts`` null is a continuous law, which holds the
+    guidance object and reads it at every RK stage (not sampled at ``dt``); its builder is
+    ``(cfg, model, scenario, guidance)``."""
 
     type: str
     config: type
     guidance: tuple[str, ...] = ()
     build: str | None = None
+    continuous: bool = False
 
 
 @dataclass(frozen=True)
 class GuidanceKind:
     """A ``guidance.type``: its section, its builder ``(cfg) -> guidance`` (None: the vessel's
-    set-up reads it, e.g. document 004's references) and the vessel models it serves (None: any)."""
+    set-up reads it; ``reads_scenario``: ``(cfg, scenario)``, a
+    reference computed from the vessel) and the vessel models it serves (None: any)."""
 
     type: str
     config: type
     build: str | None = None
     vessels: tuple[str, ...] | None = None
+    reads_scenario: bool = False
 
 
 @dataclass(frozen=True)
@@ -113,6 +109,9 @@ class MetricKind:
     vessels: tuple[str, ...] | None = None
 
 
+#: document 004's yaw-rate references, which its continuous laws read at every RK stage
+_YAW_RATE_REFERENCES = ("yaw-rate", "yaw-rate-sine", "heading-capture", "steady-turn")
+
 CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
     ControllerKind("open-loop", S.OpenLoopConfig, build="shipgnc.scenarios.runner:open_loop_controller"),
     ControllerKind("heading-speed", S.HeadingSpeedConfig, guidance=("schedule", "los"),
@@ -125,8 +124,17 @@ CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
                    build="shipgnc.scenarios.mariner:fl_controller"),
     ControllerKind("los-fl", S.LOSFLConfig, guidance=("path",),
                    build="shipgnc.scenarios.mariner:los_fl_controller"),
-    ControllerKind("yaw-rate-fsm", S.YawRateFSMConfig,
-                   guidance=("yaw-rate", "yaw-rate-sine", "heading-capture")),
+    ControllerKind("yaw-rate-fsm", S.YawRateFSMConfig, guidance=_YAW_RATE_REFERENCES,
+                   build="shipgnc.scenarios.catamaran:fsm_controller", continuous=True),
+    ControllerKind("yaw-rate-place", S.YawRateBaselineConfig, guidance=_YAW_RATE_REFERENCES,
+                   build="shipgnc.scenarios.catamaran:baseline_controller", continuous=True),
+    ControllerKind("yaw-rate-pi-design", S.YawRateBaselineConfig, guidance=_YAW_RATE_REFERENCES,
+                   build="shipgnc.scenarios.catamaran:baseline_controller", continuous=True),
+    ControllerKind("yaw-rate-pi", S.YawRateBaselineConfig, guidance=_YAW_RATE_REFERENCES,
+                   build="shipgnc.scenarios.catamaran:baseline_controller", continuous=True),
+    ControllerKind("heading-lqr", S.HeadingLQRConfig, build="shipgnc.scenarios.catamaran:heading_lqr",
+                   continuous=True),
+    ControllerKind("fixed-angle", S.FixedAngleConfig, build="shipgnc.scenarios.catamaran:fixed_angle"),
 )}
 
 GUIDANCE: dict[str, GuidanceKind] = {k.type: k for k in (
@@ -135,11 +143,16 @@ GUIDANCE: dict[str, GuidanceKind] = {k.type: k for k in (
     GuidanceKind("course-schedule", S.CourseScheduleConfig, build="shipgnc.scenarios.runner:course_schedule"),
     GuidanceKind("path", S.PathConfig, build="shipgnc.scenarios.mariner:path_guidance",
                  vessels=("mariner",)),
-    # document 004's references: the law holds its reference (evaluated at every RK stage in
-    # continuous mode), so the catamaran's set-up builds them with the controller
-    GuidanceKind("yaw-rate", S.YawRateGuidanceConfig, vessels=("catamaran",)),
-    GuidanceKind("yaw-rate-sine", S.YawRateSineConfig, vessels=("catamaran",)),
-    GuidanceKind("heading-capture", S.HeadingCaptureConfig, vessels=("catamaran",)),
+    # document 004's references: a continuous law holds the object and evaluates it at every
+    # RK stage (ControllerKind.continuous)
+    GuidanceKind("yaw-rate", S.YawRateGuidanceConfig, vessels=("catamaran",),
+                 build="shipgnc.scenarios.catamaran:yaw_rate_reference"),
+    GuidanceKind("yaw-rate-sine", S.YawRateSineConfig, vessels=("catamaran",),
+                 build="shipgnc.scenarios.catamaran:sine_reference"),
+    GuidanceKind("heading-capture", S.HeadingCaptureConfig, vessels=("catamaran",),
+                 build="shipgnc.scenarios.catamaran:heading_capture"),
+    GuidanceKind("steady-turn", S.SteadyTurnGuidanceConfig, vessels=("catamaran",),
+                 build="shipgnc.scenarios.catamaran:steady_turn_reference", reads_scenario=True),
 )}
 
 DISTURBANCES: dict[str, DisturbanceKind] = {k.type: k for k in (
@@ -157,6 +170,7 @@ METRICS: dict[str, MetricKind] = {k.name: k for k in (
     MetricKind("course-quality", "controlled", guidance="course-schedule", sections=("quality",)),
     MetricKind("path-tracking", "controlled", guidance="path"),
     MetricKind("catamaran", vessels=("catamaran",)),
+    MetricKind("catamaran-comparison", vessels=("catamaran",)),
     MetricKind("route", "route"),
     MetricKind("none"),
 )}
@@ -174,13 +188,14 @@ VESSEL_KINDS: dict[str, VesselKind] = {k.model: k for k in (
                initial_state="shipgnc.scenarios.mariner:initial_states",
                check="shipgnc.scenarios.mariner:check"),
     VesselKind("catamaran", S.CatamaranVesselConfig, "shipgnc.scenarios.catamaran:vessel_parts",
-               controllers=("yaw-rate-fsm",), current=True, cases=True,
+               controllers=("yaw-rate-fsm", "yaw-rate-place", "yaw-rate-pi-design", "yaw-rate-pi",
+                            "heading-lqr", "fixed-angle"), current=True,
                # its runs set their own initial state (document 004: u = 4 m/s, the rest 0)
                # and integrate with RK4 at their step
                ignores=("simulation.initial_state", "simulation.integrator", "simulation.method",
                         "simulation.rtol", "simulation.atol"),
-               setup="shipgnc.scenarios.catamaran:setup_of", run="shipgnc.scenarios.catamaran:run",
-               initial_state="shipgnc.scenarios.catamaran:initial_state"),
+               initial_state="shipgnc.scenarios.catamaran:initial_state",
+               check="shipgnc.scenarios.catamaran:check"),
     *(VesselKind(name, CatalogueVesselConfig, "shipgnc.vessels.scenario:vessel",
                  controllers=("course",), controller="shipgnc.vessels.scenario:controller",
                  initial_state="shipgnc.vessels.scenario:initial_state")
@@ -202,11 +217,6 @@ def having(flag: str) -> tuple[str, ...]:
     section named ``flag``."""
     return tuple(name for name, kind in VESSEL_KINDS.items()
                  if getattr(kind, flag, False) is True or flag in kind.sections)
-
-
-def having_cases() -> tuple[str, ...]:
-    """The vessel models that take a ``case`` section."""
-    return tuple(name for name, kind in VESSEL_KINDS.items() if kind.cases)
 
 
 def config_classes(table: dict) -> tuple[type, ...]:

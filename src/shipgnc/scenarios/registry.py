@@ -105,9 +105,9 @@ def refuse_unused(scenario: Scenario, keys) -> None:
             reads = [s for s in used if s not in ("name", "description", "document", "metrics",
                                                   "document_figures")]
             hint = ""
-            if section == "case" and scenario.kind.cases:  # the catamaran's earlier shape
-                hint = (f"; {scenario.name} is written with controllers and guidance (e.g. "
-                        "guidance.omega, guidance.psi_target_rad, controllers.NAME.Ts; "
+            if section == "case" and scenario.vessel.model == "catamaran":  # the older spelling
+                hint = (f"; {scenario.name} is written with controller(s), guidance and runs "
+                        "(e.g. guidance.omega, guidance.psi_target_rad, controllers.NAME.Ts; "
                         "shipgnc show lists them)")
             raise ConfigError(f"--set {key}: scenario {scenario.name!r} does not use the section "
                               f"{section!r}, so the setting would be ignored; its sections: "
@@ -190,8 +190,8 @@ def scenario_yaml(scenario: Scenario) -> str:
     scenario, with its value or default, so that each line is one a ``--set`` can change;
     sections it does not read (:meth:`Scenario.used_sections`: ``actuator`` beyond the boat,
     ``quality`` beyond document 003's index, ``vessel`` of a route) and fields its vessel
-    ignores (:meth:`Scenario.ignored_fields`) are left out. A catamaran case's ``options`` list
-    every option of its builder with its default (``t_end`` and ``dt`` come from ``simulation``).
+    ignores (:meth:`Scenario.ignored_fields`) are left out; ``runs`` as given (a ``case``
+    section, the older spelling, printed as the runs it makes).
     Each field's unit is a comment after it, and the vessel's optional fields not set are listed
     commented out (:func:`~shipgnc.scenarios.commented.commented_yaml`)."""
     from shipgnc.scenarios.commented import commented_yaml
@@ -207,10 +207,4 @@ def scenario_yaml(scenario: Scenario) -> str:
             node = node.get(part, {}) if isinstance(node, dict) else {}
         if isinstance(node, dict):
             node.pop(leaf, None)
-    if scenario.shape == "case":
-        from shipgnc.scenarios.catamaran import builder_options
-
-        defaults = {k: v for k, v in builder_options(scenario.case.builder).items()
-                    if k not in ("t_end", "dt")}
-        data["case"]["options"] = {**defaults, **data["case"].get("options", {})}
     return commented_yaml(yaml.safe_dump(data, sort_keys=False), scenario)

@@ -42,14 +42,14 @@ class Setup:
     guidance: object | None
     disturbance: object | None
     u0: np.ndarray | None = None
-    #: the run's own record for its metrics: document 004's case (a
-    #: :class:`~shipgnc.cases.catamaran.CatamaranCase`), or document 002's sailed run
-    #: (``(SailPlan, run key)`` of :mod:`shipgnc.scenarios.routing`)
+    #: the run's own record for its metrics: document 002's sailed run (``(SailPlan, run key)``
+    #: of :mod:`shipgnc.scenarios.routing`)
     case: object | None = None
     #: sensors and estimator between the true state and the controller, or None
     navigation: object | None = None
     #: the run's own step and duration (a ``SimulationConfig``: document 002's sailed runs, whose
-    #: duration follows the route); None: the scenario's ``simulation`` section
+    #: duration follows the route, a run of ``runs`` with a duration of its own); None: the
+    #: scenario's ``simulation`` section
     simulation: object | None = None
 
 
@@ -110,7 +110,7 @@ def vessel_parts(scenario: Scenario):
 
 def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
     """x0 of the scenario's vessel: the registry entry's own (the Mariner's Monte Carlo batch,
-    a catalogue vessel's steady run, a catamaran case's first run), else
+    a catalogue vessel's steady run, document 004's start), else
     (north, east, ψ, u, v, r) from ``simulation.initial_state``."""
     kind = scenario.kind
     if kind.initial_state is not None:
@@ -121,16 +121,19 @@ def initial_states(scenario: Scenario, seed: int) -> np.ndarray:
 
 def sampled(cfg, scenario: Scenario):
     """The controller config with its sampling period resolved: ``Ts`` left out (None) follows
-    ``simulation.dt`` (a controller that samples at every step)."""
-    if getattr(cfg, "Ts", 0.0) is None:
+    ``simulation.dt`` (a controller that samples at every step), except for a continuous law
+    (:attr:`~shipgnc.scenarios.components.ControllerKind.continuous`)."""
+    if getattr(cfg, "Ts", 0.0) is None and not C.CONTROLLERS[cfg.type].continuous:
         return cfg.model_copy(update={"Ts": scenario.simulation.dt})
     return cfg
 
 
-def controller_of(cfg, model, scenario: Scenario):
+def controller_of(cfg, model, scenario: Scenario, guidance=None):
     """The controller of section ``cfg``: the vessel entry's own builder, else the controller
-    entry's."""
+    entry's (a continuous law's is also handed the ``guidance`` object it reads)."""
     own = scenario.kind.controller
+    if C.CONTROLLERS[cfg.type].continuous:
+        return C.resolve(C.CONTROLLERS[cfg.type].build)(cfg, model, scenario, guidance)
     return C.resolve(own or C.CONTROLLERS[cfg.type].build)(cfg, model, scenario)
 
 
@@ -194,14 +197,17 @@ def course_schedule(g):
     return CourseSchedule([e.t for e in g.schedule], [deg(e.psi_deg) for e in g.schedule])
 
 
-def guidance_of(g):
-    """The guidance object of section ``g`` (None: none), by its registry entry."""
+def guidance_of(g, scenario: Scenario | None = None):
+    """The guidance object of section ``g`` (None: none), by its registry entry (one that
+    ``reads_scenario`` is handed the ``scenario``)."""
     if g is None:
         return None
-    build = C.GUIDANCE[g.type].build
-    if build is None:
+    kind = C.GUIDANCE[g.type]
+    if kind.build is None:
         raise ConfigError(f"guidance type {g.type!r}: read by its vessel's set-up, not built alone")
-    return C.resolve(build)(g)
+    if kind.reads_scenario:
+        return C.resolve(kind.build)(g, scenario)
+    return C.resolve(kind.build)(g)
 
 
 def disturbance_of(d, scenario: Scenario, model=None):
@@ -256,48 +262,55 @@ def wave_loads(d, scenario: Scenario):
 
 
 def variant_names(scenario: Scenario) -> list[str] | None:
-    """The names of a ``controller`` dimension: a comparison's controllers, or the run keys of a
-    catamaran scenario with several runs (e.g. laws 20 and 21; one run has none, as its
-    ``shipgnc run``); None for one run."""
+    """The names of a ``controller`` dimension: a comparison's controllers or the scenario's
+    ``runs`` (one run has none, as its ``shipgnc run``); None for one run."""
     if scenario.route is not None:  # the sailed runs (path, sail, legs), when it sails
         from shipgnc.scenarios import routing
 
         return routing.sail_runs(scenario) if scenario.sail is not None else None
-    if scenario.kind.run is not None:  # a vessel whose runs are its own
-        from shipgnc.scenarios import catamaran
+    names = list(run_plan(scenario))
+    return names if len(names) > 1 else None
 
-        keys = catamaran.run_keys(scenario)
-        return keys if len(keys) > 1 else None
-    return list(scenario.controllers) if scenario.controllers is not None else None
+
+def run_plan(scenario: Scenario) -> dict[str, tuple[Scenario, str | None]]:
+    """Each run of a (non-route) scenario by name: the scenario it runs and the controller
+    variant in it — a ``controllers`` entry, or a run of ``runs`` (its own scenario)."""
+    if scenario.runs is not None:
+        return {name: (run, None) for name, run in scenario.run_scenarios().items()}
+    return {name: (scenario, name) for name in scenario.variants}
 
 
 def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = None) -> Setup:
     """Instantiate the scenario's components for one controller ``variant`` (default: the first).
 
     ``seed`` draws a Monte Carlo batch's initial offsets (default: ``simulation.seed`` or 0).
-    A catamaran scenario's ``variant`` is a run key: a controller's name, or a run of its case
-    builder (see :func:`shipgnc.scenarios.catamaran.setup`); a route scenario's is a sailed run
+    With ``runs``, ``variant`` is a run's name (its ``simulation`` in ``Setup.simulation`` when
+    it differs from the scenario's); a route scenario's is a sailed run
     (:func:`shipgnc.scenarios.routing.sail_setup`)."""
     if scenario.route is not None:
         from shipgnc.scenarios import routing
 
         return routing.sail_setup(scenario, variant, seed or 0)
-    kind = scenario.kind
     seed = seed if seed is not None else (scenario.simulation.seed or 0)
-    if scenario.shape == "case":
-        return C.resolve(kind.setup)(scenario, variant, seed)
+    if scenario.runs is not None:
+        runs = scenario.run_scenarios()
+        name = variant if variant is not None else next(iter(runs))
+        if name not in runs:
+            raise ConfigError(f"run {name!r}: not in this scenario; have {', '.join(runs)}")
+        setup = build(runs[name], seed=seed)
+        if runs[name].simulation != scenario.simulation:
+            setup.simulation = runs[name].simulation
+        return setup
     variants = scenario.variants
     name = variant if variant is not None else next(iter(variants))
     if name not in variants:
         raise ConfigError(f"controller {name!r}: not in this scenario; have {', '.join(variants)}")
-    if kind.setup is not None:
-        return C.resolve(kind.setup)(scenario, name, seed)
     model, actuator, u0 = vessel_parts(scenario)
     cfg = variants[name]
+    guidance = guidance_of(scenario.guidance, scenario)
     return Setup(model, initial_states(scenario, seed), actuator,
-                 controller_of(sampled(cfg, scenario), model, scenario),
-                 guidance_of(scenario.guidance),
-                 disturbance_of(scenario.disturbance, scenario, model), u0,
+                 controller_of(sampled(cfg, scenario), model, scenario, guidance),
+                 guidance, disturbance_of(scenario.disturbance, scenario, model), u0,
                  navigation=navigation(scenario, cfg))
 
 
@@ -354,12 +367,12 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
         from shipgnc.scenarios import routing
 
         out = routing.sail_metrics(result, *setup.case)
-    elif scenario.metrics == "catamaran" and setup.case is not None:
+    elif scenario.metrics in ("catamaran", "catamaran-comparison"):
         from shipgnc.scenarios import catamaran
 
         # the events of the member's own run: those in result.attrs, else its logged δ (a batch's
         # controller keeps one event list for all its ships)
-        out = catamaran.score(scenario, result, setup.case)
+        out = catamaran.score(scenario, result, setup)
     elif scenario.metrics == "stern-kick":
         out = metrics.stern_kick_metrics(result)
     elif scenario.metrics == "heading-steps":
@@ -473,7 +486,8 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     ``result.attrs["interrupted"] = 1`` and ``metrics["interrupted"] = True``).
 
     With ``controllers`` every variant runs on the same plant, guidance and disturbance (same
-    seed); the result gets a ``controller`` dimension and the metrics are keyed by controller.
+    seed); with ``runs`` each run is the scenario with the run's sections laid over it. With
+    several runs the result gets a ``controller`` dimension and the metrics are keyed by run.
     ``on_divergence="stop"`` keeps the partial result of a diverging run (flagged in
     ``result.attrs["diverged"]`` and ``metrics["diverged"]``) instead of raising; comparisons
     always keep going, since a controller that diverges is a finding, not an error.
@@ -485,7 +499,6 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     elif overrides:
         raise ConfigError("overrides apply to a scenario name or file, not to a Scenario object")
     sim = scenario.simulation
-    compare = scenario.controllers is not None
     # one sea for every controller of a comparison, also when no seed is given (recorded)
     seed = sim.seed if sim is not None and sim.seed is not None else int(
         np.random.SeedSequence().generate_state(1)[0])
@@ -493,19 +506,17 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         from shipgnc.scenarios import routing
 
         return routing.run(scenario, seed=seed)
-    if scenario.kind.run is not None:  # a vessel whose runs are its own (document 004's cases)
-        return C.resolve(scenario.kind.run)(scenario, seed=seed, progress=progress,
-                                            on_divergence=on_divergence,
-                                            keep_interrupted=keep_interrupted)
+    plan = run_plan(scenario)
+    compare = len(plan) > 1
     results, all_metrics, setups = {}, {}, {}
     run = _Interruptible()
-    for name in scenario.variants:
+    for name, (each, variant) in plan.items():
         if keep_interrupted and held():  # Ctrl-C after the last run finished: keep those done, no more
             run.interrupted = True
-            run.message = (f"interrupted after {len(results)} of {len(scenario.variants)} runs "
+            run.message = (f"interrupted after {len(results)} of {len(plan)} runs "
                            "(each complete)")
             break
-        setup = build(scenario, name, seed=seed)
+        setup, sim = build(each, variant, seed=seed), each.simulation
         # the metrics see every step: an unthinned record, thinned to log_every once scored
         every = scoring_log_every(setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every,
                                   scored=scenario.metrics is not None)
@@ -523,7 +534,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                     log_every=every, backend="numpy" if observer is not None else sim.backend,
                     on_divergence="stop" if compare else on_divergence,
                     attrs={"scenario": scenario.name, "controller": name, "seed": seed,
-                           **_vessel_attrs(setup.model, scenario)})
+                           **_vessel_attrs(setup.model, each)})
                 if keep_interrupted:  # finished: a Ctrl-C from now on keeps the complete result
                     hold()
         except DivergenceError as exc:  # a controller's note (e.g. poor margins) may say why
@@ -535,7 +546,9 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
             run.result.attrs["navigation_notes"] = "; ".join(setup.navigation.notes())
         if getattr(setup.controller, "notes", None) and run.result is not None:
             run.result.attrs["controller_notes"] = "; ".join(setup.controller.notes)
-        all_metrics[name] = run.metrics(lambda r, s=setup: compute_metrics(scenario, r, s))
+        if getattr(setup.controller, "events", None) is not None and run.result is not None:
+            run.result.attrs["events"] = json.dumps(list(setup.controller.events))  # kept in the file
+        all_metrics[name] = run.metrics(lambda r, s=setup, e=each: compute_metrics(e, r, s))
         results[name], setups[name] = thin(run.result, sim.log_every // every), setup
         if run.interrupted:
             break
@@ -605,6 +618,8 @@ def _vessel_attrs(model, scenario: Scenario) -> dict:
     if isinstance(model, VectoredThrustBoat):
         attrs.update(preset=scenario.vessel.preset, L_m=model.params.L_m, length=model.length,
                      beam=model.beam)
+    elif isinstance(getattr(scenario.vessel, "preset", None), str):  # e.g. document 004's hull
+        attrs["preset"] = scenario.vessel.preset
     return attrs
 
 

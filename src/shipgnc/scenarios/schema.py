@@ -11,9 +11,17 @@ allowed (:func:`format_validation_error`).
 from __future__ import annotations
 
 import math
-from typing import Annotated, ClassVar, Literal, Union
+from typing import Annotated, Any, ClassVar, Literal, Union
 
-from pydantic import Discriminator, Field, Tag, ValidationError, field_validator, model_validator
+from pydantic import (
+    Discriminator,
+    Field,
+    PrivateAttr,
+    Tag,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from shipgnc.config_types import Finite, Strict, format_validation_error
 from shipgnc.errors import ConfigError
@@ -63,6 +71,25 @@ ControllerConfig = _union_by_type(C.CONTROLLERS)
 GuidanceConfig = _union_by_type(C.GUIDANCE)
 DisturbanceConfig = _union_by_type(C.DISTURBANCES)
 MetricSet = Literal[tuple(C.METRICS)]
+#: the sections a run of ``runs`` may override (the scenario's identity, its metric set, a
+#: route and the runs themselves are the scenario's)
+RUN_SECTIONS = ("vessel", "actuator", "simulation", "controller", "guidance", "disturbance",
+                "current", "sensors", "estimator", "quality", "montecarlo")
+RunName = Annotated[str, Field(pattern=r"^[A-Za-z0-9_.@/\-]+$")]
+
+
+def merged(base: dict, override: dict) -> dict:
+    """``base`` with ``override`` laid over it: mappings merged key by key, except a section whose
+    ``type`` changes, which is replaced whole; any other value (``null`` too) replaces."""
+    out = dict(base)
+    for key, value in override.items():
+        old = out.get(key)
+        if (isinstance(old, dict) and isinstance(value, dict)
+                and value.get("type", old.get("type")) == old.get("type")):
+            out[key] = merged(old, value)
+        else:
+            out[key] = value
+    return out
 
 
 class Scenario(Strict):
@@ -83,9 +110,10 @@ class Scenario(Strict):
     disturbance: DisturbanceConfig | None = None
     quality: QualityConfig = Field(default_factory=QualityConfig)
     montecarlo: MonteCarloConfig | None = None
-    #: document 004's case builders (vessel model ``catamaran``), in place of controller(s) and
-    #: guidance, for comparisons whose runs differ in reference, plant or duration
-    case: CatamaranCaseConfig | None = None
+    #: runs by name, each a partial override of the sections above (:data:`RUN_SECTIONS`), e.g.
+    #: the reference, the plant or the duration: one result with a ``controller`` dimension keyed
+    #: by run, like ``controllers`` (``case``, document 004's older spelling, is read as runs)
+    runs: dict[RunName, dict[str, Any]] | None = None
     #: document 002's routing problem, and optionally a ship sailing the route
     route: RouteConfig | None = None
     sail: SailConfig | None = None
@@ -97,6 +125,10 @@ class Scenario(Strict):
     #: estimator between the sensors and the controller (the controller acts on its estimate)
     sensors: list[SensorConfig] = Field(default_factory=list)
     estimator: EstimatorConfig | None = None
+    #: each run of ``runs`` as a scenario of its own (set when validated)
+    _runs: dict | None = PrivateAttr(default=None)
+    #: written with the older ``case`` section (a ``--set case.options.…`` is then read)
+    _spelled_case: bool = PrivateAttr(default=False)
 
     @field_validator("current")
     @classmethod
@@ -118,42 +150,50 @@ class Scenario(Strict):
 
     @property
     def shape(self) -> str:
-        """``route`` (a route section), ``case`` (document 004's case builders) or ``controlled``
-        (vessel, controller(s), guidance, disturbance)."""
-        if self.route is not None:
-            return "route"
-        return "case" if self.case is not None else "controlled"
+        """``route`` (a route section) or ``controlled`` (vessel, controller(s), guidance,
+        disturbance; with ``runs``, one such set-up per run)."""
+        return "route" if self.route is not None else "controlled"
 
     @property
     def variants(self) -> dict[str, object]:
-        """Controllers by name (one unnamed controller is called ``controller``)."""
+        """Controllers by name (one unnamed controller is called ``controller``); with ``runs``,
+        each run's controller by run name."""
+        if self._runs is not None:
+            return {name: run.controller for name, run in self._runs.items()}
         return dict(self.controllers) if self.controllers else {"controller": self.controller}
 
+    def run_scenarios(self) -> dict[str, Scenario]:
+        """Each run of ``runs`` as the scenario it makes: the common sections with the run's laid
+        over them (:func:`merged`), validated as one."""
+        if self._runs is None:
+            raise ConfigError(f"scenario {self.name!r} has no runs section")
+        return dict(self._runs)
+
     def where(self, name: str) -> str:
-        """The field that holds controller ``name``: ``controller`` or ``controllers.NAME``."""
+        """The field that holds controller ``name``: ``controller``, ``controllers.NAME`` or
+        ``runs.NAME.controller``."""
+        if self.runs is not None:
+            return f"runs.{name}.controller"
         return "controller" if self.controller is not None else f"controllers.{name}"
 
     def used_sections(self) -> tuple[str, ...]:
         """The top-level sections this kind of scenario reads; a ``--set`` into any other would
         be silently ignored, so :func:`~shipgnc.scenarios.registry.load_scenario` refuses it.
         Every scenario reads its identity (``name``, ``description``, ``document``, ``metrics``,
-        ``document_figures``); a route reads ``route`` and ``sail``; a case (document 004's
-        builders) ``vessel``, ``simulation``, ``case`` and ``current``; the others their vessel,
+        ``document_figures``); a route reads ``route`` and ``sail``; the others their vessel,
         simulation, controller(s), guidance and disturbance, plus the sections their registry
         entry names (the boat's ``actuator``, the Mariner's ``montecarlo``), ``current`` and
-        ``sensors``/``estimator`` where the vessel takes them, and the metric set's (document
-        003's ``quality``)."""
+        ``sensors``/``estimator`` where the vessel takes them, the metric set's (document
+        003's ``quality``), and ``runs`` (``case``, its older spelling, where given)."""
         common = ("name", "description", "document", "metrics", "document_figures")
         if self.route is not None:
             return (*common, "route", "sail")
         kind = self.kind
-        used = [*common, "vessel", "simulation"]
-        if self.shape == "case":
+        used = [*common, "vessel", "simulation", "controller", "controllers", "guidance", "runs"]
+        if kind.disturbances:
+            used.append("disturbance")
+        if self._spelled_case:
             used.append("case")
-        else:
-            used += ["controller", "controllers", "guidance"]
-            if kind.disturbances:
-                used.append("disturbance")
         used += kind.sections
         if kind.current:
             used.append("current")
@@ -188,6 +228,22 @@ class Scenario(Strict):
         return scenario.model_copy(
             update={"simulation": sim.model_copy(update={"initial_state": init})})
 
+    @model_validator(mode="wrap")
+    @classmethod
+    def _older_case(cls, data, handler) -> Scenario:
+        """A ``case`` section (document 004's case builders) read as the ``runs`` it makes
+        (:func:`~shipgnc.scenarios.catamaran_case.case_as_runs`)."""
+        if not (isinstance(data, dict) and "case" in data):
+            return handler(data)
+        vessel = data.get("vessel")
+        if not isinstance(vessel, dict) or vessel.get("model") != "catamaran":
+            raise ValueError("case: document 004's case builders need vessel model 'catamaran'")
+        from shipgnc.scenarios.catamaran_case import case_as_runs
+
+        scenario = handler(case_as_runs(data))
+        scenario._spelled_case = True
+        return scenario
+
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
         self._consistent_navigation()
@@ -195,12 +251,9 @@ class Scenario(Strict):
             return self._consistent_route()
         if self.simulation is None:
             raise ValueError("simulation: required field is missing (dt, t_end, ...)")
+        if self.runs is not None:
+            return self._consistent_runs()
         kind = self.kind
-        if self.case is not None and not kind.cases:
-            raise ValueError(f"case: document 004's cases need vessel model "
-                             f"{' or '.join(map(repr, C.having_cases()))}, not {self.vessel.model!r}")
-        if self.shape == "case":
-            return self._consistent_case(kind)
         self._ignored_unset(kind)
         self._sections_fit(kind)
         self._controllers_fit(kind)
@@ -314,7 +367,7 @@ class Scenario(Strict):
     def _consistent_route(self) -> Scenario:
         if self.route is None:
             raise ValueError("sail: needs a route section (the route to sail)")
-        for name in ("controller", "controllers", "guidance", "disturbance", "montecarlo", "case"):
+        for name in ("controller", "controllers", "guidance", "disturbance", "montecarlo", "runs"):
             if getattr(self, name) is not None:
                 raise ValueError(f"{name}: a route scenario takes its route from the route section "
                                  "(and its ship from sail)")
@@ -322,20 +375,28 @@ class Scenario(Strict):
             raise ValueError(f"metrics = {self.metrics!r}: a route scenario reports 'route'")
         return self
 
-    def _consistent_case(self, kind: C.VesselKind) -> Scenario:
-        for name in ("controller", "controllers", "guidance", "disturbance", "montecarlo"):
-            if getattr(self, name) is not None:
-                raise ValueError(f"{name}: a scenario with a case section takes its runs from the "
-                                 "case builder (set them in case.options); or leave out case and "
-                                 "give controller(s) and guidance")
-        if self.actuator != ActuatorConfig():
-            raise ValueError("actuator: the catamaran's thruster is set in case.options")
-        self._ignored_unset(kind)
-        scores = [name for name, m in C.METRICS.items()
-                  if m.vessels is not None and self.vessel.model in m.vessels]
-        if self.metrics != "none" and self.metrics not in scores:
-            raise ValueError(f"metrics = {self.metrics!r}: a scenario with a case section reports "
-                             f"{' or '.join(map(repr, scores))}")
+    def _consistent_runs(self) -> Scenario:
+        """Each run: the common sections with the run's laid over them, validated as a scenario
+        of its own (every check above, per run)."""
+        if not self.runs:
+            raise ValueError("runs: empty; give at least one run (name: the sections it changes)")
+        if self.controllers is not None:
+            raise ValueError("controllers: with runs, each run gives its controller "
+                             "(runs.NAME.controller), or a common controller")
+        base = self.model_dump(mode="json", exclude_unset=True, exclude={"runs"})
+        runs = {}
+        for name, override in self.runs.items():
+            bad = [key for key in override if key not in RUN_SECTIONS]
+            if bad:
+                raise ValueError(f"runs.{name}.{bad[0]}: a run overrides the sections "
+                                 f"{', '.join(RUN_SECTIONS)}")
+            try:
+                runs[name] = type(self).model_validate(merged(base, override))
+            except ValidationError as exc:
+                parts = format_validation_error(exc, "run").removeprefix("scenario run: ").split("; ")
+                raise ValueError("; ".join(f"runs.{name}: {part.removeprefix('scenario: ')}"
+                                           for part in parts)) from None
+        self._runs = runs
         return self
 
 

@@ -144,6 +144,35 @@ class MarinerVesselConfig(Strict):
         return MarinerParams.from_paper_units(**self.params_paper).U
 
 
+class CatamaranThrusterConfig(Strict):
+    """``vessel.thruster``: the thruster lag (22) of document 004, T_t δ̇ = k_t v_a − δ (S8)."""
+
+    field_units: ClassVar[dict[str, str]] = {"T_t": "s", "k_t": "1"}
+
+    #: true lag time constant
+    T_t: Positive = 2.0
+    #: true gain
+    k_t: Positive = 1.0
+
+
+class CatamaranSpreadConfig(Strict):
+    """``vessel.spread``: ``n`` plants drawn from ``seed`` (S10, check 16), each factor uniform in
+    its [low, high] range, drawn in the order J, m_x, m_y."""
+
+    field_units: ClassVar[dict[str, str]] = {"J_factor": "1", "m_x_factor": "1", "m_y_factor": "1"}
+
+    #: number of ships (one batched run)
+    n: Annotated[int, Field(ge=1)] = 40
+    #: seed of the draws
+    seed: Annotated[int, Field(ge=0, lt=2**63)] = 10
+    #: range of the multiplier of J (yaw inertia)
+    J_factor: tuple[Positive, Positive] = (0.7, 1.3)
+    #: range of the multiplier of m_x
+    m_x_factor: tuple[Positive, Positive] = (0.9, 1.1)
+    #: range of the multiplier of m_y
+    m_y_factor: tuple[Positive, Positive] = (0.9, 1.1)
+
+
 class CatamaranVesselConfig(Strict):
     """``vessel`` for document 004's twin-azimuth catamaran: parameter preset (note 004-4.4).
 
@@ -162,9 +191,16 @@ class CatamaranVesselConfig(Strict):
     low_speed: Literal["continued", "literal"] = "continued"
     #: other :class:`CatamaranParams` overrides (SI), e.g. ``{J_zz: 4.0e6, T_v: 18000}``
     params: dict[str, Finite] = Field(default_factory=dict)
+    #: the plant's true thruster lag (22) (null: the ideal thruster, δ̇ = u); the controller's
+    #: model keeps the ideal one
+    thruster: CatamaranThrusterConfig | None = None
+    #: plant uncertainty: that many ships in one batched run, each with its own masses and
+    #: inertia (the controller's model keeps the nominal ones)
+    spread: CatamaranSpreadConfig | None = None
 
     def overrides(self) -> dict:
-        """Parameter overrides of the preset (the defaults left out)."""
+        """Parameter overrides of the preset (the defaults left out): the catamaran itself, plant
+        and the controller's model alike."""
         out = dict(self.params)
         if self.coriolis is not None:
             out["coriolis"] = self.coriolis
@@ -458,13 +494,58 @@ class YawRateFSMConfig(Strict):
     2.5 s for ``si`` and ``si-consistent``, 0.1 s and 0.0625 s for ``paper``); ``Ts`` [s]: a
     sampled law (null: continuous, the document's mode)."""
 
-    field_units: ClassVar[dict[str, str]] = {"T_u": "s", "h": "s", "Ts": "s"}
+    field_units: ClassVar[dict[str, str]] = {"T_u": "s", "h": "s", "Ts": "s", "T_a": "s",
+        "k_a": "1"}
 
     type: Literal["yaw-rate-fsm"]
     law: Literal[20, 21] = 21
     T_u: Positive | None = None
     h: Positive | None = None
     Ts: Positive | None = None
+    #: the thruster lag the law assumes, through the actuator inverse (23) (null: none, the law
+    #: commands δ̇)
+    T_a: Positive | None = None
+    #: the thruster gain the law assumes with ``T_a`` (null: 1)
+    k_a: Positive | None = None
+
+
+class YawRateBaselineConfig(Strict):
+    """``controller`` types ``yaw-rate-place`` (pole placement at the FSM's poles −1/T_u, −1/h),
+    ``yaw-rate-pi-design`` (a PI designed on the Nomoto model for the same poles, with
+    anti-windup) and ``yaw-rate-pi`` (law (20) with cos δ frozen, the PI of note 004-4.11.3):
+    document 004's comparison baselines on the nominal model, fed by the scenario's yaw-rate
+    guidance. ``T_u``, ``h`` [s]: null = the preset's (as ``yaw-rate-fsm``); ``Ts`` [s]: null =
+    continuous."""
+
+    field_units: ClassVar[dict[str, str]] = {"T_u": "s", "h": "s", "Ts": "s"}
+
+    type: Literal["yaw-rate-place", "yaw-rate-pi-design", "yaw-rate-pi"]
+    T_u: Positive | None = None
+    h: Positive | None = None
+    Ts: Positive | None = None
+
+
+class HeadingLQRConfig(Strict):
+    """``controller`` type ``heading-lqr``: the LQR heading autopilot of note 004-4.11.3 on the
+    nominal model, tracking the ramp of heading capture (17) to ``psi_target_rad`` (K*) at
+    ``omega_c`` [rad/s] itself (no guidance section)."""
+
+    field_units: ClassVar[dict[str, str]] = {"omega_c": "rad/s", "Ts": "s"}
+
+    type: Literal["heading-lqr"]
+    psi_target_rad: Finite = 0.8
+    omega_c: Positive = 0.0022
+    Ts: Positive | None = None
+
+
+class FixedAngleConfig(Strict):
+    """``controller`` type ``fixed-angle`` (S5): no law; the thruster starts at ``delta_rad`` and
+    stays there. null: the document's 0.6 rad for the printed-sign presets; on the consistent
+    hull (no steady turn at 0.6 rad) the angle of the steady turn at r = 0.036434 rad/s, the
+    0.6 rad run's rate in ``si``."""
+
+    type: Literal["fixed-angle"]
+    delta_rad: Finite | None = None
 
 
 # --------------------------------------------------------------------------- guidance
@@ -569,6 +650,14 @@ class YawRateSineConfig(Strict):
     type: Literal["yaw-rate-sine"]
     amplitude: Finite = 0.0072
     reading: Literal["pi", "literal"] = "pi"
+
+
+class SteadyTurnGuidanceConfig(Strict):
+    """A constant yaw-rate reference ω* equal to the hull's steady yaw rate at thruster angle
+    ``delta_rad`` (S5's "same angle" run); null: the ``fixed-angle`` controller's default angle."""
+
+    type: Literal["steady-turn"]
+    delta_rad: Finite | None = None
 
 
 class HeadingCaptureConfig(Strict):

@@ -59,18 +59,21 @@ def check_sweepable(scenario) -> None:
                               "members to sweep; sweep a scenario that sails its route (e.g. "
                               "zermelo-sail), or solve this one with shipgnc run")
         return
-    if scenario.shape == "case":  # its runs: runner.build's Setup of each run key
-        case, t_end = scenario.case, scenario.simulation.t_end
-        if case.builder == "montecarlo":
-            raise ConfigError(f"scenario {scenario.name!r} is itself one batched run of plant draws "
-                              "(its ships take the batch axis a study gives its members): sweep "
-                              "catamaran-turn with --mc and --perturb instead")
-        rate_end = case.options.get("t_end_rate", 300.0)
-        if case.builder == "compare" and isinstance(rate_end, (int, float)) and rate_end < t_end:
-            raise ConfigError(f"scenario {scenario.name!r}: its yaw-rate runs last "
-                              f"case.options.t_end_rate = {rate_end:g} s, its heading runs "
-                              f"simulation.t_end = {t_end:g} s, and a study runs every member for "
-                              f"simulation.t_end: --set case.options.t_end_rate={t_end:g} to sweep it")
+    if getattr(scenario.vessel, "spread", None) is not None:
+        raise ConfigError(f"scenario {scenario.name!r} is itself one batched run of plant draws "
+                          "(vessel.spread: its ships take the batch axis a study gives its members): "
+                          "sweep catamaran-turn with --mc and --perturb instead")
+    if scenario.runs is not None:  # a study runs every member of every run for simulation.t_end
+        sim = scenario.simulation
+        own = {name: run.simulation for name, run in scenario.run_scenarios().items()
+               if (run.simulation.t_end, run.simulation.dt) != (sim.t_end, sim.dt)}
+        if own:
+            name, first = next(iter(own.items()))
+            fix = " ".join(f"--set runs.{n}.simulation.t_end={sim.t_end:g}" for n in own)
+            raise ConfigError(f"scenario {scenario.name!r}: run {name!r} lasts {first.t_end:g} s at "
+                              f"dt = {first.dt:g} s, the scenario simulation.t_end = {sim.t_end:g} s "
+                              f"at dt = {sim.dt:g} s, and a study runs every member for one "
+                              f"duration: {fix} to sweep it")
     if scenario.montecarlo is not None:
         raise ConfigError(f"scenario {scenario.name!r} has its own montecarlo section; sweep the "
                           "single-run scenario with --mc and --perturb instead")
