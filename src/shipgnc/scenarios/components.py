@@ -61,8 +61,9 @@ class VesselKind:
 @dataclass(frozen=True)
 class ControllerKind:
     """A ``controller.type``: its section, the guidance types it needs (one of them; empty: none)
-    and its builder ``(cfg, model, scenario)`` (None: the vessel's own, :attr:`VesselKind.controller`). ``continuous``: ``Ts`` null is a continuous law, which holds the
-    guidance object and reads it at every RK stage (not sampled at ``dt``); its builder is
+    and its builder ``(cfg, model, scenario)`` (None: the vessel's own,
+    :attr:`VesselKind.controller`). ``continuous``: ``Ts`` null is a continuous law, which holds
+    the guidance object and reads it at every RK stage (not sampled at ``dt``); its builder is
     ``(cfg, model, scenario, guidance)``."""
 
     type: str
