@@ -130,10 +130,14 @@ def sampled(cfg, scenario: Scenario):
 
 
 def controller_of(cfg, model, scenario: Scenario):
-    """The controller of section ``cfg``: the vessel entry's own builder, else the controller
-    entry's."""
-    own = scenario.kind.controller
-    return C.resolve(own or C.CONTROLLERS[cfg.type].build)(cfg, model, scenario)
+    """The controller of section ``cfg``, by the controller entry's builder for the vessel's
+    capabilities (:func:`~shipgnc.scenarios.components.controller_builder`: e.g. a ``course``
+    controller is the heading autopilot on a vessel with a rudder state, document 003's law on
+    CyberShip II)."""
+    build = C.controller_builder(cfg.type, scenario.kind)
+    if build is None:
+        raise ConfigError(f"controller type {cfg.type!r}: built by its vessel's set-up, not alone")
+    return C.resolve(build)(cfg, model, scenario)
 
 
 def open_loop_controller(cfg, model, scenario: Scenario):
@@ -156,8 +160,9 @@ def course_controller(cfg, model, scenario: Scenario):
     from shipgnc.control import course
 
     if cfg.design is not None:
-        raise ConfigError("controller.design = 'auto': designs a catalogue vessel's heading "
-                          "autopilot (shipgnc vessels); give CyberShip II's gains or variant")
+        raise ConfigError("controller.design = 'auto': designs the heading autopilot of a vessel "
+                          "with a rudder state (the catalogue's, shipgnc vessels); give CyberShip "
+                          "II's gains or variant")
     params, propeller_rps = model.params, scenario.vessel.propeller_rps
     gains = cfg.gains()
     common = {"Ts": cfg.Ts, "propeller_rps": propeller_rps}
