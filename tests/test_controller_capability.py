@@ -99,9 +99,9 @@ def test_a_registered_controller_kind_steers_a_catalogue_vessel(rudder_hold_kind
     Fossen 2021 eq. 7.43): after 15 T the transient e^(−t/T) is below 1e-6."""
     K, T, delta = 0.05, 20.0, math.radians(10.0)
     scenario = load_scenario("mariner-cst-heading", [
-        "vessel={model: nomoto, K: 0.05, T: 20.0, speed_mps: 6.0}", "metrics=none",
+        f"vessel={{model: nomoto, K: {K}, T: {T}, speed_mps: 6.0}}", "metrics=none",
         "controller={type: rudder-hold, delta_deg: 10.0}", "guidance=null",
-        "simulation.t_end=300", "simulation.backend=numpy"])
+        f"simulation.t_end={15 * T}", "simulation.backend=numpy"])
     assert isinstance(build(scenario).controller, RudderHold)
     run = run_scenario(scenario)
     r = run.result["r"].values
