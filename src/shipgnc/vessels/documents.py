@@ -50,6 +50,7 @@ class DocumentVessel:
         design, (low, high) = self.speeds(model)
         rudder = rudder_limits(model)
         lower, upper = model.input_limits()
+        # astern: a thrust or propeller-speed input that may turn negative
         can_reverse = any(s.name in ("T", "n") and lo < 0 for s, lo in zip(model.inputs, lower,
                                                                           strict=True))
         return {"name": self.name, "title": self.title, "source": self.source,
