@@ -20,10 +20,12 @@ BY_VESSEL = {"vectored-thrust-boat": "boat-los", "cybership2": "cybership-calm",
 def _hooks():
     for table in (C.VESSEL_KINDS, C.CONTROLLERS, C.GUIDANCE, C.DISTURBANCES):
         for key, kind in table.items():
-            for hook in ("build", "setup", "run", "controller", "initial_state", "check"):
+            for hook in ("build", "setup", "run", "initial_state", "check"):
                 target = getattr(kind, hook, None)
                 if target is not None:
                     yield f"{key}.{hook}", target
+            for capability, target in getattr(kind, "by_capability", ()):
+                yield f"{key}.by_capability[{capability}]", target
 
 
 @pytest.mark.parametrize(("where", "target"), list(_hooks()))
@@ -34,6 +36,7 @@ def test_every_hook_names_a_function(where, target):
 def test_every_fit_names_a_registered_component():
     for kind in C.VESSEL_KINDS.values():
         assert set(kind.controllers) <= set(C.CONTROLLERS), kind.model
+        assert C.controller_types(kind), f"{kind.model}: no controller fits it"
         assert set(kind.disturbances) <= set(C.DISTURBANCES), kind.model
     for kind in C.CONTROLLERS.values():
         assert set(kind.guidance) <= set(C.GUIDANCE), kind.type
@@ -62,14 +65,15 @@ def test_a_controller_that_does_not_fit_is_refused_with_the_registry_s_list(vess
     data, source = raw_scenario(BY_VESSEL[vessel])
     validate(data, source)  # the scenario as built in
     kind = C.VESSEL_KINDS[vessel]
-    foreign = next(t for t in C.CONTROLLERS if t not in kind.controllers)
+    fitting = C.controller_types(kind)
+    foreign = next(t for t in C.CONTROLLERS if t not in fitting)
     changed = copy.deepcopy(data)
     changed.pop("controllers", None)
     minimal = {"open-loop": {"schedule": [{"t": 0, "T": 0, "alpha_deg": 0}]},
                "course": {"variant": "pd"}}.get(foreign, {})
     changed["controller"] = {"type": foreign, **minimal}
     with pytest.raises(ConfigError, match=rf"type '{foreign}' does not fit vessel model '{vessel}' "
-                                          rf"\(allowed: {', '.join(kind.controllers)}\)"):
+                                          rf"\(allowed: {', '.join(fitting)}\)"):
         validate(changed, source)
 
 
@@ -159,8 +163,10 @@ def test_the_runner_dispatches_by_the_registry():
 
     assert C.GUIDANCE["los"].build.endswith(":los_guidance")
     assert isinstance(build(load_scenario("boat-los")).guidance, LOSGuidance)
-    # a catalogue vessel's ``course`` controller is its entry's own hook, not document 003's law
+    # a ``course`` controller on a vessel with a rudder state is the heading autopilot (the
+    # builder for the capability the catalogue declares), on CyberShip II document 003's law
     assert isinstance(build(load_scenario("mariner-cst-heading")).controller, HeadingAutopilot)
+    assert not isinstance(build(load_scenario("cybership-calm")).controller, HeadingAutopilot)
 
 
 def test_show_of_a_catamaran_scenario_lists_what_a_set_can_change():

@@ -33,7 +33,11 @@ class Signal:
 
 @runtime_checkable
 class Model(Protocol):
-    """What the simulator needs from a vessel model."""
+    """What the simulator, the scenario runner and a study need from a vessel model: every model
+    of ``shipgnc vessels`` has it, the documents' (:mod:`shipgnc.models`) and the catalogue's
+    (:class:`shipgnc.vessels.base.CatalogueModel`, whose steering machine is part of the model:
+    state ``delta``, input ``delta_c``). A compiled loop also takes an optional ``kernel()``
+    (:mod:`shipgnc.kernels`)."""
 
     params: Any
     states: tuple[Signal, ...]
@@ -44,6 +48,10 @@ class Model(Protocol):
 
     def derivatives(self, x: np.ndarray, u: np.ndarray, d: np.ndarray | None = None) -> np.ndarray:
         """ẋ = f(x, u, d) for ``x`` of shape (..., n_states), ``u`` of shape (..., n_inputs)."""
+        ...
+
+    def input_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds of the inputs (``-inf``/``inf``: none)."""
         ...
 
 

@@ -36,7 +36,7 @@ def plant_params(model) -> dict:
     a catalogue vessel the numeric parameters of its ``vessel:`` section (e.g. ``Cb`` of a vessel
     built from main dimensions, which the built matrices no longer name)."""
     config = getattr(model, "vessel_config", None)
-    return config.scalar_params() if config is not None else model.params.as_dict()
+    return config.scalar_params(model) if config is not None else model.params.as_dict()
 
 
 def with_params(model, **changes: float):

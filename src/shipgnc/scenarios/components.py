@@ -39,9 +39,11 @@ class VesselKind:
     takes a ``current`` section; ``sections``: other top-level sections it reads (e.g. the boat's
     ``actuator``); ``ignores``: dotted fields of those sections it does not read (a ``--set`` into
     one is refused, ``shipgnc show`` leaves it out); ``comparisons``: takes a ``controllers``
-    mapping. Optional hooks, each ``"module:function"``: ``controller(cfg, model, scenario)``
-    (its own controller builder), ``initial_state(scenario, seed) -> x0``, ``check(scenario)``
-    (rules of its own, raising ValueError)."""
+    mapping; ``capabilities``: what the vessel offers a controller (:data:`RUDDER_STATE`: the
+    steering machine is in the model), so that a controller kind with a builder for a capability
+    (:attr:`ControllerKind.by_capability`) fits it without being listed in ``controllers``.
+    Optional hooks, each ``"module:function"``: ``initial_state(scenario, seed) -> x0``,
+    ``check(scenario)`` (rules of its own, raising ValueError)."""
 
     model: str
     config: type
@@ -53,24 +55,34 @@ class VesselKind:
     sections: tuple[str, ...] = ()
     ignores: tuple[str, ...] = ()
     comparisons: bool = True
-    controller: str | None = None
+    capabilities: tuple[str, ...] = ()
     initial_state: str | None = None
     check: str | None = None
+
+
+#: a vessel capability: the steering machine is part of the model (states ``psi`` at 2, ``r`` at 5,
+#: ``delta`` at 6, first input ``delta_c``, a steady straight run ``straight_state()``: the vessel
+#: catalogue's layout, :mod:`shipgnc.vessels.base`)
+RUDDER_STATE = "rudder-state"
 
 
 @dataclass(frozen=True)
 class ControllerKind:
     """A ``controller.type``: its section, the guidance types it needs (one of them; empty: none)
-    and its builder ``(cfg, model, scenario)`` (None: the vessel's own,
-    :attr:`VesselKind.controller`). ``continuous``: ``Ts`` null is a continuous law, which holds
-    the guidance object and reads it at every RK stage (not sampled at ``dt``); its builder is
-    ``(cfg, model, scenario, guidance)``."""
+    and its builder ``(cfg, model, scenario)``. ``continuous``: ``Ts`` null is a continuous law,
+    which holds the guidance object and reads it at every RK stage (not sampled at ``dt``); its
+    builder is ``(cfg, model, scenario, guidance)``.
+
+    ``by_capability``: ``(capability, "module:function")`` pairs, the builder for a vessel that
+    declares that capability (:attr:`VesselKind.capabilities`; the first that matches), in place of
+    ``build``; every vessel that declares one of them fits this type."""
 
     type: str
     config: type
     guidance: tuple[str, ...] = ()
     build: str | None = None
     continuous: bool = False
+    by_capability: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -118,7 +130,8 @@ CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
     ControllerKind("heading-speed", S.HeadingSpeedConfig, guidance=("schedule", "los"),
                    build="shipgnc.scenarios.runner:heading_speed_controller"),
     ControllerKind("course", S.CourseControllerConfig, guidance=("course-schedule",),
-                   build="shipgnc.scenarios.runner:course_controller"),
+                   build="shipgnc.scenarios.runner:course_controller",
+                   by_capability=((RUDDER_STATE, "shipgnc.vessels.autopilot:course_autopilot"),)),
     ControllerKind("lqr", S.PathLQRConfig, guidance=("path",),
                    build="shipgnc.scenarios.mariner:lqr_controller"),
     ControllerKind("fl", S.OutputFLConfig, guidance=("path",),
@@ -198,8 +211,7 @@ VESSEL_KINDS: dict[str, VesselKind] = {k.model: k for k in (
                initial_state="shipgnc.scenarios.catamaran:initial_state",
                check="shipgnc.scenarios.catamaran:check"),
     *(VesselKind(name, CatalogueVesselConfig, "shipgnc.vessels.scenario:vessel",
-                 controllers=("course",), controller="shipgnc.vessels.scenario:controller",
-                 initial_state="shipgnc.vessels.scenario:initial_state")
+                 capabilities=(RUDDER_STATE,), initial_state="shipgnc.vessels.scenario:initial_state")
       for name in CATALOGUE_VESSELS),
 )}
 
@@ -211,6 +223,25 @@ def of_vessel(model: str) -> VesselKind:
     except KeyError:
         raise ConfigError(f"vessel.model = {model!r}: unknown vessel model; allowed: "
                           f"{', '.join(VESSEL_KINDS)}") from None
+
+
+def controller_types(kind: VesselKind) -> tuple[str, ...]:
+    """The ``controller.type`` values that fit vessel ``kind``: those its entry lists, then those
+    with a builder for a capability it declares (in registry order)."""
+    served = (t for t, c in CONTROLLERS.items()
+              if any(cap in kind.capabilities for cap, _ in c.by_capability))
+    return tuple(dict.fromkeys((*kind.controllers, *served)))
+
+
+def controller_builder(type_: str, kind: VesselKind) -> str | None:
+    """The builder ``"module:function"`` of controller type ``type_`` on vessel ``kind``: the one
+    for the first capability the vessel declares (:attr:`ControllerKind.by_capability`), else the
+    type's own ``build``."""
+    entry = CONTROLLERS[type_]
+    for capability, target in entry.by_capability:
+        if capability in kind.capabilities:
+            return target
+    return entry.build
 
 
 def having(flag: str) -> tuple[str, ...]:

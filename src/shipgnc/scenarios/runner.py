@@ -129,12 +129,17 @@ def sampled(cfg, scenario: Scenario):
 
 
 def controller_of(cfg, model, scenario: Scenario, guidance=None):
-    """The controller of section ``cfg``: the vessel entry's own builder, else the controller
-    entry's (a continuous law's is also handed the ``guidance`` object it reads)."""
-    own = scenario.kind.controller
+    """The controller of section ``cfg``, by the controller entry's builder for the vessel's
+    capabilities (:func:`~shipgnc.scenarios.components.controller_builder`: e.g. a ``course``
+    controller is the heading autopilot on a vessel with a rudder state, document 003's law on
+    CyberShip II); a continuous law's builder is also handed the ``guidance`` object it reads."""
+    build = C.controller_builder(cfg.type, scenario.kind)
+    if build is None:
+        raise ConfigError(f"controller type {cfg.type!r}: no builder for vessel model "
+                          f"{scenario.kind.model!r}")
     if C.CONTROLLERS[cfg.type].continuous:
-        return C.resolve(C.CONTROLLERS[cfg.type].build)(cfg, model, scenario, guidance)
-    return C.resolve(own or C.CONTROLLERS[cfg.type].build)(cfg, model, scenario)
+        return C.resolve(build)(cfg, model, scenario, guidance)
+    return C.resolve(build)(cfg, model, scenario)
 
 
 def open_loop_controller(cfg, model, scenario: Scenario):
@@ -157,8 +162,9 @@ def course_controller(cfg, model, scenario: Scenario):
     from shipgnc.control import course
 
     if cfg.design is not None:
-        raise ConfigError("controller.design = 'auto': designs a catalogue vessel's heading "
-                          "autopilot (shipgnc vessels); give CyberShip II's gains or variant")
+        raise ConfigError("controller.design = 'auto': designs the heading autopilot of a vessel "
+                          "with a rudder state (the catalogue's, shipgnc vessels); give CyberShip "
+                          "II's gains or variant")
     params, propeller_rps = model.params, scenario.vessel.propeller_rps
     gains = cfg.gains()
     common = {"Ts": cfg.Ts, "propeller_rps": propeller_rps}

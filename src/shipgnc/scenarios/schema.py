@@ -327,15 +327,16 @@ class Scenario(Strict):
         if self.controllers is not None and not self.controllers:
             raise ValueError("'controllers' is empty")
         if self.controllers is not None and not kind.comparisons:
-            comparing = [n for n, k in C.VESSEL_KINDS.items() if k.comparisons and k.controllers]
+            comparing = [n for n, k in C.VESSEL_KINDS.items() if k.comparisons and C.controller_types(k)]
             raise ValueError(f"controllers: comparisons run on vessel models "
                              f"{', '.join(comparing)} in this release; for the "
                              f"{self.vessel.model} give one 'controller'")
+        fitting = C.controller_types(kind)
         for name, ctrl in self.variants.items():
             where = self.where(name)
-            if ctrl.type not in kind.controllers:
+            if ctrl.type not in fitting:
                 raise ValueError(f"{where}: type {ctrl.type!r} does not fit vessel model "
-                                 f"{self.vessel.model!r} (allowed: {', '.join(kind.controllers)})")
+                                 f"{self.vessel.model!r} (allowed: {', '.join(fitting)})")
             needs = C.CONTROLLERS[ctrl.type].guidance
             if needs and (self.guidance is None or self.guidance.type not in needs):
                 raise ValueError(f"{where}: type {ctrl.type!r} needs a guidance section of type "

@@ -80,7 +80,7 @@ def check_plant(perturb, model, flag: str = "--perturb") -> None:
     for p in plant:
         if p.param not in allowed:
             if p.param not in nominal:
-                why = f"the {kind} has no parameter {p.param!r}"
+                why = _missing(model, p.param)
             elif not _numeric(nominal[p.param]):
                 why = f"{PARAM_PREFIX}{p.param} of the {kind} is not a number"
             else:
@@ -100,6 +100,27 @@ def check_plant(perturb, model, flag: str = "--perturb") -> None:
                     raise ConfigError(f"{flag} {p}: members would draw {p.param} = {drawn:g}, "
                                       f"outside the model's range ({exc}); narrow the "
                                       "distribution") from None
+
+
+def _missing(model, name: str) -> str:
+    """Why ``model`` has no parameter ``name`` to perturb: a catalogue vessel's section may take
+    it but not give it (a default the builder works out, e.g. ``R66``; an alternative, e.g.
+    ``Cb`` beside the matrices), or give it as a matrix; else the model has none."""
+    config = getattr(model, "vessel_config", None)
+    if config is None:
+        return f"the {type(model).__name__} has no parameter {name!r}"
+    from shipgnc.vessels.catalogue import get_vessel
+
+    given = config.params()
+    if name in given:
+        return f"vessel.{name} of the {config.model} vessel section is not a number (a matrix)"
+    if name in config.optional_fields():
+        return (f"the {config.model} vessel section does not set {name} (give it there, "
+                f"vessel.{name}: VALUE, to perturb it about that value)")
+    if name in get_vessel(config.model).param_names:
+        return (f"the {config.model} vessel section with {', '.join(given)} does not take "
+                f"{name}")
+    return f"the {config.model} vessel has no parameter {name!r}"
 
 
 def member_params(study: Study, model, start: int, stop: int) -> dict[str, np.ndarray]:

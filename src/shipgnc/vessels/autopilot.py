@@ -11,6 +11,9 @@ is within the rudder limit (conditional integration, no wind-up). Further inputs
 
 Reads the catalogue state layout (``psi`` at index 2, ``r`` at 5; :mod:`shipgnc.vessels.base`)
 and the reference ``psi_d`` (e.g. :class:`~shipgnc.guidance.schedule.CourseSchedule`).
+
+:func:`course_autopilot` is the ``course`` controller's builder for a vessel that declares a rudder
+state (the registry's ``rudder-state`` capability: every catalogue vessel).
 """
 
 from __future__ import annotations
@@ -19,10 +22,13 @@ import math
 
 import numpy as np
 
-from shipgnc.errors import require
+from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
+
+#: the PD gains of ``controller: {type: course}`` left out: K_P [rad/rad], K_D [s]
+DEFAULT_KP, DEFAULT_KD = 1.0, 10.0
 
 
 class HeadingAutopilot:
@@ -88,3 +94,43 @@ def heading_autopilot_step(t, x, ref, z, p, cmd, sig):
     cmd[0] = delta_c
     for j in range(int(p[6])):
         cmd[1 + j] = p[7 + j]
+
+
+def course_autopilot(cfg, model, scenario=None) -> HeadingAutopilot:
+    """The heading autopilot of a ``course`` controller section ``cfg`` on a vessel with a rudder
+    state (``scenario`` unused: the gains are the section's).
+
+    ``variant: pd`` with ``Kp`` [rad of rudder per rad of heading error] and ``Kd`` [s] (defaults
+    1.0 and 10.0 s; gains whose linearised loop is unstable or has a phase margin under 30° get a
+    note), or ``design: auto`` with ``bandwidth`` [rad/s] and ``zeta``: gains designed for the
+    vessel (:mod:`shipgnc.vessels.autopilot_design`). The vessel's trim rudder is the feed-forward
+    δ₀ and its other inputs (propeller) are held at their straight-run values."""
+    from shipgnc.vessels.autopilot_design import check_loop, design_autopilot, design_model
+    from shipgnc.vessels.scenario import straight_inputs
+
+    if cfg.variant != "pd":
+        raise ConfigError(f"controller.variant = {cfg.variant!r}: document 003's sliding-mode laws "
+                          "are designed on CyberShip II; a vessel with a rudder state is steered by "
+                          "variant 'pd' (Kp, Kd, or design: auto)")
+    inputs = straight_inputs(model)
+    if getattr(cfg, "design", None) == "auto":
+        design = design_autopilot(model, bandwidth=cfg.bandwidth,
+                                  **({} if cfg.zeta is None else {"zeta": cfg.zeta}))
+        Kp, Kd = design.Kp, design.Kd
+        notes = [f"designed autopilot: Kp = {Kp:.4g}, Kd = {Kd:.4g} s; {design.check.describe()}"]
+    else:
+        Kp = DEFAULT_KP if cfg.Kp is None else cfg.Kp
+        Kd = DEFAULT_KD if cfg.Kd is None else cfg.Kd
+        notes = []
+        try:
+            check = check_loop(design_model(model), Kp, Kd)
+        except ConfigError:  # no linear design model (e.g. a pure integrator): nothing to note
+            check = None
+        if check is not None and check.poor:
+            notes.append(f"the autopilot's gains (Kp = {Kp:g}, Kd = {Kd:g} s) leave the linearised "
+                         f"loop with poor margins ({check.describe()}); controller: "
+                         "{type: course, design: auto} designs gains for this vessel")
+    pilot = HeadingAutopilot(Kp, Kd, Ts=cfg.Ts, delta_max=float(model.delta_max),
+                             trim=float(inputs[0]), hold=tuple(inputs[1:]))
+    pilot.notes = notes
+    return pilot

@@ -92,7 +92,21 @@ class VesselEntry:
                 "max_rudder_deg": math.degrees(self.max_rudder_rad),
                 "max_rudder_rate_deg_s": math.degrees(self.max_rudder_rate_rad_s),
                 "can_reverse": self.can_reverse, "states": list(self.states),
-                "params": list(self.param_names)}
+                "params": list(self.param_names),
+                "document": None, "source_kind": "paper", "presets": [], "inputs": self.inputs(),
+                "speed_note": "the source's range of validity"}
+
+    def inputs(self) -> list[dict]:
+        """The inputs with their unit and limits, of the model at its design speed (a model given
+        by its parameters, e.g. ``nomoto``, has the rudder command alone)."""
+        from shipgnc.vessels.base import RUDDER_INPUT
+        from shipgnc.vessels.documents import input_rows
+
+        try:
+            model = self.build()
+        except ConfigError:  # needs its parameters: the catalogue's rudder command
+            return input_rows((RUDDER_INPUT,), [-self.max_rudder_rad], [self.max_rudder_rad])
+        return input_rows(model.inputs, *model.input_limits())
 
 
 def _need(name: str, params: dict, keys: tuple[str, ...]) -> None:
@@ -225,6 +239,16 @@ register(VesselEntry(
     max_rudder_rad=math.radians(35.0), max_rudder_rate_rad_s=math.radians(65.0 / 28.0),
     can_reverse=False, builder=_linear,
     param_names=("M", "N", "B", "L", "T", "Cb", "R66", "xg", "T_surge")))
+
+
+def listing() -> dict[str, dict]:
+    """Every vessel a scenario may name, as :meth:`VesselEntry.row` dicts by name: the documents'
+    models (:mod:`shipgnc.vessels.documents`, each with its presets) first, then the catalogue's."""
+    from shipgnc.vessels.documents import document_vessels
+
+    rows = {name: vessel.row() for name, vessel in document_vessels().items()}
+    rows.update((name, entry.row()) for name, entry in VESSELS.items())
+    return rows
 
 
 def get_vessel(name: str) -> VesselEntry:

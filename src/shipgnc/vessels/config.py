@@ -4,6 +4,7 @@ writes."""
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, model_validator
@@ -126,11 +127,28 @@ class CatalogueVesselConfig(Strict):
         object.__setattr__(model, "vessel_config", self)  # frozen dataclass: set once, here
         return model
 
-    def scalar_params(self) -> dict[str, float]:
-        """The section's numeric parameters given (the matrices and ``speed_mps`` left out): what
-        a study may perturb as ``vessel.params.NAME``, e.g. ``Cb`` of a vessel built from its
-        main dimensions."""
-        return {k: float(v) for k, v in self.params().items() if isinstance(v, (int, float))}
+    def scalar_params(self, model=None) -> dict[str, float]:
+        """What a study may perturb as ``vessel.params.NAME``: the section's numeric parameters
+        given (e.g. ``Cb`` of a vessel built from its main dimensions; the matrices and
+        ``speed_mps`` left out), the steering machine's ``rudder_max_deg``,
+        ``rudder_rate_deg_s``, ``rudder_time_constant_s`` and the entry's other parameters the
+        model holds (e.g. the KVLCC2's ``T_n``) at the values of ``model`` (default: this section
+        built)."""
+        out = {k: float(v) for k, v in self.params().items()
+               if isinstance(v, (int, float)) and not isinstance(v, bool)}
+        from shipgnc.vessels.catalogue import get_vessel
+
+        model = self.build() if model is None else model
+        held = {"rudder_max_deg": math.degrees(model.delta_max),
+                "rudder_rate_deg_s": math.degrees(model.delta_rate),
+                "rudder_time_constant_s": model.T_delta}
+        for name in get_vessel(self.model).param_names:
+            value = getattr(model, name, None)
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                held[name] = value
+        for name, value in held.items():
+            out.setdefault(name, float(value))
+        return out
 
     def with_params(self, **changes: float):
         """The model rebuilt with some of :meth:`scalar_params` changed, validated as the file
@@ -140,10 +158,11 @@ class CatalogueVesselConfig(Strict):
         from shipgnc.config_types import format_validation_error
 
         allowed = self.scalar_params()
+        changes = {k: v for k, v in changes.items() if k not in allowed or v != allowed[k]}
         for key in changes:
             if key not in allowed:
-                raise ConfigError(f"vessel.params.{key}: not a parameter given in the {self.model} "
-                                  f"vessel section; allowed: {', '.join(sorted(allowed))}")
+                raise ConfigError(f"vessel.params.{key}: not a number of the {self.model} vessel "
+                                  f"section; allowed: {', '.join(sorted(allowed))}")
         try:
             config = type(self).model_validate({**self.model_dump(exclude_none=True), **changes})
         except ValidationError as exc:

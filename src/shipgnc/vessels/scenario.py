@@ -1,15 +1,12 @@
-"""Catalogue vessels in scenario files: ``vessel: {model: NAME, ...}`` (the runner's hooks).
+"""Catalogue vessels in scenario files: ``vessel: {model: NAME, ...}`` (their registry entry's
+builder and initial state).
 
-A scenario steers a catalogue vessel with ``controller: {type: course, variant: pd, Kp, Kd}``
-(gains in rad of rudder per rad of heading error and per rad/s of yaw rate; defaults 1.0 and
-10.0 s; gains whose linearised loop is unstable or has a phase margin under 30° get a note), or
-``controller: {type: course, design: auto, bandwidth, zeta}``: gains designed for the vessel
-(:mod:`shipgnc.vessels.autopilot_design`); and a ``course-schedule`` guidance:
-:class:`~shipgnc.vessels.autopilot.HeadingAutopilot`
-with the vessel's trim rudder as feed-forward and its other inputs (propeller) held at the
-straight-run values. The vessel starts in its steady straight run at ``vessel.speed_mps``
-(``model.straight_state``); ``initial_state`` places it (north, east, psi_deg) and may give a yaw
-rate or sway; its ``u`` must be left out (0), null or equal to the vessel's speed.
+Every catalogue vessel declares the capability ``rudder-state`` (its steering machine is in the
+model), so any controller kind with a builder for that capability steers it: the ``course``
+controller's is :func:`shipgnc.vessels.autopilot.course_autopilot`. The vessel starts in its
+steady straight run at ``vessel.speed_mps`` (``model.straight_state``); ``initial_state`` places
+it (north, east, psi_deg) and may give a yaw rate or sway; its ``u`` must be left out (0), null or
+equal to the vessel's speed.
 """
 
 from __future__ import annotations
@@ -19,8 +16,6 @@ import math
 import numpy as np
 
 from shipgnc.errors import ConfigError
-
-DEFAULT_KP, DEFAULT_KD = 1.0, 10.0
 
 
 def vessel(scenario):
@@ -58,38 +53,3 @@ def initial_state(scenario, seed: int | None = None) -> np.ndarray:
     x0[4] = x0[4] + init.v
     x0[5] = math.radians(init.r_deg_s)
     return x0
-
-
-def controller(cfg, model, scenario=None):
-    """The heading autopilot of a ``course`` controller config (variant ``pd`` only; ``scenario``
-    unused: the gains are the config's)."""
-    from shipgnc.vessels.autopilot import HeadingAutopilot
-
-    if cfg.type != "course" or cfg.variant != "pd":
-        raise ConfigError(f"controller: catalogue vessels are steered by type 'course', variant "
-                          f"'pd' (a heading autopilot), not {cfg.type!r} "
-                          f"{getattr(cfg, 'variant', '')!r}".rstrip())
-    from shipgnc.vessels.autopilot_design import check_loop, design_autopilot, design_model
-
-    inputs = straight_inputs(model)
-    if getattr(cfg, "design", None) == "auto":
-        design = design_autopilot(model, bandwidth=cfg.bandwidth,
-                                  **({} if cfg.zeta is None else {"zeta": cfg.zeta}))
-        Kp, Kd = design.Kp, design.Kd
-        notes = [f"designed autopilot: Kp = {Kp:.4g}, Kd = {Kd:.4g} s; {design.check.describe()}"]
-    else:
-        Kp = DEFAULT_KP if cfg.Kp is None else cfg.Kp
-        Kd = DEFAULT_KD if cfg.Kd is None else cfg.Kd
-        notes = []
-        try:
-            check = check_loop(design_model(model), Kp, Kd)
-        except ConfigError:  # no linear design model (e.g. a pure integrator): nothing to note
-            check = None
-        if check is not None and check.poor:
-            notes.append(f"the autopilot's gains (Kp = {Kp:g}, Kd = {Kd:g} s) leave the linearised "
-                         f"loop with poor margins ({check.describe()}); controller: "
-                         "{type: course, design: auto} designs gains for this vessel")
-    pilot = HeadingAutopilot(Kp, Kd, Ts=cfg.Ts, delta_max=float(model.delta_max),
-                             trim=float(inputs[0]), hold=tuple(inputs[1:]))
-    pilot.notes = notes
-    return pilot
