@@ -81,5 +81,6 @@ def autopilot(
                      soft_wrap=True)
         for line in d.lines():
             stdout.print(line, soft_wrap=True, markup=False)
-        stdout.print(f"scenario: controller: {{type: course, Kp: {d.Kp:.4g}, Kd: {d.Kd:.4g}}} or "
-                     "{type: course, design: auto}", soft_wrap=True, markup=False)
+        ts = f", Ts: {sample_time:g}" if sample_time > 0 else ""
+        stdout.print(f"scenario: controller: {{type: course, Kp: {d.Kp:.4g}, Kd: {d.Kd:.4g}{ts}}} "
+                     f"or {{type: course, design: auto{ts}}}", soft_wrap=True, markup=False)
