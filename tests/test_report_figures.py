@@ -116,7 +116,8 @@ SHORT = {
 #: a label's quantity and its unit in brackets: "heading ψ [deg]"
 UNIT = re.compile(r"\w.*\[[^\]]+\]")
 #: the unitless quantities figures may draw, with what they count
-UNITLESS = {"ships": "Monte Carlo members in a histogram bin"}
+UNITLESS = {"ships": "Monte Carlo members in a histogram bin",
+            "members": "sweep members in a histogram bin"}
 
 
 def _short(name: str) -> list[str]:
@@ -223,5 +224,21 @@ def test_trial_figures_are_ready_for_a_report(tmp_path, drawn):
     assert out.exit_code == 0, out.output
     assert {name for name, _ in drawn} >= {"turning_circle.png", "zigzag_10_10.png", "spiral.png",
                                            "pull_out.png"}
+    bad = [p for name, fig in drawn for p in _problems(name, fig)]
+    assert not bad, "\n".join(bad)
+
+
+def test_sweep_figure_is_ready_for_a_report(tmp_path, drawn):
+    """``shipgnc sweep``'s figure (a Monte Carlo over the initial heading) passes
+    :func:`_problems`."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+
+    out = CliRunner().invoke(app, ["sweep", "boat-autopilot", "--mc", "4", "--perturb",
+                                   "psi_deg=uniform:-10,10", "--set", "simulation.t_end=30",
+                                   "--out", str(tmp_path / "sweep")])
+    assert out.exit_code == 0, out.output
+    assert [name for name, _ in drawn] == ["sweep.png"]
     bad = [p for name, fig in drawn for p in _problems(name, fig)]
     assert not bad, "\n".join(bad)
