@@ -1,6 +1,9 @@
 """Figures a report can use: the sweep's panels are titled in words and their axes carry the
-metric's unit (from its name, the project's rule: a metric named ``*_deg`` is in degrees), and the
-course comparison keeps its labels inside the figure and names its one controller by its law."""
+metric's unit (from its name, the project's rule: a metric named ``*_deg`` is in degrees), the
+course comparison keeps its labels inside the figure and names its one controller by its law, and
+the figures of every built-in scenario, of ``shipgnc trial all`` and of ``shipgnc sweep``, opened
+as matplotlib artists, label every axis with a quantity and its unit, have titles and name their
+curves in a legend."""
 
 from __future__ import annotations
 
