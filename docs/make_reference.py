@@ -237,7 +237,8 @@ def scenario_page() -> str:
 
 #: the worked example of the vessel page: a 12 m workboat from its main dimensions
 EXAMPLE = {"vessel": {"model": "linear-3dof", "speed_mps": 5.14, "L": 12.0, "B": 4.0, "T": 1.2,
-                      "Cb": 0.5, "rudder_max_deg": 35.0, "rudder_rate_deg_s": 15.0}}
+                      "Cb": 0.5, "rudder_max_deg": 35.0, "rudder_rate_deg_s": 20.0,
+                      "rudder_time_constant_s": 0.2}}
 
 
 def vessel_page() -> str:
@@ -267,7 +268,9 @@ def vessel_page() -> str:
         "machine (" + ", ".join(f"`{p}`" for p in STEERING_PARAMS) + "), which every model "
         "takes. Fields left out keep the model's own values.",
         "For example, a 12 m workboat from its main dimensions (Clarke's regression for the "
-        "hydrodynamic derivatives), at 10 kn, with a 15 °/s steering machine:",
+        "hydrodynamic derivatives), at 10 kn, with a small craft's steering machine (20 °/s, "
+        "time constant 0.2 s: fast enough for `shipgnc design autopilot` to hold this "
+        "course-unstable hull):",
         f"```yaml\n{example}\n```",
         INTRO_UNITS,
         section_text(CatalogueVesselConfig, "vessel", set(), level="##"),

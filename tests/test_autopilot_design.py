@@ -9,6 +9,7 @@ and rate limit) against the linearised loop's settling time.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -34,6 +35,7 @@ KN = 1852 / 3600
 WORKBOAT = dict(L=12.0, B=4.0, T=1.2, Cb=0.5)        # 10 kn
 COASTER = dict(L=60.0, B=8.0, T=3.5, Cb=0.45)        # 12 kn
 TANKER = dict(L=300.0, B=50.0, T=18.0, Cb=0.8)       # 15 kn
+WORKBOAT_STEERING = dict(rudder_rate_deg_s=20.0, rudder_time_constant_s=0.2)
 runner = CliRunner()
 
 
@@ -63,18 +65,20 @@ def test_gains_are_fossens_pole_placement_on_a_nomoto_vessel():
     assert np.sort_complex(poles) == pytest.approx(np.sort_complex([expected, expected.conjugate()]))
 
 
-@pytest.mark.parametrize("name, speed, params", [
-    ("coaster 60 m", 12 * KN, COASTER),
-    ("tanker 300 m", 15 * KN, TANKER),
+@pytest.mark.parametrize("name, speed, params, dt", [
+    ("coaster 60 m", 12 * KN, COASTER, 0.5),
+    ("tanker 300 m", 15 * KN, TANKER, 0.5),
+    ("workboat 12 m", 10 * KN, WORKBOAT | WORKBOAT_STEERING, 0.1),
 ])
-def test_designed_loop_settles_a_20_degree_step(name, speed, params):
-    """The simulated vessel (rudder saturation and rate limit) settles within 2 % of a 20° step no
-    later than the linearised loop plus the time the rate limit can add: the rudder's travel to
-    its limit and back, 2 δ_max/δ̇_max; the rudder never beyond its limit."""
+def test_designed_loop_settles_a_20_degree_step(name, speed, params, dt):
+    """The simulated vessel (rudder saturation and rate limit, the autopilot sampled every dt)
+    settles within 2 % of a 20° step no later than the linearised loop plus the time the rate
+    limit can add: the rudder's travel to its limit and back, 2 δ_max/δ̇_max; the rudder never
+    beyond its limit. The workboat, course-unstable with a pole at 0.83 rad/s, with a small
+    craft's steering machine (20°/s, T_δ = 0.2 s), by the servo-aware rule."""
     ship = get_vessel("linear-3dof").build(speed, **params)
-    d = design_autopilot(ship)
+    d = design_autopilot(ship, sample_time=dt)
     assert d.check.stable and d.check.phase_margin_deg >= MIN_PHASE_MARGIN_DEG
-    dt = 0.5
     predicted = d.settling_time() + 2 * ship.delta_max / ship.delta_rate
     t_end = dt * math.ceil(1.5 * predicted / dt)
     inputs = straight_inputs(ship)
@@ -100,6 +104,49 @@ def test_workboat_is_refused_with_the_steering_machine_named():
         design_autopilot(ship)
     # the gains of the Mariner scenario leave it unstable or with no phase margin: noted in a run
     assert check_loop(dm, 1.0, 40.0).poor
+
+
+def test_workboat_refusals_name_the_numbers():
+    """Below ω_δ = p no PD holds the ship (Routh on s(s − p)(1 + s/ω_δ) + b(K_P + K_D s): the s²
+    coefficient ω_δ − p); just above it (15°/s, T_δ = 1 s: ω_δ = 1 rad/s) a PD can stabilise it,
+    but with a sensitivity peak above 1.93: refused with the best M_s found."""
+    ship = get_vessel("linear-3dof").build(10 * KN, **WORKBOAT)
+    with pytest.raises(ConfigError, match=r"p = 0\.827 rad/s.*ω_δ = 0\.232 rad/s") as slow:
+        design_autopilot(ship)
+    assert "\n" not in str(slow.value)
+    ship = get_vessel("linear-3dof").build(10 * KN, **WORKBOAT, rudder_rate_deg_s=15.0)
+    with pytest.raises(ConfigError, match=r"ω_δ = 1 rad/s.*too slow.*M_s = 2\.\d+, the design needs "
+                       r"M_s <= 1\.93"):
+        design_autopilot(ship)
+
+
+def _loop_from_the_matrices(ship, d, w, sample_time):
+    """L(jω) from the vessel's own M, N, B (sway–yaw): r/δ = [0 1](jωM + N)⁻¹B, the servo lag at
+    ω_δ = min(1/T_δ, δ̇_max/10°) and the hold as the exact delay e^(−jωT_s/2)."""
+    M, N, B = ship.M[1:, 1:], ship.N[1:, 1:], ship.B[1:, 0]
+    r = np.array([np.linalg.solve(1j * x * M + N, B)[1] for x in w])
+    wd = min(1 / ship.T_delta, ship.delta_rate / math.radians(10.0))
+    return (d.Kp + d.Kd * 1j * w) * r / (1j * w) / (1 + 1j * w / wd) * np.exp(-1j * w * sample_time / 2)
+
+
+def test_servo_aware_design_of_the_workboat_meets_its_margins():
+    """With a small craft's steering machine (20°/s, T_δ = 0.2 s) and the autopilot sampled at
+    10 Hz, Fossen's servo-free rule fails its check and the servo-aware rule's gains have, on the
+    loop built from the vessel's matrices (not the numerical linearisation, not python-control),
+    a sensitivity peak ≤ 1.93 and a phase margin ≥ 30° (the Padé hold and the frequency grid
+    allow 2 %); a 15 % larger K_P breaks the M_s bound (the largest K_P, locally)."""
+    ship = get_vessel("linear-3dof").build(10 * KN, **WORKBOAT, **WORKBOAT_STEERING)
+    d = design_autopilot(ship, sample_time=0.1)
+    assert d.rule == "servo-aware" and d.check.stable
+    w = np.logspace(-3, 2, 20000)
+    L = _loop_from_the_matrices(ship, d, w, 0.1)
+    assert np.max(1 / np.abs(1 + L)) <= 1.93 * 1.02
+    crossing = np.nonzero(np.diff(np.sign(np.abs(L) - 1)))[0]
+    pm = [180 + math.degrees(np.angle(L[i])) % 360 - 360 for i in crossing]
+    assert len(pm) == 1 and pm[0] >= 30 * 0.98 and d.check.phase_margin_deg >= 30
+    assert pm[0] == pytest.approx(d.check.phase_margin_deg, abs=1.0)
+    d_up = dataclasses.replace(d, Kp=1.15 * d.Kp)
+    assert np.max(1 / np.abs(1 + _loop_from_the_matrices(ship, d_up, w, 0.1))) > 1.93
 
 
 def test_cli_design_and_refusals(tmp_path):

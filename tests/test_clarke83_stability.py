@@ -74,3 +74,55 @@ def test_mariner_regression_yr_is_the_hydrodynamic_part_of_the_published_yr():
     hydro = COEFFICIENTS["Yr"] + COEFFICIENTS["m"]
     assert hydro == pytest.approx(0.00299, abs=1e-5)
     assert abs(yr_clarke - hydro) < 0.2 * hydro < abs(yr_clarke - COEFFICIENTS["Yr"])
+
+
+#: the 12 m workboat: L, B, T [m], C_b, 10 kn
+WORKBOAT = (12.0, 4.0, 1.2, 0.5, 10 * 1852 / 3600)
+
+
+def test_workboat_dimensions_by_hand():
+    """L/B = 3, B/T = 10/3, T/L = 0.1, C_b = 0.5: S = π·0.01 = 0.0314159;
+    −Y′_v/S = 1 + 0.4·0.5·10/3 = 1.666667; −N′_r/S = 0.25 + 0.039·10/3 − 0.56/3 = 0.193333;
+    −N′_v/S = 0.5 + 2.4·0.1 = 0.74; −Y′_r/S = −0.5 + 2.2/3 − 0.08·10/3 = −0.033333;
+    m′ = 2 C_b B T/L² = 0.033333, m′/S = 1.061033.
+    C′/S² = 1.666667·0.193333 − 0.74·(1.061033 − 0.033333) = 0.322222 − 0.760498 = −0.438276:
+    course-unstable; without the rigid body's −m′ (Fossen's MSS/PVS ``clarke83``)
+    0.322222 + 0.74·0.033333 = +0.346889, course-stable."""
+    L, B, T, Cb, U = WORKBOAT
+    assert _stability_index(U, L, B, T, Cb, 0.0) == pytest.approx(-0.438276, abs=2e-5)
+
+
+def test_workboat_matrices_against_the_peer_formulation():
+    """Fossen's PythonVehicleSimulator ``clarke83`` (and MSS ``clarke83.m``) for the workboat,
+    written out from the published regressions (Clarke, Gedling & Hine 1983) and its
+    dimensionalisation N = ½ρL²U·diag(1, 1, L)·N′·diag(1, 1, L), M_A likewise with ½ρL³,
+    I_z = m R66², R66 = 0.25 L: the sway–yaw inertia is the same; the damping differs only by
+    the rigid body's centripetal term m U in the sway equation's r column (the peer's N has
+    Clarke's hydrodynamic Y′_r alone). The yaw pole of the regression's model, from the hand-worked
+    prime matrices below (eigenvalue of −M′⁻¹N′ times U/L), is +0.827 rad/s: 1.93 in U/L, where
+    the peer's N gives a stable oscillatory pair."""
+    L, B, T, Cb, U = WORKBOAT
+    S = math.pi * (T / L) ** 2
+    m_prime = 2 * Cb * B * T / L**2
+    # −(derivative)/S from the regressions, worked by hand (test_workboat_dimensions_by_hand)
+    yvdot, yrdot, nvdot, nrdot = 0.7, 0.186667, 0.23, 0.001667
+    yv, yr, nv, nr = 1.666667, -0.033333, 0.74, 0.193333
+    iz_prime = m_prime * 0.25**2
+    q = 0.5 * RHO
+    scale_m = np.array([[L**3, L**4], [L**4, L**5]]) * q * S
+    scale_n = np.array([[L**2, L**3], [L**3, L**4]]) * q * U * S
+    m = RHO * Cb * L * B * T
+    M_peer = np.diag([m, m * 0.25**2 * L**2]) + scale_m * np.array([[yvdot, yrdot], [nvdot, nrdot]])
+    N_peer = scale_n * np.array([[yv, yr], [nv, nr]])
+    M, N = clarke83(U, L, B, T, Cb, 0.25 * L, 0.0, L)
+    assert M[1:, 1:] == pytest.approx(M_peer, rel=2e-4)
+    assert N[1:, 1:] - N_peer == pytest.approx(np.array([[0.0, m * U], [0.0, 0.0]]),
+                                               abs=2e-4 * np.abs(N_peer).max())
+    M_prime = np.diag([m_prime, iz_prime]) / S + np.array([[yvdot, yrdot], [nvdot, nrdot]])
+    N_prime = np.array([[yv, yr + m_prime / S], [nv, nr]])
+    poles = np.linalg.eigvals(-np.linalg.solve(M_prime, N_prime)) * U / L
+    assert poles.real.max() == pytest.approx(0.827, abs=2e-3)
+    peer = np.linalg.eigvals(-np.linalg.solve(M_prime, N_prime - np.array([[0, m_prime / S], [0, 0]])))
+    assert np.all(peer.real < 0) and np.all(peer.imag != 0)
+    ours = np.linalg.eigvals(-np.linalg.solve(M[1:, 1:], N[1:, 1:]))
+    assert ours.real.max() == pytest.approx(poles.real.max(), rel=1e-3)

@@ -1,10 +1,14 @@
 """Figures a report can use: the sweep's panels are titled in words and their axes carry the
-metric's unit (from its name, the project's rule: a metric named ``*_deg`` is in degrees), and the
-course comparison keeps its labels inside the figure and names its one controller by its law."""
+metric's unit (from its name, the project's rule: a metric named ``*_deg`` is in degrees), the
+course comparison keeps its labels inside the figure and names its one controller by its law, and
+the figures of every built-in scenario, of ``shipgnc trial all`` and of ``shipgnc sweep``, opened
+as matplotlib artists, label every axis with a quantity and its unit, have titles and name their
+curves in a legend."""
 
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -90,12 +94,40 @@ def test_course_comparison_keeps_its_labels_inside_and_names_the_law():
         assert extent.x0 >= box.x0 and extent.x1 <= box.x1 and extent.y1 <= box.y1, text.get_text()
 
 
-#: one built-in scenario per kind of figure a run writes (dashboard, stern-kick close-up, course
-#: comparison of one and of several controllers, path tracking, catamaran), shortened
-FIGURE_SCENARIOS = [("boat-stern-kick", 20), ("boat-los-gnss", 30), ("cybership-calm", 60),
-                    ("mariner-cst-heading", 100), ("mariner-lqr", 600), ("catamaran-turn", 30),
-                    ("catamaran-compare", 30)]
-UNIT = re.compile(r"\[[^\]]+\]")
+#: how each built-in scenario is shortened for the figure check (the figures' kinds, labels and
+#: legends do not depend on the length of the run): a simulated scenario runs ``simulation.t_end``
+#: = 30 s unless listed; Monte Carlo scenarios run a few members; routes a coarser level-set grid;
+#: every simulation on the numpy loop (no compilation on a cold kernel cache)
+SHORT = {
+    "mariner-compare": ["simulation.t_end=600"],
+    "mariner-fl-lookahead": ["simulation.t_end=600"],
+    "mariner-fl-paper": ["simulation.t_end=600"],
+    "mariner-los-ekf": ["simulation.t_end=600"],
+    "mariner-los-fl": ["simulation.t_end=600"],
+    "mariner-lqr": ["simulation.t_end=600"],
+    "mariner-cst-heading": ["simulation.t_end=100"],
+    "mariner-montecarlo": ["simulation.t_end=600", "montecarlo.runs=8"],
+    "mariner-montecarlo-wide": ["simulation.t_end=600", "montecarlo.runs=8"],
+    "cybership-calm": ["simulation.t_end=60"],
+    "catamaran-montecarlo": ["simulation.t_end=30", "case.options.n=20"],
+    "zermelo-paper": ["route.grid=0.2"],
+    "zermelo-shoal": ["route.grid=0.2"],
+    "zermelo-vortex": [],
+    "zermelo-sail": ["sail.backend=numpy"],
+    "zermelo-sail-mariner": ["sail.dt=1", "sail.backend=numpy"],
+}
+#: a label's quantity and its unit in brackets: "heading ψ [deg]"
+UNIT = re.compile(r"\w.*\[[^\]]+\]")
+#: the unitless quantities figures may draw, with what they count
+UNITLESS = {"ships": "Monte Carlo members in a histogram bin",
+            "members": "sweep members in a histogram bin"}
+
+
+def _short(name: str) -> list[str]:
+    items = SHORT.get(name, ["simulation.t_end=30"])
+    if any(item.startswith("simulation.") for item in items):
+        items = [*items, "simulation.backend=numpy"]
+    return items
 
 
 def _label(ax, axis: str) -> str:
@@ -109,31 +141,107 @@ def _label(ax, axis: str) -> str:
     return ""
 
 
-@pytest.mark.parametrize(("scenario", "t_end"), FIGURE_SCENARIOS)
-def test_every_axis_of_a_run_s_figures_has_labels_with_units(scenario, t_end, tmp_path, monkeypatch):
-    """The figures ``shipgnc run`` writes, opened as matplotlib artists: every axis that draws data
-    has an x and a y label (its own or its shared row's / column's), each with a unit in
-    brackets (every quantity these figures draw has one: time, position, speed, angle, rate,
-    force)."""
-    import shipgnc.viz.dashboard as dashboard
-    from shipgnc.scenarios.runner import run_scenario
-    from shipgnc.scenarios.write import write_outputs
-
-    monkeypatch.setenv("SHIPGNC_FIGURE_PROCESS", "0")  # drawn here, so that they can be opened
-    figures = []
-    save = dashboard.save_figure
-    monkeypatch.setattr(dashboard, "save_figure",
-                        lambda fig, path, *a, **k: figures.append((path.name, fig)) or save(fig, path, *a, **k))
-    run = run_scenario(scenario, overrides=[f"simulation.t_end={t_end}"])
-    write_outputs(run, tmp_path / "out", figures=True)
-    assert figures
+def _problems(name: str, fig) -> list[str]:
+    """What keeps ``fig`` from a report: every axis that draws data has an x and a y label (its
+    own or its shared row's / column's) naming a quantity with its unit in brackets (or a
+    documented unitless count, :data:`UNITLESS`), a title (its own, any of the three positions, or
+    the figure's), and an axis drawing several curves a legend in the figure naming them."""
+    suptitle = fig._suptitle.get_text() if fig._suptitle is not None else ""
+    legends = [*fig.legends, *(ax.get_legend() for ax in fig.axes if ax.get_legend() is not None)]
+    names = [t.get_text() for legend in legends for t in legend.get_texts()]
     bad = []
-    for name, fig in figures:
-        for ax in fig.axes:
-            if not ax.get_visible() or not (ax.lines or ax.collections or ax.patches or ax.images):
-                continue
-            for axis in ("x", "y"):
-                text = _label(ax, axis)
-                if not UNIT.search(text):
-                    bad.append(f"{name}: {axis} label {text!r} (panel {ax.get_title()!r})")
+    if any(not n.strip() or n.startswith("_") for n in names):
+        bad.append(f"{name}: a legend entry without a name: {names}")
+    for ax in fig.axes:
+        if not ax.get_visible() or not (ax.lines or ax.collections or ax.patches or ax.images):
+            continue
+        titles = [ax.get_title(loc=loc) for loc in ("left", "center", "right")]
+        where = f"panel {next((t for t in titles if t), '')!r} of {name}"
+        for axis in ("x", "y"):
+            text = _label(ax, axis)
+            if not (UNIT.search(text) or text in UNITLESS):
+                bad.append(f"{where}: {axis} label {text!r}")
+        if not any(titles) and not suptitle:
+            bad.append(f"{where}: no title")
+        curves = [line for line in ax.lines if len(line.get_xdata()) > 2]
+        if len(curves) >= 2 and not legends:
+            bad.append(f"{where}: {len(curves)} curves and no legend")
+    return bad
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures a command saves, as matplotlib figures (drawn in this process)."""
+    from matplotlib.figure import Figure
+
+    monkeypatch.setenv("SHIPGNC_FIGURE_PROCESS", "0")
+    figures = []
+    save = Figure.savefig
+
+    def keep(self, path, *args, **kwargs):
+        figures.append((Path(str(path)).name, self))
+        return save(self, path, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    return figures
+
+
+def test_the_figure_check_covers_every_built_in_scenario():
+    from shipgnc.scenarios.registry import builtin_names
+
+    assert set(SHORT) <= set(builtin_names())
+    assert len(builtin_names()) == len(set(builtin_names()))
+
+
+def _built_in_names() -> list[str]:
+    from shipgnc.scenarios.registry import builtin_names
+
+    return builtin_names()
+
+
+@pytest.mark.parametrize("scenario", _built_in_names())
+def test_every_built_in_scenario_s_figures_are_ready_for_a_report(scenario, tmp_path, drawn):
+    """``shipgnc run`` of every built-in scenario (shortened, :data:`SHORT`): its figures,
+    opened as matplotlib artists, pass :func:`_problems`."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+
+    sets = [arg for item in _short(scenario) for arg in ("--set", item)]
+    out = CliRunner().invoke(app, ["run", scenario, *sets, "--out", str(tmp_path / "run")])
+    assert out.exit_code == 0, out.output
+    assert drawn, "no figure"
+    bad = [p for name, fig in drawn for p in _problems(name, fig)]
+    assert not bad, "\n".join(bad)
+
+
+def test_trial_figures_are_ready_for_a_report(tmp_path, drawn):
+    """``shipgnc trial all``'s figures (turning circle, zig-zags, spiral, pull-out) pass
+    :func:`_problems`."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+
+    out = CliRunner().invoke(app, ["trial", "all", "--vessel", "mariner-cst", "--out",
+                                   str(tmp_path / "trials")])
+    assert out.exit_code == 0, out.output
+    assert {name for name, _ in drawn} >= {"turning_circle.png", "zigzag_10_10.png", "spiral.png",
+                                           "pull_out.png"}
+    bad = [p for name, fig in drawn for p in _problems(name, fig)]
+    assert not bad, "\n".join(bad)
+
+
+def test_sweep_figure_is_ready_for_a_report(tmp_path, drawn):
+    """``shipgnc sweep``'s figure (a Monte Carlo over the initial heading) passes
+    :func:`_problems`."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+
+    out = CliRunner().invoke(app, ["sweep", "boat-autopilot", "--mc", "4", "--perturb",
+                                   "psi_deg=uniform:-10,10", "--set", "simulation.t_end=30",
+                                   "--out", str(tmp_path / "sweep")])
+    assert out.exit_code == 0, out.output
+    assert [name for name, _ in drawn] == ["sweep.png"]
+    bad = [p for name, fig in drawn for p in _problems(name, fig)]
     assert not bad, "\n".join(bad)

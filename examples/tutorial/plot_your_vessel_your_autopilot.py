@@ -16,10 +16,16 @@ code gives today). The steps:
 7. the same path with the command line: a vessel file, its IMO trials, a scenario with the
    designed autopilot and a Monte Carlo study, each a command to copy.
 
-Download the script at the bottom of the page and change the dimensions to your ship's. The
-design refuses, in one line, a ship its steering machine cannot hold (e.g. a small beamy hull
-that Clarke's regressions make strongly course-unstable, with the large-ship rudder rate of
-2.32°/s): give such a vessel its own ``rudder_rate_deg_s`` and ``rudder_time_constant_s``.
+Download the script at the bottom of the page and change the dimensions to your ship's. A small
+beamy hull is a different animal: Clarke's regressions, extrapolated to a 12 m workboat
+(L 12 m, B 4 m, T 1.2 m, C_b 0.5, 10 kn; L/B = 3, T/L = 0.1), give a course-unstable ship with a
+yaw pole at +0.83 rad/s, 1.9 in units of U/L (the 300 m tanker of step 7 has 0.19), once the
+rigid body's centripetal terms are in the equations (Fossen's MSS ``clarke83`` leaves them out
+and calls the same hull course-stable). Such a ship needs a steering machine faster than its
+pole: with the large-ship rudder (2.32°/s, T_δ = 1 s) the design refuses it in one line naming
+both numbers; with a small craft's (``rudder_rate_deg_s: 20``, ``rudder_time_constant_s: 0.2``)
+and the autopilot sampled at 10 Hz, it designs the gains with the steering machine in the loop
+(step 3, and step 7's workboat).
 """
 
 # %%
@@ -154,7 +160,12 @@ fig.tight_layout()
 # K_P = Tω_n²/K, K_D = (2ζω_nT − 1)/K, K_I = ω_n K_P/10, for a bandwidth between :math:`1/|T|` (the
 # ship's own yaw dynamics) and the steering machine's (its time constant, and its rate limit over
 # 10° of rudder). The loop is then checked on the full linearised model with the steering machine
-# as a lag: its closed-loop poles and margins.
+# as a lag: its closed-loop poles and margins. For a ship whose unstable yaw pole is near the
+# steering machine's bandwidth (the small beamy hull above), Fossen's rule, which leaves the servo
+# out, fails that check; the design then searches the PD gains with the servo (and the
+# autopilot's sampling) in the loop, the stiffest whose sensitivity peak is at most 1.93 (a phase
+# margin of at least 30°), and refuses the ship, in one line, only when the steering machine is
+# too slow for it.
 
 from shipgnc.vessels.autopilot import HeadingAutopilot  # noqa: E402
 from shipgnc.vessels.autopilot_design import design_autopilot  # noqa: E402
@@ -290,7 +301,7 @@ SCENARIO_FILE = """\
 name: my-heading
 metrics: course-quality
 vessel: {model: linear-3dof, speed_mps: 6.173, L: 60, B: 8, T: 3.5, Cb: 0.45}
-simulation: {dt: 0.5, t_end: 300.0}
+simulation: {dt: 0.1, t_end: 300.0}
 controller: {type: course, design: auto}   # or: bandwidth: 0.08 (rad/s), zeta: 1.0
 guidance:
   type: course-schedule
@@ -301,7 +312,7 @@ guidance:
 
 COMMANDS = """\
 shipgnc trial all --vessel my-vessel.yaml --out runs/my-vessel-trials
-shipgnc design autopilot --vessel my-vessel.yaml
+shipgnc design autopilot --vessel my-vessel.yaml --sample-time 0.1
 shipgnc run my-heading.yaml --out runs/my-heading
 shipgnc sweep my-heading.yaml --mc 20 --perturb vessel.params.Cb=normal:10% \\
     --perturb psi_deg=uniform:-10,10 --out runs/my-heading-mc
@@ -309,6 +320,19 @@ shipgnc sweep my-heading.yaml --mc 20 --perturb vessel.params.Cb=normal:10% \\
 print(VESSEL_FILE, SCENARIO_FILE, COMMANDS, sep="\n")
 
 # %%
+# For the 12 m workboat, change the vessel line in both files to
+#
+# .. code-block:: yaml
+#
+#    vessel: {model: linear-3dof, speed_mps: 5.144, L: 12, B: 4, T: 1.2, Cb: 0.5,
+#             rudder_rate_deg_s: 20, rudder_time_constant_s: 0.2}
+#
+# ``shipgnc design autopilot`` then prints the servo-aware rule's gains and its margins table
+# (closed loop stable, phase margin ≥ 30°, sensitivity peak M_s ≤ 1.93, the linearised settling
+# time); the run settles the 20° step in about half a minute. Its trials, and the 300 m tanker's,
+# are refused in one line: a linear model of a course-unstable ship has no steady turn, and its
+# turning circle and pull-out would grow without bound.
+#
 # ``shipgnc trial all`` prints every trial and the IMO table (yes/NO per criterion) and writes
 # the figures; ``shipgnc design autopilot`` prints the design model, the allowed bandwidths, the
 # gains, the margins and the predicted settling time; the run writes ``metrics.json`` (settling,

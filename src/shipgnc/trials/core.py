@@ -109,6 +109,19 @@ def solas_rudder_rate(entry=None) -> float:
     return SOLAS_RUDDER_RATE * math.sqrt(scale)
 
 
+def _refuse_course_unstable_linear(model, name: str) -> None:
+    """A linear 3-DOF model of a course-unstable ship has no steady turn and its large-rudder
+    manoeuvres grow without bound (:meth:`~shipgnc.vessels.linear.Linear3DOFVessel.sway_yaw_pole`):
+    its trials would print numbers without meaning, so they are refused in one line."""
+    pole = getattr(model, "sway_yaw_pole", None)
+    if pole is None or (p := pole()) <= 0:
+        return
+    raise ConfigError(f"trial: the linear model of {name} is course-unstable (a pole at +{p:.3g} 1/s: "
+                      f"a yaw disturbance doubles in {math.log(2) / p:.3g} s): a linear model has "
+                      "no steady turn and its rudder manoeuvres grow without bound, so it has no "
+                      "trials; its autopilot: shipgnc design autopilot")
+
+
 def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
             max_rudder_deg: float | None = None, rudder_rate_deg_s: float | None = None,
             dt: float | None = None, steering_gear: str = "model", **params) -> TrialShip:
@@ -165,6 +178,7 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
         max_rudder = float(lim()[1][0]) if lim is not None else math.radians(35.0)
         rate = math.inf
         can_reverse = getattr(model, "full_astern", None) is not None
+    _refuse_course_unstable_linear(model, name)
     if max_rudder_deg is not None:
         max_rudder = math.radians(max_rudder_deg)
     if rudder_rate_deg_s is not None:

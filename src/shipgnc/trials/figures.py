@@ -123,7 +123,7 @@ def zigzag_figure(res: dict, path, literature: dict | None = None) -> Path:
                     f"{_f(literature.get('first_overshoot_deg'), '.1f')}°, "
                     f"{_f(literature.get('second_overshoot_deg'), '.1f')}°")
         ax.set_title(txt, fontsize=8, loc="left")
-        ax.set_ylabel("[°]", fontsize=style.LABEL_SIZE)
+        ax.set_ylabel("heading change ψ, rudder δ [°]", fontsize=style.LABEL_SIZE)
         ax.legend(loc="best", **style.LEGEND)
     axes[-1, 0].set_xlabel("time from execute [s]", fontsize=style.LABEL_SIZE)
     fig.suptitle(_title(res, f"zig-zag {d:g}°/{p:g}°"), fontsize=style.LABEL_SIZE + 1)

@@ -114,7 +114,7 @@ def course_autopilot(cfg, model, scenario=None) -> HeadingAutopilot:
                           "variant 'pd' (Kp, Kd, or design: auto)")
     inputs = straight_inputs(model)
     if getattr(cfg, "design", None) == "auto":
-        design = design_autopilot(model, bandwidth=cfg.bandwidth,
+        design = design_autopilot(model, bandwidth=cfg.bandwidth, sample_time=cfg.Ts,
                                   **({} if cfg.zeta is None else {"zeta": cfg.zeta}))
         Kp, Kd = design.Kp, design.Kd
         notes = [f"designed autopilot: Kp = {Kp:.4g}, Kd = {Kd:.4g} s; {design.check.describe()}"]

@@ -90,6 +90,13 @@ class Linear3DOFVessel(CatalogueModel):
     def straight_state(self, speed_mps: float | None = None) -> np.ndarray:
         return self.state(u=self.U)
 
+    def sway_yaw_pole(self) -> float:
+        """The largest real part [1/s] of the eigenvalues of −M⁻¹N (the surge pole −1/T_surge
+        decoupled from dimensions, the sway–yaw pair's rightmost): > 0 for a
+        course-unstable ship, whose linear model has no steady turn (N ν = B δ gives the unstable
+        equilibrium) and whose large-rudder manoeuvres grow without bound."""
+        return float(np.max(np.linalg.eigvals(self._A).real))
+
 
 def from_dimensions(*, speed_mps: float, L: float, B: float, T: float, Cb: float,
                     R66: float | None = None, xg: float = 0.0, T_surge: float | None = None,

@@ -180,7 +180,7 @@ def fig_sine(ds, law: str = "law (21)"):
     if "r_ref" in ds:
         a1.plot(ds.time, ds.r_ref, label="ω*", **REFERENCE)
     a1.set_xlabel("t [s]", fontsize=LABEL_SIZE)
-    a1.set_ylabel("[rad/s]", fontsize=LABEL_SIZE)
+    a1.set_ylabel("yaw rate r, reference ω* [rad/s]", fontsize=LABEL_SIZE)
     a1.legend(**LEGEND)
     fig.suptitle(f"Fig. 7 — sinusoidal yaw-rate reference, {law}", fontsize=LABEL_SIZE + 2)
     return fig
