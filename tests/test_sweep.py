@@ -218,11 +218,15 @@ def test_products_on_the_path_do_not_depend_on_the_batch():
     setup = build(load_scenario("mariner-lqr"))
     assert isinstance(setup.controller, PathLQR)
     x = np.tile(setup.x0, (300, 1)) + np.random.default_rng(0).normal(0.0, 50.0, (300, setup.x0.size))
+    path = setup.guidance  # the path frame: the law's references y_r, ψ_r
     setup.controller.reset((300,))
-    many = setup.controller.step(0.0, x, None)
+    path.reset((300,), setup.model)
+    many = setup.controller.step(0.0, x, path.reference(0.0, x))
     for i in (0, 7, 299):
         setup.controller.reset((1,))
-        np.testing.assert_array_equal(setup.controller.step(0.0, x[i:i + 1], None)[0], many[i])
+        path.reset((1,), setup.model)
+        one = setup.controller.step(0.0, x[i:i + 1], path.reference(0.0, x[i:i + 1]))
+        np.testing.assert_array_equal(one[0], many[i])
 
 
 def test_mariner_with_wave_noise_chunks_to_the_bit():

@@ -311,7 +311,7 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
         given = tuple(s.name for s in getattr(guidance, "references", ()))
         require(given[:len(needed)] == tuple(needed), "guidance", type(guidance).__name__,
                 f"{type(controller).__name__} needs references {', '.join(needed)} "
-                f"(e.g. ReferenceSchedule or LOSGuidance)")
+                f"(e.g. ReferenceSchedule, LOSGuidance; PathGuidance for a path law)")
     if getattr(controller, "continuous", False):
         limited = np.isfinite(actuator.rate)
         require(bool(np.all(actuator.tau[limited] > 0)), "actuator.rate",
