@@ -233,6 +233,8 @@ class Scenario(Strict):
     def _older_case(cls, data, handler) -> Scenario:
         """A ``case`` section (document 004's case builders) read as the ``runs`` it makes
         (:func:`~shipgnc.scenarios.catamaran_case.case_as_runs`)."""
+        if isinstance(data, dict) and "case" in data and data["case"] is None:  # --set case=null
+            data = {key: value for key, value in data.items() if key != "case"}
         if not (isinstance(data, dict) and "case" in data):
             return handler(data)
         vessel = data.get("vessel")

@@ -191,10 +191,10 @@ class CatamaranVesselConfig(Strict):
     low_speed: Literal["continued", "literal"] = "continued"
     #: other :class:`CatamaranParams` overrides (SI), e.g. ``{J_zz: 4.0e6, T_v: 18000}``
     params: dict[str, Finite] = Field(default_factory=dict)
-    #: the plant's true thruster lag (22) (null: the ideal thruster, δ̇ = u); the controller's
+    #: the plant's true thruster lag (22) (null = the ideal thruster, δ̇ = u); the controller's
     #: model keeps the ideal one
     thruster: CatamaranThrusterConfig | None = None
-    #: plant uncertainty: that many ships in one batched run, each with its own masses and
+    #: plant uncertainty, that many ships in one batched run, each with its own masses and
     #: inertia (the controller's model keeps the nominal ones)
     spread: CatamaranSpreadConfig | None = None
 
@@ -502,10 +502,10 @@ class YawRateFSMConfig(Strict):
     T_u: Positive | None = None
     h: Positive | None = None
     Ts: Positive | None = None
-    #: the thruster lag the law assumes, through the actuator inverse (23) (null: none, the law
+    #: the thruster lag the law assumes, through the actuator inverse (23) (null = none, the law
     #: commands δ̇)
     T_a: Positive | None = None
-    #: the thruster gain the law assumes with ``T_a`` (null: 1)
+    #: the thruster gain the law assumes with ``T_a`` (null = 1)
     k_a: Positive | None = None
 
 
