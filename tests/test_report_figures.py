@@ -51,7 +51,7 @@ def _study(grid: bool):
 def test_sweep_panels_have_titles_in_words_and_units(tmp_path, monkeypatch, grid):
     from matplotlib.figure import Figure
 
-    from shipgnc.study.summary import spread_figure
+    from shipgnc.viz.study_summary import spread_figure
 
     figures = []
     monkeypatch.setattr(Figure, "savefig", lambda self, *a, **k: figures.append(self))
@@ -71,8 +71,8 @@ def test_course_comparison_keeps_its_labels_inside_and_names_the_law():
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     from shipgnc.scenarios.registry import load_scenario
-    from shipgnc.scenarios.write import controller_title
     from shipgnc.viz.comparison import course_comparison
+    from shipgnc.viz.run_files import controller_title
 
     title = controller_title(load_scenario("mariner-cst-heading").controller)
     assert title == "course autopilot pd: Kp = 1, Kd = 40"
@@ -117,7 +117,7 @@ def test_every_axis_of_a_run_s_figures_has_labels_with_units(scenario, t_end, tm
     force)."""
     import shipgnc.viz.dashboard as dashboard
     from shipgnc.scenarios.runner import run_scenario
-    from shipgnc.scenarios.write import write_outputs
+    from shipgnc.viz.run_files import write_outputs
 
     monkeypatch.setenv("SHIPGNC_FIGURE_PROCESS", "0")  # drawn here, so that they can be opened
     figures = []

@@ -158,7 +158,7 @@ def run_command(
             stack.enter_context(keeping())
         from shipgnc.scenarios.registry import load_scenario
         from shipgnc.scenarios.runner import divergence_message, metrics_json, run_scenario
-        from shipgnc.scenarios.write import FiguresNotDrawn, write_outputs
+        from shipgnc.viz.run_files import FiguresNotDrawn, write_outputs
 
         if realtime is not None and not (realtime > 0 and realtime < float("inf")):
             raise ConfigError(f"--realtime = {realtime}: must be a number > 0 (1.0 = real time)")
