@@ -37,8 +37,8 @@ def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer repeats, no 0.02 nm level set")
     args = parser.parse_args(argv)
+    from shipgnc.environment.fields import shear
     from shipgnc.routing import pmp
-    from shipgnc.routing.fields import shear
     from shipgnc.routing.levelset import reachability
 
     fld = shear(-0.5 / H)

@@ -10,7 +10,7 @@ One table, every row in this run:
   miss tolerance;
 * a point vortex (Lamb–Oseen, core 5 % of |AB|) and a moving one (drifting across the route);
 * a double gyre, v_N = −sin πe′ cos πn′, v_E = cos πe′ sin πn′ [m/s], e′ = east − 0.5 m,
-  n′ = north − 0.5 m (:class:`~shipgnc.routing.fields.DoubleGyre` of centre (0.5, 0.5) m, cells of 1 m),
+  n′ = north − 0.5 m (:class:`~shipgnc.environment.fields.DoubleGyre` of centre (0.5, 0.5) m, cells of 1 m),
   V = 1 m/s from (0.6, 0.6) to the point (2.4, 2.4): analytic, and sampled on a 101 × 101 grid over
   [−0.5, 3.5]² (bilinear) — gridded data take the same compiled path as analytic fields. This is
   shipgnc's own problem, not the peer's;
@@ -48,8 +48,8 @@ NM, H, KN = 1852.0, 3600.0, 1852.0 / 3600.0
 
 
 def problems():
+    from shipgnc.environment import fields as F
     from shipgnc.routing import closed_form as cf
-    from shipgnc.routing import fields as F
 
     shear = F.shear(-0.5 / H)
     doc = cf.shear_closed_form(0.5 * KN, -0.5 / H, np.array([-1.86, 3.66]) * NM, np.zeros(2))
@@ -92,7 +92,7 @@ def peer_gyre(north, east):
 
 def check_peer_field() -> float:
     """Largest difference [m/s] between the peer's gyre and DoubleGyre(1, 1, (0, 0)) at 1 000 points."""
-    from shipgnc.routing import fields as F
+    from shipgnc.environment import fields as F
 
     rng = np.random.default_rng(0)
     n, e = rng.uniform(-0.5, 3.5, (2, 1000))
@@ -115,8 +115,8 @@ def main(argv=None) -> dict:
     parser.add_argument("--quick", action="store_true", help="one repeat, no numpy column")
     parser.add_argument("--full", action="store_true", help="the numpy reference on every row (minutes)")
     args = parser.parse_args(argv)
+    from shipgnc.environment.fields import NumpyReference
     from shipgnc.routing import solve_route
-    from shipgnc.routing.fields import NumpyReference
 
     repeats = 1 if args.quick else 2
     start = time.perf_counter()

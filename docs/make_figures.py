@@ -31,7 +31,7 @@ JOBS = {
 }
 #: figure sets drawn by a generator: name → (generator, files it writes)
 SETS = {
-    "routing": ("shipgnc.routing.figures:document_figures",
+    "routing": ("shipgnc.viz.route_figures:document_figures",
                 ("zermelo-paper.png", "zermelo-vortex.png", "zermelo-shoal.png")),
     "catamaran": ("shipgnc.viz.catamaran:render_document_figures",
                   ("catamaran-fig1-phi3.png", "catamaran-fig2-3-laws.png", "catamaran-turn.png",
@@ -41,7 +41,7 @@ SETS = {
     "routing-geo": ("shipgnc.routing.geo.figures:document_figure", ("routing-geo-channel.png",)),
     "cybership-analysis": ("cybership_analysis:figure", ("cybership-analysis.png",)),
     "observer-loop": ("observer_loop:figure", ("observer-loop-rudder.png",)),
-    "trials": ("shipgnc.trials.figures:document_figures",
+    "trials": ("shipgnc.viz.trial_figures:document_figures",
                tuple(f"trials-{v}-{w}.png" for v in ("mariner", "kvlcc2")
                      for w in ("turning", "zigzag-20", "zigzag-10", "spiral"))),
 }
@@ -57,7 +57,7 @@ def study_figure(directory: Path) -> list[Path]:
     members with random initial headings and speeds."""
     from shipgnc.study.execute import run_study
     from shipgnc.study.spec import Perturbation, Study, parse_grid
-    from shipgnc.study.summary import spread_figure
+    from shipgnc.viz.study_summary import spread_figure
 
     study = Study("boat-autopilot", grid=(parse_grid("controller.omega_ref=0.5,1.0,2.0"),), members=200,
                   seed=1, perturb=(Perturbation.parse("psi_deg=uniform:-30,30"),
@@ -78,7 +78,7 @@ def _generator(path: str):
 
 def main(names: list[str]) -> None:
     from shipgnc.scenarios.runner import run_scenario
-    from shipgnc.scenarios.write import write_outputs
+    from shipgnc.viz.run_files import write_outputs
 
     known = [*JOBS, *SETS]
     wanted = names or known

@@ -457,7 +457,7 @@ def setup_of(**kw):
 
 
 def test_unsupported_reasons():
-    from shipgnc.routing.fields import GriddedCurrent, UniformCurrent, sample_field
+    from shipgnc.environment.fields import GriddedCurrent, UniformCurrent, sample_field
 
     gridded = GriddedCurrent(sample_field(UniformCurrent(0.5, 0.0), [0.0, 1e5], [0.0, 1e5]))
 

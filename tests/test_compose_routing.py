@@ -1,5 +1,5 @@
 """Document 002's sailed routes in the composed compiled loop: the routing fields' compiled form
-(:meth:`~shipgnc.routing.fields.CurrentField.current_kernel`), the Mariner's field current, the
+(:meth:`~shipgnc.environment.fields.CurrentField.current_kernel`), the Mariner's field current, the
 heading autopilot :class:`HeadingFL` and the tabulated :class:`HeadingProfile`, each against its numpy
 form; and ``zermelo-sail`` run compiled equal to its numpy run."""
 
@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 from shipgnc.control.feedback_linearization import HeadingFL, heading_fl_step
+from shipgnc.environment import fields as F
 from shipgnc.errors import ConfigError
 from shipgnc.guidance.schedule import HeadingProfile
 from shipgnc.kernels import NotCompiled
 from shipgnc.models.mariner import MarinerDisturbance, MarinerWitOppe, mariner_disturbance, rudder
-from shipgnc.routing import fields as F
 from shipgnc.scenarios.routing import _shifted
 from shipgnc.sim.simulator import simulate
 

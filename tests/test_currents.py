@@ -15,11 +15,11 @@ from shipgnc.environment.current_field import (
     parse_current,
 )
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
+from shipgnc.environment.fields import SumField, UniformCurrent
 from shipgnc.errors import ConfigError
 from shipgnc.models.catamaran import Catamaran, straight_running_state
 from shipgnc.models.cybership2 import CyberShip2, surge_equilibrium
 from shipgnc.models.fossen3dof import VectoredThrustBoat
-from shipgnc.routing.fields import SumField, UniformCurrent
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.sim.simulator import simulate
 

@@ -19,10 +19,10 @@ import yaml
 
 from shipgnc.cases import catamaran as C
 from shipgnc.environment.current_field import CurrentDisturbance, GaussMarkovCurrent
+from shipgnc.environment.fields import SumField, UniformCurrent
 from shipgnc.errors import ConfigError
 from shipgnc.models.catamaran import EAST, NORTH, U, V
 from shipgnc.models.mariner import MarinerParams, MarinerWitOppe, MarinerYawDisturbance
-from shipgnc.routing.fields import SumField, UniformCurrent
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build, run_scenario
 from shipgnc.scenarios.schema import CURRENT_VESSELS

@@ -21,8 +21,8 @@ from shipgnc.analysis.identification import zigzag_trial
 from shipgnc.cli import app
 from shipgnc.errors import ConfigError
 from shipgnc.identify import identify_log, identify_nomoto1, read_log
-from shipgnc.identify.report import build_vessel, resimulate, vessel_yaml
 from shipgnc.models.base import state_index
+from shipgnc.viz.identify_report import build_vessel, resimulate, vessel_yaml
 
 runner = CliRunner()
 

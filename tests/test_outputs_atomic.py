@@ -325,7 +325,7 @@ def test_a_real_failing_hdf5_write_is_one_line_not_a_crash(tmp_path):
 def test_write_outputs_api_is_atomic_too(tmp_path, monkeypatch):
     from shipgnc.errors import ShipGNCError
     from shipgnc.scenarios.runner import run_scenario
-    from shipgnc.scenarios.write import write_outputs
+    from shipgnc.viz.run_files import write_outputs
 
     run = run_scenario("boat-stern-kick", overrides=["simulation.t_end=2"])
     written = write_outputs(run, tmp_path / "api", figures=False)
@@ -370,7 +370,7 @@ def test_a_study_is_written_atomically_over_an_earlier_one(tmp_path, monkeypatch
 
 
 def test_summary_leaves_diverged_members_out_and_counts_them():
-    from shipgnc.study.summary import summary_rows
+    from shipgnc.viz.study_summary import summary_rows
 
     ds = xr.Dataset({"rmse": ("member", np.array([1.0, 2.0, 3.0, 1e6])),
                      "diverged": ("member", np.array([0.0, 0.0, 0.0, 1.0]))},

@@ -192,7 +192,7 @@ def test_cli_writes_the_draws(tmp_path):
                               "vessel.params.m=normal:5%", "--set", "simulation.t_end=10",
                               "--out", str(tmp_path), "--no-figures"])
     assert res.exit_code == 0, res.output
-    from shipgnc.study.summary import load_dataset
+    from shipgnc.viz.study_summary import load_dataset
 
     ds = load_dataset(tmp_path / "sweep.nc")
     assert ds["param_m"].dims == ("member",) and len(np.unique(ds["param_m"].values)) == 4
@@ -249,7 +249,7 @@ def test_a_catalogue_vessel_from_main_dimensions_takes_a_parameter_of_its_file(t
                               "vessel.params.Cb=normal:10%", "--perturb", "psi_deg=normal:5",
                               "--out", str(tmp_path / "out"), "--no-figures"])
     assert res.exit_code == 0, res.output
-    from shipgnc.study.summary import load_dataset
+    from shipgnc.viz.study_summary import load_dataset
 
     ds = load_dataset(tmp_path / "out" / "sweep.nc")
     cb, psi = ds["param_Cb"].values, ds["initial_state_psi_deg"].values

@@ -55,7 +55,7 @@ def _study(grid: bool):
 def test_sweep_panels_have_titles_in_words_and_units(tmp_path, monkeypatch, grid):
     from matplotlib.figure import Figure
 
-    from shipgnc.study.summary import spread_figure
+    from shipgnc.viz.study_summary import spread_figure
 
     figures = []
     monkeypatch.setattr(Figure, "savefig", lambda self, *a, **k: figures.append(self))
@@ -75,7 +75,7 @@ def test_course_comparison_keeps_its_labels_inside_and_names_the_law():
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     from shipgnc.scenarios.registry import load_scenario
-    from shipgnc.scenarios.write import controller_title
+    from shipgnc.viz.run_files import controller_title
     from shipgnc.viz.comparison import course_comparison
 
     title = controller_title(load_scenario("mariner-cst-heading").controller)

@@ -9,8 +9,8 @@ import pytest
 from typer.testing import CliRunner
 
 from shipgnc.cli import app
-from shipgnc.routing.field_spec import parse_field
-from shipgnc.routing.fields import LambOseenVortex, RigidRotation, SumField, UniformCurrent
+from shipgnc.environment.field_spec import parse_field
+from shipgnc.environment.fields import LambOseenVortex, RigidRotation, SumField, UniformCurrent
 from shipgnc.units import KNOT, NAUTICAL_MILE
 
 runner = CliRunner()
@@ -147,7 +147,7 @@ def test_field_strings_and_nautical_units():
 def test_netcdf_field(tmp_path):
     import numpy as np
 
-    from shipgnc.routing.fields import sample_field
+    from shipgnc.environment.fields import sample_field
 
     ds = sample_field(UniformCurrent(0.0, 0.1), np.linspace(-2000, 2000, 5), np.linspace(-2000, 2000, 5))
     path = tmp_path / "c.nc"

@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 
-from shipgnc.routing import fields as F
+from shipgnc.environment import fields as F
 from shipgnc.routing import solve_route
 
 V = 1.0

@@ -17,9 +17,9 @@ import sys
 import numpy as np
 import pytest
 
+from shipgnc.environment.field_spec import parse_field
+from shipgnc.environment.fields import UniformCurrent
 from shipgnc.routing import pmp
-from shipgnc.routing.field_spec import parse_field
-from shipgnc.routing.fields import UniformCurrent
 from shipgnc.routing.router import solve_route
 
 NM = 1852.0

@@ -7,8 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from shipgnc.errors import ConfigError
-from shipgnc.routing.fields import (
+from shipgnc.environment.fields import (
     FieldDomainError,
     GriddedCurrent,
     LambOseenVortex,
@@ -19,6 +18,7 @@ from shipgnc.routing.fields import (
     sample_field,
     shear,
 )
+from shipgnc.errors import ConfigError
 from shipgnc.units import KNOT, NAUTICAL_MILE
 
 NM, H = NAUTICAL_MILE, 3600.0

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from matplotlib.quiver import QuiverKey
 
-from shipgnc.routing.fields import LambOseenVortex, shear
-from shipgnc.routing.figures import route_figure
+from shipgnc.environment.fields import LambOseenVortex, shear
 from shipgnc.routing.router import solve_route
 from shipgnc.units import KNOT, NAUTICAL_MILE
+from shipgnc.viz.route_figures import route_figure
 
 NM = NAUTICAL_MILE
 

@@ -341,7 +341,7 @@ def test_a_current_without_units_is_refused_per_cf(tmp_path):
     with pytest.raises(ConfigError, match="no units attribute") as exc:
         GeoProblem((50.5, -10.5), (50.5, -10.2), 5.0, current=str(path), land="none")
     assert "\n" not in str(exc.value) and "nounits.nc" in str(exc.value)
-    from shipgnc.routing.field_spec import parse_field
+    from shipgnc.environment.field_spec import parse_field
 
     plane = tmp_path / "plane.nc"
     n = np.linspace(0.0, 1000.0, 11)

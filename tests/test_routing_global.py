@@ -8,9 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from shipgnc.errors import ConfigError
-from shipgnc.routing import pmp
-from shipgnc.routing.fields import (
+from shipgnc.environment.fields import (
     FieldDomainError,
     GriddedCurrent,
     LambOseenVortex,
@@ -18,6 +16,8 @@ from shipgnc.routing.fields import (
     sample_field,
     shear,
 )
+from shipgnc.errors import ConfigError
+from shipgnc.routing import pmp
 from shipgnc.routing.graph import graph_route, stencil
 from shipgnc.routing.levelset import _compiled_rate, _pad3, front_rate, reachability
 from shipgnc.routing.obstacles import path_hits, segments_hit

@@ -16,8 +16,8 @@ import sys
 import numpy as np
 import pytest
 
+from shipgnc.environment.field_spec import parse_field
 from shipgnc.routing import closed_form, solve_route
-from shipgnc.routing.field_spec import parse_field
 
 K, V, A, B = 1e-4, 1.0, (0.0, 0.0), (0.0, 1000.0)
 METHODS = ["auto", "pmp", "levelset", "graph"]

@@ -1,6 +1,6 @@
 """The router's compiled extremals against their numpy references (notes 002-2.9.1, 002-2.9.4).
 
-* :func:`~shipgnc.routing.fields.field_state` equals every field's numpy ``_velocity`` and ``_jacobian``
+* :func:`~shipgnc.environment.fields.field_state` equals every field's numpy ``_velocity`` and ``_jacobian``
   (analytic terms, sums, tides, a moving vortex, the double gyre, bilinear grids steady and in time,
   clamped at the grid's edge as the unchecked numpy evaluation is);
 * the RK4 family kernel equals ``integrate_family``'s numpy loop, extremals leaving a grid frozen alike;
@@ -18,11 +18,11 @@ import math
 import numpy as np
 import pytest
 
+from shipgnc.environment import fields as F
+from shipgnc.environment.field_spec import parse_field
+from shipgnc.environment.fields import field_state
 from shipgnc.routing import extremal_kernels as ek
-from shipgnc.routing import fields as F
 from shipgnc.routing import pmp
-from shipgnc.routing.field_spec import parse_field
-from shipgnc.routing.fields import field_state
 
 GRID = np.linspace(-0.5, 3.5, 101)
 GYRE = F.DoubleGyre(1.0, 1.0, (0.5, 0.5))

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 import shapely
 
+from shipgnc.environment.fields import GriddedCurrent, UniformCurrent, sample_field, shear
 from shipgnc.routing import levelset
-from shipgnc.routing.fields import GriddedCurrent, UniformCurrent, sample_field, shear
 from shipgnc.routing.levelset import reachability
 from shipgnc.routing.obstacles import as_polygons
 from shipgnc.routing.router import default_domain, solve_route

@@ -17,9 +17,9 @@ import tracemalloc
 import numpy as np
 import pytest
 
+from shipgnc.environment import fields as F
+from shipgnc.environment.field_spec import parse_field
 from shipgnc.routing import extremal_kernels, levelset, pmp
-from shipgnc.routing import fields as F
-from shipgnc.routing.field_spec import parse_field
 from shipgnc.routing.memory import levelset_memory, route_memory_estimate, sweep_memory
 from shipgnc.routing.router import default_domain, solve_route
 

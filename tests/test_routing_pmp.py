@@ -7,6 +7,14 @@ import math
 import numpy as np
 import pytest
 
+from shipgnc.environment.fields import (
+    LambOseenVortex,
+    Modulated,
+    RankineVortex,
+    RigidRotation,
+    UniformCurrent,
+    shear,
+)
 from shipgnc.routing import pmp
 from shipgnc.routing.closed_form import (
     shear_closed_form,
@@ -15,14 +23,6 @@ from shipgnc.routing.closed_form import (
     straight_course,
     tidal_uniform_solution,
     uniform_solution,
-)
-from shipgnc.routing.fields import (
-    LambOseenVortex,
-    Modulated,
-    RankineVortex,
-    RigidRotation,
-    UniformCurrent,
-    shear,
 )
 from shipgnc.routing.router import solve_route
 from shipgnc.units import KNOT, NAUTICAL_MILE
@@ -160,7 +160,7 @@ def test_z9_uniform_currents():
     assert r.time_s / H == pytest.approx(19.209115, abs=5e-7)
     assert math.degrees(r.heading_start) == pytest.approx(281.166, abs=5e-4)
     # the closed form against numerical PMP (forward shooting in the same field, as an affine field)
-    from shipgnc.routing.fields import AffineCurrent
+    from shipgnc.environment.fields import AffineCurrent
 
     ext = pmp.shoot(AffineCurrent((0.0, 0.3 * KNOT)), V, A, B, r.heading_start + 0.02, r.time_s * 0.98)
     assert ext.duration == pytest.approx(r.time_s, rel=1e-9)

@@ -20,8 +20,8 @@ import math
 
 import pytest
 
+from shipgnc.environment.fields import RankineVortex
 from shipgnc.routing.closed_form import rotation_time
-from shipgnc.routing.fields import RankineVortex
 from shipgnc.routing.pmp import MISS_REL
 from shipgnc.routing.router import agreement_tolerance, solve_route
 

@@ -102,8 +102,8 @@ def test_a_boat_without_thrust_drifts_with_the_current():
     the current, exactly (ν_r stays 0, η̇ = v_c)."""
     import numpy as np
 
+    from shipgnc.environment.fields import UniformCurrent
     from shipgnc.models.fossen3dof import VectoredThrustBoat
-    from shipgnc.routing.fields import UniformCurrent
     from shipgnc.routing.sailing import BoatInCurrent, FieldCurrent
     from shipgnc.sim.simulator import simulate
 
@@ -149,7 +149,7 @@ def test_unreachable_target_exits_3():
 def test_a_wall_is_gone_round_not_through(tmp_path):
     """A 10 km wall across a 1 km route in still water: the detour past its ends (≈ 10.23 km) is the
     route; no method may sail through the wall, and a level set that leaks says so."""
-    from shipgnc.routing.fields import UniformCurrent
+    from shipgnc.environment.fields import UniformCurrent
     from shipgnc.routing.router import solve_route
 
     wall = [[(400.0, -5000.0), (400.0, 5000.0), (600.0, 5000.0), (600.0, -5000.0)]]

@@ -14,10 +14,10 @@ from typer.testing import CliRunner
 
 from shipgnc.cli import app
 from shipgnc.errors import ConfigError, ShipGNCWarning
-from shipgnc.study import summary
 from shipgnc.study.chunk import plan_chunks, run_chunk
 from shipgnc.study.execute import assemble, run_study
 from shipgnc.study.spec import Perturbation, Study, parse_grid
+from shipgnc.viz import study_summary as summary
 
 runner = CliRunner()
 

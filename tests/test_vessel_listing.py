@@ -153,7 +153,7 @@ def test_one_parameter_of_each_vessel_perturbed_over_four_members(vessel, tmp_pa
     from shipgnc.models.per_ship import plant_params
     from shipgnc.scenarios.registry import load_scenario
     from shipgnc.scenarios.runner import build
-    from shipgnc.study.summary import load_dataset
+    from shipgnc.viz.study_summary import load_dataset
 
     scenario, overrides, param = PERTURBED[vessel]
     overrides = (*overrides, *SHORT)

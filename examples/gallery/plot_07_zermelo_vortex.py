@@ -12,7 +12,7 @@ and 002-F3 on :doc:`/002_zermelo_routing`).
 import matplotlib.pyplot as plt
 import numpy as np
 
-from shipgnc.routing.fields import LambOseenVortex
+from shipgnc.environment.fields import LambOseenVortex
 from shipgnc.routing.router import solve_route
 from shipgnc.viz.style import show_example
 

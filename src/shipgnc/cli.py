@@ -158,7 +158,6 @@ def run_command(
             stack.enter_context(keeping())
         from shipgnc.scenarios.registry import load_scenario
         from shipgnc.scenarios.runner import divergence_message, metrics_json, run_scenario
-        from shipgnc.scenarios.write import FiguresNotDrawn, write_outputs
 
         if realtime is not None and not (realtime > 0 and realtime < float("inf")):
             raise ConfigError(f"--realtime = {realtime}: must be a number > 0 (1.0 = real time)")
@@ -190,6 +189,9 @@ def run_command(
             stderr.print(f"[bold red]error:[/] {_one_line(divergence_message(run))}; --keep-partial "
                          "writes the partial result", soft_wrap=True)
             raise typer.Exit(3)
+        # the files' writer after the run: its imports (the routing scenarios) are not the run's
+        from shipgnc.viz.run_files import FiguresNotDrawn, write_outputs
+
         try:
             written, no_figures = write_outputs(run, out_dir, figures=figures, figure_process=figure_process,
                                                 overwrite=overwrite), None

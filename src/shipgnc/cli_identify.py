@@ -70,8 +70,8 @@ def identify(
                    "units": data.units, **ident.to_json()}
         text = json.dumps(_finite(payload), indent=2, ensure_ascii=False)
         if out is not None:
-            from shipgnc.identify.report import identification_figure, vessel_yaml
             from shipgnc.outputs import atomic_dir
+            from shipgnc.viz.identify_report import identification_figure, vessel_yaml
 
             with atomic_dir(out, command="identify") as tmp:
                 (tmp / "identify.json").write_text(text + "\n", encoding="utf-8")

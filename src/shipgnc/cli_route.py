@@ -143,7 +143,7 @@ def _plane_route(a, b, speed, field, units, method, obstacles, json_, out, horiz
                  grid, length, tscale, nautical, limit) -> None:
     """``route`` on the plane (N, E), after the command's own checks; SI from here on."""
     from shipgnc.cli import stderr, stdout
-    from shipgnc.routing.field_spec import parse_field
+    from shipgnc.environment.field_spec import parse_field
     from shipgnc.routing.router import solve_route
 
     fld = parse_field(field, units)
@@ -169,7 +169,7 @@ def _plane_route(a, b, speed, field, units, method, obstacles, json_, out, horiz
     text = json.dumps(payload, indent=2, ensure_ascii=False, default=_jsonable)
     if out is not None:  # atomic: a temporary directory moved into place when complete
         from shipgnc.outputs import atomic_dir
-        from shipgnc.routing.figures import route_figure
+        from shipgnc.viz.route_figures import route_figure
 
         with atomic_dir(out, command="route") as tmp:
             (tmp / "route.json").write_text(text + "\n", encoding="utf-8")
@@ -360,13 +360,13 @@ def _geo_route_run(start, target, speed, field, method, obstacles, units, json_,
 
 def _geo_field(field: str, units: str):
     """A CF-NetCDF path, ``still``/``none``, or ``uniform:north=..,east=..`` (true north/east)."""
-    from shipgnc.routing.fields import UniformCurrent
+    from shipgnc.environment.fields import UniformCurrent
 
     text = field.strip()
     if text.lower() in ("still", "none", "0"):
         return None
     if text.lower().startswith("uniform"):
-        from shipgnc.routing.field_spec import parse_field
+        from shipgnc.environment.field_spec import parse_field
 
         fld = parse_field(text, units)
         if isinstance(fld, UniformCurrent):

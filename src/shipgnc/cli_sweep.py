@@ -172,7 +172,7 @@ def write_study(ds, out: Path, *, figures: bool = True, overwrite: bool = False,
     when complete, replacing an earlier shipgnc run whole)."""
     from shipgnc.outputs import atomic_dir, moved
     from shipgnc.scenarios.runner import write_table
-    from shipgnc.study.summary import save_dataset, spread_figure, summary_rows
+    from shipgnc.viz.study_summary import save_dataset, spread_figure, summary_rows
 
     out = Path(out)
     with atomic_dir(out, overwrite=overwrite, command="sweep", status=status) as tmp:
@@ -191,7 +191,7 @@ def _print_summary(run, max_columns: int = 8) -> None:
 
     def metric_text4(value) -> str:
         return metric_text(value, digits=4)
-    from shipgnc.study.summary import summary_rows
+    from shipgnc.viz.study_summary import summary_rows
 
     ds = run.dataset
     rows = summary_rows(ds)

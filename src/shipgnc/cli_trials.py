@@ -139,8 +139,8 @@ def trial(
         text = json.dumps(payload, indent=2, ensure_ascii=False)
         if out is not None:
             from shipgnc.outputs import atomic_dir
-            from shipgnc.trials.figures import trial_figures
             from shipgnc.trials.series import write_series
+            from shipgnc.viz.trial_figures import trial_figures
 
             with atomic_dir(out, command="trial") as tmp:
                 (tmp / "trial.json").write_text(text + "\n", encoding="utf-8")

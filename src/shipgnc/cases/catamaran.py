@@ -91,7 +91,7 @@ class CatamaranCase:
 
 
 def with_current(case: CatamaranCase, current, force=None) -> CatamaranCase:
-    """``case`` in an earth-fixed ``current`` (a :class:`~shipgnc.routing.fields.CurrentField`,
+    """``case`` in an earth-fixed ``current`` (a :class:`~shipgnc.environment.fields.CurrentField`,
     :class:`~shipgnc.environment.current_field.GaussMarkovCurrent` or a sum; a spec string of
     :func:`~shipgnc.environment.current_field.parse_current`), with an optional body-axis ``force``
     disturbance: the catamaran's disturbance ``[X_env, Y_env, N_env, current_north,

@@ -9,8 +9,8 @@ Property 10.1; :mod:`shipgnc.models.fossen3dof`). The Mariner of document 000 ke
 disturbance ``[b_r, current_north, current_east]`` (:class:`~shipgnc.models.mariner.MarinerDisturbance`),
 which takes the same field objects.
 
-**The current objects** are those of the router (:mod:`shipgnc.routing.fields`: uniform, affine /
-shear, rotation, vortices, sums, tidal :class:`~shipgnc.routing.fields.Modulated`, gridded) and
+**The current objects** are those of the router (:mod:`shipgnc.environment.fields`: uniform, affine /
+shear, rotation, vortices, sums, tidal :class:`~shipgnc.environment.fields.Modulated`, gridded) and
 :class:`GaussMarkovCurrent`, a slowly varying current whose speed and direction are first-order
 Gauss–Markov processes with a saturating element (Fossen 2011 §8.3, 2021 §10.3):
 
@@ -45,10 +45,10 @@ import math
 
 import numpy as np
 
+from shipgnc.environment.fields import CurrentField, SumField, field_velocity
 from shipgnc.errors import require
 from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
 from shipgnc.models.base import state_index as index_of
-from shipgnc.routing.fields import CurrentField, SumField, field_velocity
 from shipgnc.streams import MemberStreams
 
 
@@ -182,7 +182,7 @@ class CurrentDisturbance:
     """A force disturbance (or None) and an earth-fixed current in one disturbance vector
     ``[forces..., current_north, current_east]`` (module docstring).
 
-    ``current``: a :class:`~shipgnc.routing.fields.CurrentField` (including
+    ``current``: a :class:`~shipgnc.environment.fields.CurrentField` (including
     :class:`GaussMarkovCurrent` and sums of both); ``force``: a disturbance of
     :mod:`shipgnc.environment.disturbance` or :mod:`shipgnc.environment.waves` writing ``n_force``
     channels (3: X, Y, N); ``position_index``: where the model's state holds north and east; by
@@ -192,7 +192,7 @@ class CurrentDisturbance:
     def __init__(self, current, force=None, *, n_force: int = 3,
                  position_index: tuple[int, int] | None = None):
         require(isinstance(current, CurrentField), "current", type(current).__name__,
-                "must be a current field (shipgnc.routing.fields) or a GaussMarkovCurrent")
+                "must be a current field (shipgnc.environment.fields) or a GaussMarkovCurrent")
         self.current, self.force = current, force
         self.n_force = int(n_force)
         self._given_index = None if position_index is None else tuple(int(i) for i in position_index)
@@ -319,7 +319,7 @@ _TERMS = 6
 @kernel_function
 def current_sample(t, x, z, p, w, d):
     """:meth:`CurrentDisturbance.current_velocity` for one ship: d[i], d[i + 1] = [V_N, V_E] at
-    (t, north, east), the field's terms (:func:`~shipgnc.routing.fields.field_velocity`) plus the
+    (t, north, east), the field's terms (:func:`~shipgnc.environment.fields.field_velocity`) plus the
     tabulated Gauss–Markov value of the RK stage at ``t`` (w = [t_k, v(t_k), v(t_k + dt/2),
     v(t_k + dt)]). ``p`` = [i, north index, east index, has field, has table, dt, terms...]."""
     vn = 0.0
@@ -358,7 +358,7 @@ _GM = {"speed": ("speed", 1.0), "direction": ("direction", math.pi / 180),
 
 def _gauss_markov(text: str) -> GaussMarkovCurrent:
     _, _, args = text.partition(":")
-    from shipgnc.routing.field_spec import key_values
+    from shipgnc.environment.field_spec import key_values
 
     values = {key: number * _GM[key][1]
               for key, number in key_values(args, _GM, "current gauss-markov").items()}
@@ -380,7 +380,7 @@ def _gauss_markov(text: str) -> GaussMarkovCurrent:
 def parse_current(text: str) -> CurrentField:
     """A current from a spec string (module docstring): the router's FIELD terms in SI and
     ``gauss-markov:...`` terms, joined with '+'."""
-    from shipgnc.routing.field_spec import parse_field
+    from shipgnc.environment.field_spec import parse_field
 
     require(isinstance(text, str) and text.strip() != "", "current", text, "must name a current")
     terms = []

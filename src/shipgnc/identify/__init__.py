@@ -7,7 +7,7 @@
 
 :mod:`shipgnc.identify.logs` reads and checks CSV/NetCDF logs, :mod:`shipgnc.identify.fitting`
 fits Nomoto 1/2 (through :mod:`shipgnc.analysis.identification`) and the linear 3-DOF model with
-95 % confidence intervals and a held-out score, :mod:`shipgnc.identify.report` draws the figure and
+95 % confidence intervals and a held-out score, :mod:`shipgnc.viz.identify_report` draws the figure and
 writes the vessel YAML.
 """
 

@@ -57,13 +57,13 @@ from types import MappingProxyType
 import numpy as np
 
 from shipgnc.actuators import Actuator
+from shipgnc.environment.fields import field_velocity
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
 from shipgnc.models.base import Signal
 from shipgnc.params import Params
 from shipgnc.paths import leg_table, track_leg
-from shipgnc.routing.fields import field_velocity
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 
 #: per parameter: (the document's unit, SI value of one document unit). Angles are rad in both.
@@ -360,9 +360,9 @@ class MarinerDisturbance:
     :class:`~shipgnc.environment.current.CrossCurrent` (d_y across the active leg, or along east)
     or None; ``waves`` a :class:`~shipgnc.environment.filtered_noise.SecondOrderNoise` added to ṙ
     or None; or any current field with ``__call__(t, x) -> (..., 2)`` (e.g. a
-    :mod:`shipgnc.routing.fields` field, evaluated per RK stage). In the composed loop a field
+    :mod:`shipgnc.environment.fields` field, evaluated per RK stage). In the composed loop a field
     current needs ``current_kernel()`` → ``(field_velocity, params)`` (its compiled form,
-    :meth:`shipgnc.routing.fields.CurrentField.current_kernel`).
+    :meth:`shipgnc.environment.fields.CurrentField.current_kernel`).
     """
 
     def __init__(self, b_r: float = 0.0, current=None, waves=None):
@@ -411,7 +411,7 @@ class MarinerDisturbance:
 
         Per-ship state ``[leg]``: the path current's own leg tracker (A6), from the ship's position
         at each step's start. A current field (document 002) is its ``current_kernel()`` parameters,
-        evaluated by :func:`~shipgnc.routing.fields.field_velocity` at the position and time it is
+        evaluated by :func:`~shipgnc.environment.fields.field_velocity` at the position and time it is
         called with (every RK stage when the disturbance is ``per_stage``). The wave noise does not
         depend on the state: ``table(k0, k1)`` asks the
         :class:`~shipgnc.environment.filtered_noise.SecondOrderNoise` itself for its values at
@@ -486,7 +486,7 @@ def _field_kernel(current) -> np.ndarray:
     function, params = make()
     if function is not field_velocity:
         raise NotCompiled(f"current {type(current).__name__}: its current_kernel() is not "
-                          "shipgnc.routing.fields.field_velocity")
+                          "shipgnc.environment.fields.field_velocity")
     return params
 
 

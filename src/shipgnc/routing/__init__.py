@@ -1,6 +1,6 @@
 """Time-optimal routing in a current (Zermelo's problem, document 002).
 
-* :mod:`~shipgnc.routing.fields`: current fields v(x, t) (note 002-2.9.1), usable by the router and
+* :mod:`~shipgnc.environment.fields`: current fields v(x, t) (note 002-2.9.1), usable by the router and
   as a ship's current in the simulation loop;
 * :mod:`~shipgnc.routing.pmp`: Pontryagin extremals, shooting, the batched global sweep (notes
   002-2.4–002-2.6, 002-2.9.4);
@@ -18,18 +18,18 @@ import importlib
 from typing import Any
 
 _LAZY = {
-    "UniformCurrent": "shipgnc.routing.fields",
-    "AffineCurrent": "shipgnc.routing.fields",
-    "RigidRotation": "shipgnc.routing.fields",
-    "RankineVortex": "shipgnc.routing.fields",
-    "LambOseenVortex": "shipgnc.routing.fields",
-    "DoubleGyre": "shipgnc.routing.fields",
-    "SumField": "shipgnc.routing.fields",
-    "Modulated": "shipgnc.routing.fields",
-    "GriddedCurrent": "shipgnc.routing.fields",
-    "shear": "shipgnc.routing.fields",
-    "sample_field": "shipgnc.routing.fields",
-    "parse_field": "shipgnc.routing.field_spec",
+    "UniformCurrent": "shipgnc.environment.fields",
+    "AffineCurrent": "shipgnc.environment.fields",
+    "RigidRotation": "shipgnc.environment.fields",
+    "RankineVortex": "shipgnc.environment.fields",
+    "LambOseenVortex": "shipgnc.environment.fields",
+    "DoubleGyre": "shipgnc.environment.fields",
+    "SumField": "shipgnc.environment.fields",
+    "Modulated": "shipgnc.environment.fields",
+    "GriddedCurrent": "shipgnc.environment.fields",
+    "shear": "shipgnc.environment.fields",
+    "sample_field": "shipgnc.environment.fields",
+    "parse_field": "shipgnc.environment.field_spec",
     "solve_route": "shipgnc.routing.router",
     "RouteResult": "shipgnc.routing.result",
     "Unreachable": "shipgnc.routing.result",

@@ -4,8 +4,8 @@ The extremal ODE (2.1)–(2.3) of :mod:`shipgnc.routing.pmp`,
 
     ẋ = V p/|p| + v(x, t),   ṗ = −(∂v/∂x)ᵀ p,
 
-evaluated by :func:`~shipgnc.routing.fields.field_state` from a field's compiled form
-(:meth:`~shipgnc.routing.fields.CurrentField.current_kernel` with ``grids=True``, so bilinear gridded data
+evaluated by :func:`~shipgnc.environment.fields.field_state` from a field's compiled form
+(:meth:`~shipgnc.environment.fields.CurrentField.current_kernel` with ``grids=True``, so bilinear gridded data
 is compiled too) and integrated with classical RK4 at a fixed step. The numpy forms in :mod:`pmp` stay the
 reference: :func:`family_kernel` follows ``pmp.integrate_family`` operation for operation, and a field
 without a compiled form (a bicubic grid, a user's own class) is integrated as before, with ``solve_ivp``.
@@ -18,7 +18,7 @@ costate, (2.5)). The step is
 
     h = min( TURN_PER_STEP / ‖J‖_max ,  cell / (CELL_STEPS·(V + |v|_max)) ),  at least MIN_STEPS steps,
 
-where ``‖J‖_max`` is the field's :meth:`~shipgnc.routing.fields.CurrentField.rate_bound` and ``cell`` its
+where ``‖J‖_max`` is the field's :meth:`~shipgnc.environment.fields.CurrentField.rate_bound` and ``cell`` its
 smallest grid spacing (analytic fields: no cell limit). With λh ≤ 4·10⁻³ the error is ≈ 2·10⁻¹²·λT, below
 the polish's miss tolerance (10⁻⁴ |AB|) by many orders for any λT the effort bound admits; across a cell
 edge RK4 drops to second order locally, O(h²) per edge, which the ≥ 4 steps per cell keep below the
@@ -39,8 +39,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from shipgnc.environment.fields import field_state
 from shipgnc.kernels import JIT_OPTIONS, NotCompiled, kernel_function
-from shipgnc.routing.fields import field_state
 
 #: the largest ‖J‖·h of a step: the current turns heading and costate by at most this per step [rad]
 TURN_PER_STEP = 4e-3
@@ -80,7 +80,7 @@ _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 def _speed_bound(field) -> float:
     """The largest |v| [m/s] on a gridded field's extent over its time: sampled at t = 0, at every time
     slice of its grids and over one period of each tidal factor."""
-    from shipgnc.routing.fields import GriddedCurrent, Modulated, SumField
+    from shipgnc.environment.fields import GriddedCurrent, Modulated, SumField
 
     times = {0.0}
 

@@ -311,7 +311,7 @@ def reachability(field, speed, start, target, domain, spacing, *, t0=0.0, horizo
     clipped to min(φ, band·h) at the start and after every step (the narrow band, module docstring);
     ``None`` leaves it unclipped. ``r0`` [m]: radius of the first front (default max(5h, |AB|/20), kept off
     the obstacles), drawn by ``n_rays`` short-time extremals of ``ray_steps`` steps. A gridded,
-    time-varying field (:class:`~shipgnc.routing.fields.GriddedCurrent`) is interpolated onto the grid one
+    time-varying field (:class:`~shipgnc.environment.fields.GriddedCurrent`) is interpolated onto the grid one
     time slice at a time (:class:`_GridSlices`, equal results). Returns a :class:`LevelSetResult`.
     ``compiled=False`` uses the numpy reference of the right-hand side (:func:`front_rate`) instead of its
     numba twin. ``progress(fraction)``, if given, is called after every step with the fraction of the

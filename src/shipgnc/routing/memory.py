@@ -201,7 +201,7 @@ def route_memory_estimate(fld, speed, start, target, *, method="auto", grid_spac
     ``auto`` the sweep and the level set (and, with obstacles, the graph search), ``levelset`` the level set,
     ``graph`` the graph search and the sweep that confirms its "unreachable". ``r0`` as
     :func:`~shipgnc.routing.levelset.reachability`'s."""
-    from shipgnc.routing.fields import UniformCurrent
+    from shipgnc.environment.fields import UniformCurrent
     from shipgnc.routing.router import default_domain
 
     out = RouteMemory()

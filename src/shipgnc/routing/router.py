@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
+from shipgnc.environment.fields import CurrentField, FieldDomainError, UniformCurrent
 from shipgnc.errors import ConfigError, require
-from shipgnc.routing.fields import CurrentField, FieldDomainError, UniformCurrent
 from shipgnc.routing.result import RouteResult
 
 METHODS = ("auto", "pmp", "levelset", "graph")

@@ -43,10 +43,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shipgnc.environment.fields import field_velocity
 from shipgnc.kernels import Kernel, NotCompiled, kernel_function
 from shipgnc.models.base import Signal
 from shipgnc.models.fossen3dof import DISTURBANCES, VectoredThrustBoat, boat_rhs
-from shipgnc.routing.fields import field_velocity
 
 CURRENT = (
     Signal("current_north", "m/s", "current over ground, north component"),
@@ -99,7 +99,7 @@ def boat_current_rhs(x, u, d, p, xdot):
 
 class FieldCurrent:
     """The disturbance ``[0, 0, 0, v_N, v_E]`` of :class:`BoatInCurrent`: a routing current field
-    (:mod:`shipgnc.routing.fields`) at the ship's position, at time ``t0 + t`` (the ship's clock starts
+    (:mod:`shipgnc.environment.fields`) at the ship's position, at time ``t0 + t`` (the ship's clock starts
     at the route's departure t0); evaluated at every RK stage."""
 
     per_stage = True
@@ -129,7 +129,7 @@ class FieldCurrent:
         function, params = make(t0=self.t0)
         if function is not field_velocity:
             raise NotCompiled(f"current {type(self.field).__name__}: its current_kernel() is not "
-                              "shipgnc.routing.fields.field_velocity")
+                              "shipgnc.environment.fields.field_velocity")
         return params
 
     def kernel(self, batch_shape, dt: float | None = None) -> Kernel:

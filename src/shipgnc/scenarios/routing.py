@@ -18,7 +18,7 @@ does has ``<run>_arrived: false``, ``<run>_arrival_s`` and ``<run>_arrival_ratio
 
 ``sail.backend`` chooses the loop as ``simulation.backend`` does elsewhere: ``compiled`` runs the
 composed loop (the programme tabulated at the control samples, the field by its compiled form
-:meth:`~shipgnc.routing.fields.CurrentField.current_kernel`), ``numpy`` the reference loop, ``auto`` lets
+:meth:`~shipgnc.environment.fields.CurrentField.current_kernel`), ``numpy`` the reference loop, ``auto`` lets
 :func:`~shipgnc.sim.simulator.simulate` decide by the size of the run.
 """
 
@@ -40,7 +40,7 @@ ROUTE_KEYS = ("reachable", "time_s", "time_h", "heading_start_deg", "heading_end
 
 def solve(cfg):
     """Solve the scenario's routing problem (the conversions of ``shipgnc route --units``)."""
-    from shipgnc.routing.field_spec import parse_field
+    from shipgnc.environment.field_spec import parse_field
     from shipgnc.routing.router import solve_route
 
     nautical = cfg.units == "nautical"

@@ -1,7 +1,7 @@
 """Turn a validated :class:`~shipgnc.scenarios.schema.Scenario` into objects, run it, score it.
 
 ``build`` makes the model, actuator, controller, guidance and disturbance; ``run_scenario`` calls
-the one simulation loop and computes the scenario's metrics; :func:`shipgnc.scenarios.write.write_outputs`
+the one simulation loop and computes the scenario's metrics; :func:`shipgnc.viz.run_files.write_outputs`
 saves ``result.nc``, ``metrics.json`` and the PNG figures.
 """
 

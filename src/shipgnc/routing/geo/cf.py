@@ -172,7 +172,7 @@ def _find_velocity(ds, name):
 
 
 def _factor(var, vname, name, notes):
-    from shipgnc.routing.fields import velocity_factor
+    from shipgnc.environment.fields import velocity_factor
 
     return velocity_factor(var.attrs.get("units"), f"{name}: {vname}")
 

@@ -5,7 +5,7 @@ oblique Mercator centred on the route, conformal, scale within 10⁻⁴ of one n
 document 002 (:func:`~shipgnc.routing.router.solve_route`):
 
 1. the current is resampled onto a regular plane grid (bilinear in latitude/longitude, its vectors turned
-   from true north to grid north), a :class:`~shipgnc.routing.fields.GriddedCurrent` that keeps the file's
+   from true north to grid north), a :class:`~shipgnc.environment.fields.GriddedCurrent` that keeps the file's
    time axis (linear in time); NaN cells and cells outside the file are land;
 2. land (the GSHHG coastline, or ``land=`` polygons), shallow water (depth < draft + UKC) and the current's
    NaN cells are polygons in the plane; the router keeps one level-set cell ``clearance`` off them;
@@ -238,7 +238,7 @@ class GeoProblem:
     def _plane_field(self, current: GeoCurrent):
         import xarray as xr
 
-        from shipgnc.routing.fields import GriddedCurrent
+        from shipgnc.environment.fields import GriddedCurrent
 
         grid = current.grid
         spacing = self.h if grid is None else min(grid.spacing_m() / 1.5, self.h)
@@ -250,7 +250,7 @@ class GeoProblem:
         cn, ce = self.projection.rotate(lat, lon, one, 0 * one)  # true north in the plane
         self._grid_north = (nn, ee, np.degrees(np.arctan2(ce, cn)).reshape(N.shape))
         if grid is None:
-            from shipgnc.routing.fields import AffineCurrent, UniformCurrent
+            from shipgnc.environment.fields import AffineCurrent, UniformCurrent
 
             vn, ve = current.uniform
             v = np.column_stack(self.projection.rotate(lat, lon, vn * one, ve * one))

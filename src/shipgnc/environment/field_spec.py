@@ -40,7 +40,7 @@ UNITS = ("si", "nautical")
 
 
 def _term(text: str, units: str):
-    from shipgnc.routing import fields as F
+    from shipgnc.environment import fields as F
 
     name, _, args = text.partition(":")
     name = name.strip().lower()
@@ -85,7 +85,7 @@ def parse_field(text: str, units: str = "si"):
     terms = [_term(t, units) for t in parts]
     if len(terms) == 1:
         return terms[0]
-    from shipgnc.routing.fields import SumField
+    from shipgnc.environment.fields import SumField
 
     return SumField(terms)
 

@@ -143,7 +143,7 @@ def route_figure(res, path, nautical: bool = True, extra_text: str | None = None
 
 
 def document_figures(out_dir) -> list:
-    """The figures of docs/002_zermelo_routing.md (``python -m shipgnc.routing.figures docs/figures``).
+    """The figures of docs/002_zermelo_routing.md (``python -m shipgnc.viz.route_figures docs/figures``).
 
     zermelo-paper.png: the document's case (PMP with the level-set check at 0.04 nm, hourly isochrones)
     and the document's numbers beside ours; zermelo-vortex.png: the three extremals of F2;
@@ -156,8 +156,8 @@ def document_figures(out_dir) -> list:
 
     matplotlib.use("Agg", force=False)
 
+    from shipgnc.environment.fields import LambOseenVortex, shear
     from shipgnc.routing.closed_form import straight_course
-    from shipgnc.routing.fields import LambOseenVortex, shear
     from shipgnc.routing.router import solve_route
 
     nm, h = NAUTICAL_MILE, 3600.0

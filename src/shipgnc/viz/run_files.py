@@ -177,7 +177,7 @@ def figure_title(run: ScenarioRun) -> str:
 def route_figures(run, out) -> list:
     """``route.png`` (the route over the current, isochrones when the level set ran) and, for a
     sailed route, ``sail.png`` (the ship's tracks over the route)."""
-    from shipgnc.routing.figures import route_figure
+    from shipgnc.viz.route_figures import route_figure
 
     nautical = run.scenario.route.units == "nautical"
     document = run.scenario.document_figures.get("route", {})
