@@ -75,8 +75,8 @@ def test_course_comparison_keeps_its_labels_inside_and_names_the_law():
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     from shipgnc.scenarios.registry import load_scenario
-    from shipgnc.viz.run_files import controller_title
     from shipgnc.viz.comparison import course_comparison
+    from shipgnc.viz.run_files import controller_title
 
     title = controller_title(load_scenario("mariner-cst-heading").controller)
     assert title == "course autopilot pd: Kp = 1, Kd = 40"
