@@ -161,6 +161,9 @@ class Navigation:
     # ---- the compiled loop --------------------------------------------------------------------
     def kernel_reason(self) -> str | None:
         """None when the composed loop can run this navigation system, else why not."""
+        for sensor in self.sensors:  # the shared sensor kernel computes the kinds it knows
+            if getattr(sensor, "kernel_kind", -1) < 0:
+                return f"sensor {sensor.name} ({type(sensor).__name__}) has no kernel"
         est = self.estimator
         if est is not None and not callable(getattr(est, "kernel_block", None)):
             return f"estimator {type(est).__name__} has no kernel"

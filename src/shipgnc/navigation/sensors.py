@@ -35,11 +35,15 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from typing import Annotated, ClassVar, Literal
 
 import numpy as np
+from pydantic import Field, field_validator
 
+from shipgnc.config_types import Finite, NonNegative, Positive, Strict
 from shipgnc.errors import ConfigError, require
 from shipgnc.models.base import Signal, names
+from shipgnc.navigation.records import SensorKind
 
 
 def _nonneg(field: str, value, what: str = "") -> float:
@@ -411,3 +415,103 @@ class SpeedLog(Sensor):
 
 
 SENSOR_TYPES = {"gnss": GNSS, "compass": Compass, "gyro": RateGyro, "log": SpeedLog}
+
+
+# ---- scenario files: the sections and the registry records -------------------------------------
+#: the largest sensor noise or bias (in its field's unit), whose square is a finite float
+MAX_SENSOR_ERROR = 1e150
+
+
+class SensorConfigBase(Strict):
+    """Common sensor settings (:mod:`shipgnc.navigation.sensors`): its own sample rate
+    (a whole multiple of the control period; default every control sample), a latency in control
+    samples, and intervals ``[t0, t1]`` [s] without measurements."""
+
+    field_units: ClassVar[dict[str, str]] = {"latency": "control samples", "dropouts": "s"}
+
+    name: str | None = None
+    rate_hz: Positive | None = None
+    latency: Annotated[int, Field(ge=0)] = 0
+    dropouts: list[tuple[NonNegative, NonNegative]] = Field(default_factory=list)
+
+    @field_validator("*", mode="after")
+    @classmethod
+    def _variance_finite(cls, value, info):
+        """A noise or bias whose square (the variance the filter and the draws use) overflows
+        a float is refused here, not met as an OverflowError in the run."""
+        if info.field_name.startswith(("noise", "bias")) and isinstance(value, float) \
+                and abs(value) > MAX_SENSOR_ERROR:
+            raise ValueError(f"too large: its square (the variance) overflows; at most "
+                             f"{MAX_SENSOR_ERROR:g}")
+        return value
+
+
+class GNSSConfig(SensorConfigBase):
+    """Position fix (north, east): white noise and a first-order Gauss–Markov bias."""
+
+    type: Literal["gnss"]
+    rate_hz: Positive | None = 1.0
+    noise_m: NonNegative = 1.5
+    bias_std_m: NonNegative = 0.0
+    bias_time_constant_s: Positive = 300.0
+
+
+class CompassConfig(SensorConfigBase):
+    """Heading: white noise and a constant bias (``bias_std_deg``: drawn per ship)."""
+
+    type: Literal["compass"]
+    noise_deg: NonNegative = 0.5
+    bias_deg: Finite = 0.0
+    bias_std_deg: NonNegative = 0.0
+
+
+class GyroConfig(SensorConfigBase):
+    """Yaw rate: white noise and a bias that walks (``bias_walk_deg_s``: per √s)."""
+
+    field_units: ClassVar[dict[str, str]] = {"bias_walk_deg_s": "deg/s per √s"}
+
+    type: Literal["gyro"]
+    noise_deg_s: NonNegative = 0.1
+    bias_deg_s: Finite = 0.0
+    bias_walk_deg_s: NonNegative = 0.0
+
+
+class SpeedLogConfig(SensorConfigBase):
+    """Speed through the water of one state (``u`` by default): white noise."""
+
+    field_units: ClassVar[dict[str, str]] = {"noise_m_s": "m/s"}
+
+    type: Literal["log"]
+    noise_m_s: NonNegative = 0.05
+    state: str = "u"
+
+
+def common_options(cfg: SensorConfigBase) -> dict:
+    """The options every sensor takes (:class:`Sensor`) from its section."""
+    return {"rate_hz": cfg.rate_hz, "latency": cfg.latency, "name": cfg.name,
+            "dropouts": [tuple(interval) for interval in cfg.dropouts]}
+
+
+def gnss_of(cfg: GNSSConfig) -> GNSS:
+    return GNSS(cfg.noise_m, bias_std=cfg.bias_std_m, bias_time_constant=cfg.bias_time_constant_s,
+                **common_options(cfg))
+
+
+def compass_of(cfg: CompassConfig) -> Compass:
+    return Compass(math.radians(cfg.noise_deg), bias=math.radians(cfg.bias_deg),
+                   bias_std=math.radians(cfg.bias_std_deg), **common_options(cfg))
+
+
+def gyro_of(cfg: GyroConfig) -> RateGyro:
+    return RateGyro(math.radians(cfg.noise_deg_s), bias=math.radians(cfg.bias_deg_s),
+                    bias_walk=math.radians(cfg.bias_walk_deg_s), **common_options(cfg))
+
+
+def log_of(cfg: SpeedLogConfig) -> SpeedLog:
+    return SpeedLog(cfg.noise_m_s, state=cfg.state, **common_options(cfg))
+
+
+GNSS_SENSOR = SensorKind("gnss", GNSSConfig, GNSS, gnss_of, measures=GNSS.measures)
+COMPASS_SENSOR = SensorKind("compass", CompassConfig, Compass, compass_of, measures=Compass.measures)
+GYRO_SENSOR = SensorKind("gyro", GyroConfig, RateGyro, gyro_of, measures=RateGyro.measures)
+LOG_SENSOR = SensorKind("log", SpeedLogConfig, SpeedLog, log_of, measures=("u",))

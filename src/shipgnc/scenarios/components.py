@@ -8,6 +8,8 @@ runner its dispatch (which function builds the vessel, the controller, the guida
 component is its module, its configuration section (:mod:`shipgnc.scenarios.sections`) and one
 entry here; neither the schema's checks nor the runner's dispatch names it
 (``docs/extending.md``; the RL environments and the live dashboard keep their own short lists).
+Sensors and estimators declare their records in their own modules
+(:mod:`shipgnc.navigation.records`), collected here from :data:`NAVIGATION_MODULES`.
 
 Builders are named ``"module:function"`` and imported when first used, so that reading a scenario
 file does not import every model and controller.
@@ -20,12 +22,15 @@ from dataclasses import dataclass
 from typing import Literal
 
 from shipgnc.errors import ConfigError
+from shipgnc.navigation.records import EstimatorKind, SensorKind
 from shipgnc.scenarios import sections as S
 from shipgnc.vessels.config import CATALOGUE_VESSELS, CatalogueVesselConfig
 
 
-def resolve(target: str):
-    """The function named ``"module:function"``."""
+def resolve(target):
+    """The function named ``"module:function"`` (a function itself: that function)."""
+    if callable(target):
+        return target
     module, _, name = target.partition(":")
     return getattr(importlib.import_module(module), name)
 
@@ -208,3 +213,52 @@ def having_cases() -> tuple[str, ...]:
 def config_classes(table: dict) -> tuple[type, ...]:
     """The distinct configuration classes of a table's entries, in entry order."""
     return tuple(dict.fromkeys(kind.config for kind in table.values()))
+
+
+# ---- records declared beside their components ----------------------------------------------------
+#: the built-in modules that declare sensor and estimator records (:mod:`shipgnc.navigation.records`)
+NAVIGATION_MODULES = ("shipgnc.navigation.sensors", "shipgnc.navigation.ekf",
+                      "shipgnc.navigation.passive_observer")
+SENSORS: dict[str, SensorKind] = {}
+ESTIMATORS: dict[str, EstimatorKind] = {}
+
+#: record class → (its table, the field that names it, what a scenario file calls it)
+RECORD_TABLES: dict[type, tuple[dict, str, str]] = {
+    VesselKind: (VESSEL_KINDS, "model", "vessel.model"),
+    ControllerKind: (CONTROLLERS, "type", "controller.type"),
+    GuidanceKind: (GUIDANCE, "type", "guidance.type"),
+    DisturbanceKind: (DISTURBANCES, "type", "disturbance.type"),
+    MetricKind: (METRICS, "name", "metrics"),
+    SensorKind: (SENSORS, "type", "sensors[].type"),
+    EstimatorKind: (ESTIMATORS, "type", "estimator.type"),
+}
+
+
+def records_in(obj) -> list:
+    """The registry records ``obj`` holds: a record, a list or tuple of records, or a module (its
+    module-level record instances, in definition order)."""
+    kinds = tuple(RECORD_TABLES)
+    if isinstance(obj, kinds):
+        return [obj]
+    if isinstance(obj, (list, tuple)):
+        return [r for r in obj if isinstance(r, kinds)]
+    namespace = getattr(obj, "__dict__", None) if type(obj).__name__ == "module" else None
+    return [r for r in (namespace or {}).values() if isinstance(r, kinds)]
+
+
+def register(record, origin: str) -> None:
+    """Add ``record`` to its table; a name already taken is a ConfigError naming ``origin``."""
+    table, field, what = RECORD_TABLES[type(record)]
+    name = getattr(record, field)
+    if not isinstance(name, str) or not name:
+        raise ConfigError(f"{origin}: {type(record).__name__}.{field} = {name!r}: must be a "
+                          f"non-empty name")
+    if name in table:
+        raise ConfigError(f"{origin}: {what} {name!r} is already registered; give the component "
+                          f"another name")
+    table[name] = record
+
+
+for _module in NAVIGATION_MODULES:
+    for _record in records_in(importlib.import_module(_module)):
+        register(_record, _module)

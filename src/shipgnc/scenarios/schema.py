@@ -23,13 +23,11 @@ from shipgnc.scenarios.sections import (  # noqa: F401  (re-exported: the sectio
     ActuatorConfig,
     CatamaranCaseConfig,
     CurrentConfig,
-    EstimatorConfig,
     MarinerDisturbanceConfig,
     MonteCarloConfig,
     QualityConfig,
     RouteConfig,
     SailConfig,
-    SensorConfig,
     SimulationConfig,
     VesselConfig,
 )
@@ -62,6 +60,8 @@ Vessel = Annotated[
 ControllerConfig = _union_by_type(C.CONTROLLERS)
 GuidanceConfig = _union_by_type(C.GUIDANCE)
 DisturbanceConfig = _union_by_type(C.DISTURBANCES)
+SensorConfig = _union_by_type(C.SENSORS)
+EstimatorConfig = _union_by_type(C.ESTIMATORS)
 MetricSet = Literal[tuple(C.METRICS)]
 
 
