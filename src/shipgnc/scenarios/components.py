@@ -9,7 +9,9 @@ component is its module, its configuration section (:mod:`shipgnc.scenarios.sect
 entry here; neither the schema's checks nor the runner's dispatch names it
 (``docs/extending.md``; the RL environments and the live dashboard keep their own short lists).
 Sensors and estimators declare their records in their own modules
-(:mod:`shipgnc.navigation.records`), collected here from :data:`NAVIGATION_MODULES`.
+(:mod:`shipgnc.navigation.records`), collected here from :data:`NAVIGATION_MODULES`; third-party
+packages add records of every kind through the entry-point group :data:`ENTRY_POINT_GROUP`
+(:func:`load_plugins`).
 
 Builders are named ``"module:function"`` and imported when first used, so that reading a scenario
 file does not import every model and controller.
@@ -116,6 +118,9 @@ class MetricKind:
     controllers: tuple[str, ...] | None = None
     sections: tuple[str, ...] = ()
     vessels: tuple[str, ...] | None = None
+    #: its scorer ``(scenario, result, setup) -> dict`` (``"module:function"`` or the function);
+    #: None: a built-in set scored by :func:`shipgnc.scenarios.runner.compute_metrics`
+    score: object = None
 
 
 CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
@@ -215,10 +220,14 @@ def config_classes(table: dict) -> tuple[type, ...]:
     return tuple(dict.fromkeys(kind.config for kind in table.values()))
 
 
-# ---- records declared beside their components ----------------------------------------------------
+# ---- records declared beside their components, and third-party packages' ------------------------
 #: the built-in modules that declare sensor and estimator records (:mod:`shipgnc.navigation.records`)
 NAVIGATION_MODULES = ("shipgnc.navigation.sensors", "shipgnc.navigation.ekf",
                       "shipgnc.navigation.passive_observer")
+#: the entry-point group of third-party components: an entry point names a module (its records
+#: are the record instances among its module-level names) or a record list (``module:NAME``)
+ENTRY_POINT_GROUP = "shipgnc.components"
+
 SENSORS: dict[str, SensorKind] = {}
 ESTIMATORS: dict[str, EstimatorKind] = {}
 
@@ -262,3 +271,35 @@ def register(record, origin: str) -> None:
 for _module in NAVIGATION_MODULES:
     for _record in records_in(importlib.import_module(_module)):
         register(_record, _module)
+
+_plugins_loaded = False
+
+
+def load_plugins() -> None:
+    """Register the records of every ``shipgnc.components`` entry point, once: called by the
+    scenario schema before it derives its unions (the registry's first use), not on import of
+    this module, which a plug-in imports for the record classes. A plug-in that fails to load,
+    or names no record, is a one-line ConfigError naming its distribution and entry point."""
+    global _plugins_loaded
+    if _plugins_loaded:
+        return
+    _plugins_loaded = True
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        dist = getattr(ep, "dist", None)
+        origin = (f"plug-in {ep.name!r} = {ep.value!r} (entry point of distribution "
+                  f"{dist.name if dist is not None else '?'} "
+                  f"{dist.version if dist is not None else ''}, group {ENTRY_POINT_GROUP})")
+        try:
+            loaded = ep.load()
+        except Exception as exc:  # any failure of third-party code: one line, naming the plug-in
+            detail = " ".join(str(exc).split())
+            raise ConfigError(f"{origin}: cannot be loaded: {type(exc).__name__}: {detail}") from None
+        records = records_in(loaded)
+        if not records:
+            raise ConfigError(f"{origin}: names no component record (VesselKind, ControllerKind, "
+                              "GuidanceKind, DisturbanceKind, MetricKind, SensorKind, "
+                              "EstimatorKind)")
+        for record in records:
+            register(record, origin)

@@ -320,7 +320,10 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     from shipgnc.analysis import metrics
 
     diverged = bool(result.attrs.get("diverged", 0))
-    if scenario.metrics == "route" and setup.case is not None:  # one sailed run of a route
+    score = C.METRICS[scenario.metrics].score if scenario.metrics in C.METRICS else None
+    if score is not None:  # a metric set that brings its scorer (a plug-in's)
+        out = dict(C.resolve(score)(scenario, result, setup))
+    elif scenario.metrics == "route" and setup.case is not None:  # one sailed run of a route
         from shipgnc.scenarios import routing
 
         out = routing.sail_metrics(result, *setup.case)

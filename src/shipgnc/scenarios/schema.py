@@ -33,6 +33,8 @@ from shipgnc.scenarios.sections import (  # noqa: F401  (re-exported: the sectio
 )
 from shipgnc.vessels.config import CATALOGUE_VESSELS, CatalogueVesselConfig  # noqa: F401  (re-exported)
 
+C.load_plugins()  # third-party components (entry-point group shipgnc.components), once
+
 #: vessel models a scenario's ``current`` section applies to, and those that take navigation
 CURRENT_VESSELS = C.having("current")
 NAVIGATION_VESSELS = C.having("navigation")
