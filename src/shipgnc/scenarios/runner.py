@@ -302,7 +302,7 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
 
 def navigation(scenario: Scenario, controller=None):
     """The :class:`~shipgnc.navigation.Navigation` a ``controller`` config reads through (the
-    scenario's ``sensors`` and ``estimator``, degrees converted to radians here; the controller's
+    scenario's ``sensors`` and ``estimator``, built by their registry records; the controller's
     ``sees`` picks truth, measurement or estimate), or None when it reads the true state."""
     sees = getattr(controller, "sees", None)
     if not scenario.sensors or sees == "truth":
