@@ -32,8 +32,10 @@ No navigation (``navigation=None``) is today's loop unchanged: the controller re
 Both loops run navigation: :meth:`Navigation.kernel` hands the sensors and the estimator (passive
 observer, EKF, KF) to the composed compiled loop (:mod:`shipgnc.navigation.kernels`,
 :mod:`shipgnc.sim.nav_template`) with the sensors' draws taken from the same child streams, so a
-seed gives the same run in both; a sensor without a kernel kind or an estimator without
-``kernel_block`` runs in the numpy loop (``unsupported_reason`` names it).
+seed gives the same run in both. Sensors and estimators are slots of that loop: the sensor
+kernel computes every sensor whose errors are its model (``Sensor.kernel_errors``), an
+estimator's ``kernel_block`` names its slot's function; a sensor or an estimator without them
+runs in the numpy loop (``unsupported_reason`` names it).
 
 Each sensor and estimator module declares its registry record beside its class
 (:mod:`shipgnc.navigation.records`; e.g. :data:`~shipgnc.navigation.sensors.GNSS_SENSOR`), which

@@ -259,7 +259,6 @@ class ExtendedKalmanFilter(GaussianFilter):
         angle, bias state or −1, latency, period, first slot, slots) × n_rows, Q_c diagonal,
         (driven state or −1, λ) × n_aug]``; the model's derivatives are its kernel in the
         loop."""
-        from shipgnc.navigation import kernels as nk
 
         slots = self._slots()
         block = [float(self.substeps), self.Ts, float(self.noise == "held"), float(len(self.rows)),
@@ -273,7 +272,7 @@ class ExtendedKalmanFilter(GaussianFilter):
         for a in range(self.n_aug):  # augmented states: the model state driven, decay rate
             hit = np.flatnonzero(self.Daug[a])
             block += [float(hit[0]) if hit.size else -1.0, float(self.lam[a])]
-        return nk.EKF, block, self.kernel_state(n_ships), self.kernel_map()
+        return "ekf_slot", block, self.kernel_state(n_ships), self.kernel_map()
 
     def _f(self, x, u):
         return self.model.derivatives(x, u, None)

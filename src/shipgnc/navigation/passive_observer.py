@@ -319,7 +319,7 @@ class PassiveObserver(Estimator):
                                       np.zeros((n_ships, 3)),
                                       self._x_template.reshape(n_ships, nx))], axis=1)
         assert z.shape[1] == nk.OBS_STATE + nx
-        return nk.OBSERVER, block, z, None
+        return "observer_slot", block, z, None
 
     # ---- outputs ------------------------------------------------------------------------------
     def model_estimate(self):

@@ -24,8 +24,8 @@ class SensorKind:
     :class:`~shipgnc.navigation.sensors.SensorConfigBase`); ``sensor``: its class (a
     :class:`~shipgnc.navigation.sensors.Sensor`); ``build(cfg) -> Sensor``: the sensor of a
     section, scenario units (degrees) converted to SI here; ``measures``: the model states it
-    measures by default (capability, shown in the docs). Its kernel for the compiled loop is the
-    class's (:attr:`compiled`)."""
+    measures by default (capability, shown in the docs). The compiled loop's sensor kernel
+    computes it when its class's errors are that kernel's model (:attr:`compiled`)."""
 
     type: str
     config: type
@@ -35,10 +35,10 @@ class SensorKind:
 
     @property
     def compiled(self) -> bool:
-        """The composed compiled loop computes this sensor (its class has a kernel kind of
-        :func:`shipgnc.navigation.kernels.sensors_observe`); otherwise a run with it takes the
-        numpy loop."""
-        return getattr(self.sensor, "kernel_kind", -1) >= 0
+        """The composed compiled loop computes this sensor (its class's ``kernel_errors``: its
+        errors are the model of :func:`shipgnc.navigation.kernels.sensors_observe`); otherwise
+        a run with it takes the numpy loop."""
+        return bool(getattr(self.sensor, "kernel_errors", False))
 
 
 @dataclass(frozen=True)

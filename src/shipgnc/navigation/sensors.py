@@ -166,8 +166,10 @@ class Sensor:
                 self.fresh = np.ones(self.batch_shape, dtype=bool)
 
     # ---- the compiled loop (navigation.kernels.sensors_observe) --------------------------------
-    #: kind code of the kernel; the bias process's scale (GNSS: σ_b √(1 − a²), gyro: σ_rw √h)
-    kernel_kind = -1
+    #: its errors are the sensor kernel's model, y = x + b + σ w with b_{j+1} = a b_j + s w_j
+    #: (:meth:`_kernel_bias`: σ_b, a, s; :meth:`_kernel_bias_state`: b at reset; ``noise_std``
+    #: σ), drawn in :meth:`kernel_draws`'s order; False: a run with it takes the numpy loop
+    kernel_errors = False
 
     def _kernel_bias(self) -> tuple[float, float, float]:
         """(bias_std, a, b_scale) of the kernel's bias process (0 where the sensor has none)."""
@@ -175,10 +177,10 @@ class Sensor:
 
     def kernel_params(self) -> list[float]:
         """The sensor's parameter block without its offsets (:mod:`shipgnc.navigation.kernels`):
-        ``[kind, k, every, latency, n_dropouts, noise_std, bias_std, a, b_scale]``, then (after the
+        ``[0 (reserved), k, every, latency, n_dropouts, noise_std, bias_std, a, b_scale]``, then (after the
         three offsets the navigation system adds) the state indices and the dropout intervals."""
         bstd, a, bscale = self._kernel_bias()
-        return [float(self.kernel_kind), float(len(self.measures)), float(self.every),
+        return [0.0, float(len(self.measures)), float(self.every),
                 float(self.latency), float(len(self.dropouts)), float(self.noise_std), bstd, a,
                 bscale]
 
@@ -211,8 +213,8 @@ class Sensor:
 
         k = len(self.measures)
         out = np.zeros((count, n_ships, 2 * k))
-        bstd, _a, bscale = self._kernel_bias()
-        biased = (self.kernel_kind == 0 and bstd > 0) or (self.kernel_kind == 2 and bscale > 0)
+        _bstd, _a, bscale = self._kernel_bias()
+        biased = bscale > 0
         start = 0
         if biased and self._first and count > 0:  # the first sample draws its noise only
             if self.noise_std > 0:
@@ -284,7 +286,7 @@ class GNSS(Sensor):
             (*self.batch_shape, 2))
         self._first = True
 
-    kernel_kind = 0
+    kernel_errors = True
 
     def _kernel_bias(self):
         if self.bias_std <= 0:
@@ -330,7 +332,7 @@ class Compass(Sensor):
     def _reset_errors(self) -> None:
         self._b = self.bias + (self.bias_std * self._draw() if self.bias_std > 0 else 0.0)
 
-    kernel_kind = 1
+    kernel_errors = True
 
     def _kernel_bias_state(self):
         return self._b
@@ -366,11 +368,11 @@ class RateGyro(Sensor):
         self._b = np.full((*self.batch_shape, 1), self.bias)
         self._first = True
 
-    kernel_kind = 2
+    kernel_errors = True
 
     def _kernel_bias(self):
         scale = self.bias_walk * math.sqrt(self.period) if self.bias_walk > 0 else 0.0
-        return 0.0, 0.0, scale
+        return 0.0, 1.0, scale
 
     def _kernel_bias_state(self):
         return self._b
@@ -404,7 +406,7 @@ class SpeedLog(Sensor):
         self.measures = (state,)
         self.units = ("m/s",)
 
-    kernel_kind = 3
+    kernel_errors = True
 
     def _measure(self, u):
         noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
