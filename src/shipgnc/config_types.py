@@ -10,6 +10,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Matrix3 = Annotated[list[Annotated[list[Finite], Field(min_length=3, max_length=3)]],
                     Field(min_length=3, max_length=3)]
 

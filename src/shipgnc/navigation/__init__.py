@@ -32,17 +32,45 @@ No navigation (``navigation=None``) is today's loop unchanged: the controller re
 Both loops run navigation: :meth:`Navigation.kernel` hands the sensors and the estimator (passive
 observer, EKF, KF) to the composed compiled loop (:mod:`shipgnc.navigation.kernels`,
 :mod:`shipgnc.sim.nav_template`) with the sensors' draws taken from the same child streams, so a
-seed gives the same run in both; an estimator without ``kernel_block`` runs in the numpy loop
-(``unsupported_reason`` names it).
+seed gives the same run in both. Sensors and estimators are slots of that loop: the sensor
+kernel computes every sensor whose errors are its model (``Sensor.kernel_errors``), an
+estimator's ``kernel_block`` names its slot's function; a sensor or an estimator without them
+runs in the numpy loop (``unsupported_reason`` names it).
+
+Each sensor and estimator module declares its registry record beside its class
+(:mod:`shipgnc.navigation.records`; e.g. :data:`~shipgnc.navigation.sensors.GNSS_SENSOR`), which
+the scenario registry collects. The names below are imported when first used, so that reading a
+scenario file (the records and their sections) does not import the compiled kernels.
 """
 
-from shipgnc.navigation.core import Navigation, spawn_streams
-from shipgnc.navigation.ekf import ExtendedKalmanFilter, force_psd_to_state_psd
-from shipgnc.navigation.estimator import Estimator, GaussianFilter
-from shipgnc.navigation.kalman import KalmanFilter, heading_wave_kf, van_loan
-from shipgnc.navigation.passive_observer import PassiveObserver
-from shipgnc.navigation.sensors import GNSS, SENSOR_TYPES, Compass, RateGyro, Sensor, SpeedLog
+from importlib import import_module
 
-__all__ = ["GNSS", "SENSOR_TYPES", "Compass", "Estimator", "ExtendedKalmanFilter",
+_HOMES = {
+    "Navigation": "core", "spawn_streams": "core",
+    "ExtendedKalmanFilter": "ekf", "force_psd_to_state_psd": "ekf",
+    "Estimator": "estimator", "GaussianFilter": "estimator",
+    "KalmanFilter": "kalman", "heading_wave_kf": "kalman", "van_loan": "kalman",
+    "PassiveObserver": "passive_observer",
+    "GNSS": "sensors", "SENSOR_TYPES": "sensors", "Compass": "sensors", "RateGyro": "sensors",
+    "Sensor": "sensors", "SpeedLog": "sensors",
+    "EstimatorKind": "records", "SensorKind": "records",
+}
+
+
+def __getattr__(name: str):
+    home = _HOMES.get(name)
+    if home is None:
+        raise AttributeError(f"module 'shipgnc.navigation' has no attribute {name!r}")
+    value = getattr(import_module(f"shipgnc.navigation.{home}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted([*globals(), *_HOMES])
+
+
+__all__ = ["GNSS", "SENSOR_TYPES", "Compass", "Estimator", "EstimatorKind", "ExtendedKalmanFilter",
            "GaussianFilter", "KalmanFilter", "Navigation", "PassiveObserver", "RateGyro", "Sensor",
-           "SpeedLog", "force_psd_to_state_psd", "heading_wave_kf", "spawn_streams", "van_loan"]
+           "SensorKind", "SpeedLog", "force_psd_to_state_psd", "heading_wave_kf", "spawn_streams",
+           "van_loan"]

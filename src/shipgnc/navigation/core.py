@@ -161,6 +161,9 @@ class Navigation:
     # ---- the compiled loop --------------------------------------------------------------------
     def kernel_reason(self) -> str | None:
         """None when the composed loop can run this navigation system, else why not."""
+        for sensor in self.sensors:  # the sensor kernel computes one error model (kernel_errors)
+            if not getattr(sensor, "kernel_errors", False):
+                return f"sensor {sensor.name} ({type(sensor).__name__}) has no kernel"
         est = self.estimator
         if est is not None and not callable(getattr(est, "kernel_block", None)):
             return f"estimator {type(est).__name__} has no kernel"
@@ -202,13 +205,13 @@ class Navigation:
         for name, (held, valid, fresh) in channels.items():
             params += [float(self.state_names.index(name)), float(held), float(valid),
                        float(fresh), float(self.measured[name])]
-        kind = nk.NO_ESTIMATOR
+        slot = "no_estimator"
         if self.estimator is not None:
             x_start = np.broadcast_to(np.asarray(x0, dtype=float),
                                       (*batch, len(self.state_names))).copy()
             # the estimator starts at the first control sample from the true initial state
             self.estimator.start(x_start, self._est_rng)
-            kind, block, z_est, gmap = self.estimator.kernel_block(channels, n)
+            slot, block, z_est, gmap = self.estimator.kernel_block(channels, n)
             params[3] = float(len(params))
             params += [float(v) for v in block]
             params[4] = float(sig_at)
@@ -233,9 +236,9 @@ class Navigation:
                 at += 2 * k
             return out
 
-        n_filter = (len(self.estimator.state_names) if kind == nk.EKF else 0)
+        n_filter = (len(self.estimator.state_names) if slot == "ekf_slot" else 0)
         return NavigationKernel(nk.sensors_observe, nk_flat(params), state, table, n_w,
-                                estimator=kind, n_signals=len(self.signals), hold=hold,
+                                estimator=slot, n_signals=len(self.signals), hold=hold,
                                 n_filter=n_filter)
 
 
@@ -246,11 +249,12 @@ def nk_flat(values) -> np.ndarray:
 @dataclass(frozen=True, eq=False)
 class NavigationKernel(Kernel):
     """A navigation system's :class:`~shipgnc.kernels.Kernel` with what the composed loop needs
-    beyond it: the estimator's kind (a constant of the generated loop), the number of logged
-    signals, the control samples per step (``table`` rows are control samples) and the EKF's
-    state dimension (the model's states and its augmented states)."""
+    beyond it: the estimator's slot (the function of the generated loop that runs it:
+    :mod:`shipgnc.sim.nav_template`), the number of logged signals, the control samples per step
+    (``table`` rows are control samples) and the EKF's state dimension (the model's states and
+    its augmented states)."""
 
-    estimator: int = 0
+    estimator: str = "no_estimator"
     n_signals: int = 0
     hold: int = 1
     n_filter: int = 0

@@ -62,12 +62,17 @@ independent measurements: the joint νᵀS⁻¹ν), with ``nis_dim`` the number 
 
 from __future__ import annotations
 
-import numpy as np
+from typing import Annotated, ClassVar, Literal
 
+import numpy as np
+from pydantic import Field
+
+from shipgnc.config_types import Finite, NonNegative, Positive, Strict
 from shipgnc.errors import require
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import names
 from shipgnc.navigation.estimator import GaussianFilter, as_std_vector
+from shipgnc.navigation.records import EstimatorKind
 
 
 class ExtendedKalmanFilter(GaussianFilter):
@@ -254,7 +259,6 @@ class ExtendedKalmanFilter(GaussianFilter):
         angle, bias state or −1, latency, period, first slot, slots) × n_rows, Q_c diagonal,
         (driven state or −1, λ) × n_aug]``; the model's derivatives are its kernel in the
         loop."""
-        from shipgnc.navigation import kernels as nk
 
         slots = self._slots()
         block = [float(self.substeps), self.Ts, float(self.noise == "held"), float(len(self.rows)),
@@ -268,7 +272,7 @@ class ExtendedKalmanFilter(GaussianFilter):
         for a in range(self.n_aug):  # augmented states: the model state driven, decay rate
             hit = np.flatnonzero(self.Daug[a])
             block += [float(hit[0]) if hit.size else -1.0, float(self.lam[a])]
-        return nk.EKF, block, self.kernel_state(n_ships), self.kernel_map()
+        return "ekf_slot", block, self.kernel_state(n_ships), self.kernel_map()
 
     def _f(self, x, u):
         return self.model.derivatives(x, u, None)
@@ -416,3 +420,40 @@ def force_psd_to_state_psd(model, force_psd) -> dict[str, float]:
         return {"u": float(cov[0, 0]), "v": float(cov[1, 1]), "r": float(cov[2, 2])}
     return {"u": S[0] / p.M11**2, "v": S[1] / p.M22**2, "r": S[2] / p.M33**2}
 
+
+# ---- scenario files: the section and the registry record ---------------------------------------
+class EKFConfig(Strict):
+    """An extended Kalman filter on the vessel's own model (:class:`~shipgnc.navigation.ekf.
+    ExtendedKalmanFilter`): ``process_psd`` by state name [unit²/s], initial ``P0_std`` and
+    ``x0_offset`` (SI; heading in rad; ``sample_initial``: the initial error drawn from P0),
+    ``noise``: continuous or held over each step; ``bias_states`` by state name: the spectral
+    density [unit²/s³] of a random-walk bias on that state's derivative (e.g. a current on
+    north/east, a yaw-acceleration bias on r); ``sensor_errors``: estimate the sensors' GNSS and
+    gyro biases and update with delayed fixes (default), or fold them into white noise."""
+
+    field_units: ClassVar[dict[str, str]] = {"process_psd": "(SI unit of the state)²/s",
+        "P0_std": "SI unit of the state (heading rad)",
+        "x0_offset": "SI unit of the state (heading rad)",
+        "bias_states": "(SI unit of the state)²/s³", "force_psd": "N²·s, N²·s, N²·m²·s"}
+
+    type: Literal["ekf"]
+    process_psd: dict[str, NonNegative] = Field(default_factory=dict)
+    P0_std: dict[str, Positive] = Field(default_factory=dict)
+    x0_offset: dict[str, Finite] = Field(default_factory=dict)
+    sample_initial: bool = False
+    substeps: Annotated[int, Field(ge=1, le=100)] = 1
+    noise: Literal["continuous", "held"] = "continuous"
+    bias_states: dict[str, NonNegative] = Field(default_factory=dict)
+    sensor_errors: bool = True
+    force_psd: tuple[NonNegative, NonNegative, NonNegative] | None = None
+
+
+def ekf_of(cfg: EKFConfig) -> ExtendedKalmanFilter:
+    return ExtendedKalmanFilter(
+        process_psd=dict(cfg.process_psd) or None, P0_std=dict(cfg.P0_std) or None,
+        x0_offset=dict(cfg.x0_offset) or None, substeps=cfg.substeps, noise=cfg.noise,
+        sample_initial=cfg.sample_initial, bias_states=dict(cfg.bias_states) or None,
+        sensor_errors=cfg.sensor_errors, force_psd=cfg.force_psd)
+
+
+EKF_ESTIMATOR = EstimatorKind("ekf", EKFConfig, ExtendedKalmanFilter, ekf_of)

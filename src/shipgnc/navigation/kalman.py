@@ -194,7 +194,6 @@ class KalmanFilter(GaussianFilter):
         """(kind, parameters, per-ship state, map) for the composed loop after :meth:`start`:
         ``[n, n_inputs, n_rows, A, B, input indices, Q, (held offset, fresh offset, R, angle) ×
         n_rows, C]`` (:func:`shipgnc.navigation.kernels.kf_step`)."""
-        from shipgnc.navigation import kernels as nk
 
         n = len(self.state_names)
         block = [float(n), float(len(self.input_index)), float(len(self.measured))]
@@ -206,7 +205,7 @@ class KalmanFilter(GaussianFilter):
             block += [float(channels[s][0]), float(channels[s][2]), float(self._R[i]),
                       float(s == "psi")]
         block += [float(v) for v in np.asarray(self.C, dtype=float).ravel()]
-        return nk.KF, block, self.kernel_state(n_ships), self.kernel_map()
+        return "kf_slot", block, self.kernel_state(n_ships), self.kernel_map()
 
     def update(self, t, u, meas, first) -> None:
         self.begin_sample()

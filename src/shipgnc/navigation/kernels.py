@@ -18,10 +18,13 @@ Layouts (offsets are stored as floats in ``p``; ``int()`` in the kernels):
 
 ``p``: ``[n_sensors, n_channels, o_channels, o_estimator, sig_estimator, z_estimator, o_map,
 sensor offsets ...]`` (``o_map``: a Kalman filter's map of its states to the model's, see
-:func:`gaussian_outputs`); a sensor block: ``[kind, k, every, latency, n_dropouts, noise_std,
-bias_std, a, b_scale, z_offset, w_offset, sig_offset, state index × k, (t0, t1) × n_dropouts]``
-(kind 0 GNSS, 1 compass, 2 rate gyro, 3 speed log; ``a`` = e^{−h/T_b}, ``b_scale`` the bias
-step's scale: σ_b √(1 − a²) for the GNSS, σ_rw √h for the gyro); a channel (one measured state):
+:func:`gaussian_outputs`); a sensor block: ``[0 (reserved), k, every, latency, n_dropouts,
+noise_std, bias_std, a, b_scale, z_offset, w_offset, sig_offset, state index × k, (t0, t1) ×
+n_dropouts]``. No sensor kind is compiled in: every sensor the kernel computes has the error
+model y = x + b + σ w with the bias b_{j+1} = a b_j + b_scale w_j at its samples (from the
+second on), started at its own value (``Sensor.kernel_errors``): the GNSS's Gauss–Markov bias
+(``a`` = e^{−h/T_b}, ``b_scale`` = σ_b √(1 − a²)), the gyro's random walk (a = 1, σ_rw √h), the
+compass's constant bias (b_scale = 0), the log's none (b = 0); a channel (one measured state):
 ``[state index, z offset of the held value, of the valid flag, of the fresh flag, variance]``.
 
 ``z``: ``[first, sensor blocks ..., estimator]`` (a Kalman filter's: ``[ẑ, P, NIS, NIS
@@ -41,10 +44,6 @@ from numba.extending import intrinsic
 
 from shipgnc.kernels import kernel_function, wrap
 
-#: sensor kinds in the kernel's parameters
-GNSS_KIND, COMPASS_KIND, GYRO_KIND, LOG_KIND = 0, 1, 2, 3
-#: estimator kinds: a constant of the generated loop
-NO_ESTIMATOR, OBSERVER, EKF, KF = 0, 1, 2, 3
 #: header length of ``p`` before the sensor offsets
 HEADER = 7
 #: fields of a sensor's parameter block before its state indices
@@ -88,13 +87,11 @@ def sensors_observe(t, x, z, p, w, seen, sig):
     ns = int(p[0])
     for s in range(ns):
         o = int(p[HEADER + s])
-        kind = int(p[o])
         k = int(p[o + 1])
         every = int(p[o + 2])
         lat = int(p[o + 3])
         ndrop = int(p[o + 4])
         noise = p[o + 5]
-        bstd = p[o + 6]
         a = p[o + 7]
         bscale = p[o + 8]
         zo = int(p[o + 9])
@@ -107,23 +104,18 @@ def sensors_observe(t, x, z, p, w, seen, sig):
         slot = zp + (jj % (lat + 1)) * (2 + k)
         due = jj % every == 0
         if due:  # the error states advance through a dropout too
-            if kind == GNSS_KIND and bstd > 0.0:
+            if bscale > 0.0:  # the bias b ← a b + b_scale w, from the second sample on
                 if z[zo + k + 3] == 0.0:
                     for c in range(k):
-                        z[zb + c] = a * z[zb + c] + bscale * w[wo + c]
-                z[zo + k + 3] = 0.0
-            elif kind == GYRO_KIND and bscale > 0.0:
-                if z[zo + k + 3] == 0.0:
-                    for c in range(k):
-                        z[zb + c] = z[zb + c] + bscale * w[wo + c]
+                        if a == 1.0:  # a random walk (no product a·b for the compiler to fuse)
+                            z[zb + c] = z[zb + c] + bscale * w[wo + c]
+                        else:
+                            z[zb + c] = a * z[zb + c] + bscale * w[wo + c]
                 z[zo + k + 3] = 0.0
             for c in range(k):
                 xv = x[int(p[idx + c])]
                 nz = noise * w[wo + k + c] if noise > 0.0 else 0.0
-                if kind == LOG_KIND:
-                    z[slot + 2 + c] = xv + nz
-                else:
-                    z[slot + 2 + c] = xv + z[zb + c] + nz
+                z[slot + 2 + c] = xv + z[zb + c] + nz
             lost = False
             for q in range(ndrop):
                 t0 = p[idx + k + 2 * q]

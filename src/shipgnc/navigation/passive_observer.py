@@ -71,13 +71,16 @@ u, v, r; the Mariner (no sway state) is refused.
 from __future__ import annotations
 
 import math
+from typing import ClassVar, Literal
 
 import numpy as np
 
+from shipgnc.config_types import Positive, Strict
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import Signal, names
 from shipgnc.navigation.estimator import Estimator
+from shipgnc.navigation.records import EstimatorKind
 
 ETA = ("north", "east", "psi")
 NU = ("u", "v", "r")
@@ -316,7 +319,7 @@ class PassiveObserver(Estimator):
                                       np.zeros((n_ships, 3)),
                                       self._x_template.reshape(n_ships, nx))], axis=1)
         assert z.shape[1] == nk.OBS_STATE + nx
-        return nk.OBSERVER, block, z, None
+        return "observer_slot", block, z, None
 
     # ---- outputs ------------------------------------------------------------------------------
     def model_estimate(self):
@@ -339,3 +342,36 @@ class PassiveObserver(Estimator):
         out.update({f"{s}_w_hat": self.xi2[..., k] for k, s in enumerate(ETA)})
         out.update({f"b_{s}_hat": self.b[..., k] for k, s in enumerate(ETA)})
         return out
+
+
+# ---- scenario files: the section and the registry record ---------------------------------------
+class PassiveObserverConfig(Strict):
+    """Fossen & Strand's passive observer with wave filtering (:class:`~shipgnc.navigation.
+    passive_observer.PassiveObserver`): the dominant wave (encounter) frequency ``omega0_rad_s``,
+    the wave model's damping ``zeta`` and the notch's ``zeta_notch``, the cut-off
+    ``omega_c_rad_s`` (default 1.2 ω₀), the low-frequency bandwidth ``omega_lf_rad_s`` (default
+    ω₀/10; one for all or [surge, sway, yaw]) and its damping ``zeta_lf`` (default 1), bias time
+    constant ``T_b_s``, and the velocity model (``linear``, as published, or the vessel's own
+    ``model``). It needs position and heading measurements."""
+
+    field_units: ClassVar[dict[str, str]] = {"zeta": "1", "zeta_notch": "1", "zeta_lf": "1"}
+
+    type: Literal["passive-observer"]
+    omega0_rad_s: Positive
+    zeta: Positive = 0.1
+    zeta_notch: Positive = 1.0
+    omega_c_rad_s: Positive | None = None
+    omega_lf_rad_s: Positive | tuple[Positive, Positive, Positive] | None = None
+    zeta_lf: Positive = 1.0
+    T_b_s: Positive = 1000.0
+    velocity_model: Literal["linear", "model"] = "linear"
+
+
+def observer_of(cfg: PassiveObserverConfig) -> PassiveObserver:
+    return PassiveObserver(cfg.omega0_rad_s, zeta=cfg.zeta, zeta_notch=cfg.zeta_notch,
+                           omega_c=cfg.omega_c_rad_s, omega_lf=cfg.omega_lf_rad_s,
+                           zeta_lf=cfg.zeta_lf, T_b=cfg.T_b_s, velocity_model=cfg.velocity_model)
+
+
+PASSIVE_OBSERVER = EstimatorKind("passive-observer", PassiveObserverConfig, PassiveObserver,
+                                 observer_of, needs=ETA)

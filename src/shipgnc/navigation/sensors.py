@@ -35,11 +35,15 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from typing import Annotated, ClassVar, Literal
 
 import numpy as np
+from pydantic import Field, field_validator
 
+from shipgnc.config_types import Finite, NonNegative, Positive, Strict
 from shipgnc.errors import ConfigError, require
 from shipgnc.models.base import Signal, names
+from shipgnc.navigation.records import SensorKind
 
 
 def _nonneg(field: str, value, what: str = "") -> float:
@@ -162,8 +166,10 @@ class Sensor:
                 self.fresh = np.ones(self.batch_shape, dtype=bool)
 
     # ---- the compiled loop (navigation.kernels.sensors_observe) --------------------------------
-    #: kind code of the kernel; the bias process's scale (GNSS: σ_b √(1 − a²), gyro: σ_rw √h)
-    kernel_kind = -1
+    #: its errors are the sensor kernel's model, y = x + b + σ w with b_{j+1} = a b_j + s w_j
+    #: (:meth:`_kernel_bias`: σ_b, a, s; :meth:`_kernel_bias_state`: b at reset; ``noise_std``
+    #: σ), drawn in :meth:`kernel_draws`'s order; False: a run with it takes the numpy loop
+    kernel_errors = False
 
     def _kernel_bias(self) -> tuple[float, float, float]:
         """(bias_std, a, b_scale) of the kernel's bias process (0 where the sensor has none)."""
@@ -171,10 +177,10 @@ class Sensor:
 
     def kernel_params(self) -> list[float]:
         """The sensor's parameter block without its offsets (:mod:`shipgnc.navigation.kernels`):
-        ``[kind, k, every, latency, n_dropouts, noise_std, bias_std, a, b_scale]``, then (after the
+        ``[0 (reserved), k, every, latency, n_dropouts, noise_std, bias_std, a, b_scale]``, then (after the
         three offsets the navigation system adds) the state indices and the dropout intervals."""
         bstd, a, bscale = self._kernel_bias()
-        return [float(self.kernel_kind), float(len(self.measures)), float(self.every),
+        return [0.0, float(len(self.measures)), float(self.every),
                 float(self.latency), float(len(self.dropouts)), float(self.noise_std), bstd, a,
                 bscale]
 
@@ -207,8 +213,8 @@ class Sensor:
 
         k = len(self.measures)
         out = np.zeros((count, n_ships, 2 * k))
-        bstd, _a, bscale = self._kernel_bias()
-        biased = (self.kernel_kind == 0 and bstd > 0) or (self.kernel_kind == 2 and bscale > 0)
+        _bstd, _a, bscale = self._kernel_bias()
+        biased = bscale > 0
         start = 0
         if biased and self._first and count > 0:  # the first sample draws its noise only
             if self.noise_std > 0:
@@ -280,7 +286,7 @@ class GNSS(Sensor):
             (*self.batch_shape, 2))
         self._first = True
 
-    kernel_kind = 0
+    kernel_errors = True
 
     def _kernel_bias(self):
         if self.bias_std <= 0:
@@ -326,7 +332,7 @@ class Compass(Sensor):
     def _reset_errors(self) -> None:
         self._b = self.bias + (self.bias_std * self._draw() if self.bias_std > 0 else 0.0)
 
-    kernel_kind = 1
+    kernel_errors = True
 
     def _kernel_bias_state(self):
         return self._b
@@ -362,11 +368,11 @@ class RateGyro(Sensor):
         self._b = np.full((*self.batch_shape, 1), self.bias)
         self._first = True
 
-    kernel_kind = 2
+    kernel_errors = True
 
     def _kernel_bias(self):
         scale = self.bias_walk * math.sqrt(self.period) if self.bias_walk > 0 else 0.0
-        return 0.0, 0.0, scale
+        return 0.0, 1.0, scale
 
     def _kernel_bias_state(self):
         return self._b
@@ -400,7 +406,7 @@ class SpeedLog(Sensor):
         self.measures = (state,)
         self.units = ("m/s",)
 
-    kernel_kind = 3
+    kernel_errors = True
 
     def _measure(self, u):
         noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
@@ -411,3 +417,103 @@ class SpeedLog(Sensor):
 
 
 SENSOR_TYPES = {"gnss": GNSS, "compass": Compass, "gyro": RateGyro, "log": SpeedLog}
+
+
+# ---- scenario files: the sections and the registry records -------------------------------------
+#: the largest sensor noise or bias (in its field's unit), whose square is a finite float
+MAX_SENSOR_ERROR = 1e150
+
+
+class SensorConfigBase(Strict):
+    """Common sensor settings (:mod:`shipgnc.navigation.sensors`): its own sample rate
+    (a whole multiple of the control period; default every control sample), a latency in control
+    samples, and intervals ``[t0, t1]`` [s] without measurements."""
+
+    field_units: ClassVar[dict[str, str]] = {"latency": "control samples", "dropouts": "s"}
+
+    name: str | None = None
+    rate_hz: Positive | None = None
+    latency: Annotated[int, Field(ge=0)] = 0
+    dropouts: list[tuple[NonNegative, NonNegative]] = Field(default_factory=list)
+
+    @field_validator("*", mode="after")
+    @classmethod
+    def _variance_finite(cls, value, info):
+        """A noise or bias whose square (the variance the filter and the draws use) overflows
+        a float is refused here, not met as an OverflowError in the run."""
+        if info.field_name.startswith(("noise", "bias")) and isinstance(value, float) \
+                and abs(value) > MAX_SENSOR_ERROR:
+            raise ValueError(f"too large: its square (the variance) overflows; at most "
+                             f"{MAX_SENSOR_ERROR:g}")
+        return value
+
+
+class GNSSConfig(SensorConfigBase):
+    """Position fix (north, east): white noise and a first-order Gauss–Markov bias."""
+
+    type: Literal["gnss"]
+    rate_hz: Positive | None = 1.0
+    noise_m: NonNegative = 1.5
+    bias_std_m: NonNegative = 0.0
+    bias_time_constant_s: Positive = 300.0
+
+
+class CompassConfig(SensorConfigBase):
+    """Heading: white noise and a constant bias (``bias_std_deg``: drawn per ship)."""
+
+    type: Literal["compass"]
+    noise_deg: NonNegative = 0.5
+    bias_deg: Finite = 0.0
+    bias_std_deg: NonNegative = 0.0
+
+
+class GyroConfig(SensorConfigBase):
+    """Yaw rate: white noise and a bias that walks (``bias_walk_deg_s``: per √s)."""
+
+    field_units: ClassVar[dict[str, str]] = {"bias_walk_deg_s": "deg/s per √s"}
+
+    type: Literal["gyro"]
+    noise_deg_s: NonNegative = 0.1
+    bias_deg_s: Finite = 0.0
+    bias_walk_deg_s: NonNegative = 0.0
+
+
+class SpeedLogConfig(SensorConfigBase):
+    """Speed through the water of one state (``u`` by default): white noise."""
+
+    field_units: ClassVar[dict[str, str]] = {"noise_m_s": "m/s"}
+
+    type: Literal["log"]
+    noise_m_s: NonNegative = 0.05
+    state: str = "u"
+
+
+def common_options(cfg: SensorConfigBase) -> dict:
+    """The options every sensor takes (:class:`Sensor`) from its section."""
+    return {"rate_hz": cfg.rate_hz, "latency": cfg.latency, "name": cfg.name,
+            "dropouts": [tuple(interval) for interval in cfg.dropouts]}
+
+
+def gnss_of(cfg: GNSSConfig) -> GNSS:
+    return GNSS(cfg.noise_m, bias_std=cfg.bias_std_m, bias_time_constant=cfg.bias_time_constant_s,
+                **common_options(cfg))
+
+
+def compass_of(cfg: CompassConfig) -> Compass:
+    return Compass(math.radians(cfg.noise_deg), bias=math.radians(cfg.bias_deg),
+                   bias_std=math.radians(cfg.bias_std_deg), **common_options(cfg))
+
+
+def gyro_of(cfg: GyroConfig) -> RateGyro:
+    return RateGyro(math.radians(cfg.noise_deg_s), bias=math.radians(cfg.bias_deg_s),
+                    bias_walk=math.radians(cfg.bias_walk_deg_s), **common_options(cfg))
+
+
+def log_of(cfg: SpeedLogConfig) -> SpeedLog:
+    return SpeedLog(cfg.noise_m_s, state=cfg.state, **common_options(cfg))
+
+
+GNSS_SENSOR = SensorKind("gnss", GNSSConfig, GNSS, gnss_of, measures=GNSS.measures)
+COMPASS_SENSOR = SensorKind("compass", CompassConfig, Compass, compass_of, measures=Compass.measures)
+GYRO_SENSOR = SensorKind("gyro", GyroConfig, RateGyro, gyro_of, measures=RateGyro.measures)
+LOG_SENSOR = SensorKind("log", SpeedLogConfig, SpeedLog, log_of, measures=("u",))

@@ -8,6 +8,10 @@ runner its dispatch (which function builds the vessel, the controller, the guida
 component is its module, its configuration section (:mod:`shipgnc.scenarios.sections`) and one
 entry here; neither the schema's checks nor the runner's dispatch names it
 (``docs/extending.md``; the RL environments and the live dashboard keep their own short lists).
+Sensors and estimators declare their records in their own modules
+(:mod:`shipgnc.navigation.records`), collected here from :data:`NAVIGATION_MODULES`; third-party
+packages add records of every kind through the entry-point group :data:`ENTRY_POINT_GROUP`
+(:func:`load_plugins`).
 
 Builders are named ``"module:function"`` and imported when first used, so that reading a scenario
 file does not import every model and controller.
@@ -20,12 +24,15 @@ from dataclasses import dataclass
 from typing import Literal
 
 from shipgnc.errors import ConfigError
+from shipgnc.navigation.records import EstimatorKind, SensorKind
 from shipgnc.scenarios import sections as S
 from shipgnc.vessels.config import CATALOGUE_VESSELS, CatalogueVesselConfig
 
 
-def resolve(target: str):
-    """The function named ``"module:function"``."""
+def resolve(target):
+    """The function named ``"module:function"`` (a function itself: that function)."""
+    if callable(target):
+        return target
     module, _, name = target.partition(":")
     return getattr(importlib.import_module(module), name)
 
@@ -120,6 +127,9 @@ class MetricKind:
     controllers: tuple[str, ...] | None = None
     sections: tuple[str, ...] = ()
     vessels: tuple[str, ...] | None = None
+    #: its scorer ``(scenario, result, setup) -> dict`` (``"module:function"`` or the function);
+    #: None: a built-in set scored by :func:`shipgnc.scenarios.runner.compute_metrics`
+    score: object = None
 
 
 #: document 004's yaw-rate references, which its continuous laws read at every RK stage
@@ -254,3 +264,88 @@ def having(flag: str) -> tuple[str, ...]:
 def config_classes(table: dict) -> tuple[type, ...]:
     """The distinct configuration classes of a table's entries, in entry order."""
     return tuple(dict.fromkeys(kind.config for kind in table.values()))
+
+
+# ---- records declared beside their components, and third-party packages' ------------------------
+#: the built-in modules that declare sensor and estimator records (:mod:`shipgnc.navigation.records`)
+NAVIGATION_MODULES = ("shipgnc.navigation.sensors", "shipgnc.navigation.ekf",
+                      "shipgnc.navigation.passive_observer")
+#: the entry-point group of third-party components: an entry point names a module (its records
+#: are the record instances among its module-level names) or a record list (``module:NAME``)
+ENTRY_POINT_GROUP = "shipgnc.components"
+
+SENSORS: dict[str, SensorKind] = {}
+ESTIMATORS: dict[str, EstimatorKind] = {}
+
+#: record class → (its table, the field that names it, what a scenario file calls it)
+RECORD_TABLES: dict[type, tuple[dict, str, str]] = {
+    VesselKind: (VESSEL_KINDS, "model", "vessel.model"),
+    ControllerKind: (CONTROLLERS, "type", "controller.type"),
+    GuidanceKind: (GUIDANCE, "type", "guidance.type"),
+    DisturbanceKind: (DISTURBANCES, "type", "disturbance.type"),
+    MetricKind: (METRICS, "name", "metrics"),
+    SensorKind: (SENSORS, "type", "sensors[].type"),
+    EstimatorKind: (ESTIMATORS, "type", "estimator.type"),
+}
+
+
+def records_in(obj) -> list:
+    """The registry records ``obj`` holds: a record, a list or tuple of records, or a module (its
+    module-level record instances, in definition order)."""
+    kinds = tuple(RECORD_TABLES)
+    if isinstance(obj, kinds):
+        return [obj]
+    if isinstance(obj, (list, tuple)):
+        return [r for r in obj if isinstance(r, kinds)]
+    namespace = getattr(obj, "__dict__", None) if type(obj).__name__ == "module" else None
+    return [r for r in (namespace or {}).values() if isinstance(r, kinds)]
+
+
+def register(record, origin: str) -> None:
+    """Add ``record`` to its table; a name already taken is a ConfigError naming ``origin``."""
+    table, field, what = RECORD_TABLES[type(record)]
+    name = getattr(record, field)
+    if not isinstance(name, str) or not name:
+        raise ConfigError(f"{origin}: {type(record).__name__}.{field} = {name!r}: must be a "
+                          f"non-empty name")
+    if name in table:
+        raise ConfigError(f"{origin}: {what} {name!r} is already registered; give the component "
+                          f"another name")
+    table[name] = record
+
+
+for _module in NAVIGATION_MODULES:
+    for _record in records_in(importlib.import_module(_module)):
+        register(_record, _module)
+
+_plugins_loaded = False
+
+
+def load_plugins() -> None:
+    """Register the records of every ``shipgnc.components`` entry point, once: called by the
+    scenario schema before it derives its unions (the registry's first use), not on import of
+    this module, which a plug-in imports for the record classes. A plug-in that fails to load,
+    or names no record, is a one-line ConfigError naming its distribution and entry point."""
+    global _plugins_loaded
+    if _plugins_loaded:
+        return
+    _plugins_loaded = True
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        dist = getattr(ep, "dist", None)
+        origin = (f"plug-in {ep.name!r} = {ep.value!r} (entry point of distribution "
+                  f"{dist.name if dist is not None else '?'} "
+                  f"{dist.version if dist is not None else ''}, group {ENTRY_POINT_GROUP})")
+        try:
+            loaded = ep.load()
+        except Exception as exc:  # any failure of third-party code: one line, naming the plug-in
+            detail = " ".join(str(exc).split())
+            raise ConfigError(f"{origin}: cannot be loaded: {type(exc).__name__}: {detail}") from None
+        records = records_in(loaded)
+        if not records:
+            raise ConfigError(f"{origin}: names no component record (VesselKind, ControllerKind, "
+                              "GuidanceKind, DisturbanceKind, MetricKind, SensorKind, "
+                              "EstimatorKind)")
+        for record in records:
+            register(record, origin)

@@ -322,46 +322,17 @@ def build(scenario: Scenario, variant: str | None = None, *, seed: int | None = 
 
 def navigation(scenario: Scenario, controller=None):
     """The :class:`~shipgnc.navigation.Navigation` a ``controller`` config reads through (the
-    scenario's ``sensors`` and ``estimator``, degrees converted to radians here; the controller's
+    scenario's ``sensors`` and ``estimator``, built by their registry records; the controller's
     ``sees`` picks truth, measurement or estimate), or None when it reads the true state."""
     sees = getattr(controller, "sees", None)
     if not scenario.sensors or sees == "truth":
         return None
-    import math
+    from shipgnc.navigation.core import Navigation
 
-    from shipgnc import navigation as nav
-
-    sensors = []
-    for c in scenario.sensors:
-        common = {"rate_hz": c.rate_hz, "latency": c.latency, "name": c.name,
-                  "dropouts": [tuple(interval) for interval in c.dropouts]}
-        if c.type == "gnss":
-            sensors.append(nav.GNSS(c.noise_m, bias_std=c.bias_std_m,
-                                    bias_time_constant=c.bias_time_constant_s, **common))
-        elif c.type == "compass":
-            sensors.append(nav.Compass(math.radians(c.noise_deg), bias=math.radians(c.bias_deg),
-                                       bias_std=math.radians(c.bias_std_deg), **common))
-        elif c.type == "gyro":
-            sensors.append(nav.RateGyro(math.radians(c.noise_deg_s),
-                                        bias=math.radians(c.bias_deg_s),
-                                        bias_walk=math.radians(c.bias_walk_deg_s), **common))
-        else:
-            sensors.append(nav.SpeedLog(c.noise_m_s, state=c.state, **common))
+    sensors = [C.SENSORS[c.type].build(c) for c in scenario.sensors]
     e = None if sees == "measurement" else scenario.estimator
-    if e is None:
-        estimator = None
-    elif e.type == "ekf":
-        estimator = nav.ExtendedKalmanFilter(
-            process_psd=dict(e.process_psd) or None, P0_std=dict(e.P0_std) or None,
-            x0_offset=dict(e.x0_offset) or None, substeps=e.substeps, noise=e.noise,
-            sample_initial=e.sample_initial, bias_states=dict(e.bias_states) or None,
-            sensor_errors=e.sensor_errors, force_psd=e.force_psd)
-    else:
-        estimator = nav.PassiveObserver(e.omega0_rad_s, zeta=e.zeta, zeta_notch=e.zeta_notch,
-                                        omega_c=e.omega_c_rad_s, omega_lf=e.omega_lf_rad_s,
-                                        zeta_lf=e.zeta_lf,
-                                        T_b=e.T_b_s, velocity_model=e.velocity_model)
-    return nav.Navigation(sensors, estimator)
+    estimator = None if e is None else C.ESTIMATORS[e.type].build(e)
+    return Navigation(sensors, estimator)
 
 
 def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
@@ -369,7 +340,10 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
     from shipgnc.analysis import metrics
 
     diverged = bool(result.attrs.get("diverged", 0))
-    if scenario.metrics == "route" and setup.case is not None:  # one sailed run of a route
+    score = C.METRICS[scenario.metrics].score if scenario.metrics in C.METRICS else None
+    if score is not None:  # a metric set that brings its scorer (a plug-in's)
+        out = dict(C.resolve(score)(scenario, result, setup))
+    elif scenario.metrics == "route" and setup.case is not None:  # one sailed run of a route
         from shipgnc.scenarios import routing
 
         out = routing.sail_metrics(result, *setup.case)

@@ -31,17 +31,17 @@ from shipgnc.scenarios.sections import (  # noqa: F401  (re-exported: the sectio
     ActuatorConfig,
     CatamaranCaseConfig,
     CurrentConfig,
-    EstimatorConfig,
     MarinerDisturbanceConfig,
     MonteCarloConfig,
     QualityConfig,
     RouteConfig,
     SailConfig,
-    SensorConfig,
     SimulationConfig,
     VesselConfig,
 )
 from shipgnc.vessels.config import CATALOGUE_VESSELS, CatalogueVesselConfig  # noqa: F401  (re-exported)
+
+C.load_plugins()  # third-party components (entry-point group shipgnc.components), once
 
 #: vessel models a scenario's ``current`` section applies to, and those that take navigation
 CURRENT_VESSELS = C.having("current")
@@ -70,6 +70,8 @@ Vessel = Annotated[
 ControllerConfig = _union_by_type(C.CONTROLLERS)
 GuidanceConfig = _union_by_type(C.GUIDANCE)
 DisturbanceConfig = _union_by_type(C.DISTURBANCES)
+SensorConfig = _union_by_type(C.SENSORS)
+EstimatorConfig = _union_by_type(C.ESTIMATORS)
 MetricSet = Literal[tuple(C.METRICS)]
 #: the sections a run of ``runs`` may override (the scenario's identity, its metric set, a
 #: route and the runs themselves are the scenario's)

@@ -16,10 +16,9 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import AfterValidator, Field, field_validator, model_validator
 
-from shipgnc.config_types import Finite, Positive, Strict
+from shipgnc.config_types import Finite, NonNegative, Positive, Strict
 from shipgnc.errors import ConfigError
 
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 OffsetNm = Annotated[float, Field(ge=-1000, le=1000, allow_inf_nan=False)]
 OffsetDeg = Annotated[float, Field(ge=-180, le=180, allow_inf_nan=False)]
 #: a commanded heading, up to ten turns either way (beyond that a float's degrees lose meaning)
@@ -957,124 +956,15 @@ class QualityConfig(Strict):
     lam: NonNegative = 1.0
 
 
-#: the largest sensor noise or bias (in its field's unit), whose square is a finite float
-MAX_SENSOR_ERROR = 1e150
-
-
-class _SensorBase(Strict):
-    """Common sensor settings (:mod:`shipgnc.navigation.sensors`): its own sample rate
-    (a whole multiple of the control period; default every control sample), a latency in control
-    samples, and intervals ``[t0, t1]`` [s] without measurements."""
-
-    field_units: ClassVar[dict[str, str]] = {"latency": "control samples", "dropouts": "s"}
-
-    name: str | None = None
-    rate_hz: Positive | None = None
-    latency: Annotated[int, Field(ge=0)] = 0
-    dropouts: list[tuple[NonNegative, NonNegative]] = Field(default_factory=list)
-
-    @field_validator("*", mode="after")
-    @classmethod
-    def _variance_finite(cls, value, info):
-        """A noise or bias whose square (the variance the filter and the draws use) overflows
-        a float is refused here, not met as an OverflowError in the run."""
-        if info.field_name.startswith(("noise", "bias")) and isinstance(value, float) \
-                and abs(value) > MAX_SENSOR_ERROR:
-            raise ValueError(f"too large: its square (the variance) overflows; at most "
-                             f"{MAX_SENSOR_ERROR:g}")
-        return value
-
-
-class GNSSConfig(_SensorBase):
-    """Position fix (north, east): white noise and a first-order Gauss–Markov bias."""
-
-    type: Literal["gnss"]
-    rate_hz: Positive | None = 1.0
-    noise_m: NonNegative = 1.5
-    bias_std_m: NonNegative = 0.0
-    bias_time_constant_s: Positive = 300.0
-
-
-class CompassConfig(_SensorBase):
-    """Heading: white noise and a constant bias (``bias_std_deg``: drawn per ship)."""
-
-    type: Literal["compass"]
-    noise_deg: NonNegative = 0.5
-    bias_deg: Finite = 0.0
-    bias_std_deg: NonNegative = 0.0
-
-
-class GyroConfig(_SensorBase):
-    """Yaw rate: white noise and a bias that walks (``bias_walk_deg_s``: per √s)."""
-
-    field_units: ClassVar[dict[str, str]] = {"bias_walk_deg_s": "deg/s per √s"}
-
-    type: Literal["gyro"]
-    noise_deg_s: NonNegative = 0.1
-    bias_deg_s: Finite = 0.0
-    bias_walk_deg_s: NonNegative = 0.0
-
-
-class SpeedLogConfig(_SensorBase):
-    """Speed through the water of one state (``u`` by default): white noise."""
-
-    field_units: ClassVar[dict[str, str]] = {"noise_m_s": "m/s"}
-
-    type: Literal["log"]
-    noise_m_s: NonNegative = 0.05
-    state: str = "u"
-
-
-SensorConfig = Annotated[GNSSConfig | CompassConfig | GyroConfig | SpeedLogConfig,
-                         Field(discriminator="type")]
-
-
-class EKFConfig(Strict):
-    """An extended Kalman filter on the vessel's own model (:class:`~shipgnc.navigation.ekf.
-    ExtendedKalmanFilter`): ``process_psd`` by state name [unit²/s], initial ``P0_std`` and
-    ``x0_offset`` (SI; heading in rad; ``sample_initial``: the initial error drawn from P0),
-    ``noise``: continuous or held over each step; ``bias_states`` by state name: the spectral
-    density [unit²/s³] of a random-walk bias on that state's derivative (e.g. a current on
-    north/east, a yaw-acceleration bias on r); ``sensor_errors``: estimate the sensors' GNSS and
-    gyro biases and update with delayed fixes (default), or fold them into white noise."""
-
-    field_units: ClassVar[dict[str, str]] = {"process_psd": "(SI unit of the state)²/s",
-        "P0_std": "SI unit of the state (heading rad)",
-        "x0_offset": "SI unit of the state (heading rad)",
-        "bias_states": "(SI unit of the state)²/s³", "force_psd": "N²·s, N²·s, N²·m²·s"}
-
-    type: Literal["ekf"]
-    process_psd: dict[str, NonNegative] = Field(default_factory=dict)
-    P0_std: dict[str, Positive] = Field(default_factory=dict)
-    x0_offset: dict[str, Finite] = Field(default_factory=dict)
-    sample_initial: bool = False
-    substeps: Annotated[int, Field(ge=1, le=100)] = 1
-    noise: Literal["continuous", "held"] = "continuous"
-    bias_states: dict[str, NonNegative] = Field(default_factory=dict)
-    sensor_errors: bool = True
-    force_psd: Triple | None = None
-
-
-class PassiveObserverConfig(Strict):
-    """Fossen & Strand's passive observer with wave filtering (:class:`~shipgnc.navigation.
-    passive_observer.PassiveObserver`): the dominant wave (encounter) frequency ``omega0_rad_s``,
-    the wave model's damping ``zeta`` and the notch's ``zeta_notch``, the cut-off
-    ``omega_c_rad_s`` (default 1.2 ω₀), the low-frequency bandwidth ``omega_lf_rad_s`` (default
-    ω₀/10; one for all or [surge, sway, yaw]) and its damping ``zeta_lf`` (default 1), bias time
-    constant ``T_b_s``, and the velocity model (``linear``, as published, or the vessel's own
-    ``model``). It needs position and heading measurements."""
-
-    field_units: ClassVar[dict[str, str]] = {"zeta": "1", "zeta_notch": "1", "zeta_lf": "1"}
-
-    type: Literal["passive-observer"]
-    omega0_rad_s: Positive
-    zeta: Positive = 0.1
-    zeta_notch: Positive = 1.0
-    omega_c_rad_s: Positive | None = None
-    omega_lf_rad_s: Positive | tuple[Positive, Positive, Positive] | None = None
-    zeta_lf: Positive = 1.0
-    T_b_s: Positive = 1000.0
-    velocity_model: Literal["linear", "model"] = "linear"
-
-
-EstimatorConfig = Annotated[EKFConfig | PassiveObserverConfig, Field(discriminator="type")]
+# the navigation sections live with their components, beside their registry records
+# (shipgnc.navigation.sensors, .ekf, .passive_observer); re-exported here by their old home
+from shipgnc.navigation.ekf import EKFConfig  # noqa: E402, F401
+from shipgnc.navigation.passive_observer import PassiveObserverConfig  # noqa: E402, F401
+from shipgnc.navigation.sensors import (  # noqa: E402, F401
+    MAX_SENSOR_ERROR,
+    CompassConfig,
+    GNSSConfig,
+    GyroConfig,
+    SpeedLogConfig,
+)
+from shipgnc.navigation.sensors import SensorConfigBase as _SensorBase  # noqa: E402, F401

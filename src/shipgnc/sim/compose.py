@@ -80,18 +80,19 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
              nd: int, nref: int, nout: int, nsig: int, nerr: int, nzc: int, nzg: int, nzd: int,
              has_ctrl: bool, continuous: bool, has_guid: bool, has_dist: bool, per_stage: bool,
              has_lag: bool, rate_limited: bool, hold_mode: bool, has_cur: bool = False,
-             est_kind: int = -1, nzn: int = 0, nnsig: int = 0, ne: int = 0):
+             est_slot: str | None = None, nzn: int = 0, nnsig: int = 0, ne: int = 0):
     """The composed loop of one combination (compiled on first use, memoised per process).
     ``cur_fn``: a disturbance's current part (``kernel_current``), called right after ``dist_fn``
-    with the same arguments and its own parameters, table and (empty) state. ``est_kind``: -1
-    without navigation, else the estimator of the navigation system
-    (:mod:`shipgnc.navigation.kernels`: 0 none, 1 passive observer, 2 EKF, 3 KF) whose step
-    (:mod:`shipgnc.sim.nav_template`) runs at each control sample with ``nzn`` numbers of state
-    per ship and ``nnsig`` logged signals; ``ne`` the EKF's state dimension (the model's ``nx``
-    plus its augmented states; 0: ``nx``)."""
+    with the same arguments and its own parameters, table and (empty) state. ``est_slot``: None
+    without navigation, else the slot of the navigation system's estimator (a function of
+    :mod:`shipgnc.sim.nav_template`: ``no_estimator``, ``observer_slot``, ``ekf_slot``,
+    ``kf_slot``; or an estimator's own kernel function ``"module:function"`` with the slots'
+    signature; :meth:`Navigation.kernel`) that runs after the sensors at each control sample
+    with ``nzn`` numbers of state per ship and ``nnsig`` logged signals; ``ne`` the EKF's state
+    dimension (the model's ``nx`` plus its augmented states; 0: ``nx``)."""
     key = (model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
            nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-           hold_mode, has_cur, est_kind, nzn, nnsig, ne or nx)
+           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx)
     if key not in _LOOPS:
         _LOOPS[key] = _generate(*key)
     return _LOOPS[key]
@@ -104,7 +105,9 @@ def _generate(*key):
     functions = key[:5]
     importable = all(_importable(fn) for fn in functions)
     source = _source(*key, imports=importable)
-    path = _cache_file(source, functions) if importable else None
+    slot = key[24]  # an estimator's own kernel ("module:function"): its file keys the loop too
+    hashed = (*functions, _resolve(slot)) if slot and ":" in slot else functions
+    path = _cache_file(source, hashed) if importable else None
     if path is not None:  # importable by name: numba's cache rebuilds the loop's module by name
         if str(path.parent) not in sys.path:
             sys.path.append(str(path.parent))
@@ -114,6 +117,11 @@ def _generate(*key):
     exec(compile(source.replace("CACHE = True", "CACHE = False"), "<shipgnc composed loop>",
                  "exec"), namespace)
     return namespace["loop"]
+
+
+def _resolve(target: str):
+    module, _, name = target.partition(":")
+    return getattr(importlib.import_module(module), name)
 
 
 def _importable(fn) -> bool:
@@ -223,7 +231,7 @@ def _sources_digest() -> bytes:
 
 def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
             nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-            hold_mode, has_cur, est_kind, nzn, nnsig, ne, *, imports: bool):
+            hold_mode, has_cur, est_slot, nzn, nnsig, ne, *, imports: bool):
     """Source of the combination's module: constants, the components' kernels, the navigation
     step, the loop body."""
     nl = nu if has_lag else 0
@@ -234,7 +242,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
         "has_ctrl": has_ctrl, "continuous": continuous, "has_guid": has_guid,
         "has_dist": has_dist, "per_stage": per_stage, "has_lag": has_lag,
         "rate_limited": rate_limited, "hold_mode": hold_mode, "has_cur": has_cur,
-        "has_nav": est_kind >= 0, "est_kind": est_kind, "nzn": nzn, "nnsig": nnsig, "ne": ne,
+        "has_nav": est_slot is not None, "nzn": nzn, "nnsig": nnsig, "ne": ne,
         **{f"o_{name}": lay[key] for name, key in (
             ("x", "x"), ("lag", "lag"), ("app", "applied"), ("cmd", "cmd"), ("ref", "ref"),
             ("out", "out"), ("sig", "sig"), ("d", "d"), ("done", "done"), ("zc", "zc"),
@@ -252,7 +260,13 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
         if imports:
             lines.append(f"from {py.__module__} import {py.__qualname__} as {alias}")
     lines += [f"{name} = {value!r}" for name, value in constants.items()]
-    return ("\n".join(lines) + "\n" + NAV_TEMPLATE.read_text() + "\n" + TEMPLATE.read_text()
+    slot = f"\nest_slot = {est_slot or 'no_estimator'}\n"
+    if est_slot is not None and ":" in est_slot:  # an estimator's own kernel, by its module
+        module, _, name = est_slot.partition(":")
+        slot = f"\nfrom {module} import {name} as est_slot\n"
+    elif est_slot is not None and not est_slot.isidentifier():
+        raise ValueError(f"est_slot = {est_slot!r}: not a slot of the navigation template")
+    return ("\n".join(lines) + "\n" + NAV_TEMPLATE.read_text() + slot + "\n" + TEMPLATE.read_text()
             + '\nloop = numba.njit(parallel=True, **{**JIT_OPTIONS, "cache": CACHE})(loop)\n')
 
 
@@ -347,7 +361,7 @@ class Composition:
             per_stage=bool(getattr(dist, "per_stage", False)), has_lag=act.has_lag,
             rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold",
             cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None,
-            est_kind=kn.estimator if kn else -1, nzn=zn0.shape[1], nnsig=nnsig,
+            est_slot=kn.estimator if kn else None, nzn=zn0.shape[1], nnsig=nnsig,
             ne=kn.n_filter if kn else 0)
         lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd,
                          zc0.shape[1], zg0.shape[1], zd0.shape[1], zn0.shape[1], nnsig)

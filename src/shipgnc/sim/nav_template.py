@@ -2,7 +2,8 @@
 the generated module of a combination before the loop body (:mod:`shipgnc.sim.loop_template`), so
 the estimators call the vessel model's kernel ``model_fn`` by name (a numba function passed as an
 argument would make the loop uncacheable). Free names: ``model_fn``, ``nx``, ``nu``, ``nd``,
-``est_kind``, ``ne`` (the EKF's state dimension: ``nx`` plus its augmented states), ``CACHE``;
+``est_slot`` (the estimator's step, one of the slots below, bound after them), ``ne`` (the EKF's
+state dimension: ``nx`` plus its augmented states), ``CACHE``;
 ``jac_fn`` (the model's analytic state Jacobian,
 :func:`shipgnc.navigation.kernels.jacobian_kernel`) is found from ``model_fn``. The
 arithmetic is :mod:`shipgnc.navigation.kernels`; this is
@@ -41,16 +42,29 @@ def nav_observe(t, x, u, zn, pn, w, seen, nsg, pm, wk):
     the last sample; ``zn`` the ship's navigation state, ``w`` its table row of this sample,
     ``wk`` scratch space (:data:`nav_work`)."""
     sensors_observe(t, x, zn, pn, w, seen, nsg)
-    if est_kind == 1:
-        observer_step(u, zn, pn, pm, wk)
-        observer_outputs(zn, pn, seen, nsg)
-    elif est_kind == 2:
-        ekf_step(u, zn, pn, pm, wk)
-        gaussian_outputs(x, zn, pn, seen, nsg, wk)
-    elif est_kind == 3:
-        kf_step(u, zn, pn)
-        gaussian_outputs(x, zn, pn, seen, nsg, wk)
+    est_slot(x, u, zn, pn, pm, wk, seen, nsg)
     zn[0] = 0.0
+
+
+# the estimators' slots: ``(x, u, zn, pn, pm, wk, seen, nsg)``, an estimator's update and its
+# outputs (its kernel_block names its slot; the generated module binds it to ``est_slot``)
+def no_estimator(x, u, zn, pn, pm, wk, seen, nsg):
+    pass
+
+
+def observer_slot(x, u, zn, pn, pm, wk, seen, nsg):
+    observer_step(u, zn, pn, pm, wk)
+    observer_outputs(zn, pn, seen, nsg)
+
+
+def ekf_slot(x, u, zn, pn, pm, wk, seen, nsg):
+    ekf_step(u, zn, pn, pm, wk)
+    gaussian_outputs(x, zn, pn, seen, nsg, wk)
+
+
+def kf_slot(x, u, zn, pn, pm, wk, seen, nsg):
+    kf_step(u, zn, pn)
+    gaussian_outputs(x, zn, pn, seen, nsg, wk)
 
 
 #: scratch numbers per ship of the navigation step (views into it: no allocation per sample)
@@ -465,4 +479,8 @@ ekf_faug = numba.njit(**_OPTIONS)(ekf_faug)
 ekf_delayed = numba.njit(**_OPTIONS)(ekf_delayed)
 ekf_step = numba.njit(**_OPTIONS)(ekf_step)
 gaussian_outputs = numba.njit(**_OPTIONS)(gaussian_outputs)
+no_estimator = numba.njit(**_OPTIONS)(no_estimator)
+observer_slot = numba.njit(**_OPTIONS)(observer_slot)
+ekf_slot = numba.njit(**_OPTIONS)(ekf_slot)
+kf_slot = numba.njit(**_OPTIONS)(kf_slot)
 nav_observe = numba.njit(**_OPTIONS)(nav_observe)
