@@ -559,6 +559,7 @@ def run_numpy(setup: SimSetup) -> Log:
     batch = setup.batch_shape
     dt = setup.dt
     continuous = bool(getattr(ctrl, "continuous", False))
+    switching = getattr(ctrl, "switch_within_step", None)
     reset_components(setup)
 
     signals = log_signals(setup)
@@ -617,7 +618,7 @@ def run_numpy(setup: SimSetup) -> Log:
             if dist is not None and not dist.per_stage:
                 held_d = dist(t, x)
             last = k == setup.n_steps
-            finished = gd.finished() if gd is not None else None
+            finished = finished_ships(ctrl, gd)
             all_done = finished is not None and bool(np.all(finished | ~alive))
             if k % setup.log_every == 0 or last or all_done:
                 times[n_logged] = t
@@ -647,6 +648,8 @@ def run_numpy(setup: SimSetup) -> Log:
                 break
             x_before, lag_before = x, lag
             x, lag = advance_plant(setup, t, x, lag, plan, command, ref, held_d)
+            if switching is not None:
+                x = switch_within_step(setup, t, x_before, x, command, held_d)
             if masking:  # a ship whose state is bad stops here; a stopped ship's state is held
                 bad, error = newly_diverged(setup, t + dt, alive, x=x)
                 if bad is not None:
@@ -669,6 +672,50 @@ def run_numpy(setup: SimSetup) -> Log:
     log = Log(time=times[:n_logged], data={k: v[:n_logged] for k, v in data.items()},
               signals=signals, status=status)
     return mask_diverged(log, diverged_at, first_error, dt) if masking else log
+
+
+def finished_ships(controller, guidance):
+    """Which ships are done (the run ends when every ship is): those whose guidance has
+    finished (``guidance.finished()``, e.g. the last waypoint) or whose controller's programme is
+    complete (an event-driven controller's ``finished()``, e.g. a manoeuvring trial's rudder
+    programme); None when neither says."""
+    said = [c.finished() for c in (guidance, controller)
+            if c is not None and callable(getattr(c, "finished", None))]
+    said = [np.asarray(f, dtype=bool) for f in said if f is not None]
+    if not said:
+        return None
+    return said[0] if len(said) == 1 else np.logical_or(*said)
+
+
+def switch_within_step(setup: SimSetup, t0: float, x0: np.ndarray, x1: np.ndarray,
+                       command: np.ndarray, d_held) -> np.ndarray:
+    """A command that switches on a state crossing inside the step (a zig-zag's reversal at ±ψ):
+    the controller's ``switch_within_step(t0, x0, x1, command)`` gives, per ship, the fraction θ
+    of the step [t0, t0 + dt] at which its crossing happened (NaN: none) and the command after
+    it (or None for no ship); those ships are integrated again, RK4 with the old command over θ·dt
+    and with the new one over (1 − θ)·dt, so the switch happens at the crossing, not at the next
+    sample. The actuator must be static (the input follows the command at once)."""
+    said = setup.controller.switch_within_step(t0, x0, x1, command)
+    if said is None:
+        return x1
+    theta, after = said
+    hit = np.isfinite(theta)
+    if not hit.any():
+        return x1
+    act, model, dist = setup.actuator, setup.model, setup.disturbance
+    require(act.is_static and not (dist is not None and dist.per_stage), "controller",
+            type(setup.controller).__name__, "a command that switches inside a step needs a "
+            "static actuator and no per-stage disturbance")
+    theta = np.where(hit, theta, 1.0)[..., None]
+
+    def rhs(u):
+        return lambda t, z: model.derivatives(z, u, d_held)
+
+    with np.errstate(all="ignore"):
+        mid = rk4_step(rhs(act.saturate(command)), t0, x0, theta * setup.dt)
+        end = rk4_step(rhs(act.saturate(after)), t0 + theta * setup.dt, mid,
+                       (1.0 - theta) * setup.dt)
+    return np.where(hit[..., None], end, x1)
 
 
 def newly_diverged(setup: SimSetup, t: float, alive: np.ndarray, *, x: np.ndarray | None = None,

@@ -28,7 +28,6 @@ import numpy as np
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.models.base import names
-from shipgnc.sim.integrators import rk4_step
 from shipgnc.units import KNOT
 
 #: sides of a turn: sign of the rudder (and of the heading change) for each
@@ -367,33 +366,6 @@ def programme(ship: TrialShip, kind: str, n: int, *, speed_index=0, delta_a=None
                            x0=ship.x0[idx].copy(), inputs0=ship.inputs0[idx].copy())
 
 
-def _reverse_within_step(model_of, x0, x1, t, h, inputs, sign, psi0, prog, index, max_rudder):
-    """Zig-zag ships whose heading crossed ±ψ inside the step [t, t + h] are integrated again:
-    RK4 up to the crossing θh (linear interpolation of the heading) with the old command, then
-    with the reversed one, so the reversal happens at the crossing, not at the next sample
-    (steering machine in the model only: the command is a held input)."""
-    from shipgnc.trials.zigzag import reverse_rudder
-
-    p = index["psi"]
-    c0, c1 = x0[:, p] - psi0, x1[:, p] - psi0
-    zz = prog.zz_amp != 0
-    new = reverse_rudder(sign, c1, prog.zz_psi)
-    hit = np.nonzero(zz & (new != sign) & (sign * c0 < prog.zz_psi))[0]
-    if hit.size == 0:
-        return x1
-    a, b = sign[hit] * c0[hit], sign[hit] * c1[hit]
-    theta = np.clip((prog.zz_psi[hit] - a) / np.where(b > a, b - a, 1.0), 0.0, 1.0)[:, None]
-    m = model_of(hit)
-    u_old = inputs[hit].copy()
-    u_new = u_old.copy()
-    u_new[:, 0] = np.clip(prog.delta_a[hit] + new[hit] * np.abs(prog.zz_amp[hit]), -max_rudder, max_rudder)
-    mid = rk4_step(lambda tt, z: m.derivatives(z, u_old), t, x0[hit], theta * h)
-    end = rk4_step(lambda tt, z: m.derivatives(z, u_new), t, mid, (1.0 - theta) * h)
-    out = x1.copy()
-    out[hit] = end
-    return out
-
-
 class Stacked:
     """One batch over ships whose models differ (one model per test speed): ``derivatives``
     evaluates each distinct model on its ships (``which``: the model index of each ship along
@@ -405,6 +377,7 @@ class Stacked:
         self.masks = [self.which == i for i in range(len(self.models))]
         first = self.models[0]
         self.states, self.inputs = first.states, first.inputs
+        self.state_limits = first.state_limits
 
     @classmethod
     def of(cls, models, which):
@@ -462,129 +435,53 @@ def steady_window(ship: TrialShip) -> float:
     return 60.0 if lv is None else max(60.0, 3.0 * lv)
 
 
+def trial_actuator(ship: TrialShip):
+    """The trial's actuator: with the steering machine in the model (a ``delta`` state) the
+    commands pass unchanged (the model slews its rudder); else the rudder channel saturates at
+    ``max_rudder`` and slews at ``rudder_rate`` (linear within a step), the other inputs pass."""
+    from shipgnc.actuators import Actuator
+
+    m = ship.n_inputs
+    lower, upper, rate = np.full(m, -np.inf), np.full(m, np.inf), np.full(m, np.inf)
+    if not ship.steering_in_model:
+        lower[0], upper[0], rate[0] = -ship.max_rudder, ship.max_rudder, ship.rudder_rate
+    return Actuator(lower, upper, rate=rate, names=names(ship.model.inputs))
+
+
 def run(ship: TrialShip, prog: RudderProgramme, finished, *, dt: float | None = None,
         check_every: float = 5.0) -> History:
-    """Integrate the batch of ``prog`` from its approach states with fixed-step RK4.
+    """Run the batch of ``prog`` from its approach states through
+    :func:`~shipgnc.sim.simulator.simulate` (fixed-step RK4), its rudder programme the
+    controller (:class:`~shipgnc.trials.programme.ProgrammeController`).
 
     ``finished(k, hist_view) -> (B,) bool`` is asked every ``check_every`` seconds; the run ends
     when every ship is finished or at its ``t_max`` (the largest of the batch).
     """
-    from shipgnc.actuators import Actuator
-    from shipgnc.trials.zigzag import reverse_rudder
+    from shipgnc.sim.simulator import simulate
+    from shipgnc.trials.programme import ProgrammeController
 
-    index = ship.index
-    model = Stacked.of(ship.models, prog.speed_index)
-
-    def model_of(which):
-        return Stacked.of(ship.models, prog.speed_index[which])
-
-    h = ship.dt if dt is None else float(dt)
-    B = prog.size
-    t_end = float(np.max(prog.t_max))
-    n_steps = math.ceil(t_end / h)
-    n = prog.x0.shape[-1]
-    x = prog.x0.copy()
-    X = np.empty((n_steps + 1, B, n))
-    R = np.empty((n_steps + 1, B))
-    C = np.empty((n_steps + 1, B))
-    X[0] = x
-    inputs = prog.inputs0.copy()
-    psi0 = x[:, index["psi"]].copy()
-    s = np.sign(prog.zz_amp)
-    zigzag = prog.zz_amp != 0
-    astern_value = ship.full_astern
     if np.any(prog.astern):
-        require(ship.can_reverse and astern_value is not None and inputs.shape[-1] > 1,
+        require(ship.can_reverse and ship.full_astern is not None and ship.n_inputs > 1,
                 "trial stopping", ship.name, "the vessel has no propulsion that can go full astern")
-        inputs[prog.astern, 1] = astern_value
-    act = None
-    if not ship.steering_in_model:
-        act = Actuator(np.array([-ship.max_rudder]), np.array([ship.max_rudder]),
-                       rate=np.array([ship.rudder_rate]), names=("delta_c",))
-    applied = prog.inputs0[:, :1].copy()  # actuator state (applied rudder) when not in the model
-    rdx = index["delta"] if ship.steering_in_model else None
-    check = max(1, round(check_every / h))
-    done = np.zeros(B, dtype=bool)
-    k_end = n_steps
-    t_switch = prog.t_switch  # (mutable: steady switches are written here)
-
-    auto = np.isfinite(prog.r_ref)
-    r_ref = np.where(auto, prog.r_ref, 0.0)
-    integral = np.zeros(B)
-    i_max = np.where(prog.ki > 0, ship.max_rudder / np.where(prog.ki > 0, prog.ki, 1.0), 0.0)
-
-    def command(t, xk):
-        nonlocal s
-        change = xk[:, index["psi"]] - psi0
-        s = np.where(zigzag, reverse_rudder(s, change, prog.zz_psi), s)
-        zz = prog.delta_a + s * np.abs(prog.zz_amp)
-        step = np.where(t < t_switch - 1e-9, prog.delta_a, prog.delta_b)
-        cmd = np.where(zigzag, zz, step)
-        if np.any(auto):
-            e = r_ref - xk[:, index["r"]]
-            cmd = np.where(auto, prog.delta_a + prog.kp * e + prog.ki * integral, cmd)
-        return np.clip(cmd, -ship.max_rudder, ship.max_rudder)
-
-    for k in range(n_steps):
-        t = k * h
-        cmd = command(t, x)
-        C[k] = cmd
-        if act is None:
-            inputs[:, 0] = cmd
-            R[k] = x[:, rdx]
-
-            def f(tt, z, _u=inputs):
-                return model.derivatives(z, _u)
-        else:
-            plan = act.begin_step(applied, cmd[:, None], h)
-            R[k] = applied[:, 0]
-            u_start, u_end = plan
-
-            def f(tt, z, _t=t, _a=u_start, _b=u_end):
-                theta = (tt - _t) / h
-                inputs[:, 0] = (_a + theta * (_b - _a))[:, 0]
-                return model.derivatives(z, inputs)
-            applied = u_end
-        x_old = x
-        x = rk4_step(f, t, x, h)
-        if act is None and np.any(zigzag):
-            x = _reverse_within_step(model_of, x_old, x, t, h, inputs, s, psi0, prog, index,
-                                     ship.max_rudder)
-        X[k + 1] = x
-        if np.any(auto):
-            integral = np.clip(integral + h * (r_ref - x[:, index["r"]]), -i_max, i_max)
-        if (k + 1) % check == 0 or k + 1 == n_steps:
-            if not np.all(np.isfinite(x)):
-                bad = int(np.argmax(~np.all(np.isfinite(x), axis=-1)))
-                from shipgnc.errors import DivergenceError
-
-                raise DivergenceError(f"trial of {ship.name} diverged at t = {t + h:.6g} s (ship {bad}, "
-                                      f"{prog.kind[bad]})", time=t + h, state="?", value=float("nan"),
-                                      index=(bad,))
-            view = History(np.arange(k + 2) * h, X[:k + 2], R[:k + 1], C[:k + 1], None, prog, index)
-            waiting = prog.switch_when_steady & ~np.isfinite(t_switch)
-            if np.any(waiting):
-                ok = steady(view.time, view.state("r"), k + 1, steady_window(ship),
-                            prog.switch_rel) & waiting
-                t_switch[ok] = (k + 1) * h
-            done = np.asarray(finished(k + 1, view), dtype=bool) | ((k + 1) * h >= prog.t_max - 1e-9)
-            if np.all(done):
-                k_end = k + 1
-                break
-    cmd = command(k_end * h, x)
-    C[k_end] = cmd
-    R[k_end] = x[:, rdx] if act is None else applied[:, 0]
-    time = np.arange(k_end + 1) * h
-    X, R, C = X[:k_end + 1], R[:k_end + 1], C[:k_end + 1]
+    model = Stacked.of(ship.models, prog.speed_index)
+    h = ship.dt if dt is None else float(dt)
+    n_steps = math.ceil(float(np.max(prog.t_max)) / h)
+    actuator = trial_actuator(ship)
+    pilot = ProgrammeController(ship, prog, finished, dt=h, n_steps=n_steps, actuator=actuator,
+                                check_every=check_every)
+    res = simulate(model, prog.x0, t_end=n_steps * h, dt=h, controller=pilot, actuator=actuator,
+                   u0=prog.inputs0, backend="auto", attrs={"vessel": ship.name})
+    X = np.stack([res[s.name].values for s in model.states], axis=-1)
+    k_end = X.shape[0] - 1
+    delta_c = model.inputs[0].name
+    C = res[f"{delta_c}_cmd"].values
+    R = X[..., ship.index["delta"]] if ship.steering_in_model else res[delta_c].values
     # speed over ground from the model's own kinematics (works without u, v states)
-    U = np.empty_like(R)
-    u_all = np.broadcast_to(prog.inputs0, (k_end + 1, *prog.inputs0.shape)).copy()
-    if np.any(prog.astern):
-        u_all[:, prog.astern, 1] = astern_value
-    u_all[..., 0] = R if act is not None else C
+    u_all = np.broadcast_to(pilot.held, (k_end + 1, *pilot.held.shape)).copy()
+    u_all[..., 0] = C if ship.steering_in_model else R
     xd = model.derivatives(X, u_all)
-    U[:] = np.hypot(xd[..., index["north"]], xd[..., index["east"]])
-    return History(time, X, R, C, U, prog, index)
+    U = np.hypot(xd[..., ship.index["north"]], xd[..., ship.index["east"]])
+    return History(res["time"].values, X, R, C, U, prog, ship.index)
 
 
 def run_parts(ship: TrialShip, parts, **kw) -> list[History]:
