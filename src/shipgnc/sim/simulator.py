@@ -107,7 +107,12 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     Parameters
     ----------
     controller : a :class:`~shipgnc.control.base.Controller` (``Ts`` = its sample time, default
-        ``dt``) or ``None`` for a constant input ``u0``.
+        ``dt``) or ``None`` for a constant input ``u0``. An event-driven controller (a manoeuvring
+        trial's rudder programme, :mod:`shipgnc.trials.programme`) may also have
+        ``finished()`` (per ship: its programme is complete; the run ends when every ship is
+        finished, as with a guidance's ``finished()``) and ``switch_within_step(t, x0, x1,
+        command)`` (a command that switches on a state crossing inside the step:
+        :func:`switch_within_step`; numpy loop).
     actuator : :class:`~shipgnc.actuators.Actuator`; default: the model's own input limits.
     guidance : references for the controller (:mod:`shipgnc.guidance`).
     disturbance : see :mod:`shipgnc.environment.disturbance`; drawn from ``seed``.

@@ -11,11 +11,14 @@ explanatory notes (MSC/Circ.1053); they are written out in ``docs/trials.md``.
 * **Execute**: t = 0, position (0, 0), heading 0 (the original course points north) at the moment
   the rudder command changes; the rudder moves at its rate limit (the model's own steering machine
   when ``delta`` is a state, else :class:`~shipgnc.actuators.Actuator` slewing linearly).
-* **Integration** (:func:`run`): fixed-step RK4 (:func:`shipgnc.sim.integrators.rk4_step`) over a
-  batch ``(B, n)``: every ship of a trial (a spiral's rudder angles, both turning sides, several
-  trials at once) is one array operation per RK stage; no Python loop over ships. Each ship follows
-  a :class:`RudderProgramme` (piecewise-constant rudder, zig-zag reversals, phase switches when
-  the yaw rate is steady, full astern) and the run ends when every ship's trial is complete.
+* **Integration** (:func:`run`): one run of :func:`shipgnc.sim.simulator.simulate` (fixed-step
+  RK4) over a batch ``(B, n)``: every ship of a trial (a spiral's rudder angles, both turning
+  sides, several trials at once) is one array operation per RK stage; no Python loop over ships.
+  Each ship follows a :class:`RudderProgramme` (piecewise-constant rudder, zig-zag reversals,
+  phase switches when the yaw rate is steady, full astern), the run's controller
+  (:class:`~shipgnc.trials.programme.ProgrammeController`), and the run ends when every ship's
+  trial is complete. A vessel section (a vessel file's) is built as ``shipgnc run`` builds a
+  scenario's (:func:`shipgnc.vessels.setup.vessel_setup`).
 """
 
 from __future__ import annotations
@@ -84,11 +87,15 @@ class TrialShip:
 
 
 def _entry(vessel):
-    """A catalogue entry from a name (or the entry itself); None for a plain model."""
-    if isinstance(vessel, str):
-        from shipgnc.vessels import get_vessel
+    """A catalogue entry from a name, a vessel section (a scenario's or a file's) or the entry
+    itself; None for a plain model."""
+    from shipgnc.vessels import get_vessel
+    from shipgnc.vessels.config import CatalogueVesselConfig
 
+    if isinstance(vessel, str):
         return get_vessel(vessel)
+    if isinstance(vessel, CatalogueVesselConfig):
+        return get_vessel(vessel.model)
     if hasattr(vessel, "build") and hasattr(vessel, "design_speed_mps"):
         return vessel
     return None
@@ -110,13 +117,17 @@ def solas_rudder_rate(entry=None) -> float:
 
 def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
             max_rudder_deg: float | None = None, rudder_rate_deg_s: float | None = None,
-            dt: float | None = None, steering_gear: str = "model", **params) -> TrialShip:
+            dt: float | None = None, steering_gear: str = "model", name: str | None = None,
+            **params) -> TrialShip:
     """Set a vessel up for trials: build it, solve the straight approach with its trim rudder.
 
-    ``vessel``: a catalogue name (:mod:`shipgnc.vessels`), a catalogue entry, or a model object
-    (``Model`` protocol; then ``speed_mps`` is required unless the model has a speed ``U``).
-    ``speed_mps``: one test speed or a sequence (a speed range: one batch); default the design
-    speed. ``params`` go to the entry's ``build`` (e.g. K, T of ``nomoto``). The overrides
+    ``vessel``: a catalogue name (:mod:`shipgnc.vessels`), a catalogue entry, a vessel section
+    (:class:`~shipgnc.vessels.config.CatalogueVesselConfig`: a vessel file's, a scenario's; built
+    by :func:`~shipgnc.vessels.setup.vessel_setup` as ``shipgnc run`` builds it), or a model
+    object (``Model`` protocol; then ``speed_mps`` is required unless the model has a speed
+    ``U``). ``speed_mps``: one test speed or a sequence (a speed range: one batch); default the
+    section's speed, else the design speed. ``name``: the vessel's name in the results.
+    ``params`` go to the entry's ``build`` (e.g. K, T of ``nomoto``). The overrides
     ``length_m``, ``max_rudder_deg``, ``rudder_rate_deg_s`` replace the catalogue's values.
     ``steering_gear``: ``"model"`` — the rudder moves at the vessel's own rate (the catalogue's
     steering machine); ``"solas"`` — at the SOLAS steering gear's 65°/28 s (:func:`solas_rudder_rate`),
@@ -131,24 +142,24 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
     if entry is not None and rudder_rate_deg_s is not None:
         params = {**params, "rudder_rate_deg_s": rudder_rate_deg_s}  # the model's steering machine
     if entry is not None:
-        speeds = np.atleast_1d(np.asarray(entry.design_speed_mps if speed_mps is None else speed_mps,
-                                          dtype=float))
+        from shipgnc.vessels.setup import vessel_setup
+
+        section = vessel if hasattr(vessel, "speed_mps") and hasattr(vessel, "params") else None
+        if speed_mps is None:
+            speed_mps = getattr(section, "speed_mps", None) or entry.design_speed_mps
+        speeds = np.atleast_1d(np.asarray(speed_mps, dtype=float))
         lo, hi = entry.speed_range_mps
         for s in speeds:
             require(math.isfinite(s) and lo - 1e-9 <= s <= hi + 1e-9, "--speed-kn", round(float(s) / KNOT, 4),
                     f"{entry.name} is valid for {lo / KNOT:.4g}-{hi / KNOT:.4g} kn "
                     f"({lo:.4g}-{hi:.4g} m/s)")
-        models = [entry.build(speed_mps=float(s), **params) for s in speeds]
+        setups = [vessel_setup(section or entry.name, float(s), name=name, **params) for s in speeds]
+        models = [s.model for s in setups]
         model = models[0]
-        name, source = entry.name, entry.source
-        length = entry.length_m if length_m is None else length_m
-        if length is None and params.get("L") is not None:  # a ship from its main dimensions
-            length = float(params["L"])
-        max_rudder = (math.radians(params["rudder_max_deg"]) if params.get("rudder_max_deg")
-                      is not None else entry.max_rudder_rad)
-        rate = (math.radians(params["rudder_rate_deg_s"]) if params.get("rudder_rate_deg_s")
-                is not None else entry.max_rudder_rate_rad_s)
-        can_reverse = bool(entry.can_reverse)
+        name, source = setups[0].name, entry.source
+        length = setups[0].length_m if length_m is None else length_m
+        max_rudder, rate = setups[0].max_rudder, setups[0].rudder_rate
+        can_reverse = setups[0].can_reverse
     else:
         model = vessel
         models = None
@@ -158,7 +169,7 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
             speed_mps = getattr(getattr(model, "params", model), "U", None)
         require(speed_mps is not None, "speed_mps", None, "give the test speed of a plain model [m/s]")
         speeds = np.atleast_1d(np.asarray(speed_mps, dtype=float))
-        name, source = type(model).__name__, ""
+        name, source = name or type(model).__name__, ""
         length = length_m
         lim = getattr(model, "input_limits", None)
         max_rudder = float(lim()[1][0]) if lim is not None else math.radians(35.0)
