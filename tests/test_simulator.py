@@ -273,3 +273,27 @@ def test_a_controller_switches_at_the_crossing_and_ends_the_run_when_finished():
     late = simulate(_Integrator(), np.zeros((1, 1)), t_end=6.0, dt=0.3, controller=_TurnBack(False),
                     actuator=Actuator([-10.0], [10.0]), backend="numpy")
     assert late["x"].values[:, 0].max() == pytest.approx(1.2)
+
+
+@pytest.mark.parametrize(("scenario", "key", "value", "direct"), [
+    ("boat-stern-kick", "simulation.t_end", "30.01", {"t_end": 30.01, "dt": 0.05}),
+    ("boat-autopilot", "controller.Ts", "0.07", {"t_end": 1.0, "dt": 0.05, "Ts": 0.07}),
+])
+def test_each_dt_rule_gives_one_message_from_simulate_and_from_a_scenario(scenario, key, value, direct):
+    """"t_end is a whole multiple of dt" and "Ts is a whole multiple of dt" are checked by one
+    function each (the loop's): a scenario's error is simulate's, with the scenario's field names."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+
+    kw = {"t_end": direct["t_end"], "dt": direct["dt"]}
+    if "Ts" in direct:
+        kw["controller"] = Counter(Ts=direct["Ts"])
+    with pytest.raises(ConfigError) as info:
+        simulate(VectoredThrustBoat(), np.zeros(6), **kw)
+    r = CliRunner().invoke(app, ["run", scenario, "--set", f"{key}={value}", "--no-figures"])
+    assert r.exit_code == 2, r.output
+    said = str(info.value).replace(" dt =", " simulation.dt =")
+    if key == "simulation.t_end":
+        said = said.replace("t_end =", "simulation.t_end =")
+    assert r.stderr.strip() == f"error: scenario {scenario!r}: {said}"

@@ -262,17 +262,8 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
     for name, value in (("dt", dt), ("t_end", t_end)):
         require(isinstance(value, (int, float)) and math.isfinite(value) and value > 0,
                 name, value, "must be a finite number > 0 s")
-    steps = t_end / dt
-    require(math.isfinite(steps) and steps <= MAX_STEPS, "t_end / dt", steps,
-            f"at most {MAX_STEPS:.0e} steps per run")
-    n_steps = round(steps)
-    require(n_steps >= 1 and abs(n_steps * dt - t_end) <= 1e-9 * max(1.0, t_end), "t_end",
-            t_end, f"must be a whole multiple of dt = {dt:g} s")
-    Ts = getattr(controller, "Ts", None) or dt
-    require(math.isfinite(Ts) and Ts > 0, "controller.Ts", Ts, "must be > 0 s")
-    hold = round(Ts / dt)
-    require(hold >= 1 and abs(hold * dt - Ts) <= 1e-9 * Ts, "controller.Ts", Ts,
-            f"must be a whole multiple of dt = {dt:g} s")
+    n_steps = whole_steps(t_end, dt)
+    hold = samples_per_period(getattr(controller, "Ts", None) or dt, dt)
     require(integrator in INTEGRATORS, "integrator", integrator,
             f"allowed: {', '.join(INTEGRATORS)}")
     require(on_divergence in ON_DIVERGENCE, "on_divergence", on_divergence,
@@ -339,6 +330,34 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
                     solver_options={"method": method, "rtol": rtol, "atol": atol}, rng=rng,
                     on_divergence=on_divergence, observer=observer, progress=progress,
                     log_every=log_every, u0=u0, navigation=navigation)
+
+
+def whole_steps(t_end: float, dt: float, *, section: str = "") -> int:
+    """The steps of a run, ``t_end / dt``: a whole number (the last sample is t_end itself), at
+    most :data:`MAX_STEPS`. The one check of this rule, for :func:`simulate` and for a scenario's
+    ``simulation`` section (``section``: the section the message names the fields in, e.g.
+    ``simulation.t_end``); a one-line :class:`ConfigError` otherwise."""
+    at = f"{section}." if section else ""
+    steps = t_end / dt
+    require(math.isfinite(steps) and steps <= MAX_STEPS, f"{section}: t_end / dt" if section
+            else "t_end / dt", steps, f"at most {MAX_STEPS:.0e} steps per run")
+    n_steps = round(steps)
+    require(n_steps >= 1 and abs(n_steps * dt - t_end) <= 1e-9 * max(1.0, t_end), f"{at}t_end",
+            t_end, f"must be a whole multiple of {at}dt = {dt:g} s")
+    return n_steps
+
+
+def samples_per_period(Ts: float, dt: float, *, field: str = "controller.Ts",
+                       dt_field: str = "dt") -> int:
+    """Samples per control period, ``Ts / dt``: a whole number >= 1. The one check of this rule,
+    for :func:`simulate` and for a scenario's controllers (``field``: e.g. ``controllers.pd.Ts``);
+    a one-line :class:`ConfigError` otherwise."""
+    require(isinstance(Ts, (int, float)) and math.isfinite(Ts) and Ts > 0, field, Ts,
+            "must be > 0 s")
+    hold = round(Ts / dt)
+    require(hold >= 1 and abs(hold * dt - Ts) <= 1e-9 * Ts, field, Ts,
+            f"must be a whole multiple of {dt_field} = {dt:g} s")
+    return hold
 
 
 def logged_numbers(model, batch_shape: tuple[int, ...], n_steps: int, log_every: int = 1) -> int:
