@@ -29,6 +29,7 @@ from shipgnc.frames import wrap_angle
 from shipgnc.interrupts import note
 from shipgnc.models.base import Signal, names
 from shipgnc.sim.integrators import rk4_step, solve_ivp_step
+from shipgnc.sim.transition import step_end, step_start
 from shipgnc.streams import MemberStreams, is_generator
 
 INTEGRATORS = ("rk4", "solve_ivp")
@@ -577,8 +578,7 @@ def reset_components(setup: SimSetup) -> None:
 
 def run_numpy(setup: SimSetup) -> Log:
     """The reference loop in plain numpy (readable; batched over ships)."""
-    model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller, setup.guidance,
-                                  setup.disturbance)
+    model, act, ctrl, gd = setup.model, setup.actuator, setup.controller, setup.guidance
     nav = setup.navigation
     batch = setup.batch_shape
     dt = setup.dt
@@ -637,10 +637,7 @@ def run_numpy(setup: SimSetup) -> Log:
                             raise error
                         status.update(diverged=1, message=str(error))
                         break
-            plan = act.begin_step(applied, command, dt)
-            applied_now = act.input_at(plan, 0.0, lag)
-            if dist is not None and not dist.per_stage:
-                held_d = dist(t, x)
+            plan, applied_now, held_d = step_start(setup, t, x, lag, applied, command)
             last = k == setup.n_steps
             finished = finished_ships(ctrl, gd)
             all_done = finished is not None and bool(np.all(finished | ~alive))
@@ -671,7 +668,7 @@ def run_numpy(setup: SimSetup) -> Log:
             if last or all_done:
                 break
             x_before, lag_before = x, lag
-            x, lag = advance_plant(setup, t, x, lag, plan, command, ref, held_d)
+            x, lag, applied = step_end(setup, t, x, lag, plan, command, ref, held_d)
             if switching is not None:
                 x = switch_within_step(setup, t, x_before, x, command, held_d)
             if masking:  # a ship whose state is bad stops here; a stopped ship's state is held
@@ -683,7 +680,7 @@ def run_numpy(setup: SimSetup) -> Log:
                 held = ~alive[..., None]
                 x = np.where(held, x_before, x)
                 lag = None if lag is None else np.where(held, lag_before, lag)
-            applied = act.input_at(plan, 1.0, lag)
+                applied = act.input_at(plan, 1.0, lag)
             error = None if masking else check_divergence(setup, t + dt, x)
             if error is not None:
                 if setup.on_divergence == "raise":
