@@ -52,9 +52,9 @@ def format_validation_error(error: ValidationError, source: str) -> str:
         loc = _location(item["loc"])
         msg = item["msg"].removeprefix("Value error, ")
         value = item.get("input")
-        if isinstance((item.get("ctx") or {}).get("error"), ConfigError):
+        if isinstance((item.get("ctx") or {}).get("error"), ConfigError) and msg.startswith(loc):
             parts.append(msg)  # a check shared with the loop (e.g. sim.simulator.whole_steps):
-            # its message names the field, the value and the rule itself
+            # its message names the field (within the section), the value and the rule itself
         elif item["type"] == "extra_forbidden":
             parts.append(f"{loc}: unknown field (check the spelling; see `shipgnc show`)")
         elif item["type"] == "missing":

@@ -48,7 +48,7 @@ from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import names
 from shipgnc.sim.simulator import _validate, reset_disturbance
-from shipgnc.sim.transition import Transition, step_start
+from shipgnc.sim.transition import Transition, input_plan
 from shipgnc.streams import MemberStreams
 from shipgnc.study.chunk import check_perturbable
 from shipgnc.study.spec import PERTURBABLE, Perturbation
@@ -269,8 +269,7 @@ class BatchedEpisode:
         if final.any():  # the loop's last sample (t_end, or the guidance's end) counts too,
             # with the input the loop logs there: the held command's plan at its start
             st = self.state
-            _, self.applied_now, _ = step_start(self.sim, self.t, st.x, st.lag, st.applied,
-                                                st.command)
+            _, self.applied_now = input_plan(self.sim, st.applied, st.command, st.lag)
             reward -= np.where(final, self.sample_cost(), 0.0)
         terminated = self.done | self.diverged | finished
         truncated_now = np.full(self.batch, truncated) & ~terminated

@@ -60,11 +60,19 @@ def step_start(setup, t: float, x: np.ndarray, lag, applied: np.ndarray, command
     """The first half of a step at ``t``: the actuator's plan of the step
     (:meth:`~shipgnc.actuators.Actuator.begin_step`), the input applied at its start and the held
     disturbance sample (None when there is none or it is evaluated at every RK stage)."""
-    act, dist = setup.actuator, setup.disturbance
-    plan = act.begin_step(applied, command, setup.dt)
-    applied_now = act.input_at(plan, 0.0, lag)
+    dist = setup.disturbance
+    plan, applied_now = input_plan(setup, applied, command, lag)
     held = dist(t, x) if dist is not None and not dist.per_stage else None
     return plan, applied_now, held
+
+
+def input_plan(setup, applied: np.ndarray, command: np.ndarray, lag):
+    """The actuator's plan of a step holding ``command`` from ``applied``
+    (:meth:`~shipgnc.actuators.Actuator.begin_step`) and the input applied at its start (the
+    input a loop logs at a sample)."""
+    act = setup.actuator
+    plan = act.begin_step(applied, command, setup.dt)
+    return plan, act.input_at(plan, 0.0, lag)
 
 
 def step_end(setup, t: float, x: np.ndarray, lag, plan, command: np.ndarray, ref: np.ndarray, held):

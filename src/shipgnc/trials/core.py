@@ -142,9 +142,10 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
     if entry is not None and rudder_rate_deg_s is not None:
         params = {**params, "rudder_rate_deg_s": rudder_rate_deg_s}  # the model's steering machine
     if entry is not None:
+        from shipgnc.vessels.config import CatalogueVesselConfig
         from shipgnc.vessels.setup import vessel_setup
 
-        section = vessel if hasattr(vessel, "speed_mps") and hasattr(vessel, "params") else None
+        section = vessel if isinstance(vessel, CatalogueVesselConfig) else None
         if speed_mps is None:
             speed_mps = getattr(section, "speed_mps", None) or entry.design_speed_mps
         speeds = np.atleast_1d(np.asarray(speed_mps, dtype=float))
