@@ -209,3 +209,91 @@ def test_errors_use_the_current_state_between_control_samples(backend):
     np.testing.assert_allclose(ds.psi_error.values, wrap_angle(ds.psi.values - ds.psi_d.values),
                                atol=1e-15)
     np.testing.assert_allclose(ds.u_error.values, ds.u.values - ds.u_d.values, atol=1e-15)
+
+
+class _Integrator:
+    """ẋ = u: one state, one input (an exact case for RK4: x is piecewise linear in t)."""
+
+    states = (Signal("x", "m", "position"),)
+    inputs = (Signal("u", "m/s", "speed"),)
+    state_limits = (1e6,)
+
+    def input_limits(self):
+        return np.array([-10.0]), np.array([10.0])
+
+    def derivatives(self, x, u, d=None):
+        return u + 0.0 * x
+
+
+class _TurnBack:
+    """u = +1 until x reaches 1 m, then −1 (a zig-zag's reversal, one axis); finished at x ≤ 0.5 m
+    after turning back."""
+
+    continuous = False
+    signals = ()
+    Ts = None
+
+    def __init__(self, within: bool):
+        self.within = within
+
+    def reset(self, batch_shape):
+        self.sign = np.ones(batch_shape)
+        self.done = np.zeros(batch_shape, dtype=bool)
+
+    def step(self, t, x, ref):
+        self.sign = np.where(x[..., 0] >= 1.0, -1.0, self.sign)
+        self.done = (self.sign < 0) & (x[..., 0] <= 0.5)
+        return self.sign[..., None]
+
+    def finished(self):
+        return self.done
+
+    def signal_values(self):
+        return {}
+
+    def switch_within_step(self, t, x0, x1, command):
+        if not self.within:
+            return None
+        hit = (self.sign > 0) & (x1[..., 0] >= 1.0)
+        theta = (1.0 - x0[..., 0]) / np.where(hit, x1[..., 0] - x0[..., 0], 1.0)
+        self.sign = np.where(hit, -1.0, self.sign)  # turned back inside the step
+        return np.where(hit, theta, np.nan), -command
+
+
+def test_a_controller_switches_at_the_crossing_and_ends_the_run_when_finished():
+    """ẋ = ±1 from x = 0 turning back at x = 1 m: closed form x(t) = 2 − t for t ≥ 1 s. With the
+    switch inside the step (dt = 0.3 s: crossing at θ = 1/3 of the step 0.9–1.2 s) every later
+    sample is exact; switching at the next sample (1.2 s) overshoots to 1.2 m. The run ends at the
+    first sample where the controller says finished: x ≤ 0.5 m at t = 1.5 s (x = 0.5)."""
+    exact = simulate(_Integrator(), np.zeros((1, 1)), t_end=6.0, dt=0.3, controller=_TurnBack(True),
+                     actuator=Actuator([-10.0], [10.0]), backend="numpy")
+    t, x = exact.time.values, exact["x"].values[:, 0]
+    assert t[-1] == pytest.approx(1.5)
+    np.testing.assert_allclose(x, np.where(t <= 1.0, t, 2.0 - t), atol=1e-12)
+    late = simulate(_Integrator(), np.zeros((1, 1)), t_end=6.0, dt=0.3, controller=_TurnBack(False),
+                    actuator=Actuator([-10.0], [10.0]), backend="numpy")
+    assert late["x"].values[:, 0].max() == pytest.approx(1.2)
+
+
+@pytest.mark.parametrize(("scenario", "key", "value", "direct"), [
+    ("boat-stern-kick", "simulation.t_end", "30.01", {"t_end": 30.01, "dt": 0.05}),
+    ("boat-autopilot", "controller.Ts", "0.07", {"t_end": 1.0, "dt": 0.05, "Ts": 0.07}),
+])
+def test_each_dt_rule_gives_one_message_from_simulate_and_from_a_scenario(scenario, key, value, direct):
+    """"t_end is a whole multiple of dt" and "Ts is a whole multiple of dt" are checked by one
+    function each (the loop's): a scenario's error is simulate's, with the scenario's field names."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+
+    kw = {"t_end": direct["t_end"], "dt": direct["dt"]}
+    if "Ts" in direct:
+        kw["controller"] = Counter(Ts=direct["Ts"])
+    with pytest.raises(ConfigError) as info:
+        simulate(VectoredThrustBoat(), np.zeros(6), **kw)
+    r = CliRunner().invoke(app, ["run", scenario, "--set", f"{key}={value}", "--no-figures"])
+    assert r.exit_code == 2, r.output
+    said = str(info.value).replace(" dt =", " simulation.dt =")
+    if key == "simulation.t_end":
+        said = said.replace("t_end =", "simulation.t_end =")
+    assert r.stderr.strip() == f"error: scenario {scenario!r}: {said}"

@@ -132,3 +132,32 @@ def test_a_vessel_file_is_read_as_a_scenario_reads_it(tmp_path):
     assert d["vessel"] == "coaster.yaml (linear-3dof)"
     r = runner.invoke(app, ["trial", "turning-circle", "--vessel", str(f), "--json"])
     assert json.loads(r.stdout)["rudder_rate_deg_s"] == pytest.approx(65.0 / 28.0)
+
+
+def test_a_trial_and_a_scenario_build_a_vessel_file_alike(tmp_path):
+    """One function (vessels.setup.vessel_setup) makes a vessel section ready for both commands:
+    the trial's model is the scenario's (same derivatives at the same state), its length, rudder
+    limit and rate are the file's own (L = 100 m, 30°, 15°/s with the model's steering gear)."""
+    from shipgnc.scenarios.registry import load_scenario
+    from shipgnc.scenarios.runner import build
+    from shipgnc.vessels.files import load_vessel_file
+    from shipgnc.vessels.setup import vessel_setup
+
+    f = tmp_path / "coaster.yaml"
+    f.write_text("vessel: {model: linear-3dof, speed_mps: 5.0, L: 100.0, B: 12.0, T: 5.0, "
+                 "Cb: 0.55, rudder_rate_deg_s: 15, rudder_max_deg: 30}\n", encoding="utf-8")
+    section = load_vessel_file(f)
+    ship = core.prepare(section, steering_gear="model")
+    sc = load_scenario("mariner-cst-heading")
+    start = sc.simulation.initial_state.model_copy(update={"u": None})
+    sc = sc.model_copy(update={"vessel": section, "simulation": sc.simulation.model_copy(
+        update={"initial_state": start})})
+    setup = build(sc)
+    assert ship.length_m == 100.0 and vessel_setup(section).length_m == 100.0
+    assert math.degrees(ship.max_rudder) == pytest.approx(30.0)
+    assert math.degrees(ship.rudder_rate) == pytest.approx(15.0)
+    assert setup.actuator.upper[0] == pytest.approx(ship.max_rudder)
+    x = ship.x0[0] + np.array([0, 0, 0.1, 0.2, 0.3, 0.01, 0.2])
+    u = ship.inputs0[0] + 0.1
+    np.testing.assert_array_equal(ship.model.derivatives(x, u), setup.model.derivatives(x, u))
+    assert ship.speed[0] == pytest.approx(5.0)

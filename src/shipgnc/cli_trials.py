@@ -26,15 +26,17 @@ from shipgnc.units import KNOT
 KINDS = ("turning-circle", "zigzag", "spiral", "stopping", "pull-out", "all")
 
 
-def _vessel(text: str) -> tuple[str, float | None, dict]:
-    """(catalogue name, speed from the file or None, build parameters) from --vessel."""
+def _vessel(text: str):
+    """(the vessel, the name it is shown by) from --vessel: a catalogue name, or a vessel file's
+    validated section (built as ``shipgnc run`` builds a scenario's vessel section:
+    :func:`shipgnc.vessels.setup.vessel_setup`), named by the file."""
     p = Path(text)
     if text.endswith((".yaml", ".yml")) or (p.suffix and p.is_file()):
         from shipgnc.vessels.files import load_vessel_file
 
         config = load_vessel_file(p, f"--vessel {text!r}")
-        return config.model, config.speed_mps, config.params()
-    return text, None, {}
+        return config, f"{p.name} ({config.model})"
+    return text, None
 
 
 def clean(obj):
@@ -74,23 +76,18 @@ def run_trial(kind: str, vessel: str, *, speed_kn: float | None = None, rudder_d
     dz = zigzag.parse_angles(angles) if angles is not None else None
     if angles is not None and kind not in ("zigzag",):
         raise ConfigError(f"--angles = {angles!r}: only for KIND zigzag (all runs 10/10 and 20/20)")
-    name, file_speed, params = _vessel(vessel)
-    speed = speed_kn * KNOT if speed_kn is not None else file_speed
+    section, name = _vessel(vessel)
+    speed = speed_kn * KNOT if speed_kn is not None else None
     sides = ("starboard", "port") if side is None else (side,)
     if kind == "stopping":
         from shipgnc.trials.core import _entry
 
-        entry = _entry(name)
+        entry = _entry(section)
         if not entry.can_reverse:
             raise ConfigError(f"trial stopping: vessel {entry.name} has no propulsion that can go full "
                               "astern (can_reverse is false), so it has no stopping trial")
-    if steering_gear == "solas":  # the SOLAS gear replaces the vessel file's own rate
-        params = {k: v for k, v in params.items() if k != "rudder_rate_deg_s"}
-    ship = prepare(name, speed, steering_gear=steering_gear, **params)
-    if name != vessel:  # a vessel file: named by the file, as a scenario's run would show it
-        import dataclasses
-
-        ship = dataclasses.replace(ship, name=f"{Path(vessel).name} ({name})")
+    # (the SOLAS gear replaces a vessel file's own rate; "model" keeps it)
+    ship = prepare(section, speed, steering_gear=steering_gear, name=name)
     if kind == "turning-circle":
         return turning.turning_circle(ship=ship, rudder_deg=rudder_deg, sides=sides)
     if kind == "zigzag":

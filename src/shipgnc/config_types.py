@@ -8,6 +8,8 @@ from typing import Annotated, ClassVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from shipgnc.errors import ConfigError
+
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -51,7 +53,10 @@ def format_validation_error(error: ValidationError, source: str) -> str:
         loc = _location(item["loc"])
         msg = item["msg"].removeprefix("Value error, ")
         value = item.get("input")
-        if item["type"] == "extra_forbidden":
+        if isinstance((item.get("ctx") or {}).get("error"), ConfigError) and msg.startswith(loc):
+            parts.append(msg)  # a check shared with the loop (e.g. sim.simulator.whole_steps):
+            # its message names the field (within the section), the value and the rule itself
+        elif item["type"] == "extra_forbidden":
             parts.append(f"{loc}: unknown field (check the spelling; see `shipgnc show`)")
         elif item["type"] == "missing":
             parts.append(f"{loc}: required field is missing")

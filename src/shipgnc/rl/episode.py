@@ -3,8 +3,8 @@
 The agent takes the controller's place in the one loop: every control period ``Ts`` (the
 scenario's controller sample time) it sees the state, the guidance references and the tracking
 errors, and returns a command; the actuator (saturation, rate limit, lag), the plant and the
-disturbance advance exactly as in :func:`shipgnc.sim.simulator.simulate` (same
-:func:`~shipgnc.sim.simulator.advance_plant`, same sample timing), so a classical controller used
+disturbance advance exactly as in :func:`shipgnc.sim.simulator.simulate` (the same steps, same
+sample timing: :mod:`shipgnc.sim.transition`), so a classical controller used
 as the policy earns the negative of the scenario's own metric.
 
 **Reward** — the per-sample term of the scenario's metric, summed over the samples of the control
@@ -27,32 +27,34 @@ period (the final sample t_end included in the last step):
 Each member of the batch has its own random stream (:class:`~shipgnc.streams.MemberStreams`):
 its initial-state offsets (``perturb``) are drawn first, then its disturbance.
 
-**The loop** — the plant, the actuator and the disturbance of a control period advance in the
-composed compiled loop of :func:`~shipgnc.sim.simulator.simulate` (a
-:class:`~shipgnc.sim.compose.Composition` without controller and guidance, the agent's command
-held in its rows) when every component has a kernel (``backend="auto"``, or ``"compiled"``,
-which names the component that has none), else in the numpy loop's
-:func:`~shipgnc.sim.simulator.advance_plant` (``backend="numpy"``); both give the same episode to
-round-off. The guidance's references and the rewards are evaluated in numpy at the samples the loop
-logs.
+**The loop** — a control period is one call of the loop's transition
+(:class:`~shipgnc.sim.transition.Transition`, ``transition(state, action) -> state`` as
+gymnasium's functional form has it): the agent's command held over the period's steps through the
+actuator, the plant and the disturbance, the same steps :func:`~shipgnc.sim.simulator.simulate`
+takes (:func:`~shipgnc.sim.transition.step_start`, :func:`~shipgnc.sim.transition.step_end`), in
+the composed compiled loop when every component has a kernel (``backend="auto"``, or
+``"compiled"``, which names the component that has none), else in numpy (``backend="numpy"``);
+both give the same episode to round-off. The guidance's references and the rewards are evaluated
+in numpy at the samples the period went through.
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.models.base import names
-from shipgnc.sim.simulator import _validate, advance_plant, reset_disturbance
+from shipgnc.sim.simulator import _validate, reset_disturbance
+from shipgnc.sim.transition import Transition, input_plan
 from shipgnc.streams import MemberStreams
 from shipgnc.study.chunk import check_perturbable
 from shipgnc.study.spec import PERTURBABLE, Perturbation
 
 REWARDS = ("heading-steps", "course-quality", "waypoints")
 BACKENDS = ("auto", "numpy", "compiled")
-#: an event that makes the compiled loop skip a member (one already done stays frozen)
-_SKIP = np.iinfo(np.int64).max
 #: document 004's runs an environment takes (:func:`~shipgnc.scenarios.catamaran.run_kind`, by
 #: the guidance type), with the kind of their per-sample reward (one plant and one reference for
 #: every run: the agent replaces the law)
@@ -121,8 +123,9 @@ class BatchedEpisode:
                               "use backend='numpy'")
         #: the loop that steps the plant: ``compiled`` or ``numpy``
         self.backend = "numpy" if backend == "numpy" or reason else "compiled"
-        self._comp = None
         self.hold = max(1, round(float(getattr(ctrl, "Ts", None) or sim.dt) / sim.dt))
+        #: one control period of the loop, the agent's action held: transition(state, action)
+        self.loop = Transition(self.sim, self.hold, self.backend)
         self.dt = sim.dt
         self.n_steps = self.sim.n_steps
         self.lam = float(sc.quality.lam) if sc.metrics == "course-quality" else 0.0
@@ -166,19 +169,21 @@ class BatchedEpisode:
         self.guidance.reset((self.batch,), self.model)
         if self.disturbance is not None:
             reset_disturbance(self.disturbance, self.model, (self.batch,), streams)
-        self.command = np.broadcast_to(self.sim.u0, (self.batch, self.actuator.n)).copy()
-        self.applied = self.actuator.initial(self.command)
-        self.lag = self.applied.copy() if self.actuator.has_lag else None
+        self.state = self.loop.start(self.x)
         self.ref = self.guidance.reference(0.0, self.x)
         self.done = np.zeros(self.batch, dtype=bool)
         self.diverged = np.zeros(self.batch, dtype=bool)
-        if self.backend == "compiled":
-            from shipgnc.sim.compose import Composition
-
-            # the disturbance's kernel after its reset; a log of one control period
-            self._comp = Composition(self.sim, log_samples=self.hold)
-            self._comp.S[:, :x.shape[-1]] = self.x
         return self.observation()
+
+    @property
+    def command(self) -> np.ndarray:
+        """The command held over the last control period (B, m)."""
+        return self.state.command
+
+    @property
+    def applied(self) -> np.ndarray:
+        """The input applied now (B, m), after the actuator."""
+        return self.state.applied
 
     def observation(self) -> np.ndarray:
         x = np.where(self._angle, wrap_angle(self.x), self.x)
@@ -230,77 +235,29 @@ class BatchedEpisode:
         action = action.reshape(self.batch, self.actuator.n)
         if not np.all(np.isfinite(action)):
             raise ConfigError(f"action {action.tolist()}: must be finite")
-        self.command = np.where(self.done[:, None], self.command, action)
+        action = np.where(self.done[:, None], self.command, action)
         live = ~self.done
         if self.k >= self.n_steps:  # after the episode's end: nothing moves, nothing is earned
             reward, live = np.zeros(self.batch), live & False
-        elif self._comp is not None:
-            reward, live = self._advance_compiled(live)
+            self.state = dataclasses.replace(self.state, command=action)
         else:
-            reward, live = self._advance_numpy(live)
+            reward, live = self._advance(action, live)
         return self._end_of_period(reward, live)
 
-    def _advance_numpy(self, live: np.ndarray):
-        """One control period of the plant in the numpy loop; (reward, live)."""
+    def _advance(self, action: np.ndarray, live: np.ndarray):
+        """One control period of the loop (:class:`~shipgnc.sim.transition.Transition`); the
+        rewards from the states and inputs at each step's start the members ran; (reward, live)."""
+        self.state, period = self.loop(self.state, action, live, self.ref)
         reward = np.zeros(self.batch)
-        for _ in range(self.hold):
-            plan = self.actuator.begin_step(self.applied, self.command, self.dt)
-            self.applied_now = self.actuator.input_at(plan, 0.0, self.lag)
-            reward -= np.where(live, self.sample_cost(), 0.0)
-            d = (self.disturbance(self.t, self.x) if self.disturbance is not None
-                 and not self.disturbance.per_stage else None)
-            x, lag = advance_plant(self.sim, self.t, self.x, self.lag, plan, self.command, self.ref, d)
-            applied = self.actuator.input_at(plan, 1.0, lag)
-            bad = ~np.all(np.isfinite(x) & (np.abs(x) <= np.asarray(self.model.state_limits)), axis=-1)
-            self.diverged |= bad & live
-            keep = (~live | bad)[:, None]
-            self.x = np.where(keep, self.x, x)
-            self.applied = np.where(keep, self.applied, applied)
-            if lag is not None:
-                self.lag = np.where(keep, self.lag, lag)
-            live = live & ~bad
-            self.k += 1
-            self.t = self.k * self.dt
-            if self.k >= self.n_steps:
-                break
-        return reward, live
-
-    def _advance_compiled(self, live: np.ndarray):
-        """One control period of the plant in the composed loop (the command held in the rows of
-        the members that run; the others skipped); the rewards from the states and inputs it
-        logged at each step's start, up to a member's divergence; (reward, live)."""
-        comp = self._comp
-        lay, S, out = comp.layout, comp.S, comp.out
-        nx, nu = self.x.shape[-1], self.actuator.n
-        k0, k1 = self.k, min(self.k + self.hold, self.n_steps)
-        S[:, lay["cmd"]:lay["cmd"] + nu] = self.command
-        start = S.copy()
-        comp.event[:] = np.where(live, -1, _SKIP)
-        comp.s_base = k0  # the log holds this period's steps
-        comp.prepare(k0, k1)
-        comp.call(k0, k1, self.n_steps)
-        bad = live & (comp.event >= 0)
-        k_bad = np.where(bad, comp.event // 2, self.n_steps)  # a bad state after step k_bad
-        x_log = out[:nx, :k1 - k0].transpose(1, 2, 0)  # (step, member, state) at each step's start
-        applied_log = out[comp.columns["applied"]:comp.columns["applied"] + nu, :k1 - k0].transpose(1, 2, 0)
-        reward = np.zeros(self.batch)
-        with np.errstate(all="ignore"):  # a member's log is not written after its divergence
-            for j, k in enumerate(range(k0, k1)):
-                self.x, self.applied_now = x_log[j], applied_log[j]
-                reward -= np.where(live & (k <= k_bad), self.sample_cost(), 0.0)
-        for i in np.flatnonzero(bad):  # frozen before its bad step (the numpy loop's keep): its
-            S[i] = start[i]           # row replayed up to that step, the same table's draws
-            comp.event[:] = _SKIP
-            comp.event[i] = -1
-            comp.call(k0, int(k_bad[i]), self.n_steps)
-        self.x = S[:, :nx].copy()
-        self.applied = S[:, lay["applied"]:lay["applied"] + nu].copy()
-        if self.lag is not None:
-            self.lag = S[:, lay["lag"]:lay["lag"] + nu].copy()
-        self.diverged |= bad
-        self.k = k1
+        with np.errstate(all="ignore"):  # a member's samples after its divergence are not counted
+            for j in range(period.x.shape[0]):
+                self.x, self.applied_now = period.x[j], period.applied[j]
+                reward -= np.where(period.counted[j], self.sample_cost(), 0.0)
+        self.x = self.state.x
+        self.diverged |= period.diverged
+        self.k = self.state.k
         self.t = self.k * self.dt
-        return reward, live & ~bad
+        return reward, live & ~period.diverged
 
     def _end_of_period(self, reward: np.ndarray, live: np.ndarray):
         """The period's end: the guidance's next reference at a control instant, the final
@@ -313,8 +270,8 @@ class BatchedEpisode:
         final = live & (finished | truncated)
         if final.any():  # the loop's last sample (t_end, or the guidance's end) counts too,
             # with the input the loop logs there: the held command's plan at its start
-            plan = self.actuator.begin_step(self.applied, self.command, self.dt)
-            self.applied_now = self.actuator.input_at(plan, 0.0, self.lag)
+            st = self.state
+            _, self.applied_now = input_plan(self.sim, st.applied, st.command, st.lag)
             reward -= np.where(final, self.sample_cost(), 0.0)
         terminated = self.done | self.diverged | finished
         truncated_now = np.full(self.batch, truncated) & ~terminated

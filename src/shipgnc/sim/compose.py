@@ -55,6 +55,8 @@ from shipgnc.errors import ConfigError
 from shipgnc.kernels import Kernel, NotCompiled, kernel_function
 
 _LOOPS: dict = {}
+#: an event that makes the loop skip a ship (:meth:`Composition.advance`: one not live)
+_SKIP = np.iinfo(np.int64).max
 #: the loop's body (read as source, never imported)
 TEMPLATE = Path(__file__).with_name("loop_template.py")
 #: the navigation step, written before the loop's body (it calls the model's kernel by name)
@@ -310,8 +312,9 @@ class Composition:
     each ship's divergence ``event`` (2k: a bad command at sample k, 2k + 1: a bad state after
     step k; −1: none; a ship with an event is skipped) and ``done_at``. Built after the
     components' reset (:func:`~shipgnc.sim.simulator.reset_components`); :meth:`call` runs steps
-    ``k0 … k1 − 1`` of every ship. :func:`run` drives it over a whole run; an agent's episode
-    (:class:`~shipgnc.rl.episode.BatchedEpisode`) a control period at a time, with a log of
+    ``k0 … k1 − 1`` of every ship. :func:`run` drives it over a whole run; the loop's transition
+    (:class:`~shipgnc.sim.transition.Transition`, an agent's episode) a control period at a time
+    (:meth:`advance`, :meth:`carried`, :meth:`put_state`), with a log of
     ``log_samples`` samples from sample :attr:`s_base` (set before each call) instead of the whole
     run's."""
 
@@ -427,6 +430,45 @@ class Composition:
                   self._err, self.out, self.event,
                   self.done_at if self.done_at is not None else self._no_done, table["Wu"],
                   self._pu, table["Wn"], self._pn, self.s_base)
+
+    def put_state(self, x: np.ndarray) -> None:
+        """Each ship's plant state ``x`` (B, n) into its row (e.g. a member's drawn start)."""
+        self.S[:, :x.shape[-1]] = x.reshape(self.S.shape[0], -1)
+
+    def carried(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Copies of each ship's plant state, applied input and actuator lag state (B, ·)."""
+        lay, S = self.layout, self.S
+        nx, nu = len(self.setup.model.states), self.setup.actuator.n
+        return (S[:, :nx].copy(), S[:, lay["applied"]:lay["applied"] + nu].copy(),
+                S[:, lay["lag"]:lay["lag"] + nu].copy())
+
+    def advance(self, command: np.ndarray, live: np.ndarray, k0: int, k1: int, k_last: int):
+        """Steps ``k0 … k1 − 1`` of the ``live`` ships (the others skipped) with ``command``
+        (B, m) held in their rows, the log being these steps (a :class:`Composition` built with
+        ``log_samples`` ≥ k1 − k0). A ship whose state goes bad after step k is replayed from the
+        period's start up to that step (the same table's draws), so it stays frozen before it, as
+        the numpy loop's members do. Returns the state and the applied input at each step's start
+        (steps, B, ·), which ships diverged (B,) and the step of each one's bad state
+        (``k_last`` for none)."""
+        lay, S, out = self.layout, self.S, self.out
+        nx, nu = len(self.setup.model.states), self.setup.actuator.n
+        S[:, lay["cmd"]:lay["cmd"] + nu] = command
+        start = S.copy()
+        self.event[:] = np.where(live, -1, _SKIP)
+        self.s_base = k0  # the log holds this period's steps
+        self.prepare(k0, k1)
+        self.call(k0, k1, k_last)
+        bad = live & (self.event >= 0)
+        k_bad = np.where(bad, self.event // 2, k_last)  # a bad state after step k_bad
+        x_log = out[:nx, :k1 - k0].transpose(1, 2, 0).copy()
+        a = self.columns["applied"]
+        applied_log = out[a:a + nu, :k1 - k0].transpose(1, 2, 0).copy()
+        for i in np.flatnonzero(bad):  # frozen before its bad step
+            S[i] = start[i]
+            self.event[:] = _SKIP
+            self.event[i] = -1
+            self.call(k0, int(k_bad[i]), k_last)
+        return x_log, applied_log, bad, k_bad
 
     def restore(self) -> None:
         """Leave the components as the numpy loop would (their carried states)."""

@@ -29,6 +29,7 @@ from shipgnc.frames import wrap_angle
 from shipgnc.interrupts import note
 from shipgnc.models.base import Signal, names
 from shipgnc.sim.integrators import rk4_step, solve_ivp_step
+from shipgnc.sim.transition import step_end, step_start
 from shipgnc.streams import MemberStreams, is_generator
 
 INTEGRATORS = ("rk4", "solve_ivp")
@@ -107,7 +108,12 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     Parameters
     ----------
     controller : a :class:`~shipgnc.control.base.Controller` (``Ts`` = its sample time, default
-        ``dt``) or ``None`` for a constant input ``u0``.
+        ``dt``) or ``None`` for a constant input ``u0``. An event-driven controller (a manoeuvring
+        trial's rudder programme, :mod:`shipgnc.trials.programme`) may also have
+        ``finished()`` (per ship: its programme is complete; the run ends when every ship is
+        finished, as with a guidance's ``finished()``) and ``switch_within_step(t, x0, x1,
+        command)`` (a command that switches on a state crossing inside the step:
+        :func:`switch_within_step`; numpy loop).
     actuator : :class:`~shipgnc.actuators.Actuator`; default: the model's own input limits.
     guidance : references for the controller (:mod:`shipgnc.guidance`).
     disturbance : see :mod:`shipgnc.environment.disturbance`; drawn from ``seed``.
@@ -257,17 +263,8 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
     for name, value in (("dt", dt), ("t_end", t_end)):
         require(isinstance(value, (int, float)) and math.isfinite(value) and value > 0,
                 name, value, "must be a finite number > 0 s")
-    steps = t_end / dt
-    require(math.isfinite(steps) and steps <= MAX_STEPS, "t_end / dt", steps,
-            f"at most {MAX_STEPS:.0e} steps per run")
-    n_steps = round(steps)
-    require(n_steps >= 1 and abs(n_steps * dt - t_end) <= 1e-9 * max(1.0, t_end), "t_end",
-            t_end, f"must be a whole multiple of dt = {dt:g} s")
-    Ts = getattr(controller, "Ts", None) or dt
-    require(math.isfinite(Ts) and Ts > 0, "controller.Ts", Ts, "must be > 0 s")
-    hold = round(Ts / dt)
-    require(hold >= 1 and abs(hold * dt - Ts) <= 1e-9 * Ts, "controller.Ts", Ts,
-            f"must be a whole multiple of dt = {dt:g} s")
+    n_steps = whole_steps(t_end, dt)
+    hold = samples_per_period(getattr(controller, "Ts", None) or dt, dt)
     require(integrator in INTEGRATORS, "integrator", integrator,
             f"allowed: {', '.join(INTEGRATORS)}")
     require(on_divergence in ON_DIVERGENCE, "on_divergence", on_divergence,
@@ -334,6 +331,34 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
                     solver_options={"method": method, "rtol": rtol, "atol": atol}, rng=rng,
                     on_divergence=on_divergence, observer=observer, progress=progress,
                     log_every=log_every, u0=u0, navigation=navigation)
+
+
+def whole_steps(t_end: float, dt: float, *, section: str = "") -> int:
+    """The steps of a run, ``t_end / dt``: a whole number (the last sample is t_end itself), at
+    most :data:`MAX_STEPS`. The one check of this rule, for :func:`simulate` and for a scenario's
+    ``simulation`` section (``section``: the section the message names the fields in, e.g.
+    ``simulation.t_end``); a one-line :class:`ConfigError` otherwise."""
+    at = f"{section}." if section else ""
+    steps = t_end / dt
+    require(math.isfinite(steps) and steps <= MAX_STEPS, f"{section}: t_end / dt" if section
+            else "t_end / dt", steps, f"at most {MAX_STEPS:.0e} steps per run")
+    n_steps = round(steps)
+    require(n_steps >= 1 and abs(n_steps * dt - t_end) <= 1e-9 * max(1.0, t_end), f"{at}t_end",
+            t_end, f"must be a whole multiple of {at}dt = {dt:g} s")
+    return n_steps
+
+
+def samples_per_period(Ts: float, dt: float, *, field: str = "controller.Ts",
+                       dt_field: str = "dt") -> int:
+    """Samples per control period, ``Ts / dt``: a whole number >= 1. The one check of this rule,
+    for :func:`simulate` and for a scenario's controllers (``field``: e.g. ``controllers.pd.Ts``);
+    a one-line :class:`ConfigError` otherwise."""
+    require(isinstance(Ts, (int, float)) and math.isfinite(Ts) and Ts > 0, field, Ts,
+            "must be > 0 s")
+    hold = round(Ts / dt)
+    require(hold >= 1 and abs(hold * dt - Ts) <= 1e-9 * Ts, field, Ts,
+            f"must be a whole multiple of {dt_field} = {dt:g} s")
+    return hold
 
 
 def logged_numbers(model, batch_shape: tuple[int, ...], n_steps: int, log_every: int = 1) -> int:
@@ -553,12 +578,12 @@ def reset_components(setup: SimSetup) -> None:
 
 def run_numpy(setup: SimSetup) -> Log:
     """The reference loop in plain numpy (readable; batched over ships)."""
-    model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller, setup.guidance,
-                                  setup.disturbance)
+    model, act, ctrl, gd = setup.model, setup.actuator, setup.controller, setup.guidance
     nav = setup.navigation
     batch = setup.batch_shape
     dt = setup.dt
     continuous = bool(getattr(ctrl, "continuous", False))
+    switching = getattr(ctrl, "switch_within_step", None)
     reset_components(setup)
 
     signals = log_signals(setup)
@@ -612,12 +637,9 @@ def run_numpy(setup: SimSetup) -> Log:
                             raise error
                         status.update(diverged=1, message=str(error))
                         break
-            plan = act.begin_step(applied, command, dt)
-            applied_now = act.input_at(plan, 0.0, lag)
-            if dist is not None and not dist.per_stage:
-                held_d = dist(t, x)
+            plan, applied_now, held_d = step_start(setup, t, x, lag, applied, command)
             last = k == setup.n_steps
-            finished = gd.finished() if gd is not None else None
+            finished = finished_ships(ctrl, gd)
             all_done = finished is not None and bool(np.all(finished | ~alive))
             if k % setup.log_every == 0 or last or all_done:
                 times[n_logged] = t
@@ -646,7 +668,9 @@ def run_numpy(setup: SimSetup) -> Log:
             if last or all_done:
                 break
             x_before, lag_before = x, lag
-            x, lag = advance_plant(setup, t, x, lag, plan, command, ref, held_d)
+            x, lag, applied = step_end(setup, t, x, lag, plan, command, ref, held_d)
+            if switching is not None:
+                x = switch_within_step(setup, t, x_before, x, command, held_d)
             if masking:  # a ship whose state is bad stops here; a stopped ship's state is held
                 bad, error = newly_diverged(setup, t + dt, alive, x=x)
                 if bad is not None:
@@ -656,7 +680,7 @@ def run_numpy(setup: SimSetup) -> Log:
                 held = ~alive[..., None]
                 x = np.where(held, x_before, x)
                 lag = None if lag is None else np.where(held, lag_before, lag)
-            applied = act.input_at(plan, 1.0, lag)
+                applied = act.input_at(plan, 1.0, lag)
             error = None if masking else check_divergence(setup, t + dt, x)
             if error is not None:
                 if setup.on_divergence == "raise":
@@ -669,6 +693,50 @@ def run_numpy(setup: SimSetup) -> Log:
     log = Log(time=times[:n_logged], data={k: v[:n_logged] for k, v in data.items()},
               signals=signals, status=status)
     return mask_diverged(log, diverged_at, first_error, dt) if masking else log
+
+
+def finished_ships(controller, guidance):
+    """Which ships are done (the run ends when every ship is): those whose guidance has
+    finished (``guidance.finished()``, e.g. the last waypoint) or whose controller's programme is
+    complete (an event-driven controller's ``finished()``, e.g. a manoeuvring trial's rudder
+    programme); None when neither says."""
+    said = [c.finished() for c in (guidance, controller)
+            if c is not None and callable(getattr(c, "finished", None))]
+    said = [np.asarray(f, dtype=bool) for f in said if f is not None]
+    if not said:
+        return None
+    return said[0] if len(said) == 1 else np.logical_or(*said)
+
+
+def switch_within_step(setup: SimSetup, t0: float, x0: np.ndarray, x1: np.ndarray,
+                       command: np.ndarray, d_held) -> np.ndarray:
+    """A command that switches on a state crossing inside the step (a zig-zag's reversal at ±ψ):
+    the controller's ``switch_within_step(t0, x0, x1, command)`` gives, per ship, the fraction θ
+    of the step [t0, t0 + dt] at which its crossing happened (NaN: none) and the command after
+    it (or None for no ship); those ships are integrated again, RK4 with the old command over θ·dt
+    and with the new one over (1 − θ)·dt, so the switch happens at the crossing, not at the next
+    sample. The actuator must be static (the input follows the command at once)."""
+    said = setup.controller.switch_within_step(t0, x0, x1, command)
+    if said is None:
+        return x1
+    theta, after = said
+    hit = np.isfinite(theta)
+    if not hit.any():
+        return x1
+    act, model, dist = setup.actuator, setup.model, setup.disturbance
+    require(act.is_static and not (dist is not None and dist.per_stage), "controller",
+            type(setup.controller).__name__, "a command that switches inside a step needs a "
+            "static actuator and no per-stage disturbance")
+    theta = np.where(hit, theta, 1.0)[..., None]
+
+    def rhs(u):
+        return lambda t, z: model.derivatives(z, u, d_held)
+
+    with np.errstate(all="ignore"):
+        mid = rk4_step(rhs(act.saturate(command)), t0, x0, theta * setup.dt)
+        end = rk4_step(rhs(act.saturate(after)), t0 + theta * setup.dt, mid,
+                       (1.0 - theta) * setup.dt)
+    return np.where(hit[..., None], end, x1)
 
 
 def newly_diverged(setup: SimSetup, t: float, alive: np.ndarray, *, x: np.ndarray | None = None,

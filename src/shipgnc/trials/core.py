@@ -11,11 +11,14 @@ explanatory notes (MSC/Circ.1053); they are written out in ``docs/trials.md``.
 * **Execute**: t = 0, position (0, 0), heading 0 (the original course points north) at the moment
   the rudder command changes; the rudder moves at its rate limit (the model's own steering machine
   when ``delta`` is a state, else :class:`~shipgnc.actuators.Actuator` slewing linearly).
-* **Integration** (:func:`run`): fixed-step RK4 (:func:`shipgnc.sim.integrators.rk4_step`) over a
-  batch ``(B, n)``: every ship of a trial (a spiral's rudder angles, both turning sides, several
-  trials at once) is one array operation per RK stage; no Python loop over ships. Each ship follows
-  a :class:`RudderProgramme` (piecewise-constant rudder, zig-zag reversals, phase switches when
-  the yaw rate is steady, full astern) and the run ends when every ship's trial is complete.
+* **Integration** (:func:`run`): one run of :func:`shipgnc.sim.simulator.simulate` (fixed-step
+  RK4) over a batch ``(B, n)``: every ship of a trial (a spiral's rudder angles, both turning
+  sides, several trials at once) is one array operation per RK stage; no Python loop over ships.
+  Each ship follows a :class:`RudderProgramme` (piecewise-constant rudder, zig-zag reversals,
+  phase switches when the yaw rate is steady, full astern), the run's controller
+  (:class:`~shipgnc.trials.programme.ProgrammeController`), and the run ends when every ship's
+  trial is complete. A vessel section (a vessel file's) is built as ``shipgnc run`` builds a
+  scenario's (:func:`shipgnc.vessels.setup.vessel_setup`).
 """
 
 from __future__ import annotations
@@ -28,7 +31,6 @@ import numpy as np
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.models.base import names
-from shipgnc.sim.integrators import rk4_step
 from shipgnc.units import KNOT
 
 #: sides of a turn: sign of the rudder (and of the heading change) for each
@@ -85,11 +87,15 @@ class TrialShip:
 
 
 def _entry(vessel):
-    """A catalogue entry from a name (or the entry itself); None for a plain model."""
-    if isinstance(vessel, str):
-        from shipgnc.vessels import get_vessel
+    """A catalogue entry from a name, a vessel section (a scenario's or a file's) or the entry
+    itself; None for a plain model."""
+    from shipgnc.vessels import get_vessel
+    from shipgnc.vessels.config import CatalogueVesselConfig
 
+    if isinstance(vessel, str):
         return get_vessel(vessel)
+    if isinstance(vessel, CatalogueVesselConfig):
+        return get_vessel(vessel.model)
     if hasattr(vessel, "build") and hasattr(vessel, "design_speed_mps"):
         return vessel
     return None
@@ -124,13 +130,17 @@ def _refuse_course_unstable_linear(model, name: str) -> None:
 
 def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
             max_rudder_deg: float | None = None, rudder_rate_deg_s: float | None = None,
-            dt: float | None = None, steering_gear: str = "model", **params) -> TrialShip:
+            dt: float | None = None, steering_gear: str = "model", name: str | None = None,
+            **params) -> TrialShip:
     """Set a vessel up for trials: build it, solve the straight approach with its trim rudder.
 
-    ``vessel``: a catalogue name (:mod:`shipgnc.vessels`), a catalogue entry, or a model object
-    (``Model`` protocol; then ``speed_mps`` is required unless the model has a speed ``U``).
-    ``speed_mps``: one test speed or a sequence (a speed range: one batch); default the design
-    speed. ``params`` go to the entry's ``build`` (e.g. K, T of ``nomoto``). The overrides
+    ``vessel``: a catalogue name (:mod:`shipgnc.vessels`), a catalogue entry, a vessel section
+    (:class:`~shipgnc.vessels.config.CatalogueVesselConfig`: a vessel file's, a scenario's; built
+    by :func:`~shipgnc.vessels.setup.vessel_setup` as ``shipgnc run`` builds it), or a model
+    object (``Model`` protocol; then ``speed_mps`` is required unless the model has a speed
+    ``U``). ``speed_mps``: one test speed or a sequence (a speed range: one batch); default the
+    section's speed, else the design speed. ``name``: the vessel's name in the results.
+    ``params`` go to the entry's ``build`` (e.g. K, T of ``nomoto``). The overrides
     ``length_m``, ``max_rudder_deg``, ``rudder_rate_deg_s`` replace the catalogue's values.
     ``steering_gear``: ``"model"`` — the rudder moves at the vessel's own rate (the catalogue's
     steering machine); ``"solas"`` — at the SOLAS steering gear's 65°/28 s (:func:`solas_rudder_rate`),
@@ -145,24 +155,25 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
     if entry is not None and rudder_rate_deg_s is not None:
         params = {**params, "rudder_rate_deg_s": rudder_rate_deg_s}  # the model's steering machine
     if entry is not None:
-        speeds = np.atleast_1d(np.asarray(entry.design_speed_mps if speed_mps is None else speed_mps,
-                                          dtype=float))
+        from shipgnc.vessels.config import CatalogueVesselConfig
+        from shipgnc.vessels.setup import vessel_setup
+
+        section = vessel if isinstance(vessel, CatalogueVesselConfig) else None
+        if speed_mps is None:
+            speed_mps = getattr(section, "speed_mps", None) or entry.design_speed_mps
+        speeds = np.atleast_1d(np.asarray(speed_mps, dtype=float))
         lo, hi = entry.speed_range_mps
         for s in speeds:
             require(math.isfinite(s) and lo - 1e-9 <= s <= hi + 1e-9, "--speed-kn", round(float(s) / KNOT, 4),
                     f"{entry.name} is valid for {lo / KNOT:.4g}-{hi / KNOT:.4g} kn "
                     f"({lo:.4g}-{hi:.4g} m/s)")
-        models = [entry.build(speed_mps=float(s), **params) for s in speeds]
+        setups = [vessel_setup(section or entry.name, float(s), name=name, **params) for s in speeds]
+        models = [s.model for s in setups]
         model = models[0]
-        name, source = entry.name, entry.source
-        length = entry.length_m if length_m is None else length_m
-        if length is None and params.get("L") is not None:  # a ship from its main dimensions
-            length = float(params["L"])
-        max_rudder = (math.radians(params["rudder_max_deg"]) if params.get("rudder_max_deg")
-                      is not None else entry.max_rudder_rad)
-        rate = (math.radians(params["rudder_rate_deg_s"]) if params.get("rudder_rate_deg_s")
-                is not None else entry.max_rudder_rate_rad_s)
-        can_reverse = bool(entry.can_reverse)
+        name, source = setups[0].name, entry.source
+        length = setups[0].length_m if length_m is None else length_m
+        max_rudder, rate = setups[0].max_rudder, setups[0].rudder_rate
+        can_reverse = setups[0].can_reverse
     else:
         model = vessel
         models = None
@@ -172,7 +183,7 @@ def prepare(vessel, speed_mps=None, *, length_m: float | None = None,
             speed_mps = getattr(getattr(model, "params", model), "U", None)
         require(speed_mps is not None, "speed_mps", None, "give the test speed of a plain model [m/s]")
         speeds = np.atleast_1d(np.asarray(speed_mps, dtype=float))
-        name, source = type(model).__name__, ""
+        name, source = name or type(model).__name__, ""
         length = length_m
         lim = getattr(model, "input_limits", None)
         max_rudder = float(lim()[1][0]) if lim is not None else math.radians(35.0)
@@ -381,33 +392,6 @@ def programme(ship: TrialShip, kind: str, n: int, *, speed_index=0, delta_a=None
                            x0=ship.x0[idx].copy(), inputs0=ship.inputs0[idx].copy())
 
 
-def _reverse_within_step(model_of, x0, x1, t, h, inputs, sign, psi0, prog, index, max_rudder):
-    """Zig-zag ships whose heading crossed ±ψ inside the step [t, t + h] are integrated again:
-    RK4 up to the crossing θh (linear interpolation of the heading) with the old command, then
-    with the reversed one, so the reversal happens at the crossing, not at the next sample
-    (steering machine in the model only: the command is a held input)."""
-    from shipgnc.trials.zigzag import reverse_rudder
-
-    p = index["psi"]
-    c0, c1 = x0[:, p] - psi0, x1[:, p] - psi0
-    zz = prog.zz_amp != 0
-    new = reverse_rudder(sign, c1, prog.zz_psi)
-    hit = np.nonzero(zz & (new != sign) & (sign * c0 < prog.zz_psi))[0]
-    if hit.size == 0:
-        return x1
-    a, b = sign[hit] * c0[hit], sign[hit] * c1[hit]
-    theta = np.clip((prog.zz_psi[hit] - a) / np.where(b > a, b - a, 1.0), 0.0, 1.0)[:, None]
-    m = model_of(hit)
-    u_old = inputs[hit].copy()
-    u_new = u_old.copy()
-    u_new[:, 0] = np.clip(prog.delta_a[hit] + new[hit] * np.abs(prog.zz_amp[hit]), -max_rudder, max_rudder)
-    mid = rk4_step(lambda tt, z: m.derivatives(z, u_old), t, x0[hit], theta * h)
-    end = rk4_step(lambda tt, z: m.derivatives(z, u_new), t, mid, (1.0 - theta) * h)
-    out = x1.copy()
-    out[hit] = end
-    return out
-
-
 class Stacked:
     """One batch over ships whose models differ (one model per test speed): ``derivatives``
     evaluates each distinct model on its ships (``which``: the model index of each ship along
@@ -419,6 +403,7 @@ class Stacked:
         self.masks = [self.which == i for i in range(len(self.models))]
         first = self.models[0]
         self.states, self.inputs = first.states, first.inputs
+        self.state_limits = first.state_limits
 
     @classmethod
     def of(cls, models, which):
@@ -476,129 +461,53 @@ def steady_window(ship: TrialShip) -> float:
     return 60.0 if lv is None else max(60.0, 3.0 * lv)
 
 
+def trial_actuator(ship: TrialShip):
+    """The trial's actuator: with the steering machine in the model (a ``delta`` state) the
+    commands pass unchanged (the model slews its rudder); else the rudder channel saturates at
+    ``max_rudder`` and slews at ``rudder_rate`` (linear within a step), the other inputs pass."""
+    from shipgnc.actuators import Actuator
+
+    m = ship.n_inputs
+    lower, upper, rate = np.full(m, -np.inf), np.full(m, np.inf), np.full(m, np.inf)
+    if not ship.steering_in_model:
+        lower[0], upper[0], rate[0] = -ship.max_rudder, ship.max_rudder, ship.rudder_rate
+    return Actuator(lower, upper, rate=rate, names=names(ship.model.inputs))
+
+
 def run(ship: TrialShip, prog: RudderProgramme, finished, *, dt: float | None = None,
         check_every: float = 5.0) -> History:
-    """Integrate the batch of ``prog`` from its approach states with fixed-step RK4.
+    """Run the batch of ``prog`` from its approach states through
+    :func:`~shipgnc.sim.simulator.simulate` (fixed-step RK4), its rudder programme the
+    controller (:class:`~shipgnc.trials.programme.ProgrammeController`).
 
     ``finished(k, hist_view) -> (B,) bool`` is asked every ``check_every`` seconds; the run ends
     when every ship is finished or at its ``t_max`` (the largest of the batch).
     """
-    from shipgnc.actuators import Actuator
-    from shipgnc.trials.zigzag import reverse_rudder
+    from shipgnc.sim.simulator import simulate
+    from shipgnc.trials.programme import ProgrammeController
 
-    index = ship.index
-    model = Stacked.of(ship.models, prog.speed_index)
-
-    def model_of(which):
-        return Stacked.of(ship.models, prog.speed_index[which])
-
-    h = ship.dt if dt is None else float(dt)
-    B = prog.size
-    t_end = float(np.max(prog.t_max))
-    n_steps = math.ceil(t_end / h)
-    n = prog.x0.shape[-1]
-    x = prog.x0.copy()
-    X = np.empty((n_steps + 1, B, n))
-    R = np.empty((n_steps + 1, B))
-    C = np.empty((n_steps + 1, B))
-    X[0] = x
-    inputs = prog.inputs0.copy()
-    psi0 = x[:, index["psi"]].copy()
-    s = np.sign(prog.zz_amp)
-    zigzag = prog.zz_amp != 0
-    astern_value = ship.full_astern
     if np.any(prog.astern):
-        require(ship.can_reverse and astern_value is not None and inputs.shape[-1] > 1,
+        require(ship.can_reverse and ship.full_astern is not None and ship.n_inputs > 1,
                 "trial stopping", ship.name, "the vessel has no propulsion that can go full astern")
-        inputs[prog.astern, 1] = astern_value
-    act = None
-    if not ship.steering_in_model:
-        act = Actuator(np.array([-ship.max_rudder]), np.array([ship.max_rudder]),
-                       rate=np.array([ship.rudder_rate]), names=("delta_c",))
-    applied = prog.inputs0[:, :1].copy()  # actuator state (applied rudder) when not in the model
-    rdx = index["delta"] if ship.steering_in_model else None
-    check = max(1, round(check_every / h))
-    done = np.zeros(B, dtype=bool)
-    k_end = n_steps
-    t_switch = prog.t_switch  # (mutable: steady switches are written here)
-
-    auto = np.isfinite(prog.r_ref)
-    r_ref = np.where(auto, prog.r_ref, 0.0)
-    integral = np.zeros(B)
-    i_max = np.where(prog.ki > 0, ship.max_rudder / np.where(prog.ki > 0, prog.ki, 1.0), 0.0)
-
-    def command(t, xk):
-        nonlocal s
-        change = xk[:, index["psi"]] - psi0
-        s = np.where(zigzag, reverse_rudder(s, change, prog.zz_psi), s)
-        zz = prog.delta_a + s * np.abs(prog.zz_amp)
-        step = np.where(t < t_switch - 1e-9, prog.delta_a, prog.delta_b)
-        cmd = np.where(zigzag, zz, step)
-        if np.any(auto):
-            e = r_ref - xk[:, index["r"]]
-            cmd = np.where(auto, prog.delta_a + prog.kp * e + prog.ki * integral, cmd)
-        return np.clip(cmd, -ship.max_rudder, ship.max_rudder)
-
-    for k in range(n_steps):
-        t = k * h
-        cmd = command(t, x)
-        C[k] = cmd
-        if act is None:
-            inputs[:, 0] = cmd
-            R[k] = x[:, rdx]
-
-            def f(tt, z, _u=inputs):
-                return model.derivatives(z, _u)
-        else:
-            plan = act.begin_step(applied, cmd[:, None], h)
-            R[k] = applied[:, 0]
-            u_start, u_end = plan
-
-            def f(tt, z, _t=t, _a=u_start, _b=u_end):
-                theta = (tt - _t) / h
-                inputs[:, 0] = (_a + theta * (_b - _a))[:, 0]
-                return model.derivatives(z, inputs)
-            applied = u_end
-        x_old = x
-        x = rk4_step(f, t, x, h)
-        if act is None and np.any(zigzag):
-            x = _reverse_within_step(model_of, x_old, x, t, h, inputs, s, psi0, prog, index,
-                                     ship.max_rudder)
-        X[k + 1] = x
-        if np.any(auto):
-            integral = np.clip(integral + h * (r_ref - x[:, index["r"]]), -i_max, i_max)
-        if (k + 1) % check == 0 or k + 1 == n_steps:
-            if not np.all(np.isfinite(x)):
-                bad = int(np.argmax(~np.all(np.isfinite(x), axis=-1)))
-                from shipgnc.errors import DivergenceError
-
-                raise DivergenceError(f"trial of {ship.name} diverged at t = {t + h:.6g} s (ship {bad}, "
-                                      f"{prog.kind[bad]})", time=t + h, state="?", value=float("nan"),
-                                      index=(bad,))
-            view = History(np.arange(k + 2) * h, X[:k + 2], R[:k + 1], C[:k + 1], None, prog, index)
-            waiting = prog.switch_when_steady & ~np.isfinite(t_switch)
-            if np.any(waiting):
-                ok = steady(view.time, view.state("r"), k + 1, steady_window(ship),
-                            prog.switch_rel) & waiting
-                t_switch[ok] = (k + 1) * h
-            done = np.asarray(finished(k + 1, view), dtype=bool) | ((k + 1) * h >= prog.t_max - 1e-9)
-            if np.all(done):
-                k_end = k + 1
-                break
-    cmd = command(k_end * h, x)
-    C[k_end] = cmd
-    R[k_end] = x[:, rdx] if act is None else applied[:, 0]
-    time = np.arange(k_end + 1) * h
-    X, R, C = X[:k_end + 1], R[:k_end + 1], C[:k_end + 1]
+    model = Stacked.of(ship.models, prog.speed_index)
+    h = ship.dt if dt is None else float(dt)
+    n_steps = math.ceil(float(np.max(prog.t_max)) / h)
+    actuator = trial_actuator(ship)
+    pilot = ProgrammeController(ship, prog, finished, dt=h, n_steps=n_steps, actuator=actuator,
+                                check_every=check_every)
+    res = simulate(model, prog.x0, t_end=n_steps * h, dt=h, controller=pilot, actuator=actuator,
+                   u0=prog.inputs0, backend="auto", attrs={"vessel": ship.name})
+    X = np.stack([res[s.name].values for s in model.states], axis=-1)
+    k_end = X.shape[0] - 1
+    delta_c = model.inputs[0].name
+    C = res[f"{delta_c}_cmd"].values
+    R = X[..., ship.index["delta"]] if ship.steering_in_model else res[delta_c].values
     # speed over ground from the model's own kinematics (works without u, v states)
-    U = np.empty_like(R)
-    u_all = np.broadcast_to(prog.inputs0, (k_end + 1, *prog.inputs0.shape)).copy()
-    if np.any(prog.astern):
-        u_all[:, prog.astern, 1] = astern_value
-    u_all[..., 0] = R if act is not None else C
+    u_all = np.broadcast_to(pilot.held, (k_end + 1, *pilot.held.shape)).copy()
+    u_all[..., 0] = C if ship.steering_in_model else R
     xd = model.derivatives(X, u_all)
-    U[:] = np.hypot(xd[..., index["north"]], xd[..., index["east"]])
-    return History(time, X, R, C, U, prog, index)
+    U = np.hypot(xd[..., ship.index["north"]], xd[..., ship.index["east"]])
+    return History(res["time"].values, X, R, C, U, prog, ship.index)
 
 
 def run_parts(ship: TrialShip, parts, **kw) -> list[History]:

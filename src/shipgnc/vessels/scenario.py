@@ -21,10 +21,10 @@ from shipgnc.errors import ConfigError
 def vessel(scenario):
     """(model, actuator, u0) of the scenario's catalogue vessel: the actuator is the model's
     input saturation (the steering machine is inside the model), u0 the straight-run inputs."""
-    from shipgnc.actuators import Actuator
+    from shipgnc.vessels.setup import vessel_setup
 
-    model = scenario.vessel.build()
-    return model, Actuator.for_model(model), straight_inputs(model)
+    ship = vessel_setup(scenario.vessel)
+    return ship.model, ship.actuator, ship.u0
 
 
 def straight_inputs(model) -> np.ndarray:

@@ -101,33 +101,71 @@ def build_vessel(spec: dict):
     return vessel_config(spec, "vessel").build()
 
 
+class LoggedRudder:
+    """``model`` with its rudder state replaced by the input ``delta_c`` (the steering machine
+    bypassed: the rudder angle is what the log says): ẋ = f(x with δ := u₀, u), δ̇ = 0."""
+
+    def __init__(self, model):
+        from shipgnc.models.base import state_index
+
+        self.model = model
+        self.states, self.inputs = model.states, model.inputs
+        self.state_limits = model.state_limits
+        self.i_delta = state_index(model, "delta")
+
+    def derivatives(self, x, u, d=None):
+        xs = np.array(x, dtype=float)
+        xs[..., self.i_delta] = u[..., 0]
+        dx = self.model.derivatives(xs, u)
+        dx[..., self.i_delta] = 0.0
+        return dx
+
+
+class LoggedInput:
+    """The logged rudder ``delta`` at the log's times ``t`` as a continuous open-loop law: linear
+    between samples, evaluated at every RK stage (the other inputs 0)."""
+
+    continuous = True
+    signals = ()
+    Ts = None
+
+    def __init__(self, t, delta, n_inputs: int):
+        self.t = np.asarray(t, dtype=float)
+        self.delta = np.asarray(delta, dtype=float)
+        self.n_inputs = int(n_inputs)
+
+    def reset(self, batch_shape) -> None:
+        self.batch = tuple(batch_shape)
+
+    def law(self, t, x, ref):
+        u = np.zeros((*self.batch, self.n_inputs))
+        u[..., 0] = np.interp(self.t[0] + t, self.t, self.delta)
+        return u
+
+    def signal_values(self) -> dict:
+        return {}
+
+
 def resimulate(model, t, delta, x0: np.ndarray) -> np.ndarray:
     """States (len(t), n) of the catalogue ``model`` from ``x0`` with its rudder state held on
     the logged ``delta`` (linear between samples; the steering machine bypassed), RK4 at the
-    log's step."""
-    from shipgnc.models.base import state_index
-    from shipgnc.sim.integrators import rk4_step
+    log's step (equally spaced, as :func:`shipgnc.identify.logs.read_log` gives it), through
+    :func:`~shipgnc.sim.simulator.simulate`."""
+    from shipgnc.actuators import Actuator
+    from shipgnc.errors import require
+    from shipgnc.sim.simulator import simulate
 
-    i_delta = state_index(model, "delta")
     t = np.asarray(t, dtype=float)
     delta = np.asarray(delta, dtype=float)
+    h = float(t[1] - t[0]) if t.size > 1 else 0.0
+    require(t.size > 1 and h > 0 and bool(np.allclose(np.diff(t), h, rtol=1e-9, atol=0.0)),
+            "log time", f"{t.size} samples", "need at least 2 equally spaced samples")
+    plant = LoggedRudder(model)
+    m = len(model.inputs)
     x = np.array(x0, dtype=float)
-    out = np.empty((t.size, x.size))
-    u_in = np.zeros(len(model.inputs))
-
-    def rhs(tq, xs):  # the logged rudder, linear between samples, replaces the rudder state
-        d = float(np.interp(tq, t, delta))
-        xs = xs.copy()
-        xs[i_delta] = d
-        u_in[0] = d
-        dx = model.derivatives(xs, u_in)
-        dx[i_delta] = 0.0
-        return dx
-
-    x[i_delta] = delta[0]
-    out[0] = x
-    for k in range(t.size - 1):
-        x = rk4_step(rhs, t[k], x, t[k + 1] - t[k])
-        x[i_delta] = delta[k + 1]
-        out[k + 1] = x
+    x[plant.i_delta] = delta[0]
+    res = simulate(plant, x, t_end=(t.size - 1) * h, dt=h, controller=LoggedInput(t, delta, m),
+                   actuator=Actuator(np.full(m, -np.inf), np.full(m, np.inf)), backend="numpy")
+    out = np.stack([res[s.name].values for s in model.states], axis=-1)
+    out[:, plant.i_delta] = delta
     return out
