@@ -49,16 +49,15 @@ def autopilot(
         from shipgnc.errors import require
         from shipgnc.units import KNOT
         from shipgnc.vessels.autopilot_design import design_autopilot
-        from shipgnc.vessels.catalogue import get_vessel
+        from shipgnc.vessels.setup import vessel_setup
 
         if speed_kn is not None:
             require(math.isfinite(speed_kn) and speed_kn > 0, "--speed-kn", speed_kn,
                     "must be a speed > 0 kn")
         require(math.isfinite(sample_time) and sample_time >= 0, "--sample-time", sample_time,
                 "must be a period >= 0 s (0: continuous)")
-        name, file_speed, params = _vessel(vessel)
-        speed = speed_kn * KNOT if speed_kn is not None else file_speed
-        model = get_vessel(name).build(speed, **params)
+        section, _ = _vessel(vessel)  # read as shipgnc run and shipgnc trial read it
+        model = vessel_setup(section, speed_kn * KNOT if speed_kn is not None else None).model
         d = design_autopilot(model, bandwidth=bandwidth, zeta=damping, integral=integral,
                              sample_time=sample_time)
         if json_:
