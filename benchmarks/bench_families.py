@@ -54,10 +54,9 @@ MAX_STEPS = 4000
 def family_setup(scenario_name: str):
     """(model, x0 of one ship, simulate keyword arguments, steps) of a scenario's first run."""
     from shipgnc.scenarios.registry import load_scenario
-
-    scenario = load_scenario(scenario_name)
     from shipgnc.scenarios.runner import build, simulation_of
 
+    scenario = load_scenario(scenario_name)
     setup = build(scenario)
     sim = simulation_of(scenario, setup)
     x0 = np.asarray(setup.x0, dtype=float)

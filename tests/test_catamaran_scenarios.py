@@ -29,7 +29,7 @@ def test_every_scenario_is_built_in_and_shows():
     assert set(NAMES) <= set(builtin_names())
     for name in NAMES:
         result = CliRunner().invoke(app, ["show", name])
-        shown = (("controllers:", "guidance:") if name in CONTROLLED
+        shown = (("controller", "guidance:") if name in CONTROLLED
                  else ("spread:", "controller:") if name == "catamaran-montecarlo" else ("runs:",))
         assert result.exit_code == 0 and all(s in result.stdout for s in shown), name
         assert "builder:" not in result.stdout, name
@@ -46,7 +46,7 @@ def test_controlled_scenarios_run_the_case_builders_runs(name, builder, options)
     series to the bit (document 004's laws, references and gains, note 004-4.7)."""
     short = ["simulation.t_end=150"]
     controlled = run_scenario(name, overrides=short)
-    as_case = ["controllers=null", "guidance=null", f"case={{builder: {builder}, options: {options}}}"]
+    as_case = ["controller=null", "controllers=null", "guidance=null", f"case={{builder: {builder}, options: {options}}}"]
     built = run_scenario(name, overrides=[*short, *as_case])
     assert controlled.scenario.shape == built.scenario.shape == "controlled"
     assert controlled.metrics == built.metrics

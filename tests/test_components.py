@@ -191,7 +191,7 @@ def test_show_of_a_catamaran_scenario_lists_what_a_set_can_change():
     assert "initial_state" not in shown["simulation"] and "case" not in shown
     assert shown["guidance"] == {"type": "heading-capture", "psi_target_rad": 0.8, "omega_c": 0.0022,
                                  "ramp_s": 0.0}  # document 004, S7: K* = 0.8 rad, ω_c = 0.0022 rad/s
-    assert shown["controllers"] == {"law21": {"type": "yaw-rate-fsm", "law": 21}}
+    assert shown["controller"] == {"type": "yaw-rate-fsm", "law": 21}
     for key in ("simulation.initial_state.u=3", "simulation.integrator=solve_ivp"):
         with pytest.raises(ConfigError, match=r"does not read simulation\.\w+ .*would be ignored"):
             load_scenario("catamaran-turn", [key])

@@ -268,14 +268,19 @@ def wave_loads(d, scenario: Scenario):
 
 
 def variant_names(scenario: Scenario) -> list[str] | None:
-    """The names of a ``controller`` dimension: a comparison's controllers or the scenario's
-    ``runs`` (one run has none, as its ``shipgnc run``); None for one run."""
+    """The names of a ``controller`` dimension: a comparison's ``controllers`` or the scenario's
+    ``runs``; None for one unnamed ``controller``."""
     if scenario.route is not None:  # the sailed runs (path, sail, legs), when it sails
         from shipgnc.scenarios import routing
 
         return routing.sail_runs(scenario) if scenario.sail is not None else None
-    names = list(run_plan(scenario))
-    return names if len(names) > 1 else None
+    return list(run_plan(scenario)) if compares(scenario) else None
+
+
+def compares(scenario: Scenario) -> bool:
+    """Whether the runs are keyed by name (a ``controllers`` mapping or ``runs``, even of one),
+    rather than one unnamed ``controller``."""
+    return scenario.controllers is not None or scenario.runs is not None
 
 
 def run_plan(scenario: Scenario) -> dict[str, tuple[Scenario, str | None]]:
@@ -466,8 +471,8 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
     ``result.attrs["interrupted"] = 1`` and ``metrics["interrupted"] = True``).
 
     With ``controllers`` every variant runs on the same plant, guidance and disturbance (same
-    seed); with ``runs`` each run is the scenario with the run's sections laid over it. With
-    several runs the result gets a ``controller`` dimension and the metrics are keyed by run.
+    seed); with ``runs`` each run is the scenario with the run's sections laid over it. Either
+    way the result gets a ``controller`` dimension and the metrics are keyed by name.
     ``on_divergence="stop"`` keeps the partial result of a diverging run (flagged in
     ``result.attrs["diverged"]`` and ``metrics["diverged"]``) instead of raising; comparisons
     always keep going, since a controller that diverges is a finding, not an error.
@@ -486,8 +491,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         from shipgnc.scenarios import routing
 
         return routing.run(scenario, seed=seed)
-    plan = run_plan(scenario)
-    compare = len(plan) > 1
+    plan, compare = run_plan(scenario), compares(scenario)
     results, all_metrics, setups = {}, {}, {}
     run = _Interruptible()
     for name, (each, variant) in plan.items():
