@@ -4,6 +4,8 @@ same runs."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 import yaml
 
@@ -12,6 +14,9 @@ from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build, run_scenario, variant_names
 from shipgnc.scenarios.schema import merged
 from shipgnc.study.chunk import check_sweepable
+
+#: the built-in comparisons of document 004 written with runs
+RUNS = Path(__file__).parent / "data" / "catamaran-runs"
 
 #: the five comparisons as they were written before ``runs`` (document 004's case builders)
 OLDER = {
@@ -50,10 +55,21 @@ def test_the_older_case_spelling_is_the_same_runs(tmp_path, name):
     builder, options, t_end = OLDER[name]
     more = {"log_every": 16} if name == "catamaran-montecarlo" else {}
     older = load_scenario(older_file(tmp_path, name, builder, options, t_end, **more))
-    builtin = load_scenario(name)
-    assert older.metrics == builtin.metrics
-    assert variant_names(older) == variant_names(builtin)
-    assert runs_of(older) == runs_of(builtin)
+    for scenario in (load_scenario(name), load_scenario(str(RUNS / f"{name}.yaml"))):
+        # the built-in (in the older spelling too) and the same comparison written with runs
+        assert older.metrics == scenario.metrics
+        assert variant_names(older) == variant_names(scenario)
+        assert runs_of(older) == runs_of(scenario)
+
+
+def test_dotted_run_names_take_a_setting_and_a_vessel_model_change_replaces_the_section():
+    """``--set runs.law20@0.008.…`` reaches the run named with a dot; a run that changes
+    ``vessel.model`` gets that model's section, not the common one's fields."""
+    steps = load_scenario(str(RUNS / "catamaran-steps.yaml"),
+                          ["runs.law20@0.008.controller.T_u=3.0"])
+    assert steps.run_scenarios()["law20@0.008"].controller.T_u == 3.0
+    assert merged({"vessel": {"model": "mariner-cst", "speed_mps": 7.7}},
+                  {"vessel": {"model": "kvlcc2"}})["vessel"] == {"model": "kvlcc2"}
 
 
 def test_older_options_still_act(tmp_path):

@@ -94,9 +94,9 @@ class ControllerKind:
 
 @dataclass(frozen=True)
 class GuidanceKind:
-    """A ``guidance.type``: its section, its builder ``(cfg) -> guidance`` (None: the vessel's
-    set-up reads it; ``reads_scenario``: ``(cfg, scenario)``, a
-    reference computed from the vessel) and the vessel models it serves (None: any)."""
+    """A ``guidance.type``: its section, its builder ``(cfg) -> guidance`` (``reads_scenario``:
+    ``(cfg, scenario)``, a reference computed from the vessel) and the vessel models it serves
+    (None: any)."""
 
     type: str
     config: type
@@ -107,8 +107,7 @@ class GuidanceKind:
 
 @dataclass(frozen=True)
 class DisturbanceKind:
-    """A ``disturbance.type``: its section and its builder ``(cfg, scenario)`` (None: the vessel's
-    set-up builds it)."""
+    """A ``disturbance.type``: its section and its builder ``(cfg, scenario)``."""
 
     type: str
     config: type

@@ -107,7 +107,7 @@ def refuse_unused(scenario: Scenario, keys) -> None:
             hint = ""
             if section == "case" and scenario.vessel.model == "catamaran":  # the older spelling
                 hint = (f"; {scenario.name} is written with controller(s), guidance and runs "
-                        "(e.g. guidance.omega, guidance.psi_target_rad, controllers.NAME.Ts; "
+                        "(e.g. guidance.omega, controller.Ts or runs.NAME.controller.Ts; "
                         "shipgnc show lists them)")
             raise ConfigError(f"--set {key}: scenario {scenario.name!r} does not use the section "
                               f"{section!r}, so the setting would be ignored; its sections: "
@@ -141,6 +141,12 @@ def set_path(data: dict, key: str, value: object) -> None:
     """Set ``data[k1][k2]... = value`` for a dotted key; integer parts index lists."""
     parts = key.split(".")
     node: object = data
+    if len(parts) > 2 and parts[0] == "runs" and isinstance(data.get("runs"), dict):
+        # a run's name may hold dots (law20@0.008, T2_k0.8): the longest name that exists
+        for n in range(len(parts) - 1, 1, -1):
+            if ".".join(parts[1:n]) in data["runs"]:
+                parts = ["runs", ".".join(parts[1:n]), *parts[n:]]
+                break
     for depth, part in enumerate(parts):
         last = depth == len(parts) - 1
         where = ".".join(parts[: depth + 1])

@@ -210,7 +210,7 @@ def guidance_of(g, scenario: Scenario | None = None):
         return None
     kind = C.GUIDANCE[g.type]
     if kind.build is None:
-        raise ConfigError(f"guidance type {g.type!r}: read by its vessel's set-up, not built alone")
+        raise ConfigError(f"guidance type {g.type!r}: its registry entry has no builder")
     if kind.reads_scenario:
         return C.resolve(kind.build)(g, scenario)
     return C.resolve(kind.build)(g)
@@ -225,7 +225,7 @@ def disturbance_of(d, scenario: Scenario, model=None):
     if d is not None:
         build = C.DISTURBANCES[d.type].build
         if build is None:
-            raise ConfigError(f"disturbance type {d.type!r}: built by its vessel's set-up")
+            raise ConfigError(f"disturbance type {d.type!r}: its registry entry has no builder")
         force = C.resolve(build)(d, scenario)
     current = getattr(scenario, "current", None)
     if current is None:

@@ -80,14 +80,19 @@ RUN_SECTIONS = ("vessel", "actuator", "simulation", "controller", "guidance", "d
 RunName = Annotated[str, Field(pattern=r"^[A-Za-z0-9_.@/\-]+$")]
 
 
+#: the fields that say which kind a section is: a section whose kind changes is replaced whole
+KIND_FIELDS = ("type", "model")
+
+
 def merged(base: dict, override: dict) -> dict:
     """``base`` with ``override`` laid over it: mappings merged key by key, except a section whose
-    ``type`` changes, which is replaced whole; any other value (``null`` too) replaces."""
+    kind (``type``, or a vessel's ``model``) changes, which is replaced whole; any other value
+    (``null`` too) replaces."""
     out = dict(base)
     for key, value in override.items():
         old = out.get(key)
         if (isinstance(old, dict) and isinstance(value, dict)
-                and value.get("type", old.get("type")) == old.get("type")):
+                and all(value.get(k, old.get(k)) == old.get(k) for k in KIND_FIELDS)):
             out[key] = merged(old, value)
         else:
             out[key] = value
@@ -191,7 +196,8 @@ class Scenario(Strict):
         if self.route is not None:
             return (*common, "route", "sail")
         kind = self.kind
-        used = [*common, "vessel", "simulation", "controller", "controllers", "guidance", "runs"]
+        used = [*common, "vessel", "simulation", "controller",
+                *(() if self.runs is not None else ("controllers",)), "guidance", "runs"]
         if kind.disturbances:
             used.append("disturbance")
         if self._spelled_case:

@@ -70,6 +70,8 @@ def check_sweepable(scenario) -> None:
         if own:
             name, first = next(iter(own.items()))
             fix = " ".join(f"--set runs.{n}.simulation.t_end={sim.t_end:g}" for n in own)
+            if scenario._spelled_case:  # document 004's comparison builder: its yaw-rate runs
+                fix = f"--set case.options.t_end_rate={sim.t_end:g}"
             raise ConfigError(f"scenario {scenario.name!r}: run {name!r} lasts {first.t_end:g} s at "
                               f"dt = {first.dt:g} s, the scenario simulation.t_end = {sim.t_end:g} s "
                               f"at dt = {sim.dt:g} s, and a study runs every member for one "
