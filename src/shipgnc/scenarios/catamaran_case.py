@@ -27,9 +27,6 @@ OPTIONS: dict[str, dict[str, object]] = {
     "montecarlo": {"n": 40, "seed": 10, "omega": 0.06, "t_end": None, "law": 21},
     "compare": {"t_end": None, "t_end_rate": 300.0, "baselines": "all"},
 }
-#: S8's true thruster (T_t [s], k_t) per run key
-ACTUATOR_RUNS = {"T2_k1": (2.0, 1.0), "T3_k1": (3.0, 1.0), "T1_k1": (1.0, 1.0), "T2_k0.8": (2.0, 0.8),
-                 "T2_k1.2": (2.0, 1.2)}
 
 
 def _fsm(law: int = 21, **more) -> dict:
@@ -105,6 +102,7 @@ def case_as_runs(data: dict) -> dict:
         out["guidance"] = {"type": "heading-capture", "psi_target_rad": o["psi_target"],
                            "omega_c": o["omega_c"], "ramp_s": o["ramp_s"]}
     elif builder == "actuator":
+        from shipgnc.cases.catamaran import ACTUATOR_RUNS  # S8's true thrusters
         out["guidance"] = _rate(o["omega"])
         runs = {"ideal": {"controller": _fsm(21)}}
         for key, (T_t, k_t) in ACTUATOR_RUNS.items():
@@ -129,9 +127,11 @@ def _compare(o: dict, simulation: dict) -> dict:
     most ``simulation.t_end``), S7 (K* = 0.8 rad at ω_c = 0.0022 rad/s) for ``simulation.t_end``;
     the FSM laws and the ``baselines``: ``designed`` (pole placement, designed PI),
     ``reproduction`` (the PI and LQR of note 004-4.11.3) or ``all``."""
-    if o["baselines"] not in ("all", "designed", "reproduction"):
-        raise ValueError(f"case.options.baselines = {o['baselines']!r}: allowed: all, designed, "
-                         "reproduction")
+    from shipgnc.cases.catamaran import BASELINES
+
+    if o["baselines"] not in BASELINES:
+        raise ValueError(f"case.options.baselines = {o['baselines']!r}: allowed: "
+                         f"{', '.join(BASELINES)}")
     designed, reproduction = o["baselines"] in ("all", "designed"), o["baselines"] in ("all", "reproduction")
     t_end = simulation.get("t_end")
     rate_end = o["t_end_rate"] if not isinstance(t_end, (int, float)) else min(o["t_end_rate"], t_end)
