@@ -191,3 +191,18 @@ def test_a_parameter_that_cannot_be_drawn_is_refused_in_one_line(overrides, para
     with pytest.raises(ConfigError, match=why) as err:
         run_study(study)
     assert "\n" not in str(err.value)
+
+
+def test_a_parameter_that_does_not_act_as_set_up_is_refused():
+    """The catamaran's thruster-lag constants act only with the lag (22) (``vessel.thruster``):
+    without it a draw of T_t would give members that differ in nothing, so it is refused."""
+    from shipgnc.errors import ConfigError
+    from shipgnc.scenarios.registry import load_scenario
+    from shipgnc.scenarios.runner import build
+    from shipgnc.study.plant import check_plant, perturbable_params
+    from shipgnc.study.spec import Perturbation
+
+    model = build(load_scenario("catamaran-turn")).model
+    assert "T_t" not in perturbable_params(model) and "J_zz" in perturbable_params(model)
+    with pytest.raises(ConfigError, match=r"act only with vessel\.thruster"):
+        check_plant([Perturbation.parse("vessel.params.T_t=normal:10%")], model)

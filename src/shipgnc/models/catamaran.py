@@ -147,6 +147,13 @@ class CatamaranParams(Params):
 
     # --- derived quantities (eq. (6)–(11)) ---------------------------------------------------
     @property
+    def inactive(self) -> tuple[str, ...]:
+        """Parameters that do not enter the equations as set: the lag (22)'s T_t, k_t without
+        ``delta_row="lag"`` (a study refuses to perturb them rather than draw values that change
+        nothing)."""
+        return () if self.delta_row == "lag" else ("T_t", "k_t")
+
+    @property
     def m_x(self):
         """Surge mass (1 + k₁₁)Δ [kg] (times ``m_x_factor``)."""
         return (1.0 + self.k11) * self.Delta * self.m_x_factor

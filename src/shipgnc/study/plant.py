@@ -43,6 +43,8 @@ def _signature(model):
 def _enters_equations(model, name: str, value: float) -> bool | None:
     """Whether a small change of ``name`` changes the model's equations (True), only its input
     limits or nothing (False); None when neither direction of the change is valid."""
+    if name in getattr(getattr(model, "params", None), "inactive", ()):
+        return False  # the model says so (e.g. the catamaran's lag constants without the lag)
     kernel0, lower0, upper0 = _signature(model)
     step = 1e-3 * abs(value) if value != 0 else 1e-3
     for changed in (value + step, value - step):
@@ -83,6 +85,9 @@ def check_plant(perturb, model, flag: str = "--perturb") -> None:
                 why = _missing(model, p.param)
             elif not _numeric(nominal[p.param]):
                 why = f"{PARAM_PREFIX}{p.param} of the {kind} is not a number"
+            elif p.param in getattr(model.params, "inactive", ()):
+                why = (f"{PARAM_PREFIX}{p.param} does not enter the {kind}'s equations as set up "
+                       "(the catamaran's T_t, k_t act only with vessel.thruster)")
             else:
                 why = (f"{PARAM_PREFIX}{p.param} does not enter the {kind}'s equations of motion "
                        "(an actuator limit or a drawing size, one per batch)")
