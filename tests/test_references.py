@@ -118,6 +118,8 @@ def test_every_public_module_is_on_an_api_page():
         is_package = rel.name == "__init__"
         if INTERNAL.search(name) or name in documented:
             continue
+        if is_package and " as _moved" in path.read_text(encoding="utf-8"):
+            continue  # an old name of a module that moved (tests/test_import_layers.py)
         if is_package and any(m.startswith(name + ".") for m in documented):
             continue  # a package whose modules are documented one by one
         missing.append(name)

@@ -89,7 +89,10 @@ def test_every_listed_vessel_is_a_model_of_the_one_protocol():
         assert np.shape(model.derivatives(x, np.zeros(len(model.inputs)))) == x.shape
 
 
-def test_the_table_keeps_its_columns_and_lists_every_vessel():
+def test_the_table_keeps_its_columns_and_lists_every_vessel(monkeypatch):
+    from shipgnc.cli import stdout
+
+    monkeypatch.setattr(stdout, "width", 200)  # the console is made once per process
     res = runner.invoke(app, ["vessels"], env={"COLUMNS": "200"})
     assert res.exit_code == 0, res.output
     for column in ("name", "L [m]", "U [m/s]", "valid U [m/s]", "rudder [°, °/s]", "astern",
