@@ -98,18 +98,10 @@ def yaw_response(model) -> control.TransferFunction:
     u0 = straight_inputs(model)
     dyn = [3, 4, 5, *range(7, x0.size)]  # u, v, r and the extra states; δ (6) is the input
 
-    def f(x):
-        return np.asarray(model.derivatives(x, u0), dtype=float)[dyn]
+    from shipgnc.control.finite_state import numerical_jacobian
 
-    cols = []
-    for j in [*dyn, 6]:
-        h = 1e-6 * max(1.0, abs(x0[j]))
-        xp, xm = x0.copy(), x0.copy()
-        xp[j] += h
-        xm[j] -= h
-        cols.append((f(xp) - f(xm)) / (2 * h))
-    A = np.column_stack(cols[:-1])
-    B = cols[-1].reshape(-1, 1)
+    J = numerical_jacobian(lambda x: np.asarray(model.derivatives(x, u0), dtype=float)[..., dyn], x0)
+    A, B = J[:, dyn], J[:, 6:7]
     C = np.zeros((1, len(dyn)))
     C[0, 2] = 1.0
     return control.minreal(control.tf(control.ss(A, B, C, 0.0)), verbose=False)
