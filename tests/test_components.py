@@ -124,7 +124,7 @@ def test_a_catamaran_case_refuses_what_its_builder_sets_naming_where_it_goes():
                                         r"from the case builder \(set them in case\.options\)"),
             ("guidance", {"type": "yaw-rate"}, r"guidance: a scenario with a case section")):
         data, source = raw_scenario("catamaran-actuator")
-        del data["runs"], data["guidance"]
+        data.pop("runs", None), data.pop("guidance", None)
         data["case"] = {"builder": "actuator"}
         data[section] = value
         with pytest.raises(ConfigError, match=message):
@@ -208,7 +208,8 @@ def test_show_reads_back_as_the_same_scenario_for_every_built_in():
         scenario = load_scenario(name)
         text = scenario_yaml(scenario)
         again = validate(yaml.safe_load(text), f"shown {name}")
-        assert again == scenario, name
+        # the same sections (a file in the older case spelling is shown as the runs it makes)
+        assert again.model_dump() == scenario.model_dump(), name
         assert scenario_yaml(again) == text, name
     shown = yaml.safe_load(scenario_yaml(load_scenario("cybership-waves-observer")))
     assert any(s["type"] == "gnss" and s["rate_hz"] is None for s in shown["sensors"])
