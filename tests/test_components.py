@@ -118,7 +118,7 @@ def test_a_metric_set_of_another_shape_is_refused():
 
 def test_a_catamaran_case_refuses_what_its_builder_sets_naming_where_it_goes():
     for section, value, message in (  # the older spelling: a case builder's runs
-            ("actuator", {"thrust_time_constant": 1.0}, r"runs\.ideal: actuator: applies to vessel "
+            ("actuator", {"thrust_time_constant": 1.0}, r"runs\.ideal\.actuator: applies to vessel "
                                                          r"model vectored-thrust-boat"),
             ("montecarlo", {"runs": 3}, r"montecarlo: a scenario with a case section takes its runs "
                                         r"from the case builder \(set them in case\.options\)"),

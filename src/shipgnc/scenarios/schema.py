@@ -11,6 +11,7 @@ allowed (:func:`format_validation_error`).
 from __future__ import annotations
 
 import math
+import re
 from typing import Annotated, Any, ClassVar, Literal, Union
 
 from pydantic import (
@@ -77,7 +78,8 @@ MetricSet = Literal[tuple(C.METRICS)]
 #: route and the runs themselves are the scenario's)
 RUN_SECTIONS = ("vessel", "actuator", "simulation", "controller", "guidance", "disturbance",
                 "current", "sensors", "estimator", "quality", "montecarlo")
-RunName = Annotated[str, Field(pattern=r"^[A-Za-z0-9_.@/\-]+$")]
+#: what a run's name may hold (it keys the run's metrics and its ``controller`` coordinate)
+RUN_NAME = re.compile(r"[A-Za-z0-9_.@/\-]+")
 
 
 #: the fields that say which kind a section is: a section whose kind changes is replaced whole
@@ -117,10 +119,12 @@ class Scenario(Strict):
     disturbance: DisturbanceConfig | None = None
     quality: QualityConfig = Field(default_factory=QualityConfig)
     montecarlo: MonteCarloConfig | None = None
-    #: runs by name, each a partial override of the sections above (:data:`RUN_SECTIONS`), e.g.
-    #: the reference, the plant or the duration: one result with a ``controller`` dimension keyed
-    #: by run, like ``controllers`` (``case``, document 004's older spelling, is read as runs)
-    runs: dict[RunName, dict[str, Any]] | None = None
+    #: runs by name (letters, digits and ``_ . @ / -``), each a partial override of the sections
+    #: vessel, actuator, simulation, controller, guidance, disturbance, current, sensors,
+    #: estimator, quality, montecarlo, e.g. the reference, the plant or the duration: one result
+    #: with a ``controller`` dimension keyed by run, like ``controllers`` (``case: {builder,
+    #: options}``, document 004's older spelling, is read as runs)
+    runs: dict[str, dict[str, Any]] | None = None
     #: document 002's routing problem, and optionally a ship sailing the route
     route: RouteConfig | None = None
     sail: SailConfig | None = None
@@ -396,15 +400,18 @@ class Scenario(Strict):
         base = self.model_dump(mode="json", exclude_unset=True, exclude={"runs"})
         runs = {}
         for name, override in self.runs.items():
+            if not RUN_NAME.fullmatch(name):
+                raise ValueError(f"runs: {name!r} is not a run name: letters, digits and _ . @ / - "
+                                 "only (it keys the run's metrics)")
             bad = [key for key in override if key not in RUN_SECTIONS]
             if bad:
-                raise ValueError(f"runs.{name}.{bad[0]}: a run overrides the sections "
-                                 f"{', '.join(RUN_SECTIONS)}")
+                raise ValueError(f"runs.{name}.{bad[0]}: belongs to the scenario, not to a run; a "
+                                 f"run overrides the sections {', '.join(RUN_SECTIONS)}")
             try:
                 runs[name] = type(self).model_validate(merged(base, override))
             except ValidationError as exc:
                 parts = format_validation_error(exc, "run").removeprefix("scenario run: ").split("; ")
-                raise ValueError("; ".join(f"runs.{name}: {part.removeprefix('scenario: ')}"
+                raise ValueError("; ".join(f"runs.{name}.{part.removeprefix('scenario: ')}"
                                            for part in parts)) from None
         self._runs = runs
         return self
