@@ -218,7 +218,9 @@ def test_loops_of_an_older_release_are_pruned_once_stale(tmp_path, monkeypatch):
     release's loops and a recent one of another release stay."""
     import os
 
-    monkeypatch.setattr(compose, "_PRUNED", [])
+    from shipgnc import jit_cache
+
+    monkeypatch.setattr(jit_cache, "_PRUNED", [])
     cache = tmp_path / "__pycache__"
     cache.mkdir()
     now = 1.0e9

@@ -69,3 +69,26 @@ def state_index(model: Model, name: str) -> int:
         raise ConfigError(f"state {name!r}: not a state of {type(model).__name__}; "
                           f"states are {', '.join(state_names)}")
     return state_names.index(name)
+
+
+def kernel_derivatives(model, rhs, params, x, u, d=None) -> np.ndarray:
+    """ẋ (..., nx) of ``model`` for every ship, from its scalar kernel ``rhs(x, u, d, p, xdot)``
+    (the one source of its equations, :func:`shipgnc.derive.per_ship`); ``d=None`` is a zero
+    disturbance of the model's width, which every model kernel treats as no disturbance."""
+    from shipgnc.derive import per_ship
+
+    if d is None:
+        d = np.zeros(max(len(model.disturbances), 1))
+    return per_ship(rhs, "i i i p o")(x, u, d, params, len(model.states))
+
+
+def kernel_jacobian(model, jacobian, params, x, u, d=None) -> np.ndarray:
+    """A = ∂ẋ/∂x (..., nx, nx) of ``model`` for every ship, from its scalar kernel
+    ``jacobian(x, u, d, p, A)`` writing A row-major (see :func:`kernel_derivatives`)."""
+    from shipgnc.derive import per_ship
+
+    if d is None:
+        d = np.zeros(max(len(model.disturbances), 1))
+    nx = len(model.states)
+    A = per_ship(jacobian, "i i i p o")(x, u, d, params, nx * nx)
+    return A.reshape(*A.shape[:-1], nx, nx)

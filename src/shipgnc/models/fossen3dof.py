@@ -38,13 +38,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
+from functools import cached_property
 
 import numpy as np
 
 from shipgnc.errors import ConfigError, require
-from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, flat, kernel_function
-from shipgnc.models.base import Signal
+from shipgnc.models.base import Signal, kernel_derivatives, kernel_jacobian
 from shipgnc.params import Params
 from shipgnc.units import G
 
@@ -248,74 +248,24 @@ class VectoredThrustBoat:
 
     def derivatives(self, x, u, d=None):
         """ẋ of eq. (1)–(5), (9)–(11') for ``x`` (..., 6), ``u`` (..., 2), ``d`` (..., 3) (forces),
-        (..., 5) (forces and current, module docstring) or None."""
-        p = self.params
-        psi, su, sv, sr = x[..., 2], x[..., 3], x[..., 4], x[..., 5]
-        tau_u, tau_v, tau_r = thrust_forces(u[..., 0], u[..., 1], p.L_m)
-        if d is not None:
-            tau_u, tau_v, tau_r = tau_u + d[..., 0], tau_v + d[..., 1], tau_r + d[..., 2]
-        north_dot, east_dot = body_to_ned(psi, su, sv)
-        current = body_current(psi, d)
-        ur, vr = (su, sv) if current is None else (su - current[0], sv - current[1])
-        u_dot = (tau_u + p.M22 * vr * sr + p.X_u * ur) / p.M11
-        v_dot = (tau_v - p.M11 * ur * sr + p.Y_v * vr) / p.M22
-        r_dot = (tau_r + p.munk_coefficient * ur * vr + p.N_r * sr
-                 + p.N_rr * np.abs(sr) * sr) / p.M33
-        if current is not None:  # ν̇ = ν̇_r + ν̇_c, ν̇_c = (r v_c, −r u_c, 0)
-            u_dot, v_dot = u_dot + sr * current[1], v_dot - sr * current[0]
-        return np.stack([north_dot, east_dot, sr, u_dot, v_dot, r_dot], axis=-1)
+        (..., 5) (forces and current, module docstring) or None: the batch of :func:`boat_current_rhs`."""
+        return kernel_derivatives(self, boat_current_rhs, self._kernel_params, x, u, d)
 
     def state_jacobian(self, x, u, d=None):
         """A = ∂f/∂x of :meth:`derivatives` at (x, u, d), analytic: (..., 6, 6), A[..., i, j] =
-        ∂ẋ_i/∂x_j (the input and the forces enter additively; the current rotates with ψ).
+        ∂ẋ_i/∂x_j (the batch of :func:`boat_current_rhs_jacobian`); used by the EKF
+        (:class:`~shipgnc.navigation.ekf.ExtendedKalmanFilter`) in place of central differences."""
+        return kernel_jacobian(self, boat_current_rhs_jacobian, self._kernel_params, x, u, d)
 
-        With ν_r = (u − u_c, v − v_c), (u_c, v_c) = R(ψ)ᵀ v_c, ∂(u_c, v_c)/∂ψ = (v_c, −u_c)::
-
-            ∂(ṅ, ė)/∂ψ = (−ė, ṅ),  ∂(ṅ, ė)/∂(u, v) = R(ψ),  ∂ψ̇/∂r = 1
-            ∂u̇/∂(u, v, r) = (X_u, M₂₂ r, M₂₂ v_r)/M₁₁ + (0, 0, v_c)
-            ∂v̇/∂(u, v, r) = (−M₁₁ r, Y_v, −M₁₁ u_r)/M₂₂ + (0, 0, −u_c)
-            ∂ṙ/∂(u, v, r) = (k v_r, k u_r, N_r + 2 N_|r|r |r|)/M₃₃
-
-        (eq. (9)–(11') differentiated; k = c_M (Y_v̇ − X_u̇)); used by the EKF
-        (:class:`~shipgnc.navigation.ekf.ExtendedKalmanFilter`) in place of central differences.
-        """
+    @cached_property
+    def _kernel_params(self) -> np.ndarray:
+        """[M11, M22, M33, X_u, Y_v, N_r, N_rr, k_Munk, L_m], the kernels' parameter array."""
         p = self.params
-        x = np.asarray(x, dtype=float)
-        psi, su, sv, sr = x[..., 2], x[..., 3], x[..., 4], x[..., 5]
-        c, s = np.cos(psi), np.sin(psi)
-        current = body_current(psi, d)
-        zero = np.zeros_like(psi)
-        uc, vc = (zero, zero) if current is None else current
-        ur, vr = su - uc, sv - vc
-        k = p.munk_coefficient
-        A = np.zeros((*psi.shape, 6, 6))
-        A[..., 0, 2] = -s * su - c * sv
-        A[..., 0, 3] = c
-        A[..., 0, 4] = -s
-        A[..., 1, 2] = c * su - s * sv
-        A[..., 1, 3] = s
-        A[..., 1, 4] = c
-        A[..., 2, 5] = 1.0
-        # ∂u_r/∂ψ = −v_c, ∂v_r/∂ψ = u_c
-        A[..., 3, 2] = (p.M22 * sr * uc - p.X_u * vc) / p.M11 - sr * uc
-        A[..., 3, 3] = p.X_u / p.M11
-        A[..., 3, 4] = p.M22 * sr / p.M11
-        A[..., 3, 5] = p.M22 * vr / p.M11 + vc
-        A[..., 4, 2] = (p.M11 * sr * vc + p.Y_v * uc) / p.M22 - sr * vc
-        A[..., 4, 3] = -p.M11 * sr / p.M22
-        A[..., 4, 4] = p.Y_v / p.M22
-        A[..., 4, 5] = -p.M11 * ur / p.M22 - uc
-        A[..., 5, 2] = k * (ur * uc - vr * vc) / p.M33
-        A[..., 5, 3] = k * vr / p.M33
-        A[..., 5, 4] = k * ur / p.M33
-        A[..., 5, 5] = (p.N_r + 2.0 * p.N_rr * np.abs(sr)) / p.M33
-        return A
+        return flat(p.M11, p.M22, p.M33, p.X_u, p.Y_v, p.N_r, p.N_rr, p.munk_coefficient, p.L_m)
 
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`boat_current_rhs`)."""
-        p = self.params
-        return Kernel(boat_current_rhs, flat(p.M11, p.M22, p.M33, p.X_u, p.Y_v, p.N_r, p.N_rr,
-                                             p.munk_coefficient, p.L_m))
+        return Kernel(boat_current_rhs, self._kernel_params)
 
 
 @kernel_function
@@ -339,9 +289,9 @@ def boat_rhs(x, u, d, p, xdot):
 
 @kernel_function
 def boat_current_rhs(x, u, d, p, xdot):
-    """:meth:`VectoredThrustBoat.derivatives` for one ship, operation for operation: forces
-    ``d[0:3]``, earth-fixed current ``d[3:5]`` as relative velocity (module docstring; a zero
-    current is still water)."""
+    """ẋ of eq. (1)–(5), (9)–(11') for one ship (the one source of
+    :meth:`VectoredThrustBoat.derivatives`): forces ``d[0:3]``, earth-fixed current ``d[3:5]`` as
+    relative velocity (module docstring; a zero current is still water)."""
     current_north = 0.0
     current_east = 0.0
     if d.shape[0] >= 5:  # else forces only
@@ -375,10 +325,17 @@ def _boat_rhs(x, u, d, p, xdot, current_north, current_east):
 
 @kernel_function
 def boat_current_rhs_jacobian(x, u, d, p, A):
-    """:meth:`VectoredThrustBoat.state_jacobian` for one ship: ∂ẋ/∂x of
-    :func:`boat_current_rhs` into ``A`` (6 × 6, row-major flat), the current ``d[3:5]`` when
-    ``d`` has it; ``p`` as :func:`boat_current_rhs`. Found by the composed loop's EKF by its
-    name (:func:`shipgnc.navigation.kernels.jacobian_kernel`)."""
+    """∂ẋ/∂x of :func:`boat_current_rhs` for one ship into ``A`` (6 × 6, row-major flat), the
+    current ``d[3:5]`` when ``d`` has it; ``p`` as :func:`boat_current_rhs`. Eq. (9)–(11')
+    differentiated (the input and the forces enter additively; the current rotates with ψ): with
+    ν_r = (u − u_c, v − v_c), (u_c, v_c) = R(ψ)ᵀ v_c, ∂(u_c, v_c)/∂ψ = (v_c, −u_c), k = c_M (Y_v̇ − X_u̇)::
+
+        ∂(ṅ, ė)/∂ψ = (−ė, ṅ),  ∂(ṅ, ė)/∂(u, v) = R(ψ),  ∂ψ̇/∂r = 1
+        ∂u̇/∂(u, v, r) = (X_u, M₂₂ r, M₂₂ v_r)/M₁₁ + (0, 0, v_c)
+        ∂v̇/∂(u, v, r) = (−M₁₁ r, Y_v, −M₁₁ u_r)/M₂₂ + (0, 0, −u_c)
+        ∂ṙ/∂(u, v, r) = (k v_r, k u_r, N_r + 2 N_|r|r |r|)/M₃₃
+
+    Found by the composed loop's EKF by its name (:func:`shipgnc.navigation.kernels.jacobian_kernel`)."""
     M11, M22, M33, X_u, Y_v, N_r, N_rr, k = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
     su, sv, sr = x[3], x[4], x[5]
     c, s = math.cos(x[2]), math.sin(x[2])

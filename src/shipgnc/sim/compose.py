@@ -40,18 +40,21 @@ disturbance vector are filled once for every force disturbance.
 
 from __future__ import annotations
 
-import hashlib
 import importlib
-import inspect
 import math
-import os
-import sys
 from pathlib import Path
 
-import numba
 import numpy as np
 
 from shipgnc.errors import ConfigError
+from shipgnc.jit_cache import (  # noqa: F401  (cache_dir, prune_stale_loops: public here too)
+    STALE_AFTER,
+    cache_dir,
+    import_file,
+    importable,
+    module_file,
+    prune_stale_loops,
+)
 from shipgnc.kernels import Kernel, NotCompiled, kernel_function
 
 _LOOPS: dict = {}
@@ -105,15 +108,13 @@ def _generate(*key):
     cache (loaded in ≈ 0.1 s by later processes) when every kernel is importable by name; else
     compiled in memory, once per process (a kernel defined in a script or a notebook)."""
     functions = key[:5]
-    importable = all(_importable(fn) for fn in functions)
-    source = _source(*key, imports=importable)
+    importable_by_name = all(importable(fn) for fn in functions)
+    source = _source(*key, imports=importable_by_name)
     slot = key[24]  # an estimator's own kernel ("module:function"): its file keys the loop too
     hashed = (*functions, _resolve(slot)) if slot and ":" in slot else functions
-    path = _cache_file(source, hashed) if importable else None
+    path = module_file(source, hashed, prefix="shipgnc_loop") if importable_by_name else None
     if path is not None:  # importable by name: numba's cache rebuilds the loop's module by name
-        if str(path.parent) not in sys.path:
-            sys.path.append(str(path.parent))
-        return importlib.import_module(path.stem).loop
+        return import_file(path).loop
     namespace = dict(zip(("model_fn", "ctrl_fn", "guid_fn", "dist_fn", "cur_fn"), functions,
                          strict=True))
     exec(compile(source.replace("CACHE = True", "CACHE = False"), "<shipgnc composed loop>",
@@ -124,111 +125,6 @@ def _generate(*key):
 def _resolve(target: str):
     module, _, name = target.partition(":")
     return getattr(importlib.import_module(module), name)
-
-
-def _importable(fn) -> bool:
-    py = getattr(fn, "py_func", fn)
-    try:
-        return getattr(importlib.import_module(py.__module__), py.__qualname__) is fn
-    except (ImportError, AttributeError):
-        return False
-
-
-def cache_dir() -> Path:
-    """Where composed loops are written: ``$SHIPGNC_CACHE_DIR``, else ``$XDG_CACHE_HOME/shipgnc``
-    or ``~/.cache/shipgnc`` (subfolder ``loops``)."""
-    root = os.environ.get("SHIPGNC_CACHE_DIR") or Path(
-        os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "shipgnc"
-    return Path(root) / "loops"
-
-
-def _cache_file(source: str, functions) -> Path | None:
-    """The module file of ``source`` in :func:`cache_dir`, named by a hash of it, of the package's
-    sources (and of a user's kernel files) and of the numba version (an edited kernel gets a new
-    file); written once, atomically (concurrent processes may race to write the same file). None
-    if not writable."""
-    digest = hashlib.sha256(source.encode())
-    digest.update(_sources_digest())
-    files = {inspect.getsourcefile(getattr(fn, "py_func", fn)) for fn in functions}
-    for name in sorted(f for f in files if f and not f.startswith(str(PACKAGE))):
-        digest.update(Path(name).read_bytes())  # a user's kernels outside the package
-    digest.update(numba.__version__.encode())
-    release = _release_tag()
-    path = cache_dir() / f"shipgnc_loop_{release}_{digest.hexdigest()[:16]}.py"
-    try:
-        if not path.exists():
-            path.parent.mkdir(parents=True, exist_ok=True)
-            prune_stale_loops(path.parent, release)
-            tmp = path.with_suffix(f".{os.getpid()}.tmp")
-            tmp.write_text(source)
-            os.replace(tmp, path)
-    except OSError:
-        return None
-    return path
-
-
-#: a loop module of another release of the package (other sources or numba) unused this long is
-#: deleted with its compiled files when a new loop is written [s]
-STALE_AFTER = 7 * 24 * 3600.0
-_PRUNED: list[bool] = []
-
-
-def _release_tag() -> str:
-    """8 hex digits naming the package's sources and numba's version (a loop's file name starts
-    with them, so that the loops of an older release are known)."""
-    digest = hashlib.sha256(_sources_digest())
-    digest.update(numba.__version__.encode())
-    return digest.hexdigest()[:8]
-
-
-def prune_stale_loops(folder: Path, release: str, *, now: float | None = None) -> list[Path]:
-    """Delete the loop modules of other releases (an edited or upgraded package) written and
-    compiled more than :data:`STALE_AFTER` seconds ago, and their numba cache files
-    (``__pycache__/<name>.*.nbi|nbc``); once per process, when a new loop is written. Loops of this
-    release, and recent ones of another (a second environment sharing the cache: a loop it still
-    uses but compiled over a week ago is compiled again there once), stay. Returns the modules
-    deleted."""
-    if _PRUNED:
-        return []
-    _PRUNED.append(True)
-    import time
-
-    now = time.time() if now is None else now
-    deleted = []
-    for module in folder.glob("shipgnc_loop_*.py"):
-        try:
-            stem = module.stem
-            if stem.startswith(f"shipgnc_loop_{release}_"):
-                continue
-            compiled = list((folder / "__pycache__").glob(f"{stem}.*.nb[ic]"))
-            last_use = max([module.stat().st_mtime] + [f.stat().st_mtime for f in compiled])
-            if now - last_use < STALE_AFTER:
-                continue
-            for f in compiled:
-                f.unlink(missing_ok=True)
-            module.unlink(missing_ok=True)
-            deleted.append(module)
-        except OSError:  # another process pruned it first, or a read-only cache
-            continue
-    return deleted
-
-
-#: the package's source folder: the composed loops are keyed on every file in it
-PACKAGE = Path(__file__).resolve().parents[1]
-_DIGEST: list[bytes] = []
-
-
-def _sources_digest() -> bytes:
-    """A hash of every source file of the package (once per process): a kernel's helper may live
-    in another file than the kernel (``paths.track_leg`` in the Mariner's controllers), so
-    any edit of the package gives every loop a new module."""
-    if not _DIGEST:
-        digest = hashlib.sha256()
-        for path in sorted(PACKAGE.rglob("*.py")):
-            digest.update(str(path.relative_to(PACKAGE)).encode())
-            digest.update(path.read_bytes())
-        _DIGEST.append(digest.digest())
-    return _DIGEST[0]
 
 
 def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,

@@ -64,7 +64,7 @@ def _gshhg_wkb(rl) -> bytes:
     package's version; later routes read the file. Where the cache cannot be written, in process."""
     from importlib.metadata import version
 
-    from shipgnc.sim.compose import cache_dir
+    from shipgnc.jit_cache import cache_dir
 
     path = cache_dir().parent / "coastline" / f"gshhg-{version('roaring-landmask')}.wkb"
     if path.is_file():
