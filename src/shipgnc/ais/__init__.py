@@ -1,0 +1,1 @@
+"""AIS in and out: NMEA 0183 ``!AIVDM``/``!AIVDO`` messages, the reporting rules, logged tracks."""
