@@ -81,6 +81,11 @@ def test_the_give_way_ship_must_not_cross_ahead():
     assert astern["rule_15"] == astern["rule_16"] > 0.0
     ahead = compliance_scores(*own_log(10.0, -60.0), [from_starboard], [GIVE_WAY])
     assert ahead["rule_15"] == 0.0
+    # holding course ahead of a slow target: the own ship crosses its track line (north 1000 m)
+    # at t = 200 s, 100 m ahead of its bow (the target, heading west at 1 m/s, is then at east 100)
+    slow = TargetTrack.constant(1000.0, 300.0, -math.pi / 2, 1.0)
+    held = compliance_scores(*own_log(1e9, 0.0), [slow], [GIVE_WAY])
+    assert held["rule_15"] == 0.0 and held["rule_16"] == 0.0  # no action, crossed ahead
 
 
 def test_several_targets_take_the_worst_and_codes_may_be_time_series():

@@ -4,8 +4,8 @@ Woerner, Benjamin, Novitzky & Leonard (2019, "Quantifying protocol evaluation fo
 collision avoidance", Autonomous Robots 43): each rule a score in [0, 1], 1 fully compliant, made
 of a safety score times (1 − penalty) factors. Post-processing of a run, in numpy.
 
-Per target, from its detection (the first sample with range ≤ ``r_detect``, or the first sample)
-to its CPA (the sample of least range), with χ₀, U₀ the own course and speed at detection:
+Per target, from the start of the log (the own ship on its planned course χ₀ at speed U₀, before
+the encounter) to the CPA (the sample of least range):
 
 safety   from the CPA distance r (piecewise linear, Woerner's form):
          1 for r ≥ r_safe; 1 − γ_nm (r_safe − r)/(r_safe − r_nm) down to the near-miss range r_nm;
@@ -23,7 +23,8 @@ rule_14  (head-on) s_14 = s_16 · (1 − p_nsb) · (1 − p_sts): p_nsb = 1 unle
          alteration is to starboard, p_sts = 1 when the target passes on the own starboard side
          (relative bearing at CPA > 0) instead of port to port.
 rule_15  (crossing give-way) s_15 = s_16 · (1 − p_ahead): p_ahead = 1 when the own ship crosses
-         ahead of the target (at CPA it is forward of the target's beam).
+         ahead of the target: it crosses the target's track line (the line through the target
+         along its velocity) at a point the target has yet to reach.
 rule_17  (stand-on: crossing stand-on, being overtaken) s_17 = safety · (1 − p_change) ·
          (1 − p_port): p_change = min(1, max(Δχ/Δχ_app, |ΔU|/(ΔU_app·U₀))) over the changes made
          while the range exceeds r_late (rule 17(a)(i): keep course and speed; closer, 17(a)(ii)
@@ -60,7 +61,6 @@ class ComplianceConfig(Strict):
     r_near_miss: Positive = Field(250.0, description="near-miss CPA [m]")
     r_safe: Positive = Field(926.0, description="CPA from which the safety score is 1 [m] (0.5 nm)")
     gamma_near_miss: float = Field(0.4, ge=0, le=1, description="safety lost between r_safe and r_near_miss")
-    r_detect: Positive = Field(3704.0, description="range at which an encounter starts [m] (2 nm)")
     r_early: Positive = Field(1852.0, description="action at or beyond this range is early [m] (1 nm)")
     r_late: Positive = Field(926.0, description="action at or within this range is too late [m]")
     course_change_app_deg: float = Field(30.0, gt=0, lt=180, description="a readily apparent course change")
@@ -72,7 +72,7 @@ class ComplianceConfig(Strict):
                                                                 "manoeuvre, fraction of the speed")
 
     field_units: ClassVar[dict[str, str]] = {
-        "r_collision": "m", "r_near_miss": "m", "r_safe": "m", "gamma_near_miss": "1", "r_detect": "m",
+        "r_collision": "m", "r_near_miss": "m", "r_safe": "m", "gamma_near_miss": "1",
         "r_early": "m", "r_late": "m", "speed_change_app": "1", "speed_change_md": "1"}
 
     @model_validator(mode="after")
@@ -115,6 +115,16 @@ def _encounter_code(codes) -> int:
     return int(risky[0]) if risky.size else SAFE
 
 
+def _crossed_ahead(dn, de, tvn, tve) -> float:
+    """1.0 when the own ship crosses the target's track line ahead of the target: the sign of the
+    own ship's side of the line (v_t × (p_o − p_t)) changes while the own ship is forward of the
+    target along its velocity ((p_o − p_t)·v_t > 0); else 0.0."""
+    side = np.sign(tvn * -de - tve * -dn)  # v_t × (p_o − p_t), with p_o − p_t = −(dn, de)
+    crossing = np.nonzero(side[1:] * side[:-1] < 0)[0] + 1
+    ahead = (-dn * tvn - de * tve)[crossing] > 0.0
+    return 1.0 if np.any(ahead) else 0.0
+
+
 def encounter_scores(t, own_north, own_east, own_course, own_speed, target, code,
                      config: ComplianceConfig | None = None) -> dict[str, float]:
     """The scores (module docstring) of the own ship's log against one target in situation
@@ -125,13 +135,10 @@ def encounter_scores(t, own_north, own_east, own_course, own_speed, target, code
     dn, de = tn - own_north, te - own_east
     rng = np.hypot(dn, de)
     k_cpa = int(np.argmin(rng))
-    inside = np.nonzero(rng <= c.r_detect)[0]
-    k0 = int(inside[0]) if inside.size else 0
-    k0 = min(k0, k_cpa)
-    window = slice(k0, k_cpa + 1)
-    d_chi = wrap_angle(own_course[window] - own_course[k0])
-    u0 = max(float(own_speed[k0]), 1e-9)
-    d_u = (own_speed[window] - own_speed[k0]) / u0
+    window = slice(0, k_cpa + 1)
+    d_chi = wrap_angle(own_course[window] - own_course[0])
+    u0 = max(float(own_speed[0]), 1e-9)
+    d_u = (own_speed[window] - own_speed[0]) / u0
     chi_md, chi_app = math.radians(c.course_change_md_deg), math.radians(c.course_change_app_deg)
     acted = (np.abs(d_chi) >= chi_md) | (np.abs(d_u) >= c.speed_change_md)
     k_act = int(np.argmax(acted)) if acted.any() else None
@@ -154,9 +161,7 @@ def encounter_scores(t, own_north, own_east, own_course, own_speed, target, code
             p_sts = 1.0 if beta_cpa > 0.0 else 0.0
             scores["rule_14"] = s16 * (1.0 - p_nsb) * (1.0 - p_sts)
         elif code == GIVE_WAY:
-            alpha_cpa = wrap_angle(math.atan2(-de[k_cpa], -dn[k_cpa]) - math.atan2(tve[k_cpa], tvn[k_cpa]))
-            p_ahead = 1.0 if abs(alpha_cpa) < math.pi / 2 else 0.0
-            scores["rule_15"] = s16 * (1.0 - p_ahead)
+            scores["rule_15"] = s16 * (1.0 - _crossed_ahead(dn, de, tvn, tve))
     elif code in (STAND_ON, OVERTAKEN):
         far = rng[window] > c.r_late
         p_change = min(1.0, max(float(np.max(np.abs(d_chi[far]), initial=0.0)) / chi_app,
