@@ -131,6 +131,9 @@ def encounter_scores(t, own_north, own_east, own_course, own_speed, target, code
     ``code``, with the diagnostics ``cpa_m``, ``t_cpa_s``, ``action_range_m``,
     ``course_change_max_deg``, ``speed_reduction_max`` (fraction)."""
     c = config or ComplianceConfig()
+    t = np.asarray(t, dtype=float)
+    own_north, own_east, own_course, own_speed = (np.asarray(a, dtype=float) for a in
+                                                  (own_north, own_east, own_course, own_speed))
     tn, te, tvn, tve = _target_samples(target, t)
     dn, de = tn - own_north, te - own_east
     rng = np.hypot(dn, de)
