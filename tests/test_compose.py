@@ -66,27 +66,6 @@ def test_model_kernel_equals_derivatives():
         np.testing.assert_allclose(xdot, BOAT.derivatives(x, u, None), rtol=1e-13, atol=1e-15)
 
 
-def test_controller_kernel_equals_step():
-    x0 = fleet(8)
-    ref = np.tile([0.7, 1.5], (8, 1))
-    numpy_ap, kernel_ap = HeadingSpeedAutopilot(BOAT.params), HeadingSpeedAutopilot(BOAT.params)
-    numpy_ap.reset((8,))
-    kernel_ap.reset((8,))
-    kernel = kernel_ap.kernel((8,))
-    z = kernel.state_for(8)
-    for k in range(20):
-        x = x0 + 0.01 * k
-        expected = numpy_ap.step(k * 0.05, x, ref)
-        for i in range(8):
-            cmd, sig = np.empty(2), np.empty(2)
-            kernel.function(k * 0.05, x[i], ref[i], z[i], kernel.params, cmd, sig)
-            np.testing.assert_allclose(cmd, expected[i], rtol=1e-13)
-            np.testing.assert_allclose(sig, [numpy_ap.signal_values()["psi_r"][i],
-                                             numpy_ap.signal_values()["r_r"][i]], rtol=1e-13)
-    kernel.restore(z)
-    np.testing.assert_allclose(kernel_ap.z, numpy_ap.z, rtol=1e-13)
-
-
 def test_guidance_kernel_equals_reference():
     los = LOSGuidance(SQUARE, lookahead=6.0, speed=1.2, switch_radius=2.0, integral_gain=0.3)
     los.reset((5,), BOAT)
