@@ -98,28 +98,6 @@ def test_adaptive_los_on_the_square_in_a_current_compiled_equals_numpy():
     assert first.size == 2 and np.all(np.abs(beta_hat[first]) < np.abs(beta_hat[first - 1]))
 
 
-def test_guidance_kernel_equals_reference_with_the_crab_angle_estimate():
-    square = WaypointPath([[0, 0], [40, 0], [40, 40], [0, 40]])
-    los = LOSGuidance(square, lookahead=6.0, speed=1.2, switch_radius=2.0, adaptive_gain=0.01)
-    los.reset((5,), BOAT)
-    kernel = los.kernel((5,))
-    z = kernel.state_for(5)
-    rng = np.random.default_rng(3)
-    for k in range(60):
-        x = np.zeros((5, 6))
-        x[:, :2] = rng.uniform(-5, 45, (5, 2))
-        expected = los.reference(0.1 * k, x)
-        outputs = los.output_values()
-        for i in range(5):
-            ref, out = np.empty(2), np.empty(4)
-            done = kernel.function(0.1 * k, x[i], z[i], kernel.params, ref, out)
-            np.testing.assert_allclose(ref, expected[i], rtol=1e-13, atol=1e-15)
-            np.testing.assert_allclose(out[3], outputs["crab_angle_est"][i], rtol=1e-13, atol=1e-15)
-            assert out[2] == los.leg[i] and done == los.finished()[i]
-    kernel.restore(z)
-    assert np.all(los.beta_hat != 0.0)
-
-
 def test_a_batch_of_ships_equals_the_ships_run_alone():
     path = WaypointPath([[0, 0], [300, 0]])
     current = parse_current("uniform:north=0,east=0.5")

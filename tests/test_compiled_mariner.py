@@ -1,11 +1,10 @@
 """Document 000's Mariner in the composed compiled loop (:mod:`shipgnc.sim.compose`) against the
 numpy reference loop.
 
-Each component's kernel equals its numpy form on single ships (the model's eq. (25), the path
-frame (guidance), the path controllers' laws (13), (19)–(23) and LOS + FL, the disturbance of note
-000-0.6); and every comparison of a
-whole run goes through ``simulate(..., backend="numpy")`` and ``backend="compiled"`` on fresh
-components and requires the same variables, sample times and attributes, values equal to 1e-9
+Each component's kernel equals its numpy form on single ships (the model's eq. (25), the
+disturbance of note 000-0.6; the path frame's and the path controllers' numpy forms are the batch
+of their kernels); and every comparison of a whole run goes through
+``simulate(..., backend="numpy")`` and ``backend="compiled"`` on fresh components and requires the same variables, sample times and attributes, values equal to 1e-9
 relative (round-off of the variable's scale absolute), the same divergence errors and the
 components left in the same state.
 """
@@ -16,7 +15,7 @@ import numpy as np
 import pytest
 
 from shipgnc.actuators import Actuator
-from shipgnc.control.feedback_linearization import LOSFL, OutputFL, fl_lookahead, fl_paper
+from shipgnc.control.feedback_linearization import LOSFL, fl_lookahead, fl_paper
 from shipgnc.control.lqr import PathLQR, design_lqr
 from shipgnc.environment.current import CrossCurrent
 from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNoise
@@ -151,82 +150,6 @@ def test_model_kernel_equals_derivatives():
         np.testing.assert_allclose(xdot, M.derivatives(x, u, d), rtol=1e-13, atol=1e-18)
         kernel.function(x, u, np.zeros(3), kernel.params, xdot)  # zero d is no disturbance
         np.testing.assert_allclose(xdot, M.derivatives(x, u, None), rtol=1e-13, atol=1e-18)
-
-
-def along_the_legs(n):
-    """States of ``n`` ships sample by sample, northwards along SHORT_PATH's leg 0 then onto legs
-    1 and 2: ``(k, x)`` for 25 samples."""
-    x = random_states(n, seed=3)
-    x[:, :2] = np.linspace([-100.0, -50.0], [100.0, 40.0], n)
-    for k in range(25):
-        x[:, 0] += 25.0 + 3.0 * k
-        x[:, 1] += 4.0 * k
-        x[:, 2:] += 0.01
-        yield k, x.copy()
-
-
-def test_path_guidance_kernel_equals_reference():
-    """References (y_r, ψ_r, π_p), the leg output and the end state (leg) of one ship at a time
-    against the batched numpy ``reference``, over samples that switch legs."""
-    n = 40
-    reference, compiled = PathGuidance(SHORT_PATH), PathGuidance(SHORT_PATH)
-    reference.reset((n,), M)
-    compiled.reset((n,), M)
-    kernel = compiled.kernel((n,))
-    z = kernel.state_for(n)
-    legs = set()
-    for k, x in along_the_legs(n):
-        expected = reference.reference(0.3 * k, x)
-        leg = reference.output_values()["leg"]
-        legs |= set(leg.tolist())
-        for i in range(n):
-            ref, out = np.empty(3), np.empty(1)
-            assert not kernel.function(0.3 * k, x[i], z[i], kernel.params, ref, out)
-            # y_r: the kernel's fused multiply-adds round once where numpy rounds twice
-            np.testing.assert_allclose(ref, expected[i], rtol=1e-12, atol=1e-12)
-            assert out[0] == leg[i]
-    assert legs == {0.0, 1.0, 2.0}  # the ships switch legs on the way
-    kernel.restore(z)
-    np.testing.assert_array_equal(compiled.tracker.leg, reference.tracker.leg)
-    assert compiled.tracker.leg.dtype == reference.tracker.leg.dtype
-
-
-@pytest.mark.parametrize("ctrl", [*sorted(CONTROLLERS), "fl_global", "los_global"])
-def test_controller_kernel_equals_step(ctrl):
-    """Command, logged signals and end state (e_I, signal_values) of one ship at a time over
-    a run of samples that switches legs, against the batched numpy ``step`` (both reading the
-    path frame's references)."""
-    make = {**CONTROLLERS,
-            "fl_global": lambda: OutputFL(M.params, Ts=0.3, lookahead=40.0, b_r=DOC_B_R,
-                                          d_y=DOC_D_Y, current_frame="global"),
-            "los_global": lambda: LOSFL(M.params, Ts=0.3, b_r=DOC_B_R, d_y=-DOC_D_Y,
-                                        current_frame="global")}[ctrl]
-    n = 40
-    reference, compiled = make(), make()
-    reference.reset((n,))
-    compiled.reset((n,))
-    guidance = PathGuidance(SHORT_PATH)
-    guidance.reset((n,), M)
-    kernel = compiled.kernel((n,))
-    z = kernel.state_for(n)
-    names = [s.name for s in reference.signals]
-    for k, x in along_the_legs(n):
-        ref = guidance.reference(0.3 * k, x)
-        expected = reference.step(0.3 * k, x, ref)
-        logged = reference.signal_values()
-        for i in range(n):
-            cmd, sig = np.empty(1), np.empty(len(names))
-            kernel.function(0.3 * k, x[i], ref[i], z[i], kernel.params, cmd, sig)
-            np.testing.assert_allclose(cmd, expected[i], rtol=1e-12, atol=1e-15)
-            np.testing.assert_allclose(sig, [logged[name][i] for name in names], rtol=1e-12,
-                                       atol=1e-12)
-    assert set(guidance.tracker.leg.tolist()) == {2}  # every ship reached the last leg
-    kernel.restore(z)
-    if isinstance(reference, PathLQR):
-        np.testing.assert_allclose(compiled.e_I, reference.e_I, rtol=1e-12)
-    for name in names:
-        np.testing.assert_allclose(compiled.signal_values()[name], logged[name], rtol=1e-12,
-                                   atol=1e-12)
 
 
 @pytest.mark.parametrize("frame", [None, "path", "global"])

@@ -1,5 +1,4 @@
-"""The composed compiled loop (DESIGN "Speed by composition"): each component's kernel equals its
-numpy form, and combinations no whole-loop twin ever covered run compiled and equal the numpy loop
+"""The composed compiled loop (DESIGN "Speed by composition"): the components' laws, and combinations no whole-loop twin ever covered run compiled and equal the numpy loop
 (1e-9 relative or 1e-12 absolute, the promise of ``simulate``'s ``backend``)."""
 
 from __future__ import annotations
@@ -66,42 +65,30 @@ def test_model_kernel_equals_derivatives():
         np.testing.assert_allclose(xdot, BOAT.derivatives(x, u, None), rtol=1e-13, atol=1e-15)
 
 
-def test_controller_kernel_equals_step():
-    x0 = fleet(8)
-    ref = np.tile([0.7, 1.5], (8, 1))
-    numpy_ap, kernel_ap = HeadingSpeedAutopilot(BOAT.params), HeadingSpeedAutopilot(BOAT.params)
-    numpy_ap.reset((8,))
-    kernel_ap.reset((8,))
-    kernel = kernel_ap.kernel((8,))
-    z = kernel.state_for(8)
-    for k in range(20):
-        x = x0 + 0.01 * k
-        expected = numpy_ap.step(k * 0.05, x, ref)
-        for i in range(8):
-            cmd, sig = np.empty(2), np.empty(2)
-            kernel.function(k * 0.05, x[i], ref[i], z[i], kernel.params, cmd, sig)
-            np.testing.assert_allclose(cmd, expected[i], rtol=1e-13)
-            np.testing.assert_allclose(sig, [numpy_ap.signal_values()["psi_r"][i],
-                                             numpy_ap.signal_values()["r_r"][i]], rtol=1e-13)
-    kernel.restore(z)
-    np.testing.assert_allclose(kernel_ap.z, numpy_ap.z, rtol=1e-13)
-
-
-def test_guidance_kernel_equals_reference():
-    los = LOSGuidance(SQUARE, lookahead=6.0, speed=1.2, switch_radius=2.0, integral_gain=0.3)
-    los.reset((5,), BOAT)
-    kernel = los.kernel((5,))
-    z = kernel.state_for(5)
-    rng = np.random.default_rng(2)
-    for k in range(60):
-        x = np.zeros((5, 6))
-        x[:, :2] = rng.uniform(-5, 45, (5, 2))
-        expected = los.reference(0.1 * k, x)
-        for i in range(5):
-            ref, out = np.empty(2), np.empty(3)
-            done = kernel.function(0.1 * k, x[i], z[i], kernel.params, ref, out)
-            np.testing.assert_allclose(ref, expected[i], rtol=1e-13, atol=1e-15)
-            assert out[2] == los.leg[i] and done == los.finished()[i]
+def test_los_reference_is_the_law_of_its_docstring():
+    """ψ_d = wrap(π_p − atan(e/Δ)) on the active leg, u_d = U; the next leg once s ≥ L − R_sw;
+    finished (with its completion time) once s reaches the end of the last leg."""
+    los = LOSGuidance(SQUARE, lookahead=6.0, speed=1.2, switch_radius=2.0)
+    los.reset((3,), BOAT)
+    x = np.zeros((3, 6))
+    x[:, :2] = [[10.0, 3.0], [38.5, -1.0], [45.0, 45.0]]
+    ref = los.reference(0.0, x)
+    # ship 1 switches to leg 1 (north → east side, π_p = π/2): s = −1, e = 1.5; ship 2 switches
+    # once per sample: leg 1 with s = 45, e = −5
+    np.testing.assert_allclose(ref[:, 0], [-math.atan(3.0 / 6.0), math.pi / 2 - math.atan(1.5 / 6.0),
+                                           math.pi / 2 + math.atan(5.0 / 6.0)], rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(ref[:, 1], 1.2)
+    out = los.output_values()
+    np.testing.assert_allclose(out["cross_track_error"], [3.0, 1.5, -5.0], atol=1e-13)
+    np.testing.assert_allclose(out["along_track"], [10.0, -1.0, 45.0], atol=1e-13)
+    np.testing.assert_array_equal(out["leg"], [0, 1, 1])
+    assert not los.finished().any()
+    x[2, :2] = [-1.0, 41.0]  # on the last leg (π_p = π), 41 m along its 40 m: done
+    ref = los.reference(0.5, x)
+    assert ref[2, 0] == pytest.approx(-math.pi + math.atan(1.0 / 6.0), abs=1e-12)
+    np.testing.assert_array_equal(los.finished(), [False, False, True])
+    np.testing.assert_array_equal(los.completion_time, [np.nan, np.nan, 0.5])
+    np.testing.assert_array_equal(los.waypoints_reached(), [0, 1, 3])
 
 
 def test_schedule_kernels_switch_on_the_same_sample():

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from shipgnc.control.feedback_linearization import HeadingFL, heading_fl_step
+from shipgnc.control.feedback_linearization import HeadingFL
 from shipgnc.environment import fields as F
 from shipgnc.errors import ConfigError
 from shipgnc.guidance.schedule import HeadingProfile
@@ -76,18 +76,6 @@ def test_mariner_field_current_kernel_equals_its_numpy_form():
         x = np.array([n, e, 0.4, 7.0, 0.001])
         mariner_disturbance(ti, x, k.state_for(1)[0], k.params, np.zeros(0), d)
         np.testing.assert_allclose(d, dist(ti, x), rtol=1e-13, atol=1e-15)
-
-
-def test_heading_fl_kernel_equals_step():
-    ctrl = HeadingFL(P, Ts=0.3, b_r=1e-5)
-    k = ctrl.kernel(())
-    rng = np.random.default_rng(1)
-    cmd = np.empty(1)
-    for _ in range(200):  # saturated and unsaturated commands, headings many turns away
-        x = np.array([0.0, 0.0, rng.uniform(-20, 20), rng.uniform(6, 8), rng.normal(0, 0.01)])
-        ref = np.array([rng.uniform(0, 2 * np.pi), rng.normal(0, 0.003)])
-        heading_fl_step(0.0, x, ref, np.zeros(0), k.params, cmd, np.zeros(0))
-        np.testing.assert_allclose(cmd, ctrl.step(0.0, x, ref), rtol=1e-13, atol=1e-16)
 
 
 def test_heading_profile_table_equals_its_reference():

@@ -13,6 +13,7 @@ the sample instants (needed by document 004's finite-state laws).
 
 from __future__ import annotations
 
+import math
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -30,3 +31,24 @@ class Controller(Protocol):
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray: ...
 
     def signal_values(self) -> dict[str, np.ndarray]: ...
+
+
+def kernel_step(controller, t: float, measurement, reference, n_commands: int
+                ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """One sample of ``controller`` for every ship: the batch over ships
+    (:func:`shipgnc.derive.per_ship`) of its scalar kernel ``controller.kernel(batch_shape)``, the
+    one source of its law, run on the controller's per-ship state (taken from the controller and
+    handed back to it by the kernel's ``restore``). Returns the command (..., ``n_commands``) and
+    the logged signals by name (``controller.signals``)."""
+    from shipgnc.derive import per_ship
+
+    x = np.asarray(measurement, dtype=float)
+    batch = x.shape[:-1]
+    kernel = controller.kernel(batch)
+    z = kernel.state_for(math.prod(batch))
+    signals = tuple(getattr(controller, "signals", ()))
+    command, logged = per_ship(kernel.function, "t i i z p o o")(
+        t, x, reference, z, kernel.params, n_commands, len(signals))
+    if kernel.restore is not None:
+        kernel.restore(z)
+    return command, {s.name: logged[..., j] for j, s in enumerate(signals)}

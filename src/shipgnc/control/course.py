@@ -40,8 +40,8 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
+from shipgnc.control.base import kernel_step
 from shipgnc.errors import require
-from shipgnc.frames import wrap_angle
 from shipgnc.guidance.reference import HeadingReferenceModel
 from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
@@ -56,7 +56,7 @@ def _check_positive(name: str, value: float) -> None:
 
 
 class _CourseController:
-    """Shared plumbing: sample time, references, held propeller speed, command stacking."""
+    """Shared plumbing: sample time, references, held propeller speed."""
 
     continuous = False
     reference_names = ("psi_d",)
@@ -69,9 +69,6 @@ class _CourseController:
         self.Ts = float(Ts)
         self.propeller_rps = float(propeller_rps)
         self._logged: dict[str, np.ndarray] = {}
-
-    def _command(self, delta_z: np.ndarray) -> np.ndarray:
-        return np.stack([np.full_like(delta_z, self.propeller_rps), delta_z], axis=-1)
 
     def signal_values(self) -> dict[str, np.ndarray]:
         return self._logged
@@ -95,9 +92,9 @@ class CoursePD(_CourseController):
         self._logged = {}
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        psi, r = measurement[..., 2], measurement[..., 5]
-        delta_z = self.Kp * wrap_angle(psi - reference[..., 0]) + self.Kd * r
-        return self._command(np.asarray(delta_z, dtype=float))
+        """Eq. (3) for every ship: the batch of :func:`course_pd_step`."""
+        command, self._logged = kernel_step(self, t, measurement, reference, 2)
+        return command
 
     def kernel(self, batch_shape) -> Kernel:
         """:meth:`step` for the composed loop (:func:`course_pd_step`); no per-ship state."""
@@ -106,8 +103,8 @@ class CoursePD(_CourseController):
 
 @kernel_function
 def course_pd_step(t, x, ref, z, p, cmd, sig):
-    """Eq. (3) for one ship, as :meth:`CoursePD.step`: δ_z = K_P wrap(ψ − ψ_d) + K_D r,
-    n = the held propeller speed; ``p`` = [K_P, K_D, n]."""
+    """Eq. (3) of document 003 for one ship: δ_z = K_P wrap(ψ − ψ_d) + K_D r, n = the held
+    propeller speed; ``p`` = [K_P, K_D, n]."""
     cmd[0] = p[2]
     cmd[1] = p[0] * wrap(x[2] - ref[0]) + p[1] * x[5]
 
@@ -221,27 +218,10 @@ class SlidingModeCourse(_CourseController):
         self._logged = {}
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        g = self.design
-        k1, k2 = g.K
-        h1, h2 = g.h
-        psi, r = measurement[..., 2], measurement[..., 5]
-        ref = self.reference_model
-        ref.start(psi)
-        r_dot_z = ref.acceleration(reference[..., 0])
-        e_psi = wrap_angle(psi - ref.psi)
-        e_r = r - ref.rate
-        u_eq = -k1 * e_psi - k2 * r + (g.N - k1) * ref.psi
-        feedforward = h1 * ref.rate + h2 * r_dot_z
-        if self.form == "consistent":
-            sigma = h1 * e_psi + h2 * e_r
-            delta_z = u_eq + (feedforward - self.eta * np.tanh(sigma / self.phi)) / g.hB
-        else:
-            sigma = -(h1 * e_psi + h2 * e_r)
-            delta_z = u_eq + feedforward - self.eta * np.tanh(sigma / self.phi)
-        self._logged = {"psi_z": ref.psi.copy(), "r_z": ref.rate.copy(),
-                        "sigma": np.asarray(sigma, dtype=float)}
-        ref.advance(r_dot_z, self.Ts)
-        return self._command(np.asarray(delta_z, dtype=float))
+        """Law (14) with the reference model (15) for every ship: the batch of
+        :func:`sliding_mode_step`."""
+        command, self._logged = kernel_step(self, t, measurement, reference, 2)
+        return command
 
     def kernel(self, batch_shape) -> Kernel:
         """:meth:`step` for the composed loop (:func:`sliding_mode_step`). Per-ship state
@@ -266,8 +246,14 @@ class SlidingModeCourse(_CourseController):
 
 @kernel_function
 def sliding_mode_step(t, x, ref, z, p, cmd, sig):
-    """Law (14) with the reference model (15) for one ship, as :meth:`SlidingModeCourse.step`
-    operation for operation (both forms); ``p`` from :meth:`SlidingModeCourse.kernel`, ``z`` =
+    """Law (14) of document 003 with the reference model (15) for one ship, both forms::
+
+        consistent  δ_z = Nψ_z − Kᵀx + (hᵀB_h)⁻¹[hᵀẋ_hz − η tanh(σ/φ)],  σ = hᵀ(x − x_z)
+        printed     δ_z = Nψ_z − Kᵀx + hᵀẋ_hz − η tanh(σ_p/φ),          σ_p = hᵀ(x_z − x)
+
+    with headings through wrap(ψ − ψ_z): Nψ_z − Kᵀx = −k₁ wrap(ψ − ψ_z) − k₂ r + (N − k₁)ψ_z; the
+    reference model (15) ψ̈_z = ω_n² wrap(ψ_d − ψ_z) − 2ζω_n ψ̇_z, started at ψ_z = ψ, r_z = 0 and
+    advanced by one Euler step of Ts. ``p`` from :meth:`SlidingModeCourse.kernel`, ``z`` =
     [ψ_z, r_z, started, logged ψ_z, r_z, σ], ``sig`` = [ψ_z, r_z, σ] before the Euler step."""
     k1, k2, h1, h2, N, hB, eta, phi = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
     w, zeta, Ts, consistent, rps = p[8], p[9], p[10], p[11], p[12]

@@ -51,6 +51,7 @@ import math
 
 import numpy as np
 
+from shipgnc.control.base import kernel_step
 from shipgnc.control.lqr import (
     DELTA_MAX,
     I_EAST,
@@ -71,7 +72,6 @@ from shipgnc.control.lqr import (
 )
 from shipgnc.environment.current import CURRENT_FRAMES
 from shipgnc.errors import require
-from shipgnc.frames import wrap_angle
 from shipgnc.kernels import Kernel, clip, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
 from shipgnc.units import MINUTE, NAUTICAL_MILE
@@ -152,22 +152,6 @@ class _PathFL:
     def signal_values(self) -> dict[str, np.ndarray]:
         return self._logged
 
-    def H_N(self, r):
-        """Norrbin manoeuvring characteristic H_N(r) = a r + b r³ [rad/s²] (eq. (16))."""
-        return self.a * r + self.b * r**3
-
-    def kinematics(self, measurement: np.ndarray, reference: np.ndarray) -> dict[str, np.ndarray]:
-        """Path-frame quantities of the active leg: y_r, ψ_r and its course π_p (the references,
-        by name), u, r, v, ẏ_r ("measured")."""
-        x, ref = np.asarray(measurement, dtype=float), np.asarray(reference, dtype=float)
-        y_r, psi_r, course = ref[..., R_Y], ref[..., R_PSI], ref[..., R_COURSE]
-        u, r = x[..., I_U], x[..., I_R]
-        v = self.r1 * r + self.r2 * r**3
-        d_cross = self.d_y if self.current_frame == "path" else self.d_y * np.cos(course)
-        y_dot = u * np.sin(psi_r) + v * np.cos(psi_r) + d_cross
-        return {"y_r": y_r, "psi_r": psi_r, "course": course, "u": u, "r": r, "v": v,
-                "y_dot": y_dot, "d_cross": d_cross + np.zeros_like(y_r)}
-
     def _kernel(self, function, batch_shape, *specific) -> Kernel:
         """The kernel of a path FL controller: ``p`` = [δ_max, a, b, c, r₁, r₂, b_r, d_y, global
         frame, *specific]; per-ship state of :func:`~shipgnc.control.lqr.path_state`."""
@@ -176,10 +160,10 @@ class _PathFL:
         return Kernel(function, params, path_state(self, batch_shape),
                       restore=lambda z: restore_path_state(self, batch_shape, z))
 
-    def _finish(self, raw: np.ndarray, **logged) -> np.ndarray:
-        delta = np.clip(raw, -self.delta_max, self.delta_max)
-        self._logged = logged
-        return delta[..., None]
+    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        """The law for every ship: the batch of the class's kernel (:meth:`kernel`)."""
+        command, self._logged = kernel_step(self, t, measurement, reference, 1)
+        return command
 
 
 class OutputFL(_PathFL):
@@ -213,27 +197,6 @@ class OutputFL(_PathFL):
                     f"controller.{name}", value, "must be a finite number > 0")
         self.lookahead = float(lookahead)
         self.k1, self.k2 = float(k1), float(k2)
-
-    def linearization(self, k: dict[str, np.ndarray]) -> tuple[np.ndarray, ...]:
-        """(z, ż, f, g) of the output at the path-frame quantities ``k`` (see :meth:`kinematics`)."""
-        l, psi_r, u, r = self.lookahead, k["psi_r"], k["u"], k["r"]
-        s, c = np.sin(psi_r), np.cos(psi_r)
-        lateral = k["v"] + l * r
-        z = k["y_r"] + l * s
-        z_dot = k["y_dot"] + l * r * c
-        m = self.r1 + l + 3.0 * self.r2 * r**2
-        f = (u * c - lateral * s) * r + m * c * (self.b_r - self.H_N(r))
-        g = m * self.c * c
-        return z, z_dot, f, g
-
-    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        k = self.kinematics(measurement, reference)
-        z, z_dot, f, g = self.linearization(k)
-        nu = -self.k1 * z - self.k2 * z_dot
-        # g = 0 only at ψ_r = ±90° (or r on the pivot point): saturate there instead of dividing
-        tiny = 1e-12 * abs(self.c) * (abs(self.r1) + self.lookahead + NAUTICAL_MILE)
-        g_safe = np.where(np.abs(g) < tiny, np.where(g < 0, -tiny, tiny), g)
-        return self._finish((nu - f) / g_safe, fl_output=z)
 
     def kernel(self, batch_shape) -> Kernel:
         """:meth:`step` for the composed loop (:func:`output_fl_step`), after ``reset``."""
@@ -311,31 +274,6 @@ class LOSFL(_PathFL):
         self.y_int = np.zeros(tuple(batch_shape))
         self._prev = None
 
-    def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        x = np.asarray(measurement, dtype=float)
-        k = self.kinematics(x, reference)
-        D, y_r, kappa = self.delta_los, k["y_r"], self.integral_gain
-        y_dot = k["y_dot"]
-        if self._prev is not None:
-            t0, n0, e0, rate0 = self._prev
-            h = t - t0
-            self.y_int = self.y_int + h * rate0  # forward Euler: y_int(t_k)
-            if self.rate_from_positions:
-                course = k["course"]
-                y_dot = ((x[..., I_NORTH] - n0) * -np.sin(course)
-                         + (x[..., I_EAST] - e0) * np.cos(course)) / h
-        rho = y_r + kappa * self.y_int
-        den = D**2 + rho * rho
-        rate = D * y_r / den
-        crab = np.arcsin(np.clip(k["d_cross"] / np.maximum(k["u"], 1e-6), -1.0, 1.0))
-        psi_d = -np.arctan(rho / D) - crab
-        psi_d_dot = -D * (y_dot + kappa * rate) / den
-        e = wrap_angle(k["psi_r"] - psi_d)
-        nu = -self.kp * e - self.kd * (k["r"] - psi_d_dot)
-        raw = (nu + self.H_N(k["r"]) - self.b_r) / self.c
-        self._prev = (t, x[..., I_NORTH], x[..., I_EAST], rate)
-        return self._finish(raw, los_heading=psi_d)
-
     def kernel(self, batch_shape) -> Kernel:
         """:meth:`step` for the composed loop (:func:`los_fl_step`), after ``reset``; per-ship
         state :func:`~shipgnc.control.lqr.path_state` then [y_int, ẏ_int, t, north, east, has
@@ -365,7 +303,7 @@ class LOSFL(_PathFL):
 
 
 # ----------------------------------------------------------------------------------------------
-# kernels (shipgnc.kernels): one ship's step, operation for operation as the numpy methods
+# kernels (shipgnc.kernels): one ship's step, the one source of each law
 # ----------------------------------------------------------------------------------------------
 
 #: where :func:`los_fl_step` finds its own per-ship state (after :func:`path_state`'s 2 numbers)
@@ -374,7 +312,7 @@ _LOS_OWN = 2
 
 @kernel_function
 def path_kinematics(x, ref, p):
-    """:meth:`_PathFL.kinematics` for one ship: ``(y_r, ψ_r, π_p, u, r, v, ẏ_r, d_cross, sin ψ_r,
+    """Path-frame quantities of the active leg for one ship: ``(y_r, ψ_r, π_p, u, r, v, ẏ_r, d_cross, sin ψ_r,
     cos ψ_r)`` from the path references (by name) and the state, with v = r₁ r + r₂ r³ and the
     "measured" ẏ_r = u sin ψ_r + v cos ψ_r + d_cross (d_cross = d_y, or d_y cos π_p in the
     global frame)."""
@@ -397,9 +335,15 @@ def _log_path(z, sig, extra):
 
 @kernel_function
 def output_fl_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`OutputFL.step` for one ship: z = y_r + l sin ψ_r, ż, f, g of
-    :meth:`OutputFL.linearization` ((19)–(20) with r₁ → r₁ + l + 3r₂r²), δ = clip((ν − f)/g) with
-    ν = −k₁ z − k₂ ż ((21)–(23)) and |g| kept ≥ tiny. ``p`` = [common 9, l, k₁, k₂, tiny, 3r₂]."""
+    """The output FL of :class:`OutputFL` for one ship (document 000, (19)–(23) with
+    r₁ → m = r₁ + l + 3r₂r²; u̇ neglected)::
+
+        z = y_r + l sin ψ_r,   ż = ẏ_r + l r cos ψ_r,   H_N(r) = a r + b r³   (eq. (16))
+        f = (u cos ψ_r − (v + l r) sin ψ_r) r + m cos ψ_r (b_r − H_N(r)),   g = m c cos ψ_r
+        δ = clip((ν − f)/g, ±δ_max),   ν = −k₁ z − k₂ ż
+
+    with |g| kept ≥ tiny (g = 0 only at ψ_r = ±90°, or r on the pivot point: saturate there
+    instead of dividing). ``p`` = [common 9, l, k₁, k₂, tiny, 3r₂]."""
     delta_max, a, b, c_rudder, r1, b_r = p[0], p[1], p[2], p[3], p[4], p[6]
     l, k1, k2, tiny, r2_3 = p[9], p[10], p[11], p[12], p[13]
     y_r, _, _, u, r, v, y_dot, _, s, c = path_kinematics(x, ref, p)
@@ -418,7 +362,8 @@ def output_fl_step(t, x, ref, z, p, cmd, sig):
 
 @kernel_function
 def los_fl_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`LOSFL.step` for one ship: y_int += h ẏ_int (forward Euler), ρ = y_r + κ y_int,
+    """The (integral) LOS + yaw-loop FL of :class:`LOSFL` for one ship (note 000-0.5; Fossen
+    2021 §12.4, eq. (12.108)–(12.109)): y_int += h ẏ_int (forward Euler), ρ = y_r + κ y_int,
     ẏ_int = Δ y_r/(Δ² + ρ²), ψ_d,r = −atan(ρ/Δ) − asin(clip(d_cross/max(u, 1e-6))),
     ψ̇_d,r = −Δ (ẏ_r + κ ẏ_int)/(Δ² + ρ²) (ẏ_r from the last two positions when asked),
     e = wrap(ψ_r − ψ_d,r), ν = −k_p e − k_d (r − ψ̇_d,r), δ = clip((ν + H_N(r) − b_r)/c)
@@ -481,12 +426,9 @@ class HeadingFL:
         return {}
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        x = np.asarray(measurement, dtype=float)
-        psi, r = x[..., I_PSI], x[..., I_R]
-        e = wrap_angle(psi - reference[..., 0])
-        nu = -self.kp * e - self.kd * (r - reference[..., 1])
-        raw = (nu + self.a * r + self.b * r**3 - self.b_r) / self.c
-        return np.clip(raw, -self.delta_max, self.delta_max)[..., None]
+        """The law for every ship: the batch of :func:`heading_fl_step`."""
+        command, _ = kernel_step(self, t, measurement, reference, 1)
+        return command
 
     def kernel(self, batch_shape) -> Kernel:
         """:meth:`step` for the composed loop (:func:`heading_fl_step`); no per-ship state."""
@@ -496,8 +438,9 @@ class HeadingFL:
 
 @kernel_function
 def heading_fl_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`HeadingFL.step` for one ship: e = wrap(ψ − ψ_d), ν = −k_p e − k_d (r − r_d),
-    δ = clip((ν + a r + b r³ − b_r)/c). ``p`` = [δ_max, a, b, c, k_p, k_d, b_r]."""
+    """The heading FL of :class:`HeadingFL` for one ship (note 000-0.5): e = wrap(ψ − ψ_d),
+    ν = −k_p e − k_d (r − r_d), δ = clip((ν + a r + b r³ − b_r)/c).
+    ``p`` = [δ_max, a, b, c, k_p, k_d, b_r]."""
     delta_max, a, b, c_rudder, kp, kd, b_r = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
     psi, r = x[I_PSI], x[I_R]
     e = wrap(psi - ref[0])

@@ -22,12 +22,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shipgnc.control.base import kernel_step
 from shipgnc.errors import require
-from shipgnc.frames import wrap_angle
 from shipgnc.guidance.reference import HeadingReferenceModel
 from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
-from shipgnc.models.fossen3dof import BoatParams, allocate_thrust
+from shipgnc.models.fossen3dof import BoatParams
 
 
 @dataclass(frozen=True)
@@ -80,26 +80,9 @@ class HeadingSpeedAutopilot:
         self.z_u = np.zeros(batch_shape)
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        p, g, Ts = self.params, self.gains, self.Ts
-        psi, u, r = measurement[..., 2], measurement[..., 3], measurement[..., 5]
-        psi_d, u_d = reference[..., 0], reference[..., 1]
-        ref = self.reference_model
-        ref.start(psi)
-        acc = ref.acceleration(psi_d)
-        e = wrap_angle(psi - ref.psi)
-        damping_ff = -p.N_r * ref.rate
-        if self.yaw_feedforward:
-            damping_ff = damping_ff - p.N_rr * np.abs(ref.rate) * ref.rate
-        tau_r = p.M33 * acc + damping_ff - g.Kp * e - g.Kd * (r - ref.rate) - g.Ki * self.z
-        speed_error = u_d - u
-        tau_u = np.maximum(0.0, -p.X_u * u_d + g.Kpu * speed_error + g.Kiu * self.z_u)
-        thrust, alpha = allocate_thrust(tau_u, tau_r, p.L_m)
-        self.z = np.where(np.abs(alpha) <= p.alpha_max, self.z + Ts * e, self.z)
-        self.z_u = np.where((thrust >= p.T_min) & (thrust <= p.T_max),
-                            self.z_u + Ts * speed_error, self.z_u)
-        self._logged = {"psi_r": ref.psi.copy(), "r_r": ref.rate.copy()}
-        ref.advance(acc, Ts)
-        return np.stack([thrust, alpha], axis=-1)
+        """One sample for every ship: the batch of :func:`heading_speed_step`."""
+        command, self._logged = kernel_step(self, t, measurement, reference, 2)
+        return command
 
     def signal_values(self) -> dict[str, np.ndarray]:
         return self._logged
@@ -127,7 +110,16 @@ class HeadingSpeedAutopilot:
 
 @kernel_function
 def heading_speed_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`HeadingSpeedAutopilot.step` for one ship, operation for operation."""
+    """One sample of the heading + speed autopilot for one ship (note 001-1.10, module docstring)::
+
+        ψ̈_r = ω² wrap(ψ_d − ψ_r) − 2ζω ψ̇_r,   e = wrap(ψ − ψ_r)
+        τ_r = M₃₃ψ̈_r − N_r r_r [− N_|r|r |r_r| r_r] − K_p e − K_d (r − r_r) − K_i z
+        τ_u = max(0, −X_u u_d + K_pu (u_d − u) + K_iu z_u)
+        T = √(τ_u² + (τ_r/L_m)²),  α = atan2(−τ_r/L_m, τ_u)       (the inverse of eq. (5))
+
+    then z += Ts e while |α| ≤ α_max, z_u += Ts (u_d − u) while T_min ≤ T ≤ T_max (conditional
+    integration), and the reference model advanced by one Euler step of Ts, started at ψ_r = ψ,
+    r_r = 0. ``z`` = [z, z_u, ψ_r, r_r, started], ``sig`` = [ψ_r, r_r] before the step."""
     M33, N_r, N_rr, X_u, L_m, alpha_max, T_min, T_max = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
     Kp, Kd, Ki, Kpu, Kiu, w, zeta, Ts, yaw_ff = p[8], p[9], p[10], p[11], p[12], p[13], p[14], p[15], p[16]
     psi, su, sr = x[2], x[3], x[5]

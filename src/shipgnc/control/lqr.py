@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from shipgnc.batchmath import row_dot
+from shipgnc.control.base import kernel_step
 from shipgnc.errors import ConfigError, require
 from shipgnc.guidance.path import PATH_REFERENCES
 from shipgnc.kernels import Kernel, clip, flat, kernel_function, sign
@@ -242,26 +242,10 @@ class PathLQR:
         self.e_I = np.zeros(tuple(batch_shape))
         self._logged = {}
 
-    def state(self, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        """The LQR state [y_r, ψ_r, r, e_I] (SI, shape (..., 4))."""
-        x, ref = np.asarray(measurement, dtype=float), np.asarray(reference, dtype=float)
-        y_r, psi_r = ref[..., R_Y], ref[..., R_PSI]
-        e_I = np.broadcast_to(self.e_I, y_r.shape)
-        return np.stack([y_r, psi_r, x[..., I_R], e_I], axis=-1)
-
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        xs = self.state(measurement, reference)
-        y_r = xs[..., 0]
-        raw = -row_dot(xs, self.K)
-        delta = np.clip(raw, -self.delta_max, self.delta_max)
-        integrate = np.ones(raw.shape, dtype=bool)
-        if self.anti_windup:
-            # e_I += Ts·y_r changes the law by −k_e·Ts·y_r: hold it when that deepens saturation
-            deepens = np.sign(-self.K[3] * y_r) == np.sign(raw)
-            integrate = (np.abs(raw) <= self.delta_max) | ~deepens
-        self.e_I = np.where(integrate, xs[..., 3] + self.Ts * y_r, xs[..., 3])
-        self._logged = {"integral_error": xs[..., 3]}
-        return delta[..., None]
+        """Law (13) for every ship: the batch of :func:`path_lqr_step`."""
+        command, self._logged = kernel_step(self, t, measurement, reference, 1)
+        return command
 
     def signal_values(self) -> dict[str, np.ndarray]:
         return self._logged
@@ -303,9 +287,10 @@ def restore_path_state(ctrl, batch_shape, z: np.ndarray, *, n_own: int = 0) -> n
 
 @kernel_function
 def path_lqr_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`PathLQR.step` for one ship, operation for operation: law (13)
-    δ = clip(−K·[y_r, ψ_r, r, e_I]) (the sum left to right, as :func:`~shipgnc.batchmath.row_dot`),
-    then e_I += Ts·y_r (held by the anti-windup). ``p`` = [K (4), δ_max, Ts, anti-windup];
+    """Law (13) of document 000 for one ship: δ = clip(−K·[y_r, ψ_r, r, e_I], ±δ_max) (the sum
+    left to right), then the forward-Euler integral e_I += Ts·y_r, held by the anti-windup (if
+    on) while the unclipped law is beyond ±δ_max and sign(−k_e y_r) = sign(raw).
+    ``p`` = [K (4), δ_max, Ts, anti-windup];
     ``ref`` = the path references (y_r, ψ_r by name); ``z`` = [e_I, e_I logged, logged]."""
     k_y, k_psi, k_r, k_e = p[0], p[1], p[2], p[3]
     delta_max, Ts, anti_windup = p[4], p[5], p[6]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from shipgnc.control.base import kernel_step
 from shipgnc.errors import require
 from shipgnc.kernels import Kernel, kernel_function, schedule_params, schedule_row
 from shipgnc.timeseries import PiecewiseConstant
@@ -33,8 +34,10 @@ class OpenLoopSchedule:
         self._batch_shape = tuple(batch_shape)
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        value = self.schedule(t)
-        return np.broadcast_to(value, (*self._batch_shape, value.size)).copy()
+        """The schedule's row at ``t`` for every ship: the batch of :func:`schedule_step`."""
+        ignored = np.zeros((*self._batch_shape, 0))  # the measurement and reference are not read
+        command, _ = kernel_step(self, t, ignored, ignored, self.schedule.values.shape[1])
+        return command
 
     def signal_values(self) -> dict[str, np.ndarray]:
         return {}

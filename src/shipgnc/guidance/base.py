@@ -10,6 +10,7 @@ needs to end each member's series at its own completion.
 
 from __future__ import annotations
 
+import math
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -29,3 +30,22 @@ class Guidance(Protocol):
     def output_values(self) -> dict[str, np.ndarray]: ...
 
     def finished(self) -> np.ndarray | None: ...
+
+
+def kernel_reference(guidance, t: float, x) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """One sample of ``guidance`` for every ship: the batch over ships
+    (:func:`shipgnc.derive.per_ship`) of its scalar kernel ``guidance.kernel(batch_shape)``, the
+    one source of its law, run on the guidance's per-ship state (taken from the guidance and
+    handed back to it by the kernel's ``restore``). Returns the references (..., n_references)
+    and the logged outputs by name (``guidance.outputs``)."""
+    from shipgnc.derive import per_ship
+
+    x = np.asarray(x, dtype=float)
+    batch = x.shape[:-1]
+    kernel = guidance.kernel(batch)
+    z = kernel.state_for(math.prod(batch))
+    references, outputs, _ = per_ship(kernel.function, "t i z p o o -> r")(
+        t, x, z, kernel.params, len(guidance.references), len(guidance.outputs))
+    if kernel.restore is not None:
+        kernel.restore(z)
+    return references, {s.name: outputs[..., j] for j, s in enumerate(guidance.outputs)}

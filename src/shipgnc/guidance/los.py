@@ -40,7 +40,7 @@ import math
 import numpy as np
 
 from shipgnc.errors import require
-from shipgnc.frames import wrap_angle
+from shipgnc.guidance.base import kernel_reference
 from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal, state_index
 from shipgnc.paths import WaypointPath
@@ -104,33 +104,9 @@ class LOSGuidance:
         self._t_last: float | None = None
 
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
-        north, east = x[..., self._i_north], x[..., self._i_east]
-        last = self.path.n_legs - 1
-        lengths = self.path.leg_lengths
-        s, e = self.path.project(north, east, self.leg)
-        switch = (self.leg < last) & (s >= lengths[self.leg] - self.switch_radius)
-        if np.any(switch):
-            self.leg = np.where(switch, self.leg + 1, self.leg)
-            s, e = self.path.project(north, east, self.leg)
-            self.e_int = np.where(switch, 0.0, self.e_int)
-            self.beta_hat = np.where(switch, 0.0, self.beta_hat)
-        newly_done = (self.leg == last) & (s >= lengths[last]) & ~self._done
-        self.completion_time = np.where(newly_done, t, self.completion_time)
-        self._done = self._done | newly_done
-        D, sigma, gamma = self.lookahead, self.integral_gain, self.adaptive_gain
-        if sigma > 0 and self._t_last is not None:
-            h = t - self._t_last
-            self.e_int = self.e_int + h * D * e / ((e + sigma * self.e_int) ** 2 + D * D)
-        if gamma > 0 and self._t_last is not None:
-            h = t - self._t_last
-            self.beta_hat = self.beta_hat + h * gamma * self.speed * D * e / np.sqrt(D * D + e * e)
-        self._t_last = t
-        psi_d = wrap_angle(self.path.leg_angles[self.leg] - self.beta_hat
-                           - np.arctan((e + sigma * self.e_int) / D))
-        self._outputs = {"cross_track_error": e, "along_track": s, "leg": self.leg.astype(float)}
-        if gamma > 0:
-            self._outputs["crab_angle_est"] = self.beta_hat
-        return np.stack([psi_d, np.full_like(psi_d, self.speed)], axis=-1)
+        """``[ψ_d, u_d]`` for every ship: the batch of :func:`los_reference`."""
+        references, self._outputs = kernel_reference(self, t, x)
+        return references
 
     def output_values(self) -> dict[str, np.ndarray]:
         return self._outputs
@@ -169,7 +145,16 @@ class LOSGuidance:
 
 @kernel_function
 def los_reference(t, x, z, p, ref, out):
-    """One :meth:`LOSGuidance.reference` for one ship, operation for operation."""
+    """One sample of (integral / adaptive) LOS guidance for one ship (module docstring; note
+    001-1.10, Fossen 2021 §12.4)::
+
+        (s, e) = path frame of the active leg (s along-track, e cross-track, to starboard)
+        leg += 1 once s ≥ L_leg − R_sw (not past the last leg; e_int, β̂ restart at 0)
+        ė_int = Δ e/((e + σ e_int)² + Δ²),   β̂̇ = γ U Δ e/√(Δ² + e²)   (forward Euler over h)
+        ψ_d = wrap(π_p − β̂ − atan((e + σ e_int)/Δ)),   u_d = U
+
+    finished once s reaches the end of the last leg. ``z`` = [leg, done, e_int, t_last (NaN
+    before the first sample), completion_time, β̂]; ``out`` = [e, s, leg(, β̂)]."""
     n_legs = int(p[2])
     D, sigma, speed, R_sw, gamma = p[3], p[4], p[5], p[6], p[7]
     north, east = x[int(p[0])], x[int(p[1])]

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from shipgnc.errors import require
-from shipgnc.frames import wrap_angle
+from shipgnc.guidance.base import kernel_reference
 from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal, state_index
 from shipgnc.paths import LEG_ANGLE, LegTracker, WaypointPath, leg_table, leg_value, track_leg
@@ -62,12 +62,9 @@ class PathGuidance:
         self._outputs = {}
 
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
-        x = np.asarray(x, dtype=float)
-        i_north, i_east, i_psi = self._index
-        _, y_r, angle = self.tracker.update(x[..., i_north], x[..., i_east])
-        psi_r = wrap_angle(x[..., i_psi] - angle)
-        self._outputs = {"leg": self.tracker.leg.astype(float)}
-        return np.stack(np.broadcast_arrays(y_r, psi_r, angle), axis=-1)
+        """``[y_r, ψ_r, π_p]`` for every ship: the batch of :func:`path_reference`."""
+        references, self._outputs = kernel_reference(self, t, x)
+        return references
 
     def output_values(self) -> dict[str, np.ndarray]:
         return self._outputs
@@ -96,8 +93,9 @@ _LEGS = 3
 
 @kernel_function
 def path_reference(t, x, z, p, ref, out):
-    """One :meth:`PathGuidance.reference` for one ship: the active leg (A6, :func:`track_leg`),
-    y_r, ψ_r = wrap(ψ − π_p), π_p. ``p`` = [north, east, psi indices, leg table]; ``z`` = [leg]."""
+    """The path frame of document 000 for one ship: the active leg (A6, :func:`track_leg`), then
+    eq. (2) y_r = −(n − n_i) sin π_p + (e − e_i) cos π_p, ψ_r = wrap(ψ − π_p), and π_p.
+    ``p`` = [north, east, psi indices, leg table]; ``z`` = [leg]."""
     leg, _, y_r = track_leg(x[int(p[0])], x[int(p[1])], int(z[0]), p, _LEGS)
     angle = leg_value(p, _LEGS, LEG_ANGLE, leg)
     z[0] = leg

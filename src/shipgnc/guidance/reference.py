@@ -15,9 +15,12 @@ class HeadingReferenceModel:
     """Second-order heading filter ψ̈_r + 2ζω ψ̇_r + ω² ψ_r = ω² ψ_d.
 
     ζ = 1 (critically damped) is note 001-1.10's autopilot; document 003 eq. (15) uses ω_n = 0.1,
-    ζ = 0.85. Driven by wrap(ψ_d − ψ_r), so it turns the shortest way round; initialised at the
-    measured heading with ψ̇_r = 0; advanced by explicit Euler at the controller's sample time.
-    Batched: the state arrays take the batch shape.
+    ζ = 0.85. Driven by wrap(ψ_d − ψ_r), ψ̈_r = ω² wrap(ψ_d − ψ_r) − 2ζω ψ̇_r, so it turns the
+    shortest way round; initialised at the measured heading with ψ̇_r = 0; advanced by explicit
+    Euler at the controller's sample time. The controllers that use it step it inside their
+    kernels (:func:`~shipgnc.control.heading_speed.heading_speed_step`,
+    :func:`~shipgnc.control.course.sliding_mode_step`); this object keeps its parameters and, per
+    ship, the state ``psi``, ``rate`` (None before the first sample).
     """
 
     def __init__(self, omega: float, zeta: float = 1.0):
@@ -33,20 +36,6 @@ class HeadingReferenceModel:
     def reset(self) -> None:
         self.psi = None
         self.rate = None
-
-    def acceleration(self, psi_d):
-        """ψ̈_r = ω² wrap(ψ_d − ψ_r) − 2ζω ψ̇_r."""
-        w = self.omega
-        return w * w * wrap_angle(psi_d - self.psi) - 2.0 * self.zeta * w * self.rate
-
-    def start(self, psi_measured) -> None:
-        if self.psi is None:
-            self.psi = np.array(psi_measured, dtype=float, copy=True)
-            self.rate = np.zeros_like(self.psi)
-
-    def advance(self, acceleration, Ts: float) -> None:
-        self.psi = self.psi + Ts * self.rate
-        self.rate = self.rate + Ts * acceleration
 
 
 class ThirdOrderReferenceModel:

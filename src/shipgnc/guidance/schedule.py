@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from shipgnc.errors import require
+from shipgnc.guidance.base import kernel_reference
 from shipgnc.kernels import (
     Kernel,
     NotCompiled,
@@ -52,8 +53,8 @@ class ReferenceSchedule:
         return Kernel(schedule_reference, schedule_params(self.schedule))
 
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
-        value = self.schedule(t)
-        return np.broadcast_to(value, (*self._batch_shape, value.size)).copy()
+        """The set-points at ``t`` for every ship: the batch of :func:`schedule_reference`."""
+        return schedule_references(self, t)
 
     def output_values(self) -> dict[str, np.ndarray]:
         return {}
@@ -84,14 +85,20 @@ class CourseSchedule:
         return Kernel(schedule_reference, schedule_params(self.schedule))
 
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
-        value = self.schedule(t)
-        return np.broadcast_to(value, (*self._batch_shape, 1)).copy()
+        """The course set-point at ``t`` for every ship: the batch of :func:`schedule_reference`."""
+        return schedule_references(self, t)
 
     def output_values(self) -> dict[str, np.ndarray]:
         return {}
 
     def finished(self):
         return None
+
+
+def schedule_references(guidance, t: float) -> np.ndarray:
+    """The set-points of a schedule at ``t`` for every ship of its batch (the state is not read)."""
+    references, _ = kernel_reference(guidance, t, np.zeros((*guidance._batch_shape, 0)))
+    return references
 
 
 class HeadingProfile:
@@ -200,8 +207,8 @@ def heading_profile_reference(t, x, z, p, ref, out):
 
 @kernel_function
 def schedule_reference(t, x, z, p, ref, out):
-    """The set-points' row at ``t`` (``p`` from :func:`~shipgnc.kernels.schedule_params`); never
-    finished."""
+    """The set-points' row at ``t``, the row of :class:`~shipgnc.timeseries.PiecewiseConstant`
+    holding there (``p`` from :func:`~shipgnc.kernels.schedule_params`); never finished."""
     n = int(p[0])
     m = ref.shape[0]
     row = schedule_row(p[1:1 + n], t)

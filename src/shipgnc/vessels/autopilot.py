@@ -22,8 +22,8 @@ import math
 
 import numpy as np
 
+from shipgnc.control.base import kernel_step
 from shipgnc.errors import ConfigError, require
-from shipgnc.frames import wrap_angle
 from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal
 
@@ -56,13 +56,9 @@ class HeadingAutopilot:
         self._z = np.zeros(tuple(batch_shape))
 
     def step(self, t: float, measurement: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        e = wrap_angle(measurement[..., 2] - reference[..., 0])
-        raw = self.trim - self.Kp * e - self.Kd * measurement[..., 5] - self.Ki * self._z
-        delta_c = np.clip(raw, -self.delta_max, self.delta_max)
-        if self.Ki:
-            self._z = np.where(raw == delta_c, self._z + self.Ts * e, self._z)
-        parts = [delta_c] + [np.full_like(delta_c, h) for h in self.hold]
-        return np.stack(parts, axis=-1)
+        """One sample for every ship: the batch of :func:`heading_autopilot_step`."""
+        command, _ = kernel_step(self, t, measurement, reference, 1 + len(self.hold))
+        return command
 
     def signal_values(self) -> dict[str, np.ndarray]:
         return {}
@@ -83,8 +79,12 @@ class HeadingAutopilot:
 
 @kernel_function
 def heading_autopilot_step(t, x, ref, z, p, cmd, sig):
-    """:meth:`HeadingAutopilot.step` for one ship; p = [K_P, K_D, K_I, δ₀, δ_max, Ts, n_hold,
-    hold...], z = [∫e dt]."""
+    """The PID heading autopilot for one ship (Fossen 2021, §15.3)::
+
+        δ_c = clip(δ₀ − K_P e − K_D r − K_I z, −δ_max, δ_max),   e = wrap(ψ − ψ_d)
+
+    z += Ts e only while the command is within the limit (conditional integration); the vessel's
+    further inputs held. p = [K_P, K_D, K_I, δ₀, δ_max, Ts, n_hold, hold...], z = [∫e dt]."""
     e = wrap(x[2] - ref[0])
     raw = p[3] - p[0] * e - p[1] * x[5] - p[2] * z[0]
     dmax = p[4]
