@@ -60,10 +60,11 @@ class ColavGuidance:
         Signal("speed_cmd", "m/s", "speed commanded by the collision avoidance"),
     )
 
-    def __init__(self, los: LOSGuidance, encounters, *, method: str = "none",
+    def __init__(self, los: LOSGuidance, encounters, *, method: str = "none", methods=None,
                  method_params=None, memory: int = 0):
-        require(method in METHODS, "guidance.method", method,
-                f"allowed: {', '.join(METHODS)}")
+        methods = [method] if methods is None else list(methods)
+        for m in methods:
+            require(m in METHODS, "guidance.method", m, f"allowed: {', '.join(METHODS)}")
         members = [list(encounters)] if not encounters or isinstance(encounters[0], TargetTrack) \
             else [list(m) for m in encounters]
         for m, tracks in enumerate(members):
@@ -71,8 +72,11 @@ class ColavGuidance:
                 if not isinstance(track, TargetTrack):
                     raise ConfigError(f"targets of member {m}: {track!r} is not a TargetTrack")
         self.los = los
+        if len(methods) not in (1, len(members)):
+            raise ConfigError(f"methods: {len(methods)} for {len(members)} encounters (give one, "
+                              "or one per encounter)")
         self.members = members
-        self.method = method
+        self.methods = methods
         self.method_params = flat(method_params if method_params is not None else 0.0)
         self.memory = int(memory)
         self.n_max = max(1, max(len(t) for t in members))
@@ -99,12 +103,15 @@ class ColavGuidance:
         """
         los = self.los.kernel(self._batch_shape).params
         rows = []
-        for tracks in self.members:
+        n = max(len(self.members), len(self.methods))
+        for m in range(n):
+            tracks = self.members[m % len(self.members)]
+            method = self.methods[m % len(self.methods)]
             table = np.zeros((self.n_max, self.n_samples, 5))
             table[:, :, 0] = np.inf
             for j, track in enumerate(tracks):
                 table[j, :track.t.size] = track.table()
-            rows.append(flat(los.size, METHODS[self.method], len(tracks), self.n_samples,
+            rows.append(flat(los.size, METHODS[method], len(tracks), self.n_samples,
                              self.n_max, *self._index, self.method_params.size, self.memory,
                              los, table, self.method_params))
         return np.vstack(rows)
@@ -112,8 +119,9 @@ class ColavGuidance:
     def reset(self, batch_shape, model) -> None:
         self._batch_shape = tuple(batch_shape)
         n = math.prod(self._batch_shape)
-        if len(self.members) not in (1, n):
-            raise ConfigError(f"targets: {len(self.members)} encounters for a batch of {n} ships "
+        rows = max(len(self.members), len(self.methods))
+        if rows not in (1, n):
+            raise ConfigError(f"targets: {rows} encounters for a batch of {n} ships "
                               "(give one, or one per ship)")
         self.los.reset(batch_shape, model)
         self._index = (state_index(model, "north"), state_index(model, "east"),
