@@ -29,19 +29,31 @@ import math
 
 import numpy as np
 
+from shipgnc.colav.sbmpc import sbmpc_choose
 from shipgnc.colav.tracks import TargetTrack
 from shipgnc.derive import per_ship
 from shipgnc.errors import ConfigError, require
 from shipgnc.guidance.los import LOSGuidance, los_reference
-from shipgnc.kernels import Kernel, flat, kernel_function
+from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal, state_index
 
 #: avoidance methods by name → the kernel's method code
-METHODS = {"none": 0}
-#: header of a parameter row (see :meth:`ColavGuidance.kernel`)
-_HEADER = 12
-#: the LOS part of the per-ship state
+METHODS = {"none": 0, "sbmpc": 1}
+#: header of a parameter row (see :meth:`ColavGuidance.params`)
+_HEADER = 13
+#: the LOS part of the per-ship state, then [next decision time, course offset, speed factor]
 _LOS_STATE = 6
+_HOLD = 3
+
+
+def method_parts(method: str, config=None) -> tuple[np.ndarray, int]:
+    """(flat parameters, memory length) of avoidance ``method`` with its ``config`` (None: the
+    method's defaults)."""
+    if method == "sbmpc":
+        from shipgnc.colav.sbmpc import SBMPC_MEMORY, sbmpc_params
+
+        return sbmpc_params(config), SBMPC_MEMORY
+    return flat(0.0), 0
 
 
 class ColavGuidance:
@@ -61,10 +73,12 @@ class ColavGuidance:
     )
 
     def __init__(self, los: LOSGuidance, encounters, *, method: str = "none", methods=None,
-                 method_params=None, memory: int = 0):
+                 configs=None, decision_interval: float = 5.0):
         methods = [method] if methods is None else list(methods)
         for m in methods:
             require(m in METHODS, "guidance.method", m, f"allowed: {', '.join(METHODS)}")
+        require(math.isfinite(decision_interval) and decision_interval >= 0,
+                "guidance.decision_interval", decision_interval, "must be >= 0 s")
         members = [list(encounters)] if not encounters or isinstance(encounters[0], TargetTrack) \
             else [list(m) for m in encounters]
         for m, tracks in enumerate(members):
@@ -72,13 +86,15 @@ class ColavGuidance:
                 if not isinstance(track, TargetTrack):
                     raise ConfigError(f"targets of member {m}: {track!r} is not a TargetTrack")
         self.los = los
-        if len(methods) not in (1, len(members)):
+        if len(methods) not in (1, len(members)) and len(members) != 1:
             raise ConfigError(f"methods: {len(methods)} for {len(members)} encounters (give one, "
                               "or one per encounter)")
         self.members = members
         self.methods = methods
-        self.method_params = flat(method_params if method_params is not None else 0.0)
-        self.memory = int(memory)
+        self.decision_interval = float(decision_interval)
+        configs = configs or {}
+        self.parts = {m: method_parts(m, configs.get(m)) for m in dict.fromkeys(methods)}
+        self.memory = max(memory for _, memory in self.parts.values())
         self.n_max = max(1, max(len(t) for t in members))
         self.n_samples = max([1] + [tr.t.size for tracks in members for tr in tracks])
         self._z = None
@@ -94,10 +110,10 @@ class ColavGuidance:
         return self.los.speed
 
     def params(self) -> np.ndarray:
-        """One parameter row per member ``(n_members, n_p)``::
+        """One parameter row per member ``(n_members, n_p)`` (shorter rows padded with zeros)::
 
-            [n_los, method, n_targets, n_samples, n_max, i_north, i_east, i_psi, i_u, i_v,
-             n_method_params, memory,  LOS params (n_los),
+            [n_los, method, n_targets, n_samples, n_max, i_north, i_east, i_psi, i_u, i_v
+             (-1: none), n_method_params, memory, decision interval,  LOS params (n_los),
              targets: n_max × n_samples × (t, north, east, v_north, v_east), unused samples at
              t = +inf,  method params]
         """
@@ -107,14 +123,16 @@ class ColavGuidance:
         for m in range(n):
             tracks = self.members[m % len(self.members)]
             method = self.methods[m % len(self.methods)]
+            mp, _ = self.parts[method]
             table = np.zeros((self.n_max, self.n_samples, 5))
             table[:, :, 0] = np.inf
             for j, track in enumerate(tracks):
                 table[j, :track.t.size] = track.table()
             rows.append(flat(los.size, METHODS[method], len(tracks), self.n_samples,
-                             self.n_max, *self._index, self.method_params.size, self.memory,
-                             los, table, self.method_params))
-        return np.vstack(rows)
+                             self.n_max, *self._index, mp.size, self.memory,
+                             self.decision_interval, los, table, mp))
+        width = max(r.size for r in rows)
+        return np.vstack([np.pad(r, (0, width - r.size)) for r in rows])
 
     def reset(self, batch_shape, model) -> None:
         self._batch_shape = tuple(batch_shape)
@@ -131,12 +149,13 @@ class ColavGuidance:
         self._z = np.zeros((n, self.state_width))
         self._z[:, 3] = np.nan  # LOS: no sample yet
         self._z[:, 4] = np.nan  # LOS: completion time
+        self._z[:, _LOS_STATE + 2] = 1.0  # held speed factor: the nominal
 
     @property
     def state_width(self) -> int:
-        """LOS state, the method's memory, then scratch: own (4), nominal (2), command (2),
-        targets (4 n_max)."""
-        return _LOS_STATE + self.memory + 8 + 4 * self.n_max
+        """LOS state, the held decision [next decision time, course offset, speed factor], the
+        method's memory, then scratch: own (4), nominal (2), command (2), targets (4 n_max)."""
+        return _LOS_STATE + _HOLD + self.memory + 8 + 4 * self.n_max
 
     # ------------------------------------------------------------------ numpy loop
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
@@ -209,35 +228,46 @@ class ColavGuidance:
 @kernel_function
 def colav_reference(t, x, z, p, ref, out):
     """One sample of :class:`ColavGuidance` for one ship (module docstring): LOS for the nominal
-    course, the targets dead-reckoned from their tables, then the avoidance method."""
-    n_los, n_targets = int(p[0]), int(p[2])
+    course, the targets dead-reckoned from their tables, then the avoidance method — called every
+    decision interval (the paper's re-planning period; 0: every sample), its choice held as an
+    offset from the nominal course and a factor of the nominal speed in between."""
+    n_los, method, n_targets = int(p[0]), int(p[1]), int(p[2])
     n_samples, n_max = int(p[3]), int(p[4])
     i_north, i_east, i_psi, i_u, i_v = int(p[5]), int(p[6]), int(p[7]), int(p[8]), int(p[9])
-    memory = int(p[11])
+    n_mp, memory, interval = int(p[10]), int(p[11]), p[12]
     h = _HEADER
     finished = los_reference(t, x, z[:_LOS_STATE], p[h:h + n_los], ref, out)
     table = p[h + n_los:h + n_los + n_max * n_samples * 5]
-    s = _LOS_STATE + memory  # scratch
+    mp = p[h + n_los + n_max * n_samples * 5:h + n_los + n_max * n_samples * 5 + n_mp]
+    hold = z[_LOS_STATE:_LOS_STATE + _HOLD]
+    zm = z[_LOS_STATE + _HOLD:_LOS_STATE + _HOLD + memory]
+    s = _LOS_STATE + _HOLD + memory  # scratch
     own, nominal, cmd = z[s:s + 4], z[s + 4:s + 6], z[s + 6:s + 8]
     targets = z[s + 8:s + 8 + 4 * n_max]
-    v = x[i_v] if i_v >= 0 else 0.0
-    own[0], own[1] = x[i_north], x[i_east]
-    own[2] = x[i_psi] + math.atan2(v, x[i_u])
-    own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
     nominal[0], nominal[1] = ref[0], ref[1]
-    for j in range(n_targets):
-        rows = table[j * n_samples * 5:(j + 1) * n_samples * 5]
-        k = 0
-        while k + 1 < n_samples and rows[(k + 1) * 5] <= t:
-            k += 1
-        dt = t - rows[k * 5]
-        targets[4 * j] = rows[k * 5 + 1] + rows[k * 5 + 3] * dt
-        targets[4 * j + 1] = rows[k * 5 + 2] + rows[k * 5 + 4] * dt
-        targets[4 * j + 2] = rows[k * 5 + 3]
-        targets[4 * j + 3] = rows[k * 5 + 4]
-    cmd[0], cmd[1] = nominal[0], nominal[1]
-    ref[0], ref[1] = cmd[0], cmd[1]
-    out[3], out[4], out[5] = nominal[0], cmd[0], cmd[1]
+    if method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t)):
+        v = x[i_v] if i_v >= 0 else 0.0
+        own[0], own[1] = x[i_north], x[i_east]
+        own[2] = x[i_psi] + math.atan2(v, x[i_u])
+        own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
+        for j in range(n_targets):
+            rows = table[j * n_samples * 5:(j + 1) * n_samples * 5]
+            k = 0
+            while k + 1 < n_samples and rows[(k + 1) * 5] <= t:
+                k += 1
+            dt = t - rows[k * 5]
+            targets[4 * j] = rows[k * 5 + 1] + rows[k * 5 + 3] * dt
+            targets[4 * j + 1] = rows[k * 5 + 2] + rows[k * 5 + 4] * dt
+            targets[4 * j + 2] = rows[k * 5 + 3]
+            targets[4 * j + 3] = rows[k * 5 + 4]
+        if method == 1:
+            sbmpc_choose(t, own, targets, n_targets, nominal, mp, zm, cmd)
+        hold[0] = t + interval
+        hold[1] = wrap(cmd[0] - nominal[0])
+        hold[2] = cmd[1] / nominal[1] if nominal[1] > 0.0 else 1.0
+    ref[0] = wrap(nominal[0] + hold[1]) if hold[1] != 0.0 else nominal[0]
+    ref[1] = hold[2] * nominal[1]
+    out[3], out[4], out[5] = nominal[0], ref[0], ref[1]
     return finished
 
 
@@ -259,7 +289,8 @@ def from_section(g, scenario) -> ColavGuidance:
         track = target.track(label=f"target {j + 1}")
         check_clear(track, own, g.safety_radius, f"guidance.targets[{j}]")
         tracks.append(track)
-    return ColavGuidance(los, tracks, method=g.method)
+    return ColavGuidance(los, tracks, method=g.method, configs={"sbmpc": g.sbmpc},
+                         decision_interval=g.decision_interval)
 
 
 def check_clear(track: TargetTrack, own, safety_radius: float, where: str) -> None:

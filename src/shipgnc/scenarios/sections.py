@@ -16,6 +16,7 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import AfterValidator, Field, field_validator, model_validator
 
+from shipgnc.colav.sbmpc import SBMPCConfig
 from shipgnc.config_types import Finite, NonNegative, Positive, Strict
 from shipgnc.errors import ConfigError
 
@@ -1013,7 +1014,12 @@ class ColavConfig(Strict):
                                              "switch_radius": "m", "safety_radius": "m"}
 
     type: Literal["colav"]
-    method: Literal["none"] = "none"
+    #: ``none`` (the nominal course: the baseline) or ``sbmpc`` (simulation-based MPC)
+    method: Literal["none", "sbmpc"] = "none"
+    #: SB-MPC's behaviour set, horizon and weights (Johansen, Perez & Cristofaro 2016)
+    sbmpc: SBMPCConfig = Field(default_factory=SBMPCConfig)
+    #: the avoidance method decides every this many seconds (its choice held in between)
+    decision_interval: NonNegative = 5.0
     #: ``[[north, east], ...]``, sailed in order (the nominal path)
     waypoints: Annotated[list[tuple[Finite, Finite]], Field(min_length=2)]
     #: lookahead distance Δ of the nominal LOS

@@ -33,6 +33,9 @@ OWN_SHIP = {"vessel": {"model": "frigate", "speed_mps": 9.0},
 DURATION, DT = 1200.0, 0.5
 #: the ship domain of the scores [m]
 SAFETY_RADIUS = 200.0
+#: SB-MPC for the own ship: its safety distance scaled to the ships (the ship domain), course offsets
+#: only (the frigate model holds its speed); the rest the paper's defaults
+SBMPC = {"d_safe": SAFETY_RADIUS, "speed_factors": [1.0]}
 #: the nominal path: north from the origin, long enough for any encounter
 PATH_LENGTH = 40_000.0
 
@@ -125,7 +128,8 @@ def own_scenario(own_speed: float, method: str):
                        "initial_state": {"north": 0.0, "east": 0.0, "psi_deg": 0.0}},
         "controller": OWN_SHIP["controller"],
         "guidance": {"type": "colav", "method": method, "waypoints": [[0.0, 0.0], [PATH_LENGTH, 0.0]],
-                     "lookahead": 1000.0, "safety_radius": SAFETY_RADIUS}}, "encounter sweep")
+                     "lookahead": 1000.0, "safety_radius": SAFETY_RADIUS, "sbmpc": SBMPC}},
+                    "encounter sweep")
 
 
 def run_members(members: list[Member], *, backend: str = "auto", log_every: int = 10,
@@ -147,10 +151,13 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
     for speed in speeds:
         index = [i for i, m in enumerate(members) if round(m.situation.own_speed, 9) == speed]
         methods = [members[i].method for i in index]
-        setup = build(own_scenario(speed, methods[0]))
+        scenario = own_scenario(speed, methods[0])
+        setup = build(scenario)
         g0 = setup.guidance
+        g = scenario.guidance
         guidance = ColavGuidance(g0.los, [list(members[i].situation.targets) for i in index],
-                                 methods=methods)
+                                 methods=methods, configs={"sbmpc": g.sbmpc},
+                                 decision_interval=g.decision_interval)
         x0 = np.tile(setup.x0, (len(index), 1))
         result = simulate(setup.model, x0, t_end=DURATION, dt=DT, controller=setup.controller,
                           actuator=setup.actuator, guidance=guidance, u0=setup.u0,
