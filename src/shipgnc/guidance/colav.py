@@ -6,7 +6,9 @@ Each sample the guidance
    (:func:`shipgnc.guidance.los.los_reference`, the same law and leg switching as ``type: los``);
 2. dead-reckons every target from its track table (:class:`shipgnc.colav.tracks.TargetTrack`:
    the last sample at or before t, moved on at constant velocity) to its position and velocity
-   over ground at t;
+   over ground at t, and keeps the least range to any target so far (``range_min``, its time and
+   target: the realised closest point of approach, at every guidance sample whatever the log's
+   thinning);
 3. hands the own ship ``[north, east, χ, U]`` (course and speed over ground,
    χ = ψ + atan2(v, u), U = √(u² + v²)), the targets and the nominal ``[χ_n, U_n]`` to the
    avoidance method, which returns the commanded course and speed; with ``method = none`` the
@@ -41,9 +43,10 @@ from shipgnc.models.base import Signal, state_index
 METHODS = {"none": 0, "sbmpc": 1}
 #: header of a parameter row (see :meth:`ColavGuidance.params`)
 _HEADER = 13
-#: the LOS part of the per-ship state, then [next decision time, course offset, speed factor]
+#: the LOS part of the per-ship state, then [next decision time, course offset, speed factor,
+#: least range so far, its time, its target]
 _LOS_STATE = 6
-_HOLD = 3
+_HOLD = 6
 
 
 def method_parts(method: str, config=None) -> tuple[np.ndarray, int]:
@@ -70,6 +73,9 @@ class ColavGuidance:
         Signal("course_nominal", "rad", "nominal course toward the waypoints (LOS)", angle=True),
         Signal("course_cmd", "rad", "course commanded by the collision avoidance", angle=True),
         Signal("speed_cmd", "m/s", "speed commanded by the collision avoidance"),
+        Signal("range_min", "m", "least range to any target so far (at the guidance samples)"),
+        Signal("t_range_min", "s", "time of range_min"),
+        Signal("target_range_min", "1", "target (0-based) of range_min"),
     )
 
     def __init__(self, los: LOSGuidance, encounters, *, method: str = "none", methods=None,
@@ -150,6 +156,7 @@ class ColavGuidance:
         self._z[:, 3] = np.nan  # LOS: no sample yet
         self._z[:, 4] = np.nan  # LOS: completion time
         self._z[:, _LOS_STATE + 2] = 1.0  # held speed factor: the nominal
+        self._z[:, _LOS_STATE + 3:_LOS_STATE + 6] = (np.inf, np.nan, -1.0)  # no range yet
 
     @property
     def state_width(self) -> int:
@@ -245,21 +252,24 @@ def colav_reference(t, x, z, p, ref, out):
     own, nominal, cmd = z[s:s + 4], z[s + 4:s + 6], z[s + 6:s + 8]
     targets = z[s + 8:s + 8 + 4 * n_max]
     nominal[0], nominal[1] = ref[0], ref[1]
+    for j in range(n_targets):
+        rows = table[j * n_samples * 5:(j + 1) * n_samples * 5]
+        k = 0
+        while k + 1 < n_samples and rows[(k + 1) * 5] <= t:
+            k += 1
+        dt = t - rows[k * 5]
+        targets[4 * j] = rows[k * 5 + 1] + rows[k * 5 + 3] * dt
+        targets[4 * j + 1] = rows[k * 5 + 2] + rows[k * 5 + 4] * dt
+        targets[4 * j + 2] = rows[k * 5 + 3]
+        targets[4 * j + 3] = rows[k * 5 + 4]
+        d = math.hypot(targets[4 * j] - x[i_north], targets[4 * j + 1] - x[i_east])
+        if d < hold[3]:
+            hold[3], hold[4], hold[5] = d, t, float(j)
     if method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t)):
         v = x[i_v] if i_v >= 0 else 0.0
         own[0], own[1] = x[i_north], x[i_east]
         own[2] = x[i_psi] + math.atan2(v, x[i_u])
         own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
-        for j in range(n_targets):
-            rows = table[j * n_samples * 5:(j + 1) * n_samples * 5]
-            k = 0
-            while k + 1 < n_samples and rows[(k + 1) * 5] <= t:
-                k += 1
-            dt = t - rows[k * 5]
-            targets[4 * j] = rows[k * 5 + 1] + rows[k * 5 + 3] * dt
-            targets[4 * j + 1] = rows[k * 5 + 2] + rows[k * 5 + 4] * dt
-            targets[4 * j + 2] = rows[k * 5 + 3]
-            targets[4 * j + 3] = rows[k * 5 + 4]
         if method == 1:
             sbmpc_choose(t, own, targets, n_targets, nominal, mp, zm, cmd)
         hold[0] = t + interval
@@ -268,6 +278,7 @@ def colav_reference(t, x, z, p, ref, out):
     ref[0] = wrap(nominal[0] + hold[1]) if hold[1] != 0.0 else nominal[0]
     ref[1] = hold[2] * nominal[1]
     out[3], out[4], out[5] = nominal[0], ref[0], ref[1]
+    out[6], out[7], out[8] = hold[3], hold[4], hold[5]
     return finished
 
 
