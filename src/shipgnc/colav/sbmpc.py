@@ -65,6 +65,17 @@ SBMPC_MEMORY = 2
 _N_FIXED = 21  # parameters before the behaviour set (sbmpc_params)
 
 
+def check_behaviours(course_offsets_deg, speed_factors) -> None:
+    """A candidate set holds the nominal (offset 0, factor 1), offsets in (−180°, 180°), factors
+    in [0, 1]; else a ValueError naming the field."""
+    if any(not -180.0 < a < 180.0 for a in course_offsets_deg) or 0.0 not in course_offsets_deg:
+        raise ValueError(f"course_offsets_deg = {course_offsets_deg}: offsets in (-180, 180) "
+                         "including 0 (the nominal course)")
+    if any(not 0.0 <= f <= 1.0 for f in speed_factors) or 1.0 not in speed_factors:
+        raise ValueError(f"speed_factors = {speed_factors}: factors in [0, 1] including 1 "
+                         "(the nominal speed)")
+
+
 class SBMPCConfig(Strict):
     """SB-MPC's behaviour set, prediction and cost weights (defaults and sources: module docstring)."""
 
@@ -98,12 +109,7 @@ class SBMPCConfig(Strict):
 
     @model_validator(mode="after")
     def _check(self):
-        if any(not -180.0 < a < 180.0 for a in self.course_offsets_deg) or 0.0 not in self.course_offsets_deg:
-            raise ValueError(f"course_offsets_deg = {self.course_offsets_deg}: offsets in (-180, 180) "
-                             "including 0 (the nominal course)")
-        if any(not 0.0 <= f <= 1.0 for f in self.speed_factors) or 1.0 not in self.speed_factors:
-            raise ValueError(f"speed_factors = {self.speed_factors}: factors in [0, 1] including 1 "
-                             "(the nominal speed)")
+        check_behaviours(self.course_offsets_deg, self.speed_factors)
         if self.dt > self.horizon:
             raise ValueError(f"dt = {self.dt}: at most the horizon ({self.horizon} s)")
         return self

@@ -43,6 +43,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from shipgnc.colav.colreg import GIVE_WAY, HEAD_ON, ColregConfig, classify, colreg_params
+from shipgnc.colav.sbmpc import check_behaviours
 from shipgnc.config_types import Positive, Strict
 from shipgnc.derive import per_ship
 from shipgnc.kernels import flat, kernel_function, wrap
@@ -67,12 +68,7 @@ class VOConfig(Strict):
 
     @model_validator(mode="after")
     def _check(self):
-        if any(not -180.0 < a < 180.0 for a in self.course_offsets_deg) or 0.0 not in self.course_offsets_deg:
-            raise ValueError(f"course_offsets_deg = {self.course_offsets_deg}: offsets in (-180, 180) "
-                             "including 0 (the nominal course)")
-        if any(not 0.0 <= f <= 1.0 for f in self.speed_factors) or 1.0 not in self.speed_factors:
-            raise ValueError(f"speed_factors = {self.speed_factors}: factors in [0, 1] including 1 "
-                             "(the nominal speed)")
+        check_behaviours(self.course_offsets_deg, self.speed_factors)
         return self
 
 
