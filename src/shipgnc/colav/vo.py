@@ -123,11 +123,22 @@ def vo_choose(t, own, targets, n_targets, nominal, p, z, out):
     n_factors = int(p[8])
     n = int(n_targets)
     cp = p[2:7]
+    # per target, once: must the own ship give way (COLREG half-plane)? can it be met within T?
+    gives_way = np.zeros(n, dtype=np.bool_)
+    near = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        tn, te, tvn, tve = targets[4 * i], targets[4 * i + 1], targets[4 * i + 2], targets[4 * i + 3]
+        code = classify(own[0], own[1], nominal[0], nominal[1], tn, te, tvn, tve, cp)
+        gives_way[i] = code == HEAD_ON or code == GIVE_WAY
+        reach = (abs(nominal[1]) + math.hypot(tvn, tve)) * horizon + radius
+        near[i] = math.hypot(tn - own[0], te - own[1]) <= reach
     best_level = 3  # 0: clear of VO and COLREG, 1: clear of VO, 2: neither
     best_cost = math.inf
     best_chi = 0.0
     best_factor = 1.0
     for a in range(n_offsets):
+        if best_level == 0 and best_chi == 0.0 and best_factor == 1.0:
+            break  # the nominal velocity (the first candidate) is clear: nothing is nearer
         chi = p[_N_FIXED + a]
         course = nominal[0] + chi
         for b in range(n_factors):
@@ -139,18 +150,18 @@ def vo_choose(t, own, targets, n_targets, nominal, p, z, out):
             breaks_colreg = False
             first_entry = math.inf
             for i in range(n):
-                tn, te = targets[4 * i], targets[4 * i + 1]
-                tvn, tve = targets[4 * i + 2], targets[4 * i + 3]
-                ln, le = tn - own[0], te - own[1]
-                wn, we = vn - tvn, ve - tve
-                t_in = entry_time(ln, le, wn, we, radius)
-                if t_in < first_entry:
-                    first_entry = t_in
-                if t_in <= horizon:
-                    in_vo = True
-                if not breaks_colreg and leaves_to_starboard(ln, le, wn, we):
-                    code = classify(own[0], own[1], nominal[0], nominal[1], tn, te, tvn, tve, cp)
-                    breaks_colreg = code == HEAD_ON or code == GIVE_WAY
+                if not (near[i] or gives_way[i]):
+                    continue
+                ln, le = targets[4 * i] - own[0], targets[4 * i + 1] - own[1]
+                wn, we = vn - targets[4 * i + 2], ve - targets[4 * i + 3]
+                if near[i]:
+                    t_in = entry_time(ln, le, wn, we, radius)
+                    if t_in < first_entry:
+                        first_entry = t_in
+                    if t_in <= horizon:
+                        in_vo = True
+                if gives_way[i] and leaves_to_starboard(ln, le, wn, we):
+                    breaks_colreg = True
             level = 2 if in_vo else (1 if breaks_colreg else 0)
             dvn = vn - nominal[1] * math.cos(nominal[0])
             dve = ve - nominal[1] * math.sin(nominal[0])
