@@ -159,6 +159,16 @@ def test_the_batch_runs_each_ship_and_keeps_its_memory():
     assert z[1, 0] == pytest.approx(cmd[1, 0])
 
 
+def test_bad_batch_input_names_the_argument():
+    own = np.array([[0.0, 0.0, *NOMINAL]])
+    with pytest.raises(ValueError, match="n_targets: whole numbers from 0 to 2"):
+        sbmpc_batch(0.0, own, np.zeros((1, 8)), [3], [NOMINAL], sbmpc_params(), np.zeros((1, 2)))
+    with pytest.raises(ValueError, match="targets: last axis must hold 4 numbers"):
+        sbmpc_batch(0.0, own, np.zeros((1, 7)), [1], [NOMINAL], sbmpc_params(), np.zeros((1, 2)))
+    with pytest.raises(ValueError, match="own: last axis"):
+        sbmpc_batch(0.0, own[:, :3], np.zeros((1, 8)), [1], [NOMINAL], sbmpc_params(), np.zeros((1, 2)))
+
+
 def test_a_bad_config_names_the_field():
     with pytest.raises(ValueError, match="course_offsets_deg"):
         SBMPCConfig(course_offsets_deg=[-30.0, 30.0])

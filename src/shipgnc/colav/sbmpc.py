@@ -230,9 +230,28 @@ def _sbmpc_row(t, own, targets, n_targets, nominal, p, z, out):
     sbmpc_choose(t, own, targets, int(n_targets[0]), nominal, p, z, out)
 
 
+def batch_inputs(own, targets, n_targets, nominal):
+    """The numpy entries' inputs checked and shaped: own (n, 4), targets (n, 4·n_max), n_targets
+    (n, 1) as floats, nominal (n, 2); a ValueError names the first bad one."""
+    own = np.atleast_2d(np.asarray(own, dtype=float))
+    targets = np.atleast_2d(np.asarray(targets, dtype=float))
+    nominal = np.atleast_2d(np.asarray(nominal, dtype=float))
+    counts = np.atleast_1d(np.asarray(n_targets, dtype=float)).reshape(-1, 1)
+    if own.shape[-1] != 4:
+        raise ValueError(f"own: last axis must be [north, east, course, speed], got shape {own.shape}")
+    if nominal.shape[-1] != 2:
+        raise ValueError(f"nominal: last axis must be [course, speed], got shape {nominal.shape}")
+    if targets.shape[-1] % 4:
+        raise ValueError(f"targets: last axis must hold 4 numbers per target, got shape {targets.shape}")
+    if np.any(counts < 0) or np.any(counts > targets.shape[-1] // 4) or np.any(counts != np.round(counts)):
+        raise ValueError(f"n_targets: whole numbers from 0 to {targets.shape[-1] // 4} (the targets' "
+                         f"rows), got {counts.ravel().tolist()}")
+    return own, targets, counts, nominal
+
+
 def sbmpc_batch(t, own, targets, n_targets, nominal, params, z) -> np.ndarray:
     """:func:`sbmpc_choose` for every ship (:func:`shipgnc.derive.per_ship`): own (n, 4), targets
     (n, n_max·4), n_targets (n,), nominal (n, 2), params from :func:`sbmpc_params`, z (n, 2)
     updated in place; returns the commands (n, 2)."""
-    n_targets = np.asarray(n_targets, dtype=float).reshape(-1, 1)
+    own, targets, n_targets, nominal = batch_inputs(own, targets, n_targets, nominal)
     return per_ship(_sbmpc_row, "t i i i i p z o")(t, own, targets, n_targets, nominal, params, z, 2)

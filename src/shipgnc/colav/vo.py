@@ -43,7 +43,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from shipgnc.colav.colreg import GIVE_WAY, HEAD_ON, ColregConfig, classify, colreg_params
-from shipgnc.colav.sbmpc import check_behaviours
+from shipgnc.colav.sbmpc import batch_inputs, check_behaviours
 from shipgnc.config_types import Positive, Strict
 from shipgnc.derive import per_ship
 from shipgnc.kernels import flat, kernel_function, wrap
@@ -189,5 +189,5 @@ def vo_batch(t, own, targets, n_targets, nominal, params, z) -> np.ndarray:
     """:func:`vo_choose` for every ship (:func:`shipgnc.derive.per_ship`): own (n, 4), targets
     (n, n_max·4), n_targets (n,), nominal (n, 2), params from :func:`vo_params`, z (n, 1) updated
     in place; returns the commands (n, 2)."""
-    n_targets = np.asarray(n_targets, dtype=float).reshape(-1, 1)
+    own, targets, n_targets, nominal = batch_inputs(own, targets, n_targets, nominal)
     return per_ship(_vo_row, "t i i i i p z o")(t, own, targets, n_targets, nominal, params, z, 2)
