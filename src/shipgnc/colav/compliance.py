@@ -71,8 +71,9 @@ class ComplianceConfig(Strict):
     speed_change_md: float = Field(0.1, gt=0, le=1, description="smallest speed change that is a "
                                                                 "manoeuvre, fraction of the speed")
 
-    field_units: ClassVar[dict[str, str]] = {"gamma_near_miss": "1", "speed_change_app": "1",
-                                             "speed_change_md": "1"}
+    field_units: ClassVar[dict[str, str]] = {
+        "r_collision": "m", "r_near_miss": "m", "r_safe": "m", "gamma_near_miss": "1", "r_detect": "m",
+        "r_early": "m", "r_late": "m", "speed_change_app": "1", "speed_change_md": "1"}
 
     @model_validator(mode="after")
     def _check(self):

@@ -51,7 +51,7 @@ The per-ship memory ``z`` = [χ_last, 1 − P_last]: zeros mean "the nominal beh
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -88,7 +88,7 @@ class SBMPCConfig(Strict):
     dt: Positive = Field(5.0, description="prediction sample time Δt [s]")
     d_safe: Positive = Field(50.0, description="safety distance: a predicted range inside it is a hazard [m]")
     d_close: Positive = Field(1000.0, description="range within which COLREG applies in μ [m]")
-    k_coll: NonNegative = Field(1.0, description="K_coll, collision cost per relative speed squared [s²/m²]")
+    k_coll: NonNegative = Field(1.0, description="K_coll, weight of the relative speed squared (m/s) in C")
     p_time: NonNegative = Field(1.0, description="exponent p of the inverse time to the event")
     q_distance: NonNegative = Field(4.0, description="exponent q of d_safe/d")
     kappa: NonNegative = Field(3.0, description="κ, cost of a COLREG violation")
@@ -106,6 +106,11 @@ class SBMPCConfig(Strict):
         "encounter", description="μ's head-on/crossing/overtaken judged once from the nominal velocity "
                                  "('encounter'), or from each behaviour's predicted velocity as the paper "
                                  "writes it ('predicted'; see the module docstring)")
+
+    field_units: ClassVar[dict[str, str]] = {
+        "speed_factors": "1", "horizon": "s", "dt": "s", "d_safe": "m", "d_close": "m", "k_coll": "1",
+        "p_time": "1", "q_distance": "1", "kappa": "1", "k_p": "1", "k_chi_starboard": "1/rad²",
+        "k_chi_port": "1/rad²", "k_dp": "1", "k_dchi_starboard": "1/rad²", "k_dchi_port": "1/rad²"}
 
     @model_validator(mode="after")
     def _check(self):

@@ -38,6 +38,7 @@ The per-ship memory ``z`` = [last course offset (rad)].
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -65,6 +66,8 @@ class VOConfig(Strict):
                                        description="fractions of the nominal speed tried; must include 1")
     colreg: ColregConfig = Field(default_factory=ColregConfig,
                                  description="when a target is an encounter, and which")
+
+    field_units: ClassVar[dict[str, str]] = {"radius": "m", "horizon": "s", "speed_factors": "1"}
 
     @model_validator(mode="after")
     def _check(self):
