@@ -33,6 +33,7 @@ import numpy as np
 
 from shipgnc.colav.sbmpc import sbmpc_choose
 from shipgnc.colav.tracks import TargetTrack
+from shipgnc.colav.vo import vo_choose
 from shipgnc.derive import per_ship
 from shipgnc.errors import ConfigError, require
 from shipgnc.guidance.los import LOSGuidance, los_reference
@@ -40,7 +41,7 @@ from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal, state_index
 
 #: avoidance methods by name → the kernel's method code
-METHODS = {"none": 0, "sbmpc": 1}
+METHODS = {"none": 0, "sbmpc": 1, "vo": 2}
 #: header of a parameter row (see :meth:`ColavGuidance.params`)
 _HEADER = 13
 #: the LOS part of the per-ship state, then [next decision time, course offset, speed factor,
@@ -56,6 +57,10 @@ def method_parts(method: str, config=None) -> tuple[np.ndarray, int]:
         from shipgnc.colav.sbmpc import SBMPC_MEMORY, sbmpc_params
 
         return sbmpc_params(config), SBMPC_MEMORY
+    if method == "vo":
+        from shipgnc.colav.vo import VO_MEMORY, vo_params
+
+        return vo_params(config), VO_MEMORY
     return flat(0.0), 0
 
 
@@ -272,6 +277,8 @@ def colav_reference(t, x, z, p, ref, out):
         own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
         if method == 1:
             sbmpc_choose(t, own, targets, n_targets, nominal, mp, zm, cmd)
+        else:
+            vo_choose(t, own, targets, n_targets, nominal, mp, zm, cmd)
         hold[0] = t + interval
         hold[1] = wrap(cmd[0] - nominal[0])
         hold[2] = cmd[1] / nominal[1] if nominal[1] > 0.0 else 1.0
@@ -300,7 +307,7 @@ def from_section(g, scenario) -> ColavGuidance:
         track = target.track(label=f"target {j + 1}")
         check_clear(track, own, g.safety_radius, f"guidance.targets[{j}]")
         tracks.append(track)
-    return ColavGuidance(los, tracks, method=g.method, configs={"sbmpc": g.sbmpc},
+    return ColavGuidance(los, tracks, method=g.method, configs={"sbmpc": g.sbmpc, "vo": g.vo},
                          decision_interval=g.decision_interval)
 
 

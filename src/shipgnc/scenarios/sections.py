@@ -17,6 +17,7 @@ from typing import Annotated, ClassVar, Literal
 from pydantic import AfterValidator, Field, field_validator, model_validator
 
 from shipgnc.colav.sbmpc import SBMPCConfig
+from shipgnc.colav.vo import VOConfig
 from shipgnc.config_types import Finite, NonNegative, Positive, Strict
 from shipgnc.errors import ConfigError
 
@@ -1014,10 +1015,13 @@ class ColavConfig(Strict):
                                              "switch_radius": "m", "safety_radius": "m"}
 
     type: Literal["colav"]
-    #: ``none`` (the nominal course: the baseline) or ``sbmpc`` (simulation-based MPC)
-    method: Literal["none", "sbmpc"] = "none"
+    #: ``none`` (the nominal course: the baseline), ``sbmpc`` (simulation-based MPC) or ``vo``
+    #: (velocity obstacles with COLREG constraints)
+    method: Literal["none", "sbmpc", "vo"] = "none"
     #: SB-MPC's behaviour set, horizon and weights (Johansen, Perez & Cristofaro 2016)
     sbmpc: SBMPCConfig = Field(default_factory=SBMPCConfig)
+    #: the velocity obstacles' safety radius, horizon and candidates (Kuwata et al. 2014)
+    vo: VOConfig = Field(default_factory=VOConfig)
     #: the avoidance method decides every this many seconds (its choice held in between)
     decision_interval: NonNegative = 5.0
     #: ``[[north, east], ...]``, sailed in order (the nominal path)

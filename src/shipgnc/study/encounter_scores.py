@@ -66,3 +66,31 @@ def score(scenario, result, setup) -> dict:
         value = float(arrays[key][0])
         out[key] = int(value) if key in ("collision", "cpa_target") else value
     return out
+
+
+def compliance_arrays(result, members_tracks, codes) -> dict[str, np.ndarray]:
+    """COLREG compliance after Woerner (:func:`shipgnc.colav.compliance.compliance_scores`) of
+    every member of a batch result: ``members_tracks`` one list of targets per member, ``codes``
+    their situations at t = 0 (member, target). Returns (member,) arrays: each rule's score
+    (``rule_14`` … ``rule_17``, NaN where no encounter invokes it) and ``compliance``, the least
+    score of the rules the member's encounters invoke (the safety score is ``safety``)."""
+    from shipgnc.colav.compliance import SCORES, compliance_scores
+
+    t = result["time"].values
+
+    def two(name):
+        a = result[name].values
+        return a.reshape(a.shape[0], -1)
+
+    north, east, psi, u = two("north"), two("east"), two("psi"), two("u")
+    v = two("v") if "v" in result else np.zeros_like(u)
+    course, speed = psi + np.arctan2(v, u), np.hypot(u, v)
+    out = {name: np.full(len(members_tracks), np.nan) for name in (*SCORES, "compliance")}
+    for k, tracks in enumerate(members_tracks):
+        scores = compliance_scores(t, north[:, k], east[:, k], course[:, k], speed[:, k], tracks,
+                                   list(codes[k][:len(tracks)]))
+        for name in SCORES:
+            out[name][k] = scores[name]
+        rules = [scores[name] for name in SCORES if name != "safety" and not np.isnan(scores[name])]
+        out["compliance"][k] = min(rules) if rules else np.nan
+    return out

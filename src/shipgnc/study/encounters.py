@@ -36,6 +36,8 @@ SAFETY_RADIUS = 200.0
 #: SB-MPC for the own ship: its safety distance scaled to the ships (the ship domain), course offsets
 #: only (the frigate model holds its speed); the rest the paper's defaults
 SBMPC = {"d_safe": SAFETY_RADIUS, "speed_factors": [1.0]}
+#: velocity obstacles likewise: the ship domain as the combined safety radius, course offsets only
+VO = {"radius": SAFETY_RADIUS, "speed_factors": [1.0]}
 #: the nominal path: north from the origin, long enough for any encounter
 PATH_LENGTH = 40_000.0
 
@@ -128,24 +130,28 @@ def own_scenario(own_speed: float, method: str):
                        "initial_state": {"north": 0.0, "east": 0.0, "psi_deg": 0.0}},
         "controller": OWN_SHIP["controller"],
         "guidance": {"type": "colav", "method": method, "waypoints": [[0.0, 0.0], [PATH_LENGTH, 0.0]],
-                     "lookahead": 1000.0, "safety_radius": SAFETY_RADIUS, "sbmpc": SBMPC}},
+                     "lookahead": 1000.0, "safety_radius": SAFETY_RADIUS, "sbmpc": SBMPC,
+                     "vo": VO}},
                     "encounter sweep")
 
 
 def run_members(members: list[Member], *, backend: str = "auto", log_every: int = 10,
-                keep_results: bool = False) -> SweepResult:
-    """Run every member (one batch per own-ship speed) and score it."""
+                keep_results: bool = False, compliance: bool = True) -> SweepResult:
+    """Run every member (one batch per own-ship speed) and score it (``compliance``: with the
+    COLREG compliance scores, from the log at every ``log_every``-th step)."""
     import time
 
+    from shipgnc.colav.compliance import SCORES
     from shipgnc.guidance.colav import ColavGuidance
     from shipgnc.scenarios.runner import build
     from shipgnc.sim.simulator import simulate
-    from shipgnc.study.encounter_scores import COLAV_KEYS, batch_arrays
+    from shipgnc.study.encounter_scores import COLAV_KEYS, batch_arrays, compliance_arrays
 
     check_members(members)
     speeds = sorted({round(m.situation.own_speed, 9) for m in members})
-    scores = {key: np.full(len(members), np.nan) for key in (*COLAV_KEYS, "situation", "d_cpa0_m",
-                                                             "t_cpa0_s")}
+    keys = (*COLAV_KEYS, "situation", "d_cpa0_m", "t_cpa0_s",
+            *((*SCORES, "compliance") if compliance else ()))
+    scores = {key: np.full(len(members), np.nan) for key in keys}
     out = SweepResult(members, scores)
     start = time.perf_counter()
     for speed in speeds:
@@ -156,7 +162,7 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
         g0 = setup.guidance
         g = scenario.guidance
         guidance = ColavGuidance(g0.los, [list(members[i].situation.targets) for i in index],
-                                 methods=methods, configs={"sbmpc": g.sbmpc},
+                                 methods=methods, configs={"sbmpc": g.sbmpc, "vo": g.vo},
                                  decision_interval=g.decision_interval)
         x0 = np.tile(setup.x0, (len(index), 1))
         result = simulate(setup.model, x0, t_end=DURATION, dt=DT, controller=setup.controller,
@@ -166,6 +172,9 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
         out.ship_steps += len(index) * round(DURATION / DT)
         arrays = batch_arrays(result, guidance, SAFETY_RADIUS)
         arrays.update(initial_scores(members, index))
+        if compliance:
+            arrays.update(compliance_arrays(result, [members[i].situation.targets for i in index],
+                                            situation_codes(members, index)))
         for key, value in arrays.items():
             scores[key][index] = value
         if keep_results:
@@ -189,9 +198,23 @@ def initial_scores(members, index) -> dict[str, np.ndarray]:
             "t_cpa0_s": geo["t_cpa"]}
 
 
+def situation_codes(members, index) -> np.ndarray:
+    """COLREG situation codes at t = 0 of every target of the members ``index`` (member, target)."""
+    from shipgnc.colav.colreg import situations
+
+    n_max = max(len(members[i].situation.targets) for i in index)
+    codes = np.zeros((len(index), n_max), dtype=int)
+    for k, i in enumerate(index):
+        sit = members[i].situation
+        own = [0.0, 0.0, sit.own_course, sit.own_speed]
+        for j, t in enumerate(sit.targets):
+            codes[k, j] = int(situations(own, [t.north[0], t.east[0], t.v_north[0], t.v_east[0]]))
+    return codes
+
+
 def summary(result: SweepResult) -> list[dict]:
     """One row per (encounter type, method): members, collisions, median and least minimum range,
-    median time lost."""
+    median time lost, median compliance (the least score of the rules invoked, after Woerner)."""
     rows = []
     keys = dict.fromkeys((m.situation.encounter_type or m.situation.title, m.method)
                          for m in result.members)
@@ -204,6 +227,10 @@ def summary(result: SweepResult) -> list[dict]:
                      "collisions": int(np.nansum(s["collision"][idx])),
                      "median_cpa_m": float(np.nanmedian(rng)), "min_cpa_m": float(np.nanmin(rng)),
                      "median_time_lost_s": float(np.nanmedian(s["time_lost_s"][idx]))})
+        if "compliance" in s:
+            c = s["compliance"][idx]
+            rows[-1]["median_compliance"] = float(np.nanmedian(c)) if np.isfinite(c).any() \
+                else float("nan")
     return rows
 
 
