@@ -28,7 +28,7 @@ def _member_series(result, i):
     return None, None
 
 
-def tracks_figure(result, *, outline_every: float = 120.0, window: float = 2500.0):
+def tracks_figure(result, *, outline_every: float = 60.0, window: float = 1500.0):
     """The tracks figure (module docstring)."""
     from matplotlib.patches import Polygon
 
@@ -118,4 +118,22 @@ def write_figures(result, out) -> list:
         path = out / name
         fig.savefig(path, dpi=130)
         paths.append(path)
+    return paths
+
+
+def document_figures(directory) -> list:
+    """The encounters page's figures: the standard set with 20 perturbed variants of each
+    situation (seed 1), met with no avoidance, SB-MPC and velocity obstacles."""
+    from pathlib import Path
+
+    from shipgnc.study.encounters import run_members, standard_members
+
+    result = run_members(standard_members(["none", "sbmpc", "vo"], mc=20, seed=1),
+                         keep_results=True)
+    directory = Path(directory)
+    paths = []
+    for name, fig in (("encounters-tracks.png", tracks_figure(result)),
+                      ("encounters-cpa-polar.png", polar_figure(result))):
+        fig.savefig(directory / name, dpi=110)
+        paths.append(directory / name)
     return paths
