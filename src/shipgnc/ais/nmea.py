@@ -185,7 +185,7 @@ def position_fields(r: PositionReport) -> dict:
     _check("cog", r.cog, -4 * math.pi, 4 * math.pi, "rad")
     _check("heading", r.heading, -4 * math.pi, 4 * math.pi, "rad")
     cog = COG_NA_DEG if r.cog is None else round(math.degrees(r.cog % (2 * math.pi)), 1) % 360.0
-    hdg = HEADING_NA if r.heading is None else int(round(math.degrees(r.heading % (2 * math.pi)))) % 360
+    hdg = HEADING_NA if r.heading is None else round(math.degrees(r.heading % (2 * math.pi))) % 360
     fields = dict(msg_type=r.msg_type, mmsi=r.mmsi,
                   lat=91.0 if r.lat is None else r.lat, lon=181.0 if r.lon is None else r.lon,
                   speed=SOG_NA_KN if r.sog is None else round(r.sog / KNOT, 1),
