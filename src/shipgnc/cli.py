@@ -350,6 +350,10 @@ from shipgnc.cli_design import app as _design  # noqa: E402  (controllers design
 
 app.add_typer(_design, name="design")
 
+from shipgnc.cli_ais import app as _ais  # noqa: E402  (logged AIS files)
+
+app.add_typer(_ais, name="ais")
+
 
 def main() -> None:
     """Console-script entry point. A usage error (an unknown option or command, a value that does
