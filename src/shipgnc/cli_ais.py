@@ -46,7 +46,7 @@ def info(
     from shipgnc.cli import friendly_errors, print_columns, stdout
 
     with friendly_errors():
-        from shipgnc.ais.logs import _utc, read_log, read_reports
+        from shipgnc.ais.logs import read_log, read_reports, utc_text
         from shipgnc.units import KNOT
 
         reports = read_reports(file, skip_unknown=skip_unknown)
@@ -57,11 +57,11 @@ def info(
         for tr in tracks:
             speed = [math.hypot(a, b) / KNOT for a, b in zip(tr.v_north, tr.v_east, strict=True)]
             rows.append(dict(mmsi=tr.mmsi, name=tr.name, source=tr.source, reports=int(tr.t.size),
-                             first_utc=_utc(t0 + tr.t[0]), last_utc=_utc(t0 + tr.t[-1]),
+                             first_utc=utc_text(t0 + tr.t[0]), last_utc=utc_text(t0 + tr.t[-1]),
                              span_min=round(float(tr.t[-1] - tr.t[0]) / 60.0, 2),
                              sog_min_kn=round(min(speed), 1), sog_max_kn=round(max(speed), 1)))
-        summary = dict(file=str(file), messages=len(reports), targets=len(tracks), first_utc=_utc(t0),
-                       last_utc=_utc(t1), span_min=round((t1 - t0) / 60.0, 2), origin=list(org))
+        summary = dict(file=str(file), messages=len(reports), targets=len(tracks), first_utc=utc_text(t0),
+                       last_utc=utc_text(t1), span_min=round((t1 - t0) / 60.0, 2), origin=list(org))
         if json_:
             stdout.print_json(json.dumps(dict(summary, tracks=rows)))
             return

@@ -329,15 +329,15 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
         kept: list[Report] = []
         for r in by_mmsi[mmsi]:
             if kept and r.time < kept[-1].time:
-                raise ConfigError(f"{where}: line {r.line}: MMSI {mmsi} at {_utc(r.time)} is earlier than "
-                                  f"its report at line {kept[-1].line} ({_utc(kept[-1].time)}); times "
-                                  "must not go back")
+                raise ConfigError(f"{where}: line {r.line}: MMSI {mmsi} at {utc_text(r.time)} is earlier "
+                                  f"than its report at line {kept[-1].line} ({utc_text(kept[-1].time)}); "
+                                  "times must not go back")
             if kept and r.time == kept[-1].time:
                 a, b = kept[-1].msg, r.msg
                 if (a.lat, a.lon, a.sog, a.cog) == (b.lat, b.lon, b.sog, b.cog):
                     continue  # the same report heard twice
                 raise ConfigError(f"{where}: line {r.line}: MMSI {mmsi} reports a different position at "
-                                  f"the time of line {kept[-1].line} ({_utc(r.time)})")
+                                  f"the time of line {kept[-1].line} ({utc_text(r.time)})")
             kept.append(r)
         t = np.array([r.time for r in kept]) - t0
         lat = np.array([r.msg.lat for r in kept])
@@ -356,5 +356,6 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
     return tracks, origin
 
 
-def _utc(t: float) -> str:
+def utc_text(t: float) -> str:
+    """A unix time as ISO 8601 UTC to the hundredth of a second."""
     return datetime.fromtimestamp(t, tz=timezone.utc).strftime("%Y-%m-%dT%H:%M:%S.%f")[:-4] + "Z"
