@@ -142,6 +142,7 @@ def test_bad_input_one_line_each(tmp_path):
     _raises(csv, r"line 2: field basedatetime = '2023-13-01T00:00:00': not a time")
     _raises(tmp_path / "absent.nmea", "no such file")
     _raises(_write(tmp_path, [""]), "empty")
+    _raises(_write(tmp_path, ["# nothing but a comment"]), "no position report in the file")
     _raises(_write(tmp_path, [ok]), r"origin = \(95, 0\)", origin=(95, 0))
 
 

@@ -245,7 +245,7 @@ def _read_csv(lines: list[str]) -> list[Report]:
         heading = None if hdg is None or not 0 <= hdg < 360.0 else math.radians(hdg)
         out.append(Report(line=no, time=time, msg=nmea.PositionReport(
             mmsi=mmsi, lat=None if lon is None else lat, lon=None if lat is None else lon, sog=sog, cog=cog,
-            heading=heading, msg_type=0)))
+            heading=heading, msg_type=0)))  # msg_type 0: a CSV row, not a message
     return out
 
 
@@ -316,6 +316,8 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
     for mmsi, line in sorted(first_line.items(), key=lambda kv: kv[1]):
         if mmsi not in by_mmsi:
             raise ConfigError(f"{where}: MMSI {mmsi} (first at line {line}) has no position report")
+    if not by_mmsi:
+        raise ConfigError(f"{where}: no position report in the file")
     lat_all = np.array([r.msg.lat for rs in by_mmsi.values() for r in rs])
     lon_all = np.array([r.msg.lon for rs in by_mmsi.values() for r in rs])
     if origin is None:
