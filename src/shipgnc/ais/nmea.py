@@ -110,10 +110,11 @@ def _to_rad(deg: float) -> float:
 
 
 def _rot_from_ais(turn) -> float | None:
-    """pyais gives the rate of turn in °/min (rounded), or a TurnRate member for ±127/−128."""
-    if turn is None or not isinstance(turn, (int, float)) or type(turn).__name__ == "TurnRate":
-        return None
-    if abs(turn) > 708.0:  # beyond ±708 °/min (raw ±126) the field holds a code, not a rate
+    """pyais gives the rate of turn in °/min (rounded; raw ±126 reads ±709), or a TurnRate member
+    for the codes ±127 (turning, rate unknown) and −128 (not available)."""
+    from pyais.constants import TurnRate
+
+    if turn is None or isinstance(turn, TurnRate) or not isinstance(turn, (int, float)):
         return None
     return float(turn) * DEG_PER_MIN
 
