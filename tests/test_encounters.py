@@ -221,3 +221,30 @@ def test_sweep_members_are_their_scenarios():
     assert sweep.scores["min_range_m"][0] == pytest.approx(alone.metrics["min_range_m"], abs=0.01)
     assert sweep.scores["time_lost_s"][0] == pytest.approx(alone.metrics["time_lost_s"], abs=0.01)
     assert sweep.scores["collision"][0] == alone.metrics["collision"] == 0
+
+
+def test_targets_replayed_from_an_ais_log(tmp_path):
+    """A target written as an NMEA AIS log (reports every 10 s, pyais) and replayed through
+    ``guidance.ais_log`` moves as the constant-velocity track it was written from, to the message's
+    quantisation (position 1/10000 arc minute, SOG 0.1 kn, COG 0.1°: metres over the run), and
+    its realised CPA is the closed form's to the same tolerance."""
+    from shipgnc.ais.write import write_log
+    from shipgnc.colav.tracks import TargetTrack
+
+    origin = (58.0, 10.0)
+    course = math.radians(200.0)
+    true = TargetTrack.constant(8000.0, 2500.0, course, 8.0)
+    t = np.arange(0.0, 701.0, 10.0)
+    own = {"north": U * t, "east": 0.0 * t, "sog": np.full_like(t, U), "cog": 0.0 * t}
+    path = write_log(tmp_path / "log.nmea", t, own, [true], origin, 257000001, [257000002],
+                     interval=10.0)
+    run = _run([], extra=(f"guidance.ais_log={json.dumps({'path': str(path), 'origin': origin})}",))
+    ds = run.result
+    n, e, _, _ = true.at(ds["time"].values)
+    assert ds.sizes["target"] == 1
+    np.testing.assert_allclose(ds["target_north"].values[:, 0], n, atol=5.0)
+    np.testing.assert_allclose(ds["target_east"].values[:, 0], e, atol=5.0)
+    v = 8.0 * np.array([math.cos(course), math.sin(course)]) - np.array([U, 0.0])
+    d_cpa, t_cpa = closed_form_cpa(np.array([8000.0, 2500.0]), v)
+    assert run.metrics["min_range_m"] == pytest.approx(d_cpa, abs=5.0)
+    assert run.metrics["t_min_range_s"] == pytest.approx(t_cpa, abs=2.0)

@@ -289,28 +289,6 @@ def colav_reference(t, x, z, p, ref, out):
     return finished
 
 
-def from_section(g, scenario) -> ColavGuidance:
-    """The ``guidance: {type: colav}`` section's guidance (its targets placed against the own
-    ship's start: a target inside the safety radius at t = 0 is refused, naming it)."""
-    from shipgnc.paths import WaypointPath
-
-    speed = g.speed if g.speed is not None else getattr(scenario.vessel, "speed_mps", None)
-    if speed is None:
-        raise ConfigError(f"guidance.speed: vessel model {scenario.vessel.model!r} has no "
-                          "straight-run speed; give the nominal speed in m/s")
-    los = LOSGuidance(WaypointPath(g.waypoints), lookahead=g.lookahead, speed=speed,
-                      switch_radius=g.switch_radius)
-    init = scenario.simulation.initial_state if scenario.simulation is not None else None
-    own = (init.north, init.east) if init is not None else (0.0, 0.0)
-    tracks = []
-    for j, target in enumerate(g.targets):
-        track = target.track(label=f"target {j + 1}")
-        check_clear(track, own, g.safety_radius, f"guidance.targets[{j}]")
-        tracks.append(track)
-    return ColavGuidance(los, tracks, method=g.method, configs={"sbmpc": g.sbmpc, "vo": g.vo},
-                         decision_interval=g.decision_interval)
-
-
 def check_clear(track: TargetTrack, own, safety_radius: float, where: str) -> None:
     """A target inside the safety radius of the own ship at t = 0 is a ConfigError naming it."""
     n, e, _, _ = track.at(0.0)

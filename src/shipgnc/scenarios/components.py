@@ -176,7 +176,7 @@ GUIDANCE: dict[str, GuidanceKind] = {k.type: k for k in (
                  build="shipgnc.scenarios.catamaran:heading_capture"),
     GuidanceKind("steady-turn", S.SteadyTurnGuidanceConfig, vessels=("catamaran",),
                  build="shipgnc.scenarios.catamaran:steady_turn_reference", reads_scenario=True),
-    GuidanceKind("colav", S.ColavConfig, build="shipgnc.guidance.colav:from_section",
+    GuidanceKind("colav", S.ColavConfig, build="shipgnc.study.encounters:colav_guidance",
                  reads_scenario=True),
 )}
 

@@ -1006,6 +1006,19 @@ class TargetConfig(Strict):
                            name=self.name or label, length=self.length, beam=self.beam)
 
 
+class AISLogConfig(Strict):
+    """Targets replayed from a logged AIS file (NMEA or CSV, :func:`shipgnc.ais.logs.read_log`):
+    one target per MMSI (the logging ship's own ``!AIVDO`` reports left out), dead-reckoned between
+    its reports; positions in the local plane about ``origin`` (lat, lon) [deg], where the own
+    ship's ``simulation.initial_state`` (north, east) is; null: the centre of the data."""
+
+    field_units: ClassVar[dict[str, str]] = {"origin": "deg"}
+
+    path: Annotated[str, Field(min_length=1)]
+    origin: tuple[Annotated[float, Field(ge=-90, le=90)],
+                  Annotated[float, Field(ge=-180, le=180)]] | None = None
+
+
 class ColavConfig(Strict):
     """Collision avoidance between the path guidance and the autopilot
     (:mod:`shipgnc.guidance.colav`): lookahead LOS along ``waypoints`` gives the nominal course,
@@ -1036,6 +1049,8 @@ class ColavConfig(Strict):
     safety_radius: Positive = 200.0
     #: the target ships
     targets: list[TargetConfig] = Field(default_factory=list)
+    #: more targets, replayed from a logged AIS file
+    ais_log: AISLogConfig | None = None
 
 
 # the navigation sections live with their components, beside their registry records

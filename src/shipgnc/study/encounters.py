@@ -109,6 +109,40 @@ def _bearing_deg(sit: tg.Situation) -> float:
     return math.degrees(math.atan2(t.east[0], t.north[0]))
 
 
+def colav_guidance(g, scenario):
+    """The ``guidance: {type: colav}`` section's :class:`~shipgnc.guidance.colav.ColavGuidance`
+    (the registry's builder): its targets and those of its AIS log, placed against the own ship's
+    start (a target inside the safety radius at t = 0 is refused, naming it)."""
+    from shipgnc.guidance.colav import ColavGuidance, check_clear
+    from shipgnc.guidance.los import LOSGuidance
+    from shipgnc.paths import WaypointPath
+
+    speed = g.speed if g.speed is not None else getattr(scenario.vessel, "speed_mps", None)
+    if speed is None:
+        raise ConfigError(f"guidance.speed: vessel model {scenario.vessel.model!r} has no "
+                          "straight-run speed; give the nominal speed in m/s")
+    los = LOSGuidance(WaypointPath(g.waypoints), lookahead=g.lookahead, speed=speed,
+                      switch_radius=g.switch_radius)
+    init = scenario.simulation.initial_state if scenario.simulation is not None else None
+    own = (init.north, init.east) if init is not None else (0.0, 0.0)
+    tracks = []
+    for j, target in enumerate(g.targets):
+        track = target.track(label=f"target {j + 1}")
+        check_clear(track, own, g.safety_radius, f"guidance.targets[{j}]")
+        tracks.append(track)
+    if g.ais_log is not None:
+        from shipgnc.ais.logs import read_log
+
+        logged, _ = read_log(g.ais_log.path, origin=g.ais_log.origin)
+        for track in logged:
+            if track.source == "ais-own":
+                continue
+            check_clear(track, own, g.safety_radius, f"guidance.ais_log: MMSI {track.mmsi}")
+            tracks.append(track)
+    return ColavGuidance(los, tracks, method=g.method, configs={"sbmpc": g.sbmpc, "vo": g.vo},
+                         decision_interval=g.decision_interval)
+
+
 def check_members(members: list[Member], safety_radius: float = SAFETY_RADIUS) -> None:
     """A target inside the safety radius at t = 0: a one-line ConfigError naming it."""
     from shipgnc.guidance.colav import check_clear
