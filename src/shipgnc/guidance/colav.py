@@ -172,11 +172,10 @@ class ColavGuidance:
     # ------------------------------------------------------------------ numpy loop
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
         x2 = np.asarray(x, dtype=float).reshape(-1, x.shape[-1])
-        ref, out, finished = per_ship(colav_reference, "t i z p o o -> r")(
+        ref, out, _ = per_ship(colav_reference, "t i z p o o -> r")(
             t, x2, self._z, self._params, 2, len(self.outputs))
         shape = self._batch_shape
         self._outputs = {s.name: out[:, k].reshape(shape) for k, s in enumerate(self.outputs)}
-        self._finished = finished.reshape(shape) > 0
         return ref.reshape(*shape, 2)
 
     def output_values(self) -> dict[str, np.ndarray]:

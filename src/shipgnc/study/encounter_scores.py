@@ -17,6 +17,8 @@ Per member of a run (one encounter each), from the logged outputs of the collisi
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 #: the keys of :func:`colav_arrays`, in order
@@ -64,7 +66,10 @@ def score(scenario, result, setup) -> dict:
     out = {}
     for key in COLAV_KEYS:
         value = float(arrays[key][0])
-        out[key] = int(value) if key in ("collision", "cpa_target") else value
+        if not math.isfinite(value):  # no target at all: no CPA
+            out[key] = None
+        else:
+            out[key] = int(value) if key in ("collision", "cpa_target") else value
     return out
 
 
