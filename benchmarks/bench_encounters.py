@@ -7,7 +7,8 @@ variants of each, every member a 20-minute encounter (dt 0.5 s) of the frigate u
 (deciding every 5 s, 13 course offsets, a 100 s horizon at 5 s), as one batched run:
 
 (a) the composed compiled loop (``backend="auto"``), after a warm-up that compiles or loads the
-    loop from its disk cache;
+    loop from its disk cache (its serial form and the parallel one a batch of 256 ships or more
+    runs);
 (b) the numpy loop (``backend="numpy"``: the guidance still runs its compiled kernel per ship,
     through the derived batch), on ``--numpy-mc`` variants of each type (it is slow).
 
@@ -49,7 +50,9 @@ def main() -> None:
     parser.add_argument("--mc", type=int, default=1000)
     parser.add_argument("--numpy-mc", type=int, default=10)
     args = parser.parse_args()
-    run(1, "auto")  # warm-up: compile or load the composed loop
+    # warm-up: compile or load the composed loop, serial and parallel (from 256 ships on)
+    run(1, "auto")
+    run(60, "auto")
     rows = [run(args.mc, "auto"), run(args.numpy_mc, "numpy")]
     for row in rows:
         print(f"{row['backend']:>6}: {row['encounters']:6d} encounters in {row['seconds']:8.2f} s: "
