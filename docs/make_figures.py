@@ -41,6 +41,8 @@ SETS = {
     "routing-geo": ("shipgnc.routing.geo.figures:document_figure", ("routing-geo-channel.png",)),
     "cybership-analysis": ("cybership_analysis:figure", ("cybership-analysis.png",)),
     "observer-loop": ("observer_loop:figure", ("observer-loop-rudder.png",)),
+    "encounters": ("shipgnc.viz.encounter_figures:document_figures",
+                   ("encounters-tracks.png", "encounters-cpa-polar.png")),
     "trials": ("shipgnc.viz.trial_figures:document_figures",
                tuple(f"trials-{v}-{w}.png" for v in ("mariner", "kvlcc2")
                      for w in ("turning", "zigzag-20", "zigzag-10", "spiral"))),

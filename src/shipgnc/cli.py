@@ -342,6 +342,10 @@ from shipgnc.cli_vessels import vessels as _vessels  # noqa: E402  (the vessel c
 
 app.command("vessels")(_vessels)
 
+from shipgnc.cli_encounters import encounters as _encounters  # noqa: E402  (ships meeting ships)
+
+app.command("encounters")(_encounters)
+
 from shipgnc.cli_design import app as _design  # noqa: E402  (controllers designed for a vessel)
 
 app.add_typer(_design, name="design")

@@ -138,7 +138,7 @@ CONTROLLERS: dict[str, ControllerKind] = {k.type: k for k in (
     ControllerKind("open-loop", S.OpenLoopConfig, build="shipgnc.scenarios.runner:open_loop_controller"),
     ControllerKind("heading-speed", S.HeadingSpeedConfig, guidance=("schedule", "los"),
                    build="shipgnc.scenarios.runner:heading_speed_controller"),
-    ControllerKind("course", S.CourseControllerConfig, guidance=("course-schedule",),
+    ControllerKind("course", S.CourseControllerConfig, guidance=("course-schedule", "colav"),
                    build="shipgnc.scenarios.runner:course_controller",
                    by_capability=((RUDDER_STATE, "shipgnc.vessels.autopilot:course_autopilot"),)),
     ControllerKind("lqr", S.PathLQRConfig, guidance=("path",),
@@ -176,6 +176,8 @@ GUIDANCE: dict[str, GuidanceKind] = {k.type: k for k in (
                  build="shipgnc.scenarios.catamaran:heading_capture"),
     GuidanceKind("steady-turn", S.SteadyTurnGuidanceConfig, vessels=("catamaran",),
                  build="shipgnc.scenarios.catamaran:steady_turn_reference", reads_scenario=True),
+    GuidanceKind("colav", S.ColavConfig, build="shipgnc.study.encounters:colav_guidance",
+                 reads_scenario=True),
 )}
 
 DISTURBANCES: dict[str, DisturbanceKind] = {k.type: k for k in (
@@ -195,6 +197,8 @@ METRICS: dict[str, MetricKind] = {k.name: k for k in (
     MetricKind("catamaran", vessels=("catamaran",)),
     MetricKind("catamaran-comparison", vessels=("catamaran",)),
     MetricKind("route", "route"),
+    MetricKind("colav", "controlled", guidance="colav",
+               score="shipgnc.study.encounter_scores:score"),
     MetricKind("none"),
 )}
 

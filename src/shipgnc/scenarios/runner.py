@@ -526,6 +526,8 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                 raise
             raise DivergenceError(f"{exc}; note: {'; '.join(setup.controller.notes)}", time=exc.time,
                                   state=exc.state, value=exc.value, index=exc.index) from None
+        if hasattr(setup.guidance, "add_targets") and run.result is not None:  # other ships
+            run.result = setup.guidance.add_targets(run.result)
         if setup.navigation is not None and run.result is not None:
             run.result.attrs["navigation_notes"] = "; ".join(setup.navigation.notes())
         if getattr(setup.controller, "notes", None) and run.result is not None:

@@ -16,6 +16,8 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import AfterValidator, Field, field_validator, model_validator
 
+from shipgnc.colav.sbmpc import SBMPCConfig
+from shipgnc.colav.vo import VOConfig
 from shipgnc.config_types import Finite, NonNegative, Positive, Strict
 from shipgnc.errors import ConfigError
 
@@ -953,6 +955,104 @@ class QualityConfig(Strict):
     lam: NonNegative = 1.0
 
 
+# --------------------------------------------------------------------------- collision avoidance
+
+class TargetLegEntry(Strict):
+    """From time ``t`` on, the target holds ``course_deg`` and ``speed`` over ground."""
+
+    field_units: ClassVar[dict[str, str]] = {"t": "s", "speed": "m/s"}
+    t: NonNegative
+    course_deg: HeadingDeg
+    speed: NonNegative
+
+
+class TargetConfig(Strict):
+    """A kinematic target ship: at (``north``, ``east``) at t = 0, holding ``course_deg`` and
+    ``speed`` over ground, or following ``schedule`` (course and speed from each entry's time on;
+    the first entry at t = 0 replaces ``course_deg`` and ``speed``)."""
+
+    field_units: ClassVar[dict[str, str]] = {"north": "m", "east": "m", "speed": "m/s",
+                                             "length": "m", "beam": "m"}
+
+    name: str = ""
+    mmsi: Annotated[int, Field(ge=0, le=999_999_999)] = 0
+    north: Finite
+    east: Finite
+    course_deg: HeadingDeg = 0.0
+    speed: NonNegative = 0.0
+    schedule: Annotated[list[TargetLegEntry], Field(min_length=1),
+                        AfterValidator(_in_time_order)] | None = None
+    length: Positive = 100.0
+    beam: Positive = 20.0
+
+    def track(self, label: str = "target"):
+        """The target as a :class:`~shipgnc.colav.tracks.TargetTrack`: one sample per leg, each
+        leg's start reached by sailing the previous leg (exact dead reckoning)."""
+        from shipgnc.colav.tracks import TargetTrack
+
+        legs = self.schedule or [TargetLegEntry(t=0.0, course_deg=self.course_deg, speed=self.speed)]
+        t, north, east, vn, ve = [], [], [], [], []
+        n, e = self.north, self.east
+        for k, leg in enumerate(legs):
+            if k:
+                dt = leg.t - t[-1]
+                n, e = n + vn[-1] * dt, e + ve[-1] * dt
+            t.append(leg.t)
+            north.append(n)
+            east.append(e)
+            vn.append(leg.speed * math.cos(math.radians(leg.course_deg)))
+            ve.append(leg.speed * math.sin(math.radians(leg.course_deg)))
+        return TargetTrack(t=t, north=north, east=east, v_north=vn, v_east=ve, mmsi=self.mmsi,
+                           name=self.name or label, length=self.length, beam=self.beam)
+
+
+class AISLogConfig(Strict):
+    """Targets replayed from a logged AIS file (NMEA or CSV, :func:`shipgnc.ais.logs.read_log`):
+    one target per MMSI (the logging ship's own ``!AIVDO`` reports left out), dead-reckoned between
+    its reports; positions in the local plane about ``origin`` (lat, lon) [deg], where the own
+    ship's ``simulation.initial_state`` (north, east) is; null: the centre of the data."""
+
+    field_units: ClassVar[dict[str, str]] = {"origin": "deg"}
+
+    path: Annotated[str, Field(min_length=1)]
+    origin: tuple[Annotated[float, Field(ge=-90, le=90)],
+                  Annotated[float, Field(ge=-180, le=180)]] | None = None
+
+
+class ColavConfig(Strict):
+    """Collision avoidance between the path guidance and the autopilot
+    (:mod:`shipgnc.guidance.colav`): lookahead LOS along ``waypoints`` gives the nominal course,
+    ``method`` turns it away from the ``targets`` (``none``: the nominal, the baseline)."""
+
+    field_units: ClassVar[dict[str, str]] = {"waypoints": "m", "lookahead": "m", "speed": "m/s",
+                                             "switch_radius": "m", "safety_radius": "m"}
+
+    type: Literal["colav"]
+    #: ``none`` (the nominal course: the baseline), ``sbmpc`` (simulation-based MPC) or ``vo``
+    #: (velocity obstacles with COLREG constraints)
+    method: Literal["none", "sbmpc", "vo"] = "none"
+    #: SB-MPC's behaviour set, horizon and weights (Johansen, Perez & Cristofaro 2016)
+    sbmpc: SBMPCConfig = Field(default_factory=SBMPCConfig)
+    #: the velocity obstacles' safety radius, horizon and candidates (Kuwata et al. 2014)
+    vo: VOConfig = Field(default_factory=VOConfig)
+    #: the avoidance method decides every this many seconds (its choice held in between)
+    decision_interval: NonNegative = 5.0
+    #: ``[[north, east], ...]``, sailed in order (the nominal path)
+    waypoints: Annotated[list[tuple[Finite, Finite]], Field(min_length=2)]
+    #: lookahead distance Δ of the nominal LOS
+    lookahead: Positive = 500.0
+    #: nominal speed over ground (null: the vessel's straight-run speed)
+    speed: Positive | None = None
+    #: switch to the next leg within this distance of the waypoint
+    switch_radius: NonNegative = 0.0
+    #: the ship domain of the ``colav`` metrics: a target closer than this is a collision
+    safety_radius: Positive = 200.0
+    #: the target ships
+    targets: list[TargetConfig] = Field(default_factory=list)
+    #: more targets, replayed from a logged AIS file
+    ais_log: AISLogConfig | None = None
+
+
 # the navigation sections live with their components, beside their registry records
 # (shipgnc.navigation.sensors, .ekf, .passive_observer); re-exported here by their old home
 from shipgnc.navigation.ekf import EKFConfig  # noqa: E402, F401
@@ -965,3 +1065,4 @@ from shipgnc.navigation.sensors import (  # noqa: E402, F401
     SpeedLogConfig,
 )
 from shipgnc.navigation.sensors import SensorConfigBase as _SensorBase  # noqa: E402, F401
+

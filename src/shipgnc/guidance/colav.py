@@ -1,0 +1,297 @@
+"""Collision-avoidance guidance: between the path guidance and the autopilot.
+
+Each sample the guidance
+
+1. computes the nominal course χ_n and speed U_n toward the waypoints with lookahead LOS
+   (:func:`shipgnc.guidance.los.los_reference`, the same law and leg switching as ``type: los``);
+2. dead-reckons every target from its track table (:class:`shipgnc.colav.tracks.TargetTrack`:
+   the last sample at or before t, moved on at constant velocity) to its position and velocity
+   over ground at t, and keeps the least range to any target so far (``range_min``, its time and
+   target: the realised closest point of approach, at every guidance sample whatever the log's
+   thinning);
+3. hands the own ship ``[north, east, χ, U]`` (course and speed over ground,
+   χ = ψ + atan2(v, u), U = √(u² + v²)), the targets and the nominal ``[χ_n, U_n]`` to the
+   avoidance method, which returns the commanded course and speed; with ``method = none`` the
+   command is the nominal;
+4. hands the autopilot the commanded course as its heading reference ``psi_d`` (the sideslip of
+   a steady straight run is zero on the catalogue's course-keeping models, so course and heading
+   references coincide there; Johansen, Perez & Cristofaro 2016 likewise give the autopilot the
+   chosen course) and the commanded speed as ``u_d`` (followed by controllers that take a speed
+   reference; the catalogue's heading autopilot holds its propeller).
+
+Batched: each ship of a batch may meet its own targets — the parameters are one row per ship
+(targets padded to the batch's largest count and sample count), so every member of a batch can be
+a different encounter. The per-ship arithmetic is one kernel (:func:`colav_reference`); the numpy
+loop calls its derived batch (:func:`shipgnc.derive.per_ship`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from shipgnc.colav.sbmpc import sbmpc_choose
+from shipgnc.colav.tracks import TargetTrack
+from shipgnc.colav.vo import vo_choose
+from shipgnc.derive import per_ship
+from shipgnc.errors import ConfigError, require
+from shipgnc.guidance.los import LOSGuidance, los_reference
+from shipgnc.kernels import Kernel, flat, kernel_function, wrap
+from shipgnc.models.base import Signal, state_index
+
+#: avoidance methods by name → the kernel's method code
+METHODS = {"none": 0, "sbmpc": 1, "vo": 2}
+#: header of a parameter row (see :meth:`ColavGuidance.params`)
+_HEADER = 13
+#: the LOS part of the per-ship state, then [next decision time, course offset, speed factor,
+#: least range so far, its time, its target]
+_LOS_STATE = 6
+_HOLD = 6
+
+
+def method_parts(method: str, config=None) -> tuple[np.ndarray, int]:
+    """(flat parameters, memory length) of avoidance ``method`` with its ``config`` (None: the
+    method's defaults)."""
+    if method == "sbmpc":
+        from shipgnc.colav.sbmpc import SBMPC_MEMORY, sbmpc_params
+
+        return sbmpc_params(config), SBMPC_MEMORY
+    if method == "vo":
+        from shipgnc.colav.vo import VO_MEMORY, vo_params
+
+        return vo_params(config), VO_MEMORY
+    return flat(0.0), 0
+
+
+class ColavGuidance:
+    """LOS toward the waypoints, then collision avoidance against ``encounters`` (module
+    docstring): ``encounters`` is one list of :class:`TargetTrack` per batch member (a list of
+    tracks alone: the same targets for every member)."""
+
+    references = (
+        Signal("psi_d", "rad", "desired heading: the commanded course", angle=True, tracks="psi"),
+        Signal("u_d", "m/s", "desired surge speed: the commanded speed", tracks="u"),
+    )
+    outputs = (
+        *LOSGuidance.outputs,
+        Signal("course_nominal", "rad", "nominal course toward the waypoints (LOS)", angle=True),
+        Signal("course_cmd", "rad", "course commanded by the collision avoidance", angle=True),
+        Signal("speed_cmd", "m/s", "speed commanded by the collision avoidance"),
+        Signal("range_min", "m", "least range to any target so far (at the guidance samples)"),
+        Signal("t_range_min", "s", "time of range_min"),
+        Signal("target_range_min", "1", "target (0-based) of range_min"),
+    )
+
+    def __init__(self, los: LOSGuidance, encounters, *, method: str = "none", methods=None,
+                 configs=None, decision_interval: float = 5.0):
+        methods = [method] if methods is None else list(methods)
+        for m in methods:
+            require(m in METHODS, "guidance.method", m, f"allowed: {', '.join(METHODS)}")
+        require(math.isfinite(decision_interval) and decision_interval >= 0,
+                "guidance.decision_interval", decision_interval, "must be >= 0 s")
+        members = [list(encounters)] if not encounters or isinstance(encounters[0], TargetTrack) \
+            else [list(m) for m in encounters]
+        for m, tracks in enumerate(members):
+            for track in tracks:
+                if not isinstance(track, TargetTrack):
+                    raise ConfigError(f"targets of member {m}: {track!r} is not a TargetTrack")
+        self.los = los
+        if len(methods) not in (1, len(members)) and len(members) != 1:
+            raise ConfigError(f"methods: {len(methods)} for {len(members)} encounters (give one, "
+                              "or one per encounter)")
+        self.members = members
+        self.methods = methods
+        self.decision_interval = float(decision_interval)
+        configs = configs or {}
+        self.parts = {m: method_parts(m, configs.get(m)) for m in dict.fromkeys(methods)}
+        self.memory = max(memory for _, memory in self.parts.values())
+        self.n_max = max(1, max(len(t) for t in members))
+        self.n_samples = max([1] + [tr.t.size for tracks in members for tr in tracks])
+        self._z = None
+        self._outputs: dict[str, np.ndarray] = {}
+
+    # ------------------------------------------------------------------ set-up
+    @property
+    def path(self):
+        return self.los.path
+
+    @property
+    def speed(self) -> float:
+        return self.los.speed
+
+    def params(self) -> np.ndarray:
+        """One parameter row per member ``(n_members, n_p)`` (shorter rows padded with zeros)::
+
+            [n_los, method, n_targets, n_samples, n_max, i_north, i_east, i_psi, i_u, i_v
+             (-1: none), n_method_params, memory, decision interval,  LOS params (n_los),
+             targets: n_max × n_samples × (t, north, east, v_north, v_east), unused samples at
+             t = +inf,  method params]
+        """
+        los = self.los.kernel(self._batch_shape).params
+        rows = []
+        n = max(len(self.members), len(self.methods))
+        for m in range(n):
+            tracks = self.members[m % len(self.members)]
+            method = self.methods[m % len(self.methods)]
+            mp, _ = self.parts[method]
+            table = np.zeros((self.n_max, self.n_samples, 5))
+            table[:, :, 0] = np.inf
+            for j, track in enumerate(tracks):
+                table[j, :track.t.size] = track.table()
+            rows.append(flat(los.size, METHODS[method], len(tracks), self.n_samples,
+                             self.n_max, *self._index, mp.size, self.memory,
+                             self.decision_interval, los, table, mp))
+        width = max(r.size for r in rows)
+        return np.vstack([np.pad(r, (0, width - r.size)) for r in rows])
+
+    def reset(self, batch_shape, model) -> None:
+        self._batch_shape = tuple(batch_shape)
+        n = math.prod(self._batch_shape)
+        rows = max(len(self.members), len(self.methods))
+        if rows not in (1, n):
+            raise ConfigError(f"targets: {rows} encounters for a batch of {n} ships "
+                              "(give one, or one per ship)")
+        self.los.reset(batch_shape, model)
+        self._index = (state_index(model, "north"), state_index(model, "east"),
+                       state_index(model, "psi"), state_index(model, "u"),
+                       state_index(model, "v") if "v" in [s.name for s in model.states] else -1)
+        self._params = self.params()
+        self._z = np.zeros((n, self.state_width))
+        self._z[:, 3] = np.nan  # LOS: no sample yet
+        self._z[:, 4] = np.nan  # LOS: completion time
+        self._z[:, _LOS_STATE + 2] = 1.0  # held speed factor: the nominal
+        self._z[:, _LOS_STATE + 3:_LOS_STATE + 6] = (np.inf, np.nan, -1.0)  # no range yet
+
+    @property
+    def state_width(self) -> int:
+        """LOS state, the held decision [next decision time, course offset, speed factor], the
+        method's memory, then scratch: own (4), nominal (2), command (2), targets (4 n_max)."""
+        return _LOS_STATE + _HOLD + self.memory + 8 + 4 * self.n_max
+
+    # ------------------------------------------------------------------ numpy loop
+    def reference(self, t: float, x: np.ndarray) -> np.ndarray:
+        x2 = np.asarray(x, dtype=float).reshape(-1, x.shape[-1])
+        ref, out, _ = per_ship(colav_reference, "t i z p o o -> r")(
+            t, x2, self._z, self._params, 2, len(self.outputs))
+        shape = self._batch_shape
+        self._outputs = {s.name: out[:, k].reshape(shape) for k, s in enumerate(self.outputs)}
+        return ref.reshape(*shape, 2)
+
+    def output_values(self) -> dict[str, np.ndarray]:
+        return self._outputs
+
+    def finished(self) -> np.ndarray:
+        return self._z[:, 1].reshape(self._batch_shape) > 0
+
+    @property
+    def completion_time(self) -> np.ndarray:
+        return self._z[:, 4].reshape(self._batch_shape)
+
+    def kernel(self, batch_shape) -> Kernel:
+        """:meth:`reference` for the composed loop: :func:`colav_reference` with one parameter row
+        per member."""
+        def restore(z: np.ndarray) -> None:
+            self._z = np.ascontiguousarray(z.reshape(-1, self.state_width))
+
+        return Kernel(colav_reference, self._params, self._z.copy(), restore=restore)
+
+    # ------------------------------------------------------------------ results
+    def target_states(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Every member's targets at times ``t``: ``target_north``, ``target_east`` [m],
+        ``target_sog`` [m/s], ``target_cog`` [rad], each ``(time, member, target)`` (NaN where a
+        member has fewer targets)."""
+        t = np.asarray(t, dtype=float)
+        shape = (t.size, len(self.members), self.n_max)
+        out = {k: np.full(shape, np.nan) for k in ("target_north", "target_east", "target_sog",
+                                                    "target_cog")}
+        for m, tracks in enumerate(self.members):
+            for j, track in enumerate(tracks):
+                n, e, vn, ve = track.at(t)
+                out["target_north"][:, m, j], out["target_east"][:, m, j] = n, e
+                out["target_sog"][:, m, j] = np.hypot(vn, ve)
+                out["target_cog"][:, m, j] = np.mod(np.arctan2(ve, vn), 2 * np.pi)
+        return out
+
+    def add_targets(self, result):
+        """``result`` with the targets' states on a ``target`` dimension (the member dimension of
+        a batch result; none for one ship)."""
+        time = result["time"].values
+        states = self.target_states(time)
+        ship_dims = [d for d in result["north"].dims if d != "time"]
+        names = [tr.label for tr in self.members[0]] + [""] * (self.n_max - len(self.members[0]))
+        units = {"target_north": "m", "target_east": "m", "target_sog": "m/s",
+                 "target_cog": "rad"}
+        for key, value in states.items():
+            if ship_dims:
+                dims = ("time", *ship_dims, "target")
+                value = value.reshape(time.size, *result["north"].shape[1:], self.n_max) \
+                    if len(self.members) > 1 else np.broadcast_to(
+                        value, (time.size, *result["north"].shape[1:], self.n_max))
+            else:
+                dims, value = ("time", "target"), value[:, 0, :]
+            result[key] = (dims, np.array(value), {"units": units[key]})
+        if len(self.members) == 1:
+            result = result.assign_coords(target=names)
+        return result
+
+
+@kernel_function
+def colav_reference(t, x, z, p, ref, out):
+    """One sample of :class:`ColavGuidance` for one ship (module docstring): LOS for the nominal
+    course, the targets dead-reckoned from their tables, then the avoidance method — called every
+    decision interval (the paper's re-planning period; 0: every sample), its choice held as an
+    offset from the nominal course and a factor of the nominal speed in between."""
+    n_los, method, n_targets = int(p[0]), int(p[1]), int(p[2])
+    n_samples, n_max = int(p[3]), int(p[4])
+    i_north, i_east, i_psi, i_u, i_v = int(p[5]), int(p[6]), int(p[7]), int(p[8]), int(p[9])
+    n_mp, memory, interval = int(p[10]), int(p[11]), p[12]
+    h = _HEADER
+    finished = los_reference(t, x, z[:_LOS_STATE], p[h:h + n_los], ref, out)
+    table = p[h + n_los:h + n_los + n_max * n_samples * 5]
+    mp = p[h + n_los + n_max * n_samples * 5:h + n_los + n_max * n_samples * 5 + n_mp]
+    hold = z[_LOS_STATE:_LOS_STATE + _HOLD]
+    zm = z[_LOS_STATE + _HOLD:_LOS_STATE + _HOLD + memory]
+    s = _LOS_STATE + _HOLD + memory  # scratch
+    own, nominal, cmd = z[s:s + 4], z[s + 4:s + 6], z[s + 6:s + 8]
+    targets = z[s + 8:s + 8 + 4 * n_max]
+    nominal[0], nominal[1] = ref[0], ref[1]
+    for j in range(n_targets):
+        rows = table[j * n_samples * 5:(j + 1) * n_samples * 5]
+        k = 0
+        while k + 1 < n_samples and rows[(k + 1) * 5] <= t:
+            k += 1
+        dt = t - rows[k * 5]
+        targets[4 * j] = rows[k * 5 + 1] + rows[k * 5 + 3] * dt
+        targets[4 * j + 1] = rows[k * 5 + 2] + rows[k * 5 + 4] * dt
+        targets[4 * j + 2] = rows[k * 5 + 3]
+        targets[4 * j + 3] = rows[k * 5 + 4]
+        d = math.hypot(targets[4 * j] - x[i_north], targets[4 * j + 1] - x[i_east])
+        if d < hold[3]:
+            hold[3], hold[4], hold[5] = d, t, float(j)
+    if method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t)):
+        v = x[i_v] if i_v >= 0 else 0.0
+        own[0], own[1] = x[i_north], x[i_east]
+        own[2] = x[i_psi] + math.atan2(v, x[i_u])
+        own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
+        if method == 1:
+            sbmpc_choose(t, own, targets, n_targets, nominal, mp, zm, cmd)
+        else:
+            vo_choose(t, own, targets, n_targets, nominal, mp, zm, cmd)
+        hold[0] = t + interval
+        hold[1] = wrap(cmd[0] - nominal[0])
+        hold[2] = cmd[1] / nominal[1] if nominal[1] > 0.0 else 1.0
+    ref[0] = wrap(nominal[0] + hold[1]) if hold[1] != 0.0 else nominal[0]
+    ref[1] = hold[2] * nominal[1]
+    out[3], out[4], out[5] = nominal[0], ref[0], ref[1]
+    out[6], out[7], out[8] = hold[3], hold[4], hold[5]
+    return finished
+
+
+def check_clear(track: TargetTrack, own, safety_radius: float, where: str) -> None:
+    """A target inside the safety radius of the own ship at t = 0 is a ConfigError naming it."""
+    n, e, _, _ = track.at(0.0)
+    distance = math.hypot(float(n) - own[0], float(e) - own[1])
+    if distance < safety_radius:
+        raise ConfigError(f"{where}: {distance:.1f} m from the own ship at t = 0, inside the "
+                          f"safety radius {safety_radius:g} m; place it farther away")

@@ -1,0 +1,295 @@
+"""The encounter sweep: many encounters, each a member of one batched, compiled run, scored.
+
+Each member is one situation (:mod:`shipgnc.study.trafficgen`: the standard set, its Monte Carlo
+variants, or trafficgen files) met with one avoidance method. The own ship (a catalogue vessel under
+its heading autopilot, :data:`OWN_SHIP`) starts at the origin on course 0 — a situation read from a
+file is turned about the own ship's start so that its course is 0, which changes no relative
+geometry — and follows its nominal path north through the collision-avoidance guidance
+(:class:`shipgnc.guidance.colav.ColavGuidance`); the avoidance method is a per-member parameter, so
+every method runs in the same batch. Members whose own ship sails at the same speed share a batch
+(the vessel model depends on its speed).
+
+Scores per member: :mod:`shipgnc.study.encounter_scores` (minimum range, collision, distance and
+time lost), plus the COLREG situation at t = 0 (:func:`shipgnc.colav.colreg.situations`) and the
+closed-form CPA of the initial motion (:func:`shipgnc.colav.geometry.encounter_geometry`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from shipgnc.colav.tracks import TargetTrack
+from shipgnc.errors import ConfigError
+from shipgnc.study import trafficgen as tg
+
+#: the own ship of the sweep: van Amerongen's frigate (L = 100 m) at 9 m/s under the PD heading
+#: autopilot (Kp = 1, Kd = 20 s: a phase margin over 60° on its Norrbin model)
+OWN_SHIP = {"vessel": {"model": "frigate", "speed_mps": 9.0},
+            "controller": {"type": "course", "variant": "pd", "Kp": 1.0, "Kd": 20.0}}
+#: the duration of every encounter [s] and the step [s]
+DURATION, DT = 1200.0, 0.5
+#: the ship domain of the scores [m]
+SAFETY_RADIUS = 200.0
+#: SB-MPC for the own ship: its safety distance scaled to the ships (the ship domain), course offsets
+#: only (the frigate model holds its speed); the rest the paper's defaults
+SBMPC = {"d_safe": SAFETY_RADIUS, "speed_factors": [1.0]}
+#: velocity obstacles likewise: the ship domain as the combined safety radius, course offsets only
+VO = {"radius": SAFETY_RADIUS, "speed_factors": [1.0]}
+#: the nominal path: north from the origin, long enough for any encounter
+PATH_LENGTH = 40_000.0
+
+
+@dataclass(frozen=True)
+class Member:
+    """One member of a sweep: a situation (own course 0 at the origin) and a method."""
+
+    situation: tg.Situation
+    method: str
+    mc: int = 0
+    beta_deg: float = math.nan
+
+
+@dataclass
+class SweepResult:
+    members: list[Member]
+    scores: dict[str, np.ndarray]
+    results: list = field(default_factory=list)  # (member indices, xarray Dataset) per batch
+    seconds: float = 0.0
+    ship_steps: int = 0
+
+
+def rotated(track: TargetTrack, angle: float) -> TargetTrack:
+    """``track`` turned by ``angle`` [rad] about the origin (clockwise positive, NED)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return replace(track, north=c * track.north - s * track.east, east=s * track.north + c * track.east,
+                   v_north=c * track.v_north - s * track.v_east,
+                   v_east=s * track.v_north + c * track.v_east)
+
+
+def own_frame(sit: tg.Situation) -> tg.Situation:
+    """The situation turned so that the own ship's course is 0."""
+    if sit.own_course == 0.0:
+        return sit
+    return replace(sit, own_course=0.0,
+                   targets=tuple(rotated(t, -sit.own_course) for t in sit.targets))
+
+
+def standard_members(methods, *, mc: int = 0, seed: int = 0, own_speed: float = 9.0,
+                     specs=tg.STANDARD) -> list[Member]:
+    """The standard set (``mc`` = 0) or ``mc`` perturbed variants of each of its situations
+    (:func:`shipgnc.study.trafficgen.perturbed`, drawn from ``seed``), each met with every method."""
+    rng = np.random.default_rng(seed)
+    members = []
+    for spec in specs:
+        variants = [spec] if mc == 0 else [tg.perturbed(spec, rng) for _ in range(mc)]
+        for k, variant in enumerate(variants):
+            sit = tg.parse(tg.situation_dict(variant, own_speed), variant.title)
+            sit = replace(sit, encounter_type=spec.encounter_type, title=spec.title)
+            for method in methods:
+                members.append(Member(sit, method, k, variant.beta_deg))
+    return members
+
+
+def file_members(paths, methods) -> list[Member]:
+    """Situations read from trafficgen files, each met with every method."""
+    members = []
+    for path in paths:
+        sit = own_frame(tg.read(path))
+        bearing = _bearing_deg(sit)
+        for method in methods:
+            members.append(Member(sit, method, 0, bearing))
+    return members
+
+
+def _bearing_deg(sit: tg.Situation) -> float:
+    t = sit.targets[0]
+    return math.degrees(math.atan2(t.east[0], t.north[0]))
+
+
+def colav_guidance(g, scenario):
+    """The ``guidance: {type: colav}`` section's :class:`~shipgnc.guidance.colav.ColavGuidance`
+    (the registry's builder): its targets and those of its AIS log, placed against the own ship's
+    start (a target inside the safety radius at t = 0 is refused, naming it)."""
+    from shipgnc.guidance.colav import ColavGuidance, check_clear
+    from shipgnc.guidance.los import LOSGuidance
+    from shipgnc.paths import WaypointPath
+
+    speed = g.speed if g.speed is not None else getattr(scenario.vessel, "speed_mps", None)
+    if speed is None:
+        raise ConfigError(f"guidance.speed: vessel model {scenario.vessel.model!r} has no "
+                          "straight-run speed; give the nominal speed in m/s")
+    los = LOSGuidance(WaypointPath(g.waypoints), lookahead=g.lookahead, speed=speed,
+                      switch_radius=g.switch_radius)
+    init = scenario.simulation.initial_state if scenario.simulation is not None else None
+    own = (init.north, init.east) if init is not None else (0.0, 0.0)
+    tracks = []
+    for j, target in enumerate(g.targets):
+        track = target.track(label=f"target {j + 1}")
+        check_clear(track, own, g.safety_radius, f"guidance.targets[{j}]")
+        tracks.append(track)
+    if g.ais_log is not None:
+        from shipgnc.ais.logs import read_log
+
+        logged, _ = read_log(g.ais_log.path, origin=g.ais_log.origin)
+        for track in logged:
+            if track.source == "ais-own":
+                continue
+            check_clear(track, own, g.safety_radius, f"guidance.ais_log: MMSI {track.mmsi}")
+            tracks.append(track)
+    return ColavGuidance(los, tracks, method=g.method, configs={"sbmpc": g.sbmpc, "vo": g.vo},
+                         decision_interval=g.decision_interval)
+
+
+def check_members(members: list[Member], safety_radius: float = SAFETY_RADIUS) -> None:
+    """A target inside the safety radius at t = 0: a one-line ConfigError naming it."""
+    from shipgnc.guidance.colav import check_clear
+
+    for member in members:
+        for j, track in enumerate(member.situation.targets):
+            check_clear(track, (0.0, 0.0), safety_radius,
+                        f"situation {member.situation.title}: targetShips[{j}]")
+
+
+def own_scenario(own_speed: float, method: str):
+    """The scenario of the own ship (validated like a scenario file)."""
+    from shipgnc.scenarios.schema import validate
+
+    return validate({
+        "name": "encounter", "metrics": "colav",
+        "vessel": {**OWN_SHIP["vessel"], "speed_mps": own_speed},
+        "simulation": {"dt": DT, "t_end": DURATION,
+                       "initial_state": {"north": 0.0, "east": 0.0, "psi_deg": 0.0}},
+        "controller": OWN_SHIP["controller"],
+        "guidance": {"type": "colav", "method": method, "waypoints": [[0.0, 0.0], [PATH_LENGTH, 0.0]],
+                     "lookahead": 1000.0, "safety_radius": SAFETY_RADIUS, "sbmpc": SBMPC,
+                     "vo": VO}},
+                    "encounter sweep")
+
+
+def run_members(members: list[Member], *, backend: str = "auto", log_every: int = 10,
+                keep_results: bool = False, compliance: bool = True) -> SweepResult:
+    """Run every member (one batch per own-ship speed) and score it (``compliance``: with the
+    COLREG compliance scores, from the log at every ``log_every``-th step)."""
+    import time
+
+    from shipgnc.colav.compliance import SCORES
+    from shipgnc.guidance.colav import ColavGuidance
+    from shipgnc.scenarios.runner import build
+    from shipgnc.sim.simulator import simulate
+    from shipgnc.study.encounter_scores import COLAV_KEYS, batch_arrays, compliance_arrays
+
+    check_members(members)
+    speeds = sorted({round(m.situation.own_speed, 9) for m in members})
+    keys = (*COLAV_KEYS, "situation", "d_cpa0_m", "t_cpa0_s",
+            *((*SCORES, "compliance") if compliance else ()))
+    scores = {key: np.full(len(members), np.nan) for key in keys}
+    out = SweepResult(members, scores)
+    start = time.perf_counter()
+    for speed in speeds:
+        index = [i for i, m in enumerate(members) if round(m.situation.own_speed, 9) == speed]
+        methods = [members[i].method for i in index]
+        scenario = own_scenario(speed, methods[0])
+        setup = build(scenario)
+        g0 = setup.guidance
+        g = scenario.guidance
+        guidance = ColavGuidance(g0.los, [list(members[i].situation.targets) for i in index],
+                                 methods=methods, configs={"sbmpc": g.sbmpc, "vo": g.vo},
+                                 decision_interval=g.decision_interval)
+        x0 = np.tile(setup.x0, (len(index), 1))
+        result = simulate(setup.model, x0, t_end=DURATION, dt=DT, controller=setup.controller,
+                          actuator=setup.actuator, guidance=guidance, u0=setup.u0,
+                          log_every=log_every, backend=backend, on_divergence="mask")
+        result = guidance.add_targets(result)
+        out.ship_steps += len(index) * round(DURATION / DT)
+        arrays = batch_arrays(result, guidance, SAFETY_RADIUS)
+        arrays.update(initial_scores(members, index))
+        if compliance:
+            arrays.update(compliance_arrays(result, [members[i].situation.targets for i in index],
+                                            situation_codes(members, index)))
+        for key, value in arrays.items():
+            scores[key][index] = value
+        if keep_results:
+            out.results.append((index, result))
+    out.seconds = time.perf_counter() - start
+    return out
+
+
+def initial_scores(members, index) -> dict[str, np.ndarray]:
+    """The COLREG situation (code of :data:`shipgnc.colav.colreg.SITUATIONS`) and the closed-form
+    CPA at t = 0 towards each member's first target."""
+    from shipgnc.colav.colreg import situations
+    from shipgnc.colav.geometry import encounter_geometry
+
+    own = np.array([[0.0, 0.0, members[i].situation.own_course, members[i].situation.own_speed]
+                    for i in index])
+    target = np.array([[t.north[0], t.east[0], t.v_north[0], t.v_east[0]]
+                       for t in (members[i].situation.targets[0] for i in index)])
+    geo = encounter_geometry(own, target)
+    return {"situation": situations(own, target).astype(float), "d_cpa0_m": geo["d_cpa"],
+            "t_cpa0_s": geo["t_cpa"]}
+
+
+def situation_codes(members, index) -> np.ndarray:
+    """COLREG situation codes at t = 0 of every target of the members ``index`` (member, target)."""
+    from shipgnc.colav.colreg import situations
+
+    n_max = max(len(members[i].situation.targets) for i in index)
+    codes = np.zeros((len(index), n_max), dtype=int)
+    for k, i in enumerate(index):
+        sit = members[i].situation
+        own = [0.0, 0.0, sit.own_course, sit.own_speed]
+        for j, t in enumerate(sit.targets):
+            codes[k, j] = int(situations(own, [t.north[0], t.east[0], t.v_north[0], t.v_east[0]]))
+    return codes
+
+
+def summary(result: SweepResult) -> list[dict]:
+    """One row per (encounter type, method): members, collisions, median and least minimum range,
+    median time lost, median compliance (the least score of the rules invoked, after Woerner)."""
+    rows = []
+    keys = dict.fromkeys((m.situation.encounter_type or m.situation.title, m.method)
+                         for m in result.members)
+    s = result.scores
+    for kind, method in keys:
+        idx = [i for i, m in enumerate(result.members)
+               if (m.situation.encounter_type or m.situation.title) == kind and m.method == method]
+        rng = s["min_range_m"][idx]
+        rows.append({"encounter": kind, "method": method, "members": len(idx),
+                     "collisions": int(np.nansum(s["collision"][idx])),
+                     "median_cpa_m": float(np.nanmedian(rng)), "min_cpa_m": float(np.nanmin(rng)),
+                     "median_time_lost_s": float(np.nanmedian(s["time_lost_s"][idx]))})
+        if "compliance" in s:
+            c = s["compliance"][idx]
+            rows[-1]["median_compliance"] = float(np.nanmedian(c)) if np.isfinite(c).any() \
+                else float("nan")
+    return rows
+
+
+def member_rows(result: SweepResult) -> list[dict]:
+    """One row per member with its scores."""
+    from shipgnc.colav.colreg import SITUATIONS
+
+    rows = []
+    for i, m in enumerate(result.members):
+        row = {"member": i, "title": m.situation.title, "encounter": m.situation.encounter_type,
+               "method": m.method, "mc": m.mc, "beta_deg": m.beta_deg}
+        for key, value in result.scores.items():
+            row[key] = SITUATIONS[int(value[i])] if key == "situation" else float(value[i])
+        rows.append(row)
+    return rows
+
+
+def check_methods(methods) -> list[str]:
+    """The ``--method`` list, each a known avoidance method (ConfigError naming the bad one)."""
+    from shipgnc.guidance.colav import METHODS
+
+    out = []
+    for method in methods:
+        if method not in METHODS:
+            raise ConfigError(f"--method {method!r}: unknown avoidance method; allowed: "
+                              f"{', '.join(METHODS)}")
+        out.append(method)
+    return out
