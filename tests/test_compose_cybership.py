@@ -1,4 +1,4 @@
-"""Document 003's CyberShip II family in the composed compiled loop: the model, the course
+"""Document 003's CyberShip II family in the composed compiled loop: the course
 autopilots (PD (3), sliding mode (9)–(15)) and the seeded Froude–Krylov wave loads each equal
 their numpy form, and the scenarios ``cybership-calm`` / ``cybership-waves`` run compiled equal to
 their numpy runs (1e-9 relative or 1e-12 absolute) for as long as the numpy run itself is
@@ -17,7 +17,7 @@ from shipgnc.control.course import CoursePD, SlidingModeCourse
 from shipgnc.environment import wave_kernel
 from shipgnc.environment.waves import FroudeKrylovWaveLoads, WaveSpectrum
 from shipgnc.guidance.schedule import CourseSchedule
-from shipgnc.models.cybership2 import CyberShip2, CyberShip2Params, steering_machine
+from shipgnc.models.cybership2 import CyberShip2, steering_machine
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build, run_scenario
 from shipgnc.sim.simulator import simulate
@@ -39,21 +39,6 @@ def states(n, seed=0):
 # ----------------------------------------------------------------------------------------------
 # each kernel against its numpy form, one ship at a time
 # ----------------------------------------------------------------------------------------------
-
-@pytest.mark.parametrize("rudder_model", ["table1", "skjetne"])
-def test_model_kernel_equals_derivatives(rudder_model):
-    model = CyberShip2(CyberShip2Params(rudder_model=rudder_model))
-    kernel = model.kernel()
-    rng = np.random.default_rng(1)
-    xdot = np.empty(6)
-    for x in states(60, seed=2):
-        u = np.array([rng.uniform(-5, 30), rng.uniform(-0.7, 0.7)])
-        d = rng.normal(size=3)
-        kernel.function(x, u, d, kernel.params, xdot)
-        np.testing.assert_allclose(xdot, model.derivatives(x, u, d), rtol=1e-12, atol=1e-15)
-        kernel.function(x, u, np.zeros(3), kernel.params, xdot)  # zero d is no disturbance
-        np.testing.assert_allclose(xdot, model.derivatives(x, u, None), rtol=1e-12, atol=1e-15)
-
 
 def _controllers():
     return {"pd": lambda: CoursePD(), "smc_printed": lambda: smc_paper("printed"),
