@@ -1,7 +1,7 @@
 """Document 000's Mariner in the composed compiled loop (:mod:`shipgnc.sim.compose`) against the
 numpy reference loop.
 
-Each component's kernel equals its numpy form on single ships (the model's eq. (25), the path
+Each component's kernel equals its numpy form on single ships (the path
 frame (guidance), the path controllers' laws (13), (19)–(23) and LOS + FL, the disturbance of note
 000-0.6); and every comparison of a
 whole run goes through ``simulate(..., backend="numpy")`` and ``backend="compiled"`` on fresh
@@ -139,18 +139,6 @@ def random_states(n, seed=0):
     x[:, 3] = rng.uniform(-1.0, 9.0, n)
     x[:, 4] = rng.normal(0.0, 0.02, n)
     return x
-
-
-def test_model_kernel_equals_derivatives():
-    kernel = M.kernel()
-    rng = np.random.default_rng(1)
-    for x in random_states(200):
-        u, d = rng.normal(0.0, 0.4, 1), rng.normal(0.0, [1e-4, 0.5, 0.5])
-        xdot = np.empty(5)
-        kernel.function(x, u, d, kernel.params, xdot)
-        np.testing.assert_allclose(xdot, M.derivatives(x, u, d), rtol=1e-13, atol=1e-18)
-        kernel.function(x, u, np.zeros(3), kernel.params, xdot)  # zero d is no disturbance
-        np.testing.assert_allclose(xdot, M.derivatives(x, u, None), rtol=1e-13, atol=1e-18)
 
 
 def along_the_legs(n):
