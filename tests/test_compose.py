@@ -54,18 +54,6 @@ def both(make, x0=None, **kw):
 # each component's kernel against its numpy form, one ship at a time
 # ----------------------------------------------------------------------------------------------
 
-def test_model_kernel_equals_derivatives():
-    rng = np.random.default_rng(0)
-    kernel = BOAT.kernel()
-    for _ in range(50):
-        x, u, d = rng.normal(size=6) * [50, 50, 4, 2, 1, 1], rng.normal(size=2), rng.normal(size=3)
-        xdot = np.empty(6)
-        kernel.function(x, u, d, kernel.params, xdot)
-        np.testing.assert_allclose(xdot, BOAT.derivatives(x, u, d), rtol=1e-13, atol=1e-15)
-        kernel.function(x, u, np.zeros(3), kernel.params, xdot)  # zero d is no disturbance
-        np.testing.assert_allclose(xdot, BOAT.derivatives(x, u, None), rtol=1e-13, atol=1e-15)
-
-
 def test_controller_kernel_equals_step():
     x0 = fleet(8)
     ref = np.tile([0.7, 1.5], (8, 1))
