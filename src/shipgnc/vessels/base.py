@@ -126,8 +126,8 @@ class CatalogueModel:
     def derivatives(self, x, u, d=None):
         """ẋ for ``x`` (..., n_states), ``u`` (..., n_inputs), ``d`` (..., 2) or None: the batch of
         the vessel's kernel (its ``kernel()``, :mod:`shipgnc.vessels.kernels`); a vessel without
-        one gets the kinematics and the steering machine from :func:`~shipgnc.vessels.kernels.
-        steering_rhs` and its body rates from :meth:`body_rates`."""
+        one gets the kinematics and the steering machine from
+        :func:`~shipgnc.vessels.kernels.steering_rhs` and its body rates from :meth:`body_rates`."""
         kernel = self._kernel
         if kernel is not None:
             return kernel_derivatives(self, kernel.function, kernel.params, x, u, d)
