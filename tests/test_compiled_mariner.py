@@ -1,10 +1,10 @@
 """Document 000's Mariner in the composed compiled loop (:mod:`shipgnc.sim.compose`) against the
 numpy reference loop.
 
-Each component's kernel equals its numpy form on single ships (the model's eq. (25), the
-disturbance of note 000-0.6; the path frame's and the path controllers' numpy forms are the batch
-of their kernels); and every comparison of a whole run goes through
-``simulate(..., backend="numpy")`` and ``backend="compiled"`` on fresh components and requires the same variables, sample times and attributes, values equal to 1e-9
+The model's and the components' numpy forms are the batches of their kernels (shipgnc.derive);
+every comparison of a whole run goes through
+``simulate(..., backend="numpy")`` and ``backend="compiled"`` on fresh components and requires the
+same variables, sample times and attributes, values equal to 1e-9
 relative (round-off of the variable's scale absolute), the same divergence errors and the
 components left in the same state.
 """
@@ -140,16 +140,6 @@ def random_states(n, seed=0):
     return x
 
 
-def test_model_kernel_equals_derivatives():
-    kernel = M.kernel()
-    rng = np.random.default_rng(1)
-    for x in random_states(200):
-        u, d = rng.normal(0.0, 0.4, 1), rng.normal(0.0, [1e-4, 0.5, 0.5])
-        xdot = np.empty(5)
-        kernel.function(x, u, d, kernel.params, xdot)
-        np.testing.assert_allclose(xdot, M.derivatives(x, u, d), rtol=1e-13, atol=1e-18)
-        kernel.function(x, u, np.zeros(3), kernel.params, xdot)  # zero d is no disturbance
-        np.testing.assert_allclose(xdot, M.derivatives(x, u, None), rtol=1e-13, atol=1e-18)
 
 
 @pytest.mark.parametrize("frame", [None, "path", "global"])

@@ -53,17 +53,6 @@ def both(make, x0=None, **kw):
 # each component's kernel against its numpy form, one ship at a time
 # ----------------------------------------------------------------------------------------------
 
-def test_model_kernel_equals_derivatives():
-    rng = np.random.default_rng(0)
-    kernel = BOAT.kernel()
-    for _ in range(50):
-        x, u, d = rng.normal(size=6) * [50, 50, 4, 2, 1, 1], rng.normal(size=2), rng.normal(size=3)
-        xdot = np.empty(6)
-        kernel.function(x, u, d, kernel.params, xdot)
-        np.testing.assert_allclose(xdot, BOAT.derivatives(x, u, d), rtol=1e-13, atol=1e-15)
-        kernel.function(x, u, np.zeros(3), kernel.params, xdot)  # zero d is no disturbance
-        np.testing.assert_allclose(xdot, BOAT.derivatives(x, u, None), rtol=1e-13, atol=1e-15)
-
 
 def test_los_reference_is_the_law_of_its_docstring():
     """ψ_d = wrap(π_p − atan(e/Δ)) on the active leg, u_d = U; the next leg once s ≥ L − R_sw;

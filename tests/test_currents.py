@@ -81,20 +81,14 @@ def test_current_along_the_heading_adds_to_the_ground_speed(name, model, x_eq, u
 
 
 @pytest.mark.parametrize("name,model,x_eq,u_in,i_u,U", _vessels(), ids=lambda v: str(v)[:12])
-def test_model_kernels_equal_numpy_in_a_current(name, model, x_eq, u_in, i_u, U):
-    """Each model's kernel is its numpy derivatives, operation for operation, with forces and a
-    current, in a turn (r ≠ 0: the rotation term ν̇_c = (r v_c, −r u_c) is exercised)."""
+def test_the_current_acts_in_a_turn(name, model, x_eq, u_in, i_u, U):
+    """With forces and a current, in a turn (r ≠ 0: the rotation term ν̇_c = (r v_c, −r u_c) is
+    exercised), ẋ differs from ẋ without the current."""
     rng = np.random.default_rng(5)
-    kernel = model.kernel()
     for _ in range(5):
         x = x_eq + rng.normal(0.0, 0.05, x_eq.shape) * np.maximum(1.0, np.abs(x_eq))
         d = np.concatenate([rng.normal(0.0, 1.0, 3), rng.normal(0.0, 0.3, 2)])
-        ref = model.derivatives(x, u_in, d)
-        got = np.empty_like(ref)
-        kernel.function(x, u_in, d, np.asarray(kernel.params, float).ravel(), got)
-        np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-12)
-        # and the current really acts: without it ẋ differs
-        assert not np.allclose(model.derivatives(x, u_in, d[:3]), ref)
+        assert not np.allclose(model.derivatives(x, u_in, d[:3]), model.derivatives(x, u_in, d))
 
 
 def test_composed_loop_equals_numpy_with_a_current():

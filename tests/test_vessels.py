@@ -16,7 +16,7 @@ import pytest
 from shipgnc.errors import ConfigError
 from shipgnc.models import clarke83
 from shipgnc.models.base import state_index
-from shipgnc.vessels import VESSELS, get_vessel
+from shipgnc.vessels import get_vessel
 
 PARAMS = {"nomoto": {"K": 0.05, "T": 20.0}, "nomoto2": {"K": 0.05, "T1": 20.0, "T2": 5.0, "T3": 3.0},
           "linear-3dof": {"L": 100.0, "B": 15.0, "T": 6.0, "Cb": 0.7}}
@@ -211,23 +211,6 @@ def test_bad_names_speeds_and_dimensions_are_one_line_errors(call, pattern):
     assert "\n" not in str(info.value)
 
 
-@pytest.mark.parametrize("name", sorted(VESSELS))
-def test_kernels_equal_the_numpy_derivatives(name):
-    model = get_vessel(name).build(**PARAMS.get(name, {}))
-    kernel = model.kernel()
-    rng = np.random.default_rng(7)
-    x0 = model.straight_state()
-    for trial in range(5):
-        x = x0 + rng.normal(size=x0.size) * np.r_[50, 50, 1.0, 0.3, 0.3, 0.01, 0.3, 0.5][:x0.size]
-        u = np.zeros(len(model.inputs))
-        u[0] = (-1) ** trial * (0.02 + 0.5 * trial)  # within and beyond the rudder limit
-        if u.size > 1:
-            u[1] = x0[7] * (0.8 + 0.1 * trial)
-        d = np.array([0.1, -0.2]) * trial
-        got = np.zeros_like(x)
-        kernel.function(x, u, d, kernel.params, got)
-        np.testing.assert_allclose(got, model.derivatives(x, u, d), rtol=1e-12, atol=1e-15)
-
 
 def test_heading_autopilot_is_the_pid_of_its_docstring():
     """δ_c = δ₀ − K_P e − K_D r − K_I ∫e dt (Fossen 2021, §15.3), the integral by Ts·e per sample
@@ -303,3 +286,36 @@ def test_mariner_cst_linearised_nomoto_constants_match_fossens_published_values(
     assert t_fast == pytest.approx(7.8, rel=0.015)
     assert t3 == pytest.approx(18.5, rel=0.015)
     assert gain == pytest.approx(0.185, rel=0.015)
+
+
+def test_a_vessel_written_only_in_numpy_runs_its_body_rates():
+    """A catalogue vessel without a kernel (the slow path) gets the kinematics and the steering
+    machine of the base and its own body rates: Nomoto's ṙ = (K δ − r)/T written in numpy gives
+    the kernel's ẋ of the same ship."""
+    from dataclasses import dataclass
+
+    from shipgnc.models.nomoto import NomotoModel
+    from shipgnc.vessels.base import CatalogueModel
+    from shipgnc.vessels.nomoto import NomotoVessel
+
+    @dataclass(frozen=True)
+    class NumpyNomoto(CatalogueModel):
+        K: float = 0.05
+        T: float = 20.0
+        speed: float = 6.0
+        delta_max: float = math.radians(35.0)
+        delta_rate: float = math.radians(2.32)
+        T_delta: float = 1.0
+
+        def body_rates(self, x, u):
+            zero = np.zeros_like(x[..., 3])
+            return zero, zero, (self.K * x[..., 6] - x[..., 5]) / self.T
+
+    rng = np.random.default_rng(4)
+    x = np.zeros((6, 7))
+    x[:, 2:] = rng.normal(size=(6, 5)) * [1.0, 0.0, 0.0, 0.01, 0.3]
+    x[:, 3] = 6.0
+    u, d = rng.normal(size=(6, 1)) * 0.5, rng.normal(size=(6, 2)) * 0.2
+    kernel = NomotoVessel(NomotoModel(0.05, 20.0, U=6.0), delta_rate=math.radians(2.32))
+    np.testing.assert_allclose(NumpyNomoto().derivatives(x, u, d), kernel.derivatives(x, u, d),
+                               rtol=1e-14, atol=1e-17)

@@ -19,9 +19,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from shipgnc.derive import per_ship
 from shipgnc.errors import ConfigError, require
 from shipgnc.kernels import clip, kernel_function
 
@@ -109,36 +111,28 @@ class Actuator:
         return self.saturate(command0)
 
     def begin_step(self, applied: np.ndarray, command: np.ndarray, h: float):
-        """Plan one step of length ``h``: returns ``(start, end)`` of the non-lag channels.
-
-        Without a rate limit start = end = sat(cmd); with one, end = applied moved towards
-        sat(cmd) by at most rate·h, and the input ramps linearly from start = applied to end
-        (``rate_mode="hold"``: start = end).
-        """
-        target = self.saturate(command)
-        if not self.has_rate_limit:
-            return target, target
-        step = np.clip(target - applied, -self.rate * h, self.rate * h)
-        end = applied + step
-        if self.rate_mode == "hold":
-            return end, end
-        start = np.where(np.isfinite(self.rate), applied, end)
-        return start, end
+        """Plan one step of length ``h``: returns ``(start, end)`` of the non-lag channels (the
+        batch of :func:`plan_kernel`)."""
+        return per_ship(plan_kernel, "i i p t t t o o")(
+            applied, command, self._params, h, self.has_rate_limit, self.rate_mode == "hold",
+            self.n, self.n)
 
     def input_at(self, plan, theta: float, lag_state: np.ndarray | None) -> np.ndarray:
-        """Applied input at fraction ``theta`` ∈ [0, 1] of the step (lag channels: ``lag_state``)."""
+        """Applied input at fraction ``theta`` ∈ [0, 1] of the step (lag channels: ``lag_state``;
+        the batch of :func:`input_at_kernel`)."""
         start, end = plan
-        u = end if theta == 1.0 or start is end else start + theta * (end - start)
-        if lag_state is not None:
-            u = np.where(self.tau > 0, lag_state, u)
-        return u
+        lag = np.zeros(self.n) if lag_state is None else lag_state
+        return per_ship(input_at_kernel, "i i t i p t t o")(
+            start, end, theta, lag, self._params, lag_state is not None, self.has_rate_limit,
+            self.n)
 
     def lag_derivative(self, command: np.ndarray, lag_state: np.ndarray) -> np.ndarray:
-        """ȧ = clip((sat(cmd) − a)/τ, −rate, rate) on lag channels, 0 elsewhere (eq. (22), doc 004)."""
-        target = self.saturate(command)
-        tau = np.where(self.tau > 0, self.tau, 1.0)
-        rate = np.clip((target - lag_state) / tau, -self.rate, self.rate)
-        return np.where(self.tau > 0, rate, 0.0)
+        """ȧ of the lag channels, 0 elsewhere (the batch of :func:`lag_rate_kernel`)."""
+        return per_ship(lag_rate_kernel, "i i p o")(command, lag_state, self._params, self.n)
+
+    @cached_property
+    def _params(self) -> np.ndarray:
+        return self.kernel_params()
 
     def kernel_params(self) -> np.ndarray:
         """``[lower, upper, rate, tau]`` (n each): the parameters of the kernels below."""
@@ -151,7 +145,10 @@ class Actuator:
 
 @kernel_function
 def plan_kernel(applied, cmd, pa, h, rate_limited, hold_mode, start, end):
-    """:meth:`Actuator.begin_step` for one ship: the step's input runs from ``start`` to ``end``."""
+    """One step of length ``h`` for one ship (:meth:`Actuator.begin_step`): the input runs from
+    ``start`` to ``end``. Without a rate limit start = end = sat(cmd); with one,
+    end = applied + clip(sat(cmd) − applied, ±rate·h) and the input ramps linearly from
+    start = applied to end (``hold_mode``, or a channel without a limit: start = end)."""
     n = cmd.shape[0]
     for j in range(n):
         target = clip(cmd[j], pa[j], pa[n + j])
@@ -167,7 +164,9 @@ def plan_kernel(applied, cmd, pa, h, rate_limited, hold_mode, start, end):
 
 @kernel_function
 def input_at_kernel(start, end, theta, lag, pa, has_lag, rate_limited, u):
-    """:meth:`Actuator.input_at`: the applied input at fraction ``theta`` of the step."""
+    """The applied input at fraction ``theta`` ∈ [0, 1] of the step for one ship
+    (:meth:`Actuator.input_at`): u = start + θ (end − start), the lag state ``lag`` on lag
+    channels (``has_lag``)."""
     n = u.shape[0]
     for j in range(n):
         if has_lag and pa[3 * n + j] > 0:
@@ -180,7 +179,8 @@ def input_at_kernel(start, end, theta, lag, pa, has_lag, rate_limited, u):
 
 @kernel_function
 def lag_rate_kernel(cmd, lag, pa, out):
-    """:meth:`Actuator.lag_derivative`: ȧ = clip((sat(cmd) − a)/τ, −rate, rate) on lag channels."""
+    """ȧ = clip((sat(cmd) − a)/τ, −rate, rate) on lag channels, 0 elsewhere, for one ship
+    (document 004 eq. (22); :meth:`Actuator.lag_derivative`)."""
     n = cmd.shape[0]
     for j in range(n):
         tau = pa[3 * n + j]

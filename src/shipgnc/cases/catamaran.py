@@ -96,7 +96,7 @@ def with_current(case: CatamaranCase, current, force=None) -> CatamaranCase:
     :func:`~shipgnc.environment.current_field.parse_current`), with an optional body-axis ``force``
     disturbance: the catamaran's disturbance ``[X_env, Y_env, N_env, current_north,
     current_east]``, the hull forces on the velocity through the water
-    (:func:`~shipgnc.models.catamaran.relative_state`). Sets ``case.disturbance`` and returns
+    (:func:`~shipgnc.models.catamaran.catamaran_rhs`). Sets ``case.disturbance`` and returns
     ``case``."""
     from shipgnc.environment.current_field import CurrentDisturbance, parse_current
 

@@ -29,14 +29,16 @@ Both keep the printed sway Coriolis sign; ``coriolis="consistent"`` flips it (th
 directionally unstable, note 004-C3). The document-frame form (x forward, y to port, ω and K
 clockwise) is :func:`document_derivatives`, with :func:`to_document`/:func:`from_document`.
 
-**Compiled** (:mod:`shipgnc.kernels`): :meth:`Catamaran.kernel` is :meth:`Catamaran.derivatives`
-for one ship (:func:`catamaran_rhs`, every option above; :func:`catamaran_yaw_acceleration` and,
-on scalars, :func:`yaw_acceleration_of` are Φ₃ for the laws' kernels). The kernels pass scalars,
+**One source** (:mod:`shipgnc.kernels`, :mod:`shipgnc.derive`): the equations are written once,
+for one ship, in :func:`catamaran_rhs` (every option above); :meth:`Catamaran.derivatives`,
+:meth:`Catamaran.hull_forces` and :meth:`Catamaran.yaw_acceleration` are the batches of the
+kernels, and the composed loop calls them itself (:func:`catamaran_yaw_acceleration` and, on
+scalars, :func:`yaw_acceleration_of` are Φ₃ for the laws' kernels). The kernels pass scalars,
 not arrays, to their helpers and make no arrays: numba then keeps no reference counts (atomic
 operations on every array argument) in the loop's RK stages. Per-ship plant factors (arrays of
-``m_x_factor``, ``m_y_factor``, ``J_factor``, the Monte Carlo of S10) have no kernel: a model
-kernel has one parameter array for all ships, so such a run stays in the numpy loop
-(:meth:`Catamaran.kernel_reason`).
+``m_x_factor``, ``m_y_factor``, ``J_factor``, the Monte Carlo of S10) are one parameter row per
+ship; factors along more than one batch axis have no composed loop (the run stays in the numpy
+loop, :meth:`Catamaran.kernel_reason`).
 """
 
 from __future__ import annotations
@@ -47,11 +49,11 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from shipgnc.actuators import Actuator
+from shipgnc.derive import per_ship
 from shipgnc.errors import ConfigError, require
-from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, NotCompiled, kernel_function
-from shipgnc.models.base import Signal
-from shipgnc.models.fossen3dof import CURRENT, body_current
+from shipgnc.models.base import Signal, kernel_derivatives
+from shipgnc.models.fossen3dof import CURRENT
 from shipgnc.params import Params
 
 #: resistance fit R_K(V) = a0 + a1 V + a2 V² [kN, one hull] of eq. (8)
@@ -309,27 +311,6 @@ DISTURBANCES = (
 NORTH, EAST, PSI, U, V, R, DELTA = range(7)
 
 
-def relative_state(x, d):
-    """(x with u, v through the water, the body-axis current (u_c, v_c) or None): the state the
-    hull's forces see in an earth-fixed current ``d[..., 3:5]`` [m/s] (Fossen 2021 §10.3).
-
-    The document's hull forces — resistance R(V_r) along −ν_r/V_r, its moment at x_p(β_r), the
-    yaw damping c_D V_r r, the Coriolis and Munk terms with the total masses m_x, m_y (rigid plus
-    added: Δ and k₁₁Δ, k₂₂Δ) and the lateral lift — are evaluated at ν_r = ν − ν_c and
-    ν̇ = ν̇_r + (r v_c, −r u_c, 0). With the consistent Coriolis sign the Coriolis terms are C(ν)ν of
-    M = diag(m_x, m_y, J) with x_g = 0, so Property 10.1 makes this Fossen's M_RB ν̇ + C_RB(ν)ν +
-    M_A ν̇_r + C_A(ν_r)ν_r + D(ν_r)ν_r = τ exactly for a constant current; with the printed sign
-    (not a rigid-body Coriolis term) the same substitution is applied as a reproduction. The
-    thrust does not depend on speed."""
-    current = body_current(x[..., PSI], d)
-    if current is None:
-        return x, None
-    xr = np.array(x, dtype=float, copy=True)
-    xr[..., U] = x[..., U] - current[0]
-    xr[..., V] = x[..., V] - current[1]
-    return xr, current
-
-
 @dataclass(frozen=True, eq=False)
 class Catamaran:
     """Document 004's twin-azimuth catamaran in NED form (see the module docstring)."""
@@ -356,51 +337,34 @@ class Catamaran:
         return np.array([-np.inf]), np.array([np.inf])
 
     def hull_forces(self, x):
-        """(X, Y, N) of the hull alone (resistance, yaw damping, Coriolis, Munk) in NED body axes."""
-        p = self.params
-        u, v, r = x[..., U], x[..., V], x[..., R]
-        speed = np.hypot(u, v)
-        r_over_v = p.resistance_over_speed(speed)
-        beta = np.arctan2(v, u)
-        x_p = 0.4 * p.L * (0.5 - np.abs(beta) / np.pi)
-        X = -r_over_v * u + p.m_y * v * r
-        Y = -r_over_v * v + p.sigma * p.m_x * u * r
-        Y = Y + (p.Y_vV * speed * v + p.Y_rV * speed * r + p.Y_vv * np.abs(v) * v)  # lift (si-consistent)
-        N = -x_p * r_over_v * v - p.c_D * speed * r + (p.m_x - p.m_y) * u * v
-        return X, Y, N
+        """(X, Y, N) of the hull alone (resistance, yaw damping, Coriolis, Munk) in NED body axes:
+        the batch of :func:`catamaran_hull_forces`."""
+        params, x = self._batch(np.asarray(x, dtype=float))
+        out = per_ship(catamaran_hull_forces, "i p o")(x, params, 3)
+        return out[..., 0], out[..., 1], out[..., 2]
 
     def derivatives(self, x, u, d=None):
         """ẋ for ``x`` (..., 7), ``u`` (..., 1) = [δ̇] or [v_a], ``d`` (..., 3) (forces), (..., 5)
-        (forces and an earth-fixed current [m/s], :func:`relative_state`) or None."""
-        p = self.params
-        delta = x[..., DELTA]
-        xr, current = relative_state(x, d)
-        X, Y, N = self.hull_forces(xr)
-        cd, sd = np.cos(delta), np.sin(delta)
-        X = X + 2.0 * p.T_v * cd
-        Y = Y - 2.0 * p.T_v * sd
-        N = N + p.L * p.T_v * sd
-        if d is not None:
-            X, Y, N = X + d[..., 0], Y + d[..., 1], N + d[..., 2]
-        north_dot, east_dot = body_to_ned(x[..., PSI], x[..., U], x[..., V])
-        if p.delta_row == "rate":
-            delta_dot = np.broadcast_to(u[..., 0], delta.shape)
-        else:
-            delta_dot = (-delta + p.k_t * u[..., 0]) / p.T_t
-        u_dot, v_dot = X / p.m_x, Y / p.m_y
-        if current is not None:  # ν̇ = ν̇_r + ν̇_c, ν̇_c = (r v_c, −r u_c, 0)
-            u_dot, v_dot = u_dot + x[..., R] * current[1], v_dot - x[..., R] * current[0]
-        return np.stack([north_dot, east_dot, x[..., R], u_dot, v_dot, N / p.J, delta_dot],
-                        axis=-1)
+        (forces and an earth-fixed current [m/s]) or None: the batch of :func:`catamaran_rhs`."""
+        params, x = self._batch(np.asarray(x, dtype=float), u, d)
+        return kernel_derivatives(self, catamaran_rhs, params, x, u, d)
 
     def yaw_acceleration(self, x, d=None):
         """Φ₃ = ṙ at state ``x`` (it does not depend on the input; a current in ``d`` acts on ν_r)."""
-        p = self.params
-        _, _, N = self.hull_forces(relative_state(x, d)[0])
-        N = N + p.L * p.T_v * np.sin(x[..., DELTA])
-        if d is not None:
-            N = N + d[..., 2]
-        return N / p.J
+        x = np.asarray(x, dtype=float)
+        return self.derivatives(x, np.zeros((*x.shape[:-1], 1)), d)[..., R]
+
+    def _batch(self, x, *others) -> tuple[np.ndarray, np.ndarray]:
+        """(the kernels' parameters, ``x``) for the batch: one flat array, or with per-ship factors
+        one row per ship of the broadcast batch (``x`` broadcast to it; numpy's broadcasting of
+        the factors against the states)."""
+        columns = _kernel_columns(self.params)
+        if columns.ndim == 1:
+            return columns, x
+        lead = np.broadcast_shapes(x.shape[:-1], columns.shape[:-1],
+                                   *(np.shape(a)[:-1] for a in others if a is not None))
+        rows = np.broadcast_to(columns, (*lead, N_KERNEL_PARAMS)).reshape(-1, N_KERNEL_PARAMS)
+        return np.ascontiguousarray(rows), np.broadcast_to(x, (*lead, x.shape[-1]))
 
     # --- the composed compiled loop (shipgnc.kernels) ----------------------------------------
     def kernel_reason(self) -> str | None:
@@ -432,12 +396,16 @@ def kernel_params_reason(params: CatamaranParams) -> str | None:
 def kernel_params(params: CatamaranParams) -> np.ndarray:
     """The parameters of :func:`catamaran_rhs` and :func:`catamaran_yaw_acceleration`:
     ``[m_x, m_y, J, σ m_x, m_x − m_y, c_D, 0.4 L, 2 T_v, L T_v, literal, V_m, 2000 R_K(V_m)/V_m²,
-    lag row, k_t, T_t, Y_vV, Y_rV, Y_vv]`` (each product formed as :meth:`Catamaran.hull_forces` and
-    :meth:`Catamaran.derivatives` form it, so the kernel repeats numpy's operations): a flat
-    array, or one row per ship when the mass factors vary from ship to ship."""
+    lag row, k_t, T_t, Y_vV, Y_rV, Y_vv]``: a flat array, or one row per ship when the mass
+    factors vary from ship to ship."""
     reason = kernel_params_reason(params)
     if reason:
         raise NotCompiled(reason)
+    return _kernel_columns(params)
+
+
+def _kernel_columns(params: CatamaranParams) -> np.ndarray:
+    """The columns of :func:`kernel_params` broadcast over the factors' shape (..., 18)."""
     p = params
     m_x, m_y, J = (np.asarray(v, dtype=float) for v in (p.m_x, p.m_y, p.J))
     a0, a1, a2 = RK_COEFFS
@@ -453,16 +421,20 @@ def kernel_params(params: CatamaranParams) -> np.ndarray:
 
 @kernel_function
 def _hull_forces(su, sv, sr, p, o):
-    """(X, Y, N) of the hull alone for one ship at (u, v, r) = (``su``, ``sv``, ``sr``):
-    :meth:`Catamaran.hull_forces` operation for operation — resistance R(V)/V of eq. (8)
-    (continued below V_m unless literal), Coriolis with sign σ (eq. (1)–(2)), the moment of R at
-    x_p(β), yaw damping c_D V r and the Munk moment (3). ``p[o:]`` holds :func:`kernel_params` (an
-    offset, not a slice: no array view per call). Scalars in, scalars out: no array is made or
-    passed, so the callers keep no reference counts in their hot path.
+    """(X, Y, N) of the hull alone for one ship at (u, v, r) = (``su``, ``sv``, ``sr``) (note
+    004-4.3, eq. (1)–(3), (8))::
 
-    Two exact identities replace numpy's library calls (results move at round-off level only):
-    V = √(u² + v²) for ``hypot`` (|u|, |v| ≤ 50 m/s by the state limits: no overflow), and
-    |β| = |atan2(v, u)| = atan(|v|/u) for u > 0 (atan2(|v|, u) otherwise), about half the cost."""
+        X = −R(V)/V · u + m_y v r
+        Y = −R(V)/V · v + σ m_x u r + Y_vV V v + Y_rV V r + Y_vv |v| v
+        N = −x_p(β) R(V)/V · v − c_D V r + (m_x − m_y) u v,   x_p = 0.4 L (0.5 − |β|/π)
+
+    resistance R(V) = 2000 R_K(V), R_K = 8.1 − 8.436 V + 2.536 V² [kN] (continued below V_m as
+    R_K(V_m) V²/V_m² unless ``low_speed="literal"``), Coriolis with sign σ, yaw damping c_D V r and
+    the Munk moment. V = √(u² + v²) (|u|, |v| ≤ 50 m/s by the state limits: no overflow), |β| =
+    |atan2(v, u)| = atan(|v|/u) for u > 0 (atan2(|v|, u) otherwise), about half the cost.
+    ``p[o:]`` holds :func:`kernel_params` (an offset, not a slice: no array view per call).
+    Scalars in, scalars out: no array is made or passed, so the callers keep no reference counts
+    in their hot path."""
     m_y, sig_m_x, munk, c_D, x_p0 = p[o + 1], p[o + 3], p[o + 4], p[o + 5], p[o + 6]
     speed = math.sqrt(su * su + sv * sv)
     a0, a1, a2 = RK_COEFFS
@@ -485,9 +457,18 @@ def _hull_forces(su, sv, sr, p, o):
 @kernel_function
 def catamaran_rhs(x, u, d, p, xdot):
     """ẋ of document 004 eq. (1)–(3) with δ̇ of eq. (2) (rate row) or of the lag (22) for one
-    ship: :meth:`Catamaran.derivatives`, operation for operation (``p``: :func:`kernel_params`;
-    forces ``d[0:3]``, earth-fixed current ``d[3:5]`` as relative velocity; a zero ``d`` is
-    ``d=None``)."""
+    ship (the one source of :meth:`Catamaran.derivatives`; ``p``: :func:`kernel_params`; forces
+    ``d[0:3]``; a zero ``d`` is ``d=None``).
+
+    An earth-fixed current ``d[3:5]`` [m/s] acts as relative velocity (Fossen 2021 §10.3): the
+    hull's forces of :func:`_hull_forces` — resistance R(V_r) along −ν_r/V_r, its moment at
+    x_p(β_r), the yaw damping c_D V_r r, the Coriolis and Munk terms with the total masses m_x, m_y
+    (rigid plus added: Δ and k₁₁Δ, k₂₂Δ) and the lateral lift — are evaluated at ν_r = ν − ν_c,
+    ν_c = R(ψ)ᵀ[V_N, V_E], and ν̇ = ν̇_r + (r v_c, −r u_c, 0). With the consistent Coriolis sign
+    the Coriolis terms are C(ν)ν of M = diag(m_x, m_y, J) with x_g = 0, so Property 10.1 makes
+    this Fossen's M_RB ν̇ + C_RB(ν)ν + M_A ν̇_r + C_A(ν_r)ν_r + D(ν_r)ν_r = τ exactly for a
+    constant current; with the printed sign (not a rigid-body Coriolis term) the same
+    substitution is applied as a reproduction. The thrust does not depend on speed."""
     m_x, m_y, J, two_T_v, L_T_v = p[0], p[1], p[2], p[7], p[8]
     delta = x[DELTA]
     c, s = math.cos(x[PSI]), math.sin(x[PSI])
@@ -520,9 +501,18 @@ def catamaran_rhs(x, u, d, p, xdot):
 
 
 @kernel_function
+def catamaran_hull_forces(x, p, out):
+    """(X, Y, N) of :func:`_hull_forces` at one ship's state ``x`` into ``out``."""
+    X, Y, N = _hull_forces(x[U], x[V], x[R], p, 0)
+    out[0] = X
+    out[1] = Y
+    out[2] = N
+
+
+@kernel_function
 def yaw_acceleration_of(su, sv, sr, delta, p, o):
     """Φ₃ = ṙ of eq. (3) without disturbance at (u, v, r, δ) = (``su``, ``sv``, ``sr``, ``delta``):
-    :meth:`Catamaran.yaw_acceleration` on scalars (``p[o:]``: :func:`kernel_params`), for laws that
+    ṙ of :func:`catamaran_rhs` on scalars (``p[o:]``: :func:`kernel_params`), for laws that
     read the state once and keep it out of conditional calls."""
     N = _hull_forces(su, sv, sr, p, o)[2]
     N = N + p[o + 8] * math.sin(delta)
@@ -531,8 +521,7 @@ def yaw_acceleration_of(su, sv, sr, delta, p, o):
 
 @kernel_function
 def catamaran_yaw_acceleration(x, p, o):
-    """Φ₃ = ṙ of eq. (3) at one ship's state without disturbance:
-    :meth:`Catamaran.yaw_acceleration` (``p[o:]``: :func:`kernel_params`)."""
+    """Φ₃ = ṙ of eq. (3) at one ship's state without disturbance (``p[o:]``: :func:`kernel_params`)."""
     return yaw_acceleration_of(x[U], x[V], x[R], x[DELTA], p, o)
 
 

@@ -53,10 +53,9 @@ import numpy as np
 
 from shipgnc.actuators import Actuator
 from shipgnc.errors import require
-from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, flat, kernel_function
-from shipgnc.models.base import Signal
-from shipgnc.models.fossen3dof import CURRENT, DISTURBANCES, STATES, body_current
+from shipgnc.models.base import Signal, kernel_derivatives
+from shipgnc.models.fossen3dof import CURRENT, DISTURBANCES, STATES
 from shipgnc.params import Params
 
 RUDDER_MODELS = ("table1", "skjetne")
@@ -213,33 +212,17 @@ class CyberShip2Params(Params):
 
 
 def propeller_thrust(params: CyberShip2Params, n, u):
-    """Thrust of one main propeller T = T_nn|n|n − T_nu|n|u [N], clipped at 0 when n ≥ 0."""
-    p = params
-    n = np.asarray(n, dtype=float)
-    raw = p.T_nn * np.abs(n) * n - p.T_nu * np.abs(n) * u
-    return np.where(n >= 0, np.maximum(raw, 0.0), raw)
+    """Thrust of one main propeller T = T_nn|n|n − T_nu|n|u [N], clipped at 0 when n ≥ 0
+    (:func:`_thrust` elementwise)."""
+    return np.vectorize(_thrust, otypes=[float])(params.T_nn, params.T_nu, n, u)
 
 
 def rudder_inflow(params: CyberShip2Params, n, u):
-    """u_rud = u + k_u(√(8T/(πρd²) + u²) − u) for u ≥ 0 (else u): the slipstream speed [m/s]."""
+    """u_rud = u + k_u(√(8T/(πρd²) + u²) − u) for u ≥ 0 (else u): the slipstream speed [m/s]
+    (:func:`_rudder_inflow` elementwise)."""
     p = params
-    u = np.asarray(u, dtype=float)
-    thrust = propeller_thrust(p, n, u)
-    jet = np.sqrt(np.maximum(0.0, 8.0 * thrust / (math.pi * p.rho * p.d_prop**2) + u * u))
-    return np.where(u >= 0, u + p.k_u * (jet - u), u)
-
-
-def rudder_forces(params: CyberShip2Params, delta, u, n):
-    """Sway force and yaw moment ``(tau_Y, tau_N)`` of both rudders at angle ``delta`` [rad]."""
-    p = params
-    delta = np.asarray(delta, dtype=float)
-    if p.rudder_model == "table1":
-        tau_y = -p.Y_delta * delta
-        return tau_y, -p.N_delta * delta
-    u_rud = rudder_inflow(p, n, u)
-    lift = (p.L_delta * delta - p.L_absdelta_delta * np.abs(delta) * delta) * np.abs(u_rud) * u_rud
-    tau_y = 2.0 * lift
-    return tau_y, p.x_rudder * tau_y
+    return np.vectorize(_rudder_inflow, otypes=[float])(
+        propeller_thrust(p, n, u), u, p.k_u, math.pi * p.rho * p.d_prop**2)
 
 
 def rudder_gains(params: CyberShip2Params, u: float, n: float = CRUISE_RPS) -> tuple[float, float]:
@@ -256,14 +239,9 @@ def rudder_gains(params: CyberShip2Params, u: float, n: float = CRUISE_RPS) -> t
     return y, p.x_rudder * y
 
 
-def surge_damping(params: CyberShip2Params, u):
-    """d₁₁(u) = −X_u − X_|u|u|u| − X_uuu u² [kg/s]."""
-    p = params
-    return -p.X_u - p.X_absu_u * np.abs(u) - p.X_uuu * u * u
-
-
 def surge_equilibrium(params: CyberShip2Params, n: float) -> float:
-    """Straight-run speed u [m/s] at propeller speed ``n`` [rps] with δ = 0: 2T(n, u) = d₁₁(u)u.
+    """Straight-run speed u [m/s] at propeller speed ``n`` [rps] with δ = 0: 2T(n, u) = d₁₁(u)u,
+    d₁₁(u) = −X_u − X_|u|u|u| − X_uuu u² (u̇ = 0 of :func:`cybership2_rhs`).
 
     At 8.13 rps this is 0.295838 m/s (note 003-3.5 rounds it to 0.2958; the document's 0.3 m/s).
     """
@@ -272,8 +250,10 @@ def surge_equilibrium(params: CyberShip2Params, n: float) -> float:
     require(math.isfinite(n) and n >= 0, "n", n, "propeller speed must be a finite number >= 0 rps")
     p = params
 
-    def imbalance(u: float) -> float:
-        return float(2.0 * propeller_thrust(p, n, u) - surge_damping(p, u) * u)
+    model = CyberShip2(p)
+
+    def imbalance(u: float) -> float:  # u̇ at (u, 0, 0): (2T(n, u) − d₁₁(u) u)/M₁₁
+        return float(model.derivatives(np.array([0.0, 0.0, 0.0, u, 0.0, 0.0]), np.array([n, 0.0]))[3])
 
     if imbalance(0.0) <= 0.0:
         return 0.0
@@ -309,47 +289,25 @@ class CyberShip2:
 
     def derivatives(self, x, u, d=None):
         """ẋ for ``x`` (..., 6), ``u`` (..., 2) = [n, δ], ``d`` (..., 3) (forces), (..., 5) (forces
-        and current, module docstring) or None."""
-        p = self.params
-        psi, su, sv, sr = x[..., 2], x[..., 3], x[..., 4], x[..., 5]
-        current = body_current(psi, d)
-        if current is not None:  # the hull and its propellers and rudders see ν_r
-            su, sv = su - current[0], sv - current[1]
-        n, delta = u[..., 0], u[..., 1]
-        tau_x = 2.0 * propeller_thrust(p, n, su)
-        tau_y, tau_n = rudder_forces(p, delta, su, n)
-        if d is not None:
-            tau_x, tau_y, tau_n = tau_x + d[..., 0], tau_y + d[..., 1], tau_n + d[..., 2]
-        c13 = -p.m * (p.x_G * sr + sv) + p.Y_vdot * sv + 0.5 * (p.N_vdot + p.Y_rdot) * sr
-        c23 = (p.m - p.X_udot) * su
-        abs_v, abs_r = np.abs(sv), np.abs(sr)
-        d22 = -p.Y_v - p.Y_absv_v * abs_v - p.Y_absr_v * abs_r
-        d23 = -p.Y_r - p.Y_absv_r * abs_v - p.Y_absr_r * abs_r
-        d32 = -p.N_v - p.N_absv_v * abs_v - p.N_absr_v * abs_r
-        d33 = -p.N_r - p.N_absv_r * abs_v - p.N_absr_r * abs_r
-        f_x = tau_x - c13 * sr - surge_damping(p, su) * su
-        f_y = tau_y - c23 * sr - d22 * sv - d23 * sr
-        f_n = tau_n + c13 * su + c23 * sv - d32 * sv - d33 * sr
-        (a, b), (c, e) = self._sway_yaw_inverse
-        u_dot, v_dot, r_dot = f_x / p.M11, a * f_y + b * f_n, c * f_y + e * f_n
-        if current is not None:  # back over ground: ν = ν_r + ν_c, ν̇_c = (r v_c, −r u_c, 0)
-            su, sv = x[..., 3], x[..., 4]
-            u_dot, v_dot = u_dot + sr * current[1], v_dot - sr * current[0]
-        north_dot, east_dot = body_to_ned(psi, su, sv)
-        return np.stack([north_dot, east_dot, sr, u_dot, v_dot, r_dot], axis=-1)
+        and current, module docstring) or None: the batch of :func:`cybership2_rhs`."""
+        return kernel_derivatives(self, cybership2_rhs, self._kernel_params, x, u, d)
 
     def kernel(self) -> Kernel:
-        """:meth:`derivatives` for the composed loop (:func:`cybership2_rhs`); the parameters
-        are combined exactly as the numpy form combines them."""
+        """:meth:`derivatives` for the composed loop (:func:`cybership2_rhs`)."""
+        return Kernel(cybership2_rhs, self._kernel_params)
+
+    @cached_property
+    def _kernel_params(self) -> np.ndarray:
+        """The parameters of :func:`cybership2_rhs`, in its order."""
         p = self.params
         (a, b), (c, e) = self._sway_yaw_inverse
-        return Kernel(cybership2_rhs, flat(
+        return flat(
             p.T_nn, p.T_nu, float(p.rudder_model == "skjetne"), p.Y_delta, p.N_delta,
             p.L_delta, p.L_absdelta_delta, p.k_u, math.pi * p.rho * p.d_prop**2, p.x_rudder,
             p.m, p.x_G, p.Y_vdot, 0.5 * (p.N_vdot + p.Y_rdot), p.m - p.X_udot,
             p.Y_v, p.Y_absv_v, p.Y_absr_v, p.Y_r, p.Y_absv_r, p.Y_absr_r,
             p.N_v, p.N_absv_v, p.N_absr_v, p.N_r, p.N_absv_r, p.N_absr_r,
-            p.X_u, p.X_absu_u, p.X_uuu, p.M11, a, b, c, e))
+            p.X_u, p.X_absu_u, p.X_uuu, p.M11, a, b, c, e)
 
     @cached_property
     def _sway_yaw_inverse(self) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -359,7 +317,7 @@ class CyberShip2:
 
 @kernel_function
 def _thrust(T_nn, T_nu, n, su):
-    """:func:`propeller_thrust` for one propeller speed (NaN passes through)."""
+    """T = T_nn|n|n − T_nu|n|u of one propeller, clipped at 0 for n ≥ 0 (NaN passes through)."""
     raw = T_nn * abs(n) * n - T_nu * abs(n) * su
     if n >= 0 and raw < 0.0:
         return 0.0
@@ -367,11 +325,27 @@ def _thrust(T_nn, T_nu, n, su):
 
 
 @kernel_function
+def _rudder_inflow(thrust, su, k_u, jet_den):
+    """u_rud = u + k_u(√(8T/(πρd²) + u²) − u) for u ≥ 0 (else u), ``jet_den`` = πρd²."""
+    jet = 8.0 * thrust / jet_den + su * su
+    if jet < 0.0:
+        jet = 0.0
+    jet = math.sqrt(jet)
+    return su + k_u * (jet - su) if su >= 0 else su
+
+
+@kernel_function
 def cybership2_rhs(x, u, d, p, xdot):
-    """ẋ of note 003-3.5 for one ship: M ν̇_r + C(ν_r)ν_r + D(ν_r)ν_r = τ + τ_env, η̇ = J(ψ)ν,
-    with the propeller thrust and both rudder models of :meth:`CyberShip2.derivatives`, operation
-    for operation (forces ``d[0:3]``, earth-fixed current ``d[3:5]``; zero ``d`` is still water
-    without disturbance). ``p`` from :meth:`CyberShip2.kernel`."""
+    """ẋ of note 003-3.5 for one ship (the one source of :meth:`CyberShip2.derivatives`)::
+
+        η̇ = J(ψ) ν,   M ν̇_r + C(ν_r) ν_r + D(ν_r) ν_r = τ + τ_env,   ν̇ = ν̇_r + (r v_c, −r u_c, 0)
+
+    with C, D and M of the module docstring, the propellers' τ_X = 2T(n, u_r) (T = T_nn|n|n −
+    T_nu|n|u_r, clipped at 0 for n ≥ 0) and the rudders' (τ_Y, τ_N) of Table 1 (−Y_δ δ, −N_δ δ) or
+    of Skjetne et al. (2004) (2L, x_R·2L, L = (L_δ δ − L_|δ|δ |δ|δ)|u_rud|u_rud in the slipstream
+    u_rud = u_r + k_u(√(8T/(πρd²) + u_r²) − u_r), u_r ≥ 0). Forces ``d[0:3]``, earth-fixed current
+    ``d[3:5]`` (ν_c = R(ψ)ᵀ v_c, Fossen 2021 §10.3); zero ``d`` is still water without
+    disturbance. ``p``: :attr:`CyberShip2._kernel_params`."""
     T_nn, T_nu, skjetne, Y_delta, N_delta = p[0], p[1], p[2], p[3], p[4]
     L_delta, L_absdd, k_u, jet_den, x_rudder = p[5], p[6], p[7], p[8], p[9]
     m, x_G, Y_vdot, c13_r, c23_u = p[10], p[11], p[12], p[13], p[14]
@@ -395,11 +369,7 @@ def cybership2_rhs(x, u, d, p, xdot):
         tau_y = -Y_delta * delta
         tau_n = -N_delta * delta
     else:  # lift in the propeller slipstream
-        jet = 8.0 * thrust / jet_den + su * su
-        if jet < 0.0:
-            jet = 0.0
-        jet = math.sqrt(jet)
-        u_rud = su + k_u * (jet - su) if su >= 0 else su
+        u_rud = _rudder_inflow(thrust, su, k_u, jet_den)
         lift = (L_delta * delta - L_absdd * abs(delta) * delta) * abs(u_rud) * u_rud
         tau_y = 2.0 * lift
         tau_n = x_rudder * tau_y

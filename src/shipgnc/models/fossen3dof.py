@@ -213,16 +213,6 @@ CURRENT = (
 )
 
 
-def body_current(psi, d):
-    """(u_c, v_c) = R(ψ)ᵀ[V_N, V_E]: the current of ``d[..., 3:5]`` in body axes, or None when
-    ``d`` has no current channels (Fossen 2021 §10.3)."""
-    if d is None or d.shape[-1] < 5:
-        return None
-    c, s = np.cos(psi), np.sin(psi)
-    vn, ve = d[..., 3], d[..., 4]
-    return c * vn + s * ve, -s * vn + c * ve
-
-
 @dataclass(frozen=True)
 class VectoredThrustBoat:
     """Document 001's boat: Fossen 3-DOF, one vectored thruster (see module docstring)."""

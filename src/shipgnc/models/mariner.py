@@ -52,6 +52,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
+from functools import cached_property
 from types import MappingProxyType
 
 import numpy as np
@@ -59,9 +60,8 @@ import numpy as np
 from shipgnc.actuators import Actuator
 from shipgnc.environment.fields import field_velocity
 from shipgnc.errors import ConfigError, require
-from shipgnc.frames import body_to_ned
 from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
-from shipgnc.models.base import Signal
+from shipgnc.models.base import Signal, kernel_derivatives, kernel_jacobian
 from shipgnc.params import Params
 from shipgnc.paths import leg_table, track_leg
 from shipgnc.units import MINUTE, NAUTICAL_MILE
@@ -221,62 +221,37 @@ class MarinerWitOppe:
         return self.params.sway(r)
 
     def derivatives(self, x, u, d=None):
-        """ẋ of eq. (25) for ``x`` (..., 5), ``u`` (..., 1) = [δ], ``d`` (..., 3) or None: the hull
-        terms on u, v, r through the water, the current ``d[..., 1:3]`` added to the kinematics
-        (module docstring)."""
-        p = self.params
-        psi, su, sr = x[..., 2], x[..., 3], x[..., 4]
-        north_dot, east_dot = body_to_ned(psi, su, p.sway(sr))
-        r_dot = -p.a * sr - p.b * sr**3 + p.c * u[..., 0]
-        if d is not None:
-            r_dot = r_dot + d[..., 0]
-            north_dot = north_dot + d[..., 1]
-            east_dot = east_dot + d[..., 2]
-        u_dot = -p.f * su - p.W * sr * sr + p.S
-        return np.stack([north_dot, east_dot, sr, u_dot, r_dot], axis=-1)
+        """ẋ of eq. (25) for ``x`` (..., 5), ``u`` (..., 1) = [δ], ``d`` (..., 3) or None: the batch
+        of :func:`mariner_rhs`."""
+        return kernel_derivatives(self, mariner_rhs, self._kernel_params, x, u, d)
 
     def state_jacobian(self, x, u, d=None):
         """A = ∂f/∂x of :meth:`derivatives` at (x, u, d), analytic: (..., 5, 5), A[..., i, j] =
-        ∂ẋ_i/∂x_j (δ and d enter additively). With v = r₁ r + r₂ r³, v' = r₁ + 3 r₂ r²::
+        ∂ẋ_i/∂x_j (the batch of :func:`mariner_rhs_jacobian`); used by the EKF
+        (:class:`~shipgnc.navigation.ekf.ExtendedKalmanFilter`) in place of central differences."""
+        return kernel_jacobian(self, mariner_rhs_jacobian, self._kernel_params, x, u, d)
 
-            ∂(ẋ, ẏ)/∂ψ = (−u sin ψ − v cos ψ, u cos ψ − v sin ψ)
-            ∂(ẋ, ẏ)/∂u = (cos ψ, sin ψ),   ∂(ẋ, ẏ)/∂r = (−v' sin ψ, v' cos ψ)
-            ∂ψ̇/∂r = 1,   ∂u̇/∂(u, r) = (−f, −2 W r),   ∂ṙ/∂r = −a − 3 b r²
-
-        (eq. (25) differentiated); used by the EKF
-        (:class:`~shipgnc.navigation.ekf.ExtendedKalmanFilter`) in place of central differences.
-        """
+    @cached_property
+    def _kernel_params(self) -> np.ndarray:
+        """[a, b, c, r₁, r₂, f, W, S], the kernels' parameter array."""
         p = self.params
-        x = np.asarray(x, dtype=float)
-        psi, su, sr = x[..., 2], x[..., 3], x[..., 4]
-        c, s = np.cos(psi), np.sin(psi)
-        v = p.sway(sr)
-        dv = p.r1 + 3.0 * p.r2 * sr * sr
-        A = np.zeros((*psi.shape, 5, 5))
-        A[..., 0, 2] = -s * su - c * v
-        A[..., 0, 3] = c
-        A[..., 0, 4] = -s * dv
-        A[..., 1, 2] = c * su - s * v
-        A[..., 1, 3] = s
-        A[..., 1, 4] = c * dv
-        A[..., 2, 4] = 1.0
-        A[..., 3, 3] = -p.f
-        A[..., 3, 4] = -2.0 * p.W * sr
-        A[..., 4, 4] = -p.a - 3.0 * p.b * sr * sr
-        return A
+        return flat(p.a, p.b, p.c, p.r1, p.r2, p.f, p.W, p.S)
 
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`mariner_rhs`)."""
-        p = self.params
-        return Kernel(mariner_rhs, flat(p.a, p.b, p.c, p.r1, p.r2, p.f, p.W, p.S))
+        return Kernel(mariner_rhs, self._kernel_params)
 
 
 @kernel_function
 def mariner_rhs(x, u, d, p, xdot):
-    """ẋ of eq. (25) for one ship: :meth:`MarinerWitOppe.derivatives`, operation for operation
-    (r³ = r·r·r, within an ulp of numpy's ``pow``; a zero ``d`` adds nothing; the current ``d[1:3]``
-    enters the kinematics only, u and r being through the water); ``p`` = [a, b, c, r₁, r₂, f, W,
-    S]."""
+    """ẋ of eq. (25) for one ship (the one source of :meth:`MarinerWitOppe.derivatives`)::
+
+        ẋ = u cos ψ − v sin ψ + c_N,   ẏ = u sin ψ + v cos ψ + c_E,   ψ̇ = r
+        u̇ = −f u − W r² + S,   ṙ = −a r − b r³ + c δ + b_r,   v = r₁ r + r₂ r³
+
+    (note 000-0.3, signs restored A3): the hull terms on u, v, r through the water, the current
+    ``d[1:3]`` = (c_N, c_E) added to the kinematics only, ``d[0]`` = b_r (module docstring; a zero
+    ``d`` adds nothing). r³ = r·r·r; ``p`` = [a, b, c, r₁, r₂, f, W, S]."""
     a, b, c_rudder, r1, r2, f, W, S = p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]
     psi, su, sr = x[2], x[3], x[4]
     r3 = sr * sr * sr  # a libm pow call per stage cost ≈ 40 % of the Mariner's step
@@ -291,9 +266,15 @@ def mariner_rhs(x, u, d, p, xdot):
 
 @kernel_function
 def mariner_rhs_jacobian(x, u, d, p, A):
-    """:meth:`MarinerWitOppe.state_jacobian` for one ship: ∂ẋ/∂x of :func:`mariner_rhs` into
-    ``A`` (5 × 5, row-major flat); ``p`` as :func:`mariner_rhs`. Found by the composed loop's EKF
-    by its name (:func:`shipgnc.navigation.kernels.jacobian_kernel`)."""
+    """∂ẋ/∂x of :func:`mariner_rhs` for one ship into ``A`` (5 × 5, row-major flat); ``p`` as
+    :func:`mariner_rhs`. Eq. (25) differentiated (δ and d enter additively); with
+    v = r₁ r + r₂ r³, v' = r₁ + 3 r₂ r²::
+
+        ∂(ẋ, ẏ)/∂ψ = (−u sin ψ − v cos ψ, u cos ψ − v sin ψ)
+        ∂(ẋ, ẏ)/∂u = (cos ψ, sin ψ),   ∂(ẋ, ẏ)/∂r = (−v' sin ψ, v' cos ψ)
+        ∂ψ̇/∂r = 1,   ∂u̇/∂(u, r) = (−f, −2 W r),   ∂ṙ/∂r = −a − 3 b r²
+
+    Found by the composed loop's EKF by its name (:func:`shipgnc.navigation.kernels.jacobian_kernel`)."""
     a, b, r1, r2, f, W = p[0], p[1], p[3], p[4], p[5], p[6]
     psi, su, sr = x[2], x[3], x[4]
     v = r1 * sr + r2 * sr * sr * sr

@@ -4,13 +4,13 @@ the plant, ``shipgnc sweep --perturb vessel.params.NAME=...``).
 :class:`PerShipModel` wraps one model object per ship, all of one kind (same states, inputs,
 disturbances, state and input limits), and is itself a model the simulator takes as it is:
 
-* :meth:`PerShipModel.derivatives` evaluates ship *i*'s own model on row *i* of the batch, in a
-  Python loop over the ships. That is the readable numpy reference, not a fast path (a ship costs
-  one small numpy call per RK4 stage), and it makes each ship's ẋ the same bits whatever batch
-  it shares;
-* :meth:`PerShipModel.kernel` is the compiled form: the ships' own kernels stacked, one parameter
-  row per ship ``(n_ships, n_p)`` with the one kernel function they share (see
-  :mod:`shipgnc.kernels`); the composed loop hands each ship its own row.
+* :meth:`PerShipModel.kernel` is the ships' own kernels stacked, one parameter row per ship
+  ``(n_ships, n_p)`` with the one kernel function they share (see :mod:`shipgnc.kernels`); the
+  composed loop hands each ship its own row;
+* :meth:`PerShipModel.derivatives` is the batch of that kernel over the rows
+  (:func:`shipgnc.derive.per_ship`), each ship's ẋ the same bits whatever batch it shares; for
+  models written only in numpy it evaluates ship *i*'s own model on row *i* of the batch, in a
+  Python loop over the ships (the slow path: one small numpy call per ship and RK4 stage).
 
 ``params`` (and ``input_limits``) are the nominal model's: what a controller designed on the
 model, a metric or a figure reads is the nominal design, not a ship's draw.
@@ -28,7 +28,7 @@ import numpy as np
 
 from shipgnc.errors import ConfigError
 from shipgnc.kernels import Kernel, NotCompiled
-from shipgnc.models.base import names
+from shipgnc.models.base import kernel_derivatives, names
 
 
 def plant_params(model) -> dict:
@@ -116,15 +116,20 @@ class PerShipModel:
         """Ships ``start .. stop-1`` as a model of their own (a batch of those ships alone)."""
         return PerShipModel(self.models[start:stop], self.nominal)
 
-    # --- numpy reference ---------------------------------------------------------------------
+    # --- ẋ of every ship ------------------------------------------------------------------------
     def derivatives(self, x, u, d=None):
-        """ẋ for ``x`` (n_ships, n_states): row *i* from ``models[i].derivatives`` (a Python loop
-        over the ships; ``u`` and ``d`` broadcast against the batch)."""
+        """ẋ for ``x`` (n_ships, n_states), ship *i* by its own model (``u`` and ``d`` broadcast
+        against the batch): the batch of the ships' shared kernel with one parameter row per ship
+        (:meth:`kernel`), or for models written only in numpy ``models[i].derivatives`` on row *i*
+        (a Python loop over the ships, the slow path)."""
         x = np.asarray(x, dtype=float)
         n = len(self.models)
         if x.ndim < 2 or x.shape[0] != n:
             raise ConfigError(f"PerShipModel: state of shape {x.shape} for {n} ships; expected "
                               f"({n}, ..., {len(self.states)})")
+        k = self._kernel
+        if not isinstance(k, str) and x.ndim == 2:
+            return kernel_derivatives(self, k.function, k.params, x, u, d)
         u = np.broadcast_to(u, (*x.shape[:-1], np.shape(u)[-1]))
         if d is not None:
             d = np.broadcast_to(d, (*x.shape[:-1], np.shape(d)[-1]))

@@ -24,11 +24,12 @@ any sizeable step (the rudder "moves at its rate limit" of the trials, docs/tria
 from __future__ import annotations
 
 import math
+from functools import cached_property
 
 import numpy as np
 
 from shipgnc.errors import require
-from shipgnc.models.base import Signal
+from shipgnc.models.base import Signal, kernel_derivatives
 
 BASE_STATES = (
     Signal("north", "m", "north position (NED x)"),
@@ -68,7 +69,9 @@ class CatalogueModel:
 
     A subclass defines fields ``delta_max`` [rad], ``delta_rate`` [rad/s], ``T_delta`` [s] and
     ``speed`` [m/s] (its speed of design or construction), ``extra_states``, ``inputs``,
-    ``extra_limits`` and :meth:`body_rates` returning (u̇, v̇, ṙ, extra_dots...).
+    ``extra_limits`` and a ``kernel()`` whose function (:mod:`shipgnc.vessels.kernels`) is ẋ of
+    one ship: its equations written once, :meth:`derivatives` their batch. A vessel written only
+    in numpy defines :meth:`body_rates` instead (the numpy loop's slow path).
     """
 
     extra_states: tuple[Signal, ...] = ()
@@ -103,29 +106,40 @@ class CatalogueModel:
         return np.array([-self.delta_max]), np.array([self.delta_max])
 
     def rudder_rate(self, delta, delta_c):
-        """δ̇ = sat((sat(δ_c, ±δ_max) − δ)/T_δ, ±δ̇_max) [rad/s] (steering machine)."""
-        target = np.clip(delta_c, -self.delta_max, self.delta_max)
-        return np.clip((target - delta) / self.T_delta, -self.delta_rate, self.delta_rate)
+        """δ̇ = sat((sat(δ_c, ±δ_max) − δ)/T_δ, ±δ̇_max) [rad/s] (steering machine,
+        :func:`~shipgnc.vessels.kernels.steering_rate` elementwise)."""
+        from shipgnc.vessels.kernels import steering_rate
+
+        return np.vectorize(steering_rate, otypes=[float])(
+            delta, delta_c, self.delta_max, self.delta_rate, self.T_delta)
 
     def body_rates(self, x, u):
-        """(u̇, v̇, ṙ, *extra) for states ``x`` (..., n) and inputs ``u`` (..., m)."""
+        """(u̇, v̇, ṙ, *extra) for states ``x`` (..., n) and inputs ``u`` (..., m): a vessel written
+        only in numpy defines this instead of a :meth:`kernel` (the slow path)."""
         raise NotImplementedError
 
+    @cached_property
+    def _kernel(self):
+        kernel = getattr(self, "kernel", None)
+        return kernel() if callable(kernel) else None
+
     def derivatives(self, x, u, d=None):
-        """ẋ for ``x`` (..., n_states), ``u`` (..., n_inputs), ``d`` (..., 2) or None."""
-        x = np.asarray(x, dtype=float)
-        u = np.asarray(u, dtype=float)
-        psi, su, sv, sr = x[..., 2], x[..., 3], x[..., 4], x[..., 5]
-        c, s = np.cos(psi), np.sin(psi)
-        north_dot, east_dot = c * su - s * sv, s * su + c * sv
-        if d is not None:
-            north_dot = north_dot + d[..., 0]
-            east_dot = east_dot + d[..., 1]
+        """ẋ for ``x`` (..., n_states), ``u`` (..., n_inputs), ``d`` (..., 2) or None: the batch of
+        the vessel's kernel (its ``kernel()``, :mod:`shipgnc.vessels.kernels`); a vessel without
+        one gets the kinematics and the steering machine from
+        :func:`~shipgnc.vessels.kernels.steering_rhs` and its body rates from :meth:`body_rates`."""
+        kernel = self._kernel
+        if kernel is not None:
+            return kernel_derivatives(self, kernel.function, kernel.params, x, u, d)
+        from shipgnc.vessels.kernels import steering_rhs
+
+        x, u = np.asarray(x, dtype=float), np.asarray(u, dtype=float)
+        xdot = kernel_derivatives(self, steering_rhs, [self.delta_max, self.delta_rate, self.T_delta],
+                                  x, u, d)
         rates = self.body_rates(x, u)
-        delta_dot = self.rudder_rate(x[..., 6], u[..., 0])
-        shape = np.broadcast_shapes(x.shape[:-1], u.shape[:-1])
-        parts = [north_dot, east_dot, sr, *rates[:3], delta_dot, *rates[3:]]
-        return np.stack([np.broadcast_to(p, shape) for p in parts], axis=-1)
+        for i, rate in zip((3, 4, 5, *range(7, xdot.shape[-1])), rates, strict=True):
+            xdot[..., i] = rate
+        return xdot
 
     def state(self, *, u: float, v: float = 0.0, r: float = 0.0, delta: float = 0.0,
               extra: tuple[float, ...] = (), north: float = 0.0, east: float = 0.0,

@@ -1,9 +1,9 @@
-"""Kernels of the catalogue vessels for the composed compiled loop (:mod:`shipgnc.kernels`).
-
-Each follows its model's numpy ``derivatives`` operation for operation (round-off aside: fused
-multiply-adds, r·r·r for numpy's r**3); ``tests/test_vessels.py`` holds the two equal. State layout
-and steering machine as :mod:`shipgnc.vessels.base`; ``d`` = [current_north, current_east] (zeros
-when the run has no disturbance).
+"""The catalogue vessels' equations, each written once for one ship (:mod:`shipgnc.kernels`): the
+composed loop calls these kernels, and a model's ``derivatives`` is their batch over ships
+(:func:`shipgnc.derive.per_ship`, via :meth:`~shipgnc.vessels.base.CatalogueModel.derivatives`).
+State layout and steering machine as :mod:`shipgnc.vessels.base`; ``d`` = [current_north,
+current_east] (zeros when the run has no disturbance). Each model's module docstring gives its
+equations in full, with every coefficient and the source.
 """
 
 from __future__ import annotations
@@ -15,14 +15,16 @@ from shipgnc.kernels import kernel_function
 
 @kernel_function
 def steering_rate(delta, delta_c, dmax, rate, T_delta):
-    """:meth:`CatalogueModel.rudder_rate` for one ship: sat((sat(δ_c) − δ)/T_δ, ±rate)."""
+    """The steering machine for one ship: δ̇ = sat((sat(δ_c, ±δ_max) − δ)/T_δ, ±δ̇_max) (Fossen 2021
+    §9.5, MSS ``mariner.m``; :mod:`shipgnc.vessels.base`)."""
     target = min(max(delta_c, -dmax), dmax)
     return min(max((target - delta) / T_delta, -rate), rate)
 
 
 @kernel_function
 def kinematics(x, d, xdot):
-    """Position and heading rates (base layout) plus the current ``d``."""
+    """Position and heading rates (base layout) plus the current ``d``: ṅ = u cos ψ − v sin ψ + c_N,
+    ė = u sin ψ + v cos ψ + c_E, ψ̇ = r."""
     c, s = math.cos(x[2]), math.sin(x[2])
     xdot[0] = c * x[3] - s * x[4] + d[0]
     xdot[1] = s * x[3] + c * x[4] + d[1]
@@ -30,9 +32,22 @@ def kinematics(x, d, xdot):
 
 
 @kernel_function
+def steering_rhs(x, u, d, p, xdot):
+    """The kinematics and the steering machine of a catalogue vessel (body and extra rates 0), for
+    a vessel written only in numpy (:meth:`~shipgnc.vessels.base.CatalogueModel.derivatives`);
+    p = [δ_max, rate, T_δ]."""
+    kinematics(x, d, xdot)
+    for i in range(3, xdot.shape[0]):
+        xdot[i] = 0.0
+    xdot[6] = steering_rate(x[6], u[0], p[0], p[1], p[2])
+
+
+@kernel_function
 def norrbin_rhs(x, u, d, p, xdot):
-    """:class:`~shipgnc.vessels.nomoto.NomotoVessel` (Nomoto or Norrbin); p = [K, T, a0, a1, a2,
-    a3, δ_max, rate, T_δ] (Nomoto: a1 = 1, the rest 0: H(r) = r exactly)."""
+    """:class:`~shipgnc.vessels.nomoto.NomotoVessel` for one ship: Norrbin T ṙ + H_N(r) = K δ,
+    H_N(r) = a₃r³ + a₂r² + a₁r + a₀ (document 000 eq. (3)–(6); Nomoto: a₁ = 1, the rest 0, H(r) = r
+    exactly) at constant speed without sway (u̇ = v̇ = 0), δ the actual rudder; p = [K, T, a0, a1,
+    a2, a3, δ_max, rate, T_δ]."""
     kinematics(x, d, xdot)
     r = x[5]
     H = ((p[5] * r + p[4]) * r + p[3]) * r + p[2]
@@ -44,7 +59,9 @@ def norrbin_rhs(x, u, d, p, xdot):
 
 @kernel_function
 def nomoto2_rhs(x, u, d, p, xdot):
-    """:class:`~shipgnc.vessels.nomoto.Nomoto2Vessel`; p = [K, T1, T2, T3, δ_max, rate, T_δ]."""
+    """:class:`~shipgnc.vessels.nomoto.Nomoto2Vessel` for one ship: second-order Nomoto in observer
+    canonical form ẇ = K δ − r, ṙ = (w − (T₁ + T₂) r + K T₃ δ)/(T₁T₂) (Nomoto et al. 1957; Fossen
+    2021 eq. 7.50), constant speed; p = [K, T1, T2, T3, δ_max, rate, T_δ]."""
     kinematics(x, d, xdot)
     K, T1, T2, T3 = p[0], p[1], p[2], p[3]
     r, delta, w = x[5], x[6], x[7]
@@ -57,7 +74,8 @@ def nomoto2_rhs(x, u, d, p, xdot):
 
 @kernel_function
 def linear3dof_rhs(x, u, d, p, xdot):
-    """:class:`~shipgnc.vessels.linear.Linear3DOFVessel`; p = [U, A (3×3 row-major) = −M⁻¹N,
+    """:class:`~shipgnc.vessels.linear.Linear3DOFVessel` for one ship: ν̇ = M⁻¹(B δ − N ν),
+    ν = [u − U, v, r] (Fossen 2021 §7.2, eq. 7.14–7.15); p = [U, A (3×3 row-major) = −M⁻¹N,
     b = M⁻¹B (3), δ_max, rate, T_δ]."""
     kinematics(x, d, xdot)
     n0, n1, n2 = x[3] - p[0], x[4], x[5]
@@ -70,8 +88,11 @@ def linear3dof_rhs(x, u, d, p, xdot):
 
 @kernel_function
 def mariner_cst_rhs(x, u, d, p, xdot):
-    """:class:`~shipgnc.vessels.mariner_cst.MarinerCST`; p = [U0, L, δ_max, rate, T_δ, then the
-    coefficients in :data:`~shipgnc.vessels.mariner_cst.KERNEL_ORDER`]."""
+    """:class:`~shipgnc.vessels.mariner_cst.MarinerCST` for one ship (Chislett & Strøm-Tejsen 1965,
+    as in Fossen 2021 and MSS ``mariner.m``): the polynomial X', Y', N' in u' = Δu/U, v' = v/U,
+    r' = r L/U, δ_h = −δ of the module docstring, then u̇ = X' (U²/L)/(m' − X'_u̇),
+    v̇ = (m'₃₃ Y' − m'₂₃ N') (U²/L)/det, ṙ = (−m'₃₂ Y' + m'₂₂ N') (U²/L²)/det; p = [U0, L, δ_max,
+    rate, T_δ, then the coefficients in :data:`~shipgnc.vessels.mariner_cst.KERNEL_ORDER`]."""
     kinematics(x, d, xdot)
     U0, L = p[0], p[1]
     (m, Iz, xG, Xudot, Xu, Xuu, Xuuu, Xvv, Xrr, Xdd, Xudd, Xrv, Xvd, Xuvd,
@@ -109,7 +130,11 @@ def mariner_cst_rhs(x, u, d, p, xdot):
 
 @kernel_function
 def kvlcc2_rhs(x, u, d, p, xdot):
-    """:class:`~shipgnc.vessels.kvlcc2.KVLCC2`; p as :meth:`KVLCC2.kernel` lays it out."""
+    """:class:`~shipgnc.vessels.kvlcc2.KVLCC2` for one ship: the MMG equations of Yasukawa &
+    Yoshimura (2015), eq. 4–17 (module docstring of :mod:`shipgnc.vessels.kvlcc2`): hull, propeller
+    (T = ρD²(k₀(nD)² + k₁ nD u_P + k₂ u_P²), finite at n = 0) and rudder forces, the surge and the
+    sway–yaw mass matrices, ṅ = (sat(n_c, 0, n_max) − n)/T_n; p as :meth:`KVLCC2.kernel` lays it
+    out."""
     kinematics(x, d, xdot)
     (R0, Xvv, Xvr, Xrr, Xvvvv, Yv, Yr, Yvvv, Yvvr, Yvrr, Yrrr, Nv, Nr, Nvvv, Nvvr, Nvrr, Nrrr,
      t_P, w_P0, k0, k1, k2, C1, C2p, C2m, x_P, t_R, a_H, x_H, x_R, gm, gp, l_R, eps, kappa,
@@ -141,6 +166,8 @@ def kvlcc2_rhs(x, u, d, p, xdot):
     nD = n * D
     T = rho * D * D * (k0 * nD * nD + k1 * nD * u_P + k2 * u_P * u_P)
     X_P = (1 - t_P) * T
+    # rudder inflow: u_R = ε u_P √(η{1 + κ(√(1 + 8K_T/(πJ²)) − 1)}² + 1 − η), written as
+    # ε √(η{u_P + κ(√(u_P² + 8T/(ρπD²)) − u_P)}² + (1 − η) u_P²) (finite at u_P = 0)
     slip = math.sqrt(max(u_P * u_P + 8 * T / (rho * math.pi * D * D), 0.0))
     a = u_P + kappa * (slip - u_P)
     u_R = eps * math.sqrt(eta * a * a + (1 - eta) * u_P * u_P)

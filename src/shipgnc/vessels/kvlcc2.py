@@ -150,68 +150,13 @@ class KVLCC2(CatalogueModel):
         return (np.array([-self.delta_max, 0.0]),
                 np.array([self.delta_max, 1.5 * self.n_design]))
 
-    # ----------------------------------------------------------------- forces
-
-    def thrust(self, u, beta, r_, n):
-        """(T [N], u_P = u(1 − w_P) [m/s]) of the propeller; T = ρ n² D⁴ K_T(J) written without
-        dividing by n (finite at n = 0)."""
-        c, k = COEFFICIENTS, self._k
-        beta_P = beta - c["x_P"] * r_
-        C2 = np.where(beta_P > 0, c["C2_plus"], c["C2_minus"])
-        w_P = 1 - (1 - c["w_P0"]) * (1 + (1 - np.exp(-c["C1"] * np.abs(beta_P))) * (C2 - 1))
-        u_P = u * (1 - w_P)
-        nD = n * k["D"]
-        T = RHO * k["D"] ** 2 * (c["k0"] * nD**2 + c["k1"] * nD * u_P + c["k2"] * u_P**2)
-        return T, u_P
-
-    def forces(self, u, v, r, delta, n):
-        """(X, Y, N) [N, N, N·m] on the ship: hull + propeller + rudder (module docstring)."""
-        c, k = COEFFICIENTS, self._k
-        L, d = k["L"], k["d"]
-        U2 = u**2 + v**2
-        U = np.sqrt(U2)
-        Us = np.maximum(U, 1e-9)
-        v_, r_ = v / Us, r * L / Us
-        beta = np.arctan2(-v, u)
-        q = 0.5 * RHO * L * d * U2
-        X_H = q * (-c["R0"] + c["Xvv"] * v_**2 + c["Xvr"] * v_ * r_ + c["Xrr"] * r_**2
-                   + c["Xvvvv"] * v_**4)
-        Y_H = q * (c["Yv"] * v_ + c["Yr"] * r_ + c["Yvvv"] * v_**3 + c["Yvvr"] * v_**2 * r_
-                   + c["Yvrr"] * v_ * r_**2 + c["Yrrr"] * r_**3)
-        N_H = q * L * (c["Nv"] * v_ + c["Nr"] * r_ + c["Nvvv"] * v_**3 + c["Nvvr"] * v_**2 * r_
-                       + c["Nvrr"] * v_ * r_**2 + c["Nrrr"] * r_**3)
-        T, u_P = self.thrust(u, beta, r_, n)
-        X_P = (1 - c["t_P"]) * T
-        # rudder inflow: u_R = ε u_P √(η{1 + κ(√(1 + 8K_T/(πJ²)) − 1)}² + 1 − η), written as
-        # ε √(η{u_P + κ(√(u_P² + 8T/(ρπD²)) − u_P)}² + (1 − η) u_P²) (finite at u_P = 0)
-        slip = np.sqrt(np.maximum(u_P**2 + 8 * T / (RHO * math.pi * k["D"] ** 2), 0.0))
-        eta = k["eta"]
-        u_R = c["eps"] * np.sqrt(eta * (u_P + c["kappa"] * (slip - u_P)) ** 2
-                                 + (1 - eta) * u_P**2)
-        beta_R = beta - c["l_R"] * r_
-        gamma = np.where(beta_R < 0, c["gamma_minus"], c["gamma_plus"])
-        v_R = U * gamma * beta_R
-        alpha_R = delta - np.arctan2(v_R, u_R)
-        F_N = 0.5 * RHO * k["A_R"] * (u_R**2 + v_R**2) * c["f_alpha"] * np.sin(alpha_R)
-        X_R = -(1 - c["t_R"]) * F_N * np.sin(delta)
-        Y_R = -(1 + c["a_H"]) * F_N * np.cos(delta)
-        N_R = -(c["x_R"] + c["a_H"] * c["x_H"]) * L * F_N * np.cos(delta)
-        return X_H + X_P + X_R, Y_H + Y_R, N_H + N_R
-
-    def body_rates(self, x, u):
-        """(u̇, v̇, ṙ, ṅ) of the MMG equations; ṅ = (sat(n_c) − n)/T_n."""
-        k = self._k
-        su, sv, sr, delta, n = x[..., 3], x[..., 4], x[..., 5], x[..., 6], x[..., 7]
-        X, Y, N = self.forces(su, sv, sr, delta, n)
-        m, m_x, m_y, x_G = k["m"], k["m_x"], k["m_y"], k["x_G"]
-        u_dot = (X + (m + m_y) * sv * sr + x_G * m * sr**2) / (m + m_x)
-        rhs_v = Y - (m + m_x) * su * sr
-        rhs_r = N - x_G * m * su * sr
-        Minv = k["Minv"]
-        v_dot = Minv[0, 0] * rhs_v + Minv[0, 1] * rhs_r
-        r_dot = Minv[1, 0] * rhs_v + Minv[1, 1] * rhs_r
-        n_c = np.clip(u[..., 1], 0.0, 1.5 * self.n_design) if u.shape[-1] > 1 else self.n_design
-        return (u_dot, v_dot, r_dot, (n_c - n) / self.T_n)
+    def derivatives(self, x, u, d=None):
+        """ẋ of the MMG equations (:func:`~shipgnc.vessels.kernels.kvlcc2_rhs`); an input of the
+        rudder alone ``[delta_c]`` holds the design revolutions n_c = n_design."""
+        u = np.asarray(u, dtype=float)
+        if u.shape[-1] == 1:
+            u = np.concatenate([u, np.full_like(u, self.n_design)], axis=-1)
+        return super().derivatives(x, u, d)
 
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`~shipgnc.vessels.kernels.kvlcc2_rhs`)."""

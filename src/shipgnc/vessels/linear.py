@@ -70,12 +70,6 @@ class Linear3DOFVessel(CatalogueModel):
     def speed(self) -> float:
         return self.U
 
-    def body_rates(self, x, u):
-        """ν̇ = M⁻¹(B δ − N ν), ν = [u − U, v, r], δ the actual rudder (state)."""
-        nu = np.stack([x[..., 3] - self.U, x[..., 4], x[..., 5]], axis=-1)
-        nu_dot = nu @ self._A.T + x[..., 6:7] * self._Bu
-        return (nu_dot[..., 0], nu_dot[..., 1], nu_dot[..., 2])
-
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`~shipgnc.vessels.kernels.linear3dof_rhs`)."""
         from shipgnc.vessels.kernels import linear3dof_rhs

@@ -100,42 +100,6 @@ class MarinerCST(CatalogueModel):
     def speed(self) -> float:
         return self.U0
 
-    def forces(self, du, v, r, delta):
-        """Nondimensional (X', Y', N') for Δu = u − U₀ [m/s], v [m/s], r [rad/s], δ [rad]."""
-        c = COEFFICIENTS
-        U = np.sqrt((self.U0 + du) ** 2 + v**2)
-        u_, v_, r_ = du / U, v / U, r * self.L / U
-        d = -delta
-        X = (c["Xu"] * u_ + c["Xuu"] * u_**2 + c["Xuuu"] * u_**3 + c["Xvv"] * v_**2
-             + c["Xrr"] * r_**2 + c["Xrv"] * r_ * v_ + c["Xdd"] * d**2 + c["Xudd"] * u_ * d**2
-             + c["Xvd"] * v_ * d + c["Xuvd"] * u_ * v_ * d)
-        Y = (c["Yv"] * v_ + c["Yr"] * r_ + c["Yvvv"] * v_**3 + c["Yvvr"] * v_**2 * r_
-             + c["Yvu"] * v_ * u_ + c["Yru"] * r_ * u_ + c["Yd"] * d + c["Yddd"] * d**3
-             + c["Yud"] * u_ * d + c["Yuud"] * u_**2 * d + c["Yvdd"] * v_ * d**2
-             + c["Yvvd"] * v_**2 * d + (c["Y0"] + c["Y0u"] * u_ + c["Y0uu"] * u_**2))
-        N = (c["Nv"] * v_ + c["Nr"] * r_ + c["Nvvv"] * v_**3 + c["Nvvr"] * v_**2 * r_
-             + c["Nvu"] * v_ * u_ + c["Nru"] * r_ * u_ + c["Nd"] * d + c["Nddd"] * d**3
-             + c["Nud"] * u_ * d + c["Nuud"] * u_**2 * d + c["Nvdd"] * v_ * d**2
-             + c["Nvvd"] * v_**2 * d + (c["N0"] + c["N0u"] * u_ + c["N0uu"] * u_**2))
-        return X, Y, N, U
-
-    def _accelerations(self, du, v, r, delta):
-        c = COEFFICIENTS
-        X, Y, N, U = self.forces(du, v, r, delta)
-        m11 = c["m"] - c["Xudot"]
-        m22 = c["m"] - c["Yvdot"]
-        m23 = c["m"] * c["xG"] - c["Yrdot"]
-        m32 = c["m"] * c["xG"] - c["Nvdot"]
-        m33 = c["Iz"] - c["Nrdot"]
-        det = m22 * m33 - m23 * m32
-        scale = U**2 / self.L
-        return (X * scale / m11, (m33 * Y - m23 * N) * scale / det,
-                (-m32 * Y + m22 * N) * scale / self.L / det)
-
-    def body_rates(self, x, u):
-        """(u̇, v̇, ṙ) of the module docstring; δ is the actual rudder (state ``delta``)."""
-        return self._accelerations(x[..., 3] - self.U0, x[..., 4], x[..., 5], x[..., 6])
-
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`~shipgnc.vessels.kernels.mariner_cst_rhs`)."""
         from shipgnc.vessels.kernels import mariner_cst_rhs
@@ -154,8 +118,9 @@ class MarinerCST(CatalogueModel):
         z = np.zeros(3)  # Δu, v, δ
         scale = np.array([1.0, 1.0, 1.0 / self.L])
 
-        def f(z):
-            return np.array(self._accelerations(z[0], z[1], 0.0, z[2])) / scale
+        def f(z):  # (u̇, v̇, ṙ) of the kernel at (U₀ + Δu, v, r = 0, δ)
+            x = self.state(u=self.U0 + z[0], v=z[1], delta=z[2])
+            return self.derivatives(x, np.array([z[2]]))[3:6] / scale
 
         for _ in range(30):
             fz = f(z)

@@ -33,17 +33,13 @@ from shipgnc.models.nomoto import NomotoModel, NorrbinModel
 from shipgnc.vessels.base import SOLAS_RUDDER_RATE, CatalogueModel
 
 
-def _zero(x):
-    return np.zeros_like(x[..., 3])
-
-
 @dataclass(frozen=True)
 class NomotoVessel(CatalogueModel):
     """First-order Nomoto T ṙ + r = K δ (or Norrbin T ṙ + H_N(r) = K δ) at constant speed.
 
     ``steering`` is a :class:`~shipgnc.models.nomoto.NomotoModel` or
-    :class:`~shipgnc.models.nomoto.NorrbinModel` (its ``U`` is the speed); its
-    ``yaw_acceleration(r, δ)`` gives ṙ with δ the actual rudder (the state ``delta``).
+    :class:`~shipgnc.models.nomoto.NorrbinModel` (its ``U`` is the speed; K, T, a₀…a₃), ṙ with δ
+    the actual rudder (the state ``delta``): :func:`~shipgnc.vessels.kernels.norrbin_rhs`.
     """
 
     steering: NomotoModel | NorrbinModel
@@ -57,10 +53,6 @@ class NomotoVessel(CatalogueModel):
     @property
     def speed(self) -> float:
         return self.steering.U
-
-    def body_rates(self, x, u):
-        """(u̇, v̇, ṙ) = (0, 0, steering.yaw_acceleration(r, δ))."""
-        return (_zero(x), _zero(x), self.steering.yaw_acceleration(x[..., 5], x[..., 6]))
 
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`~shipgnc.vessels.kernels.norrbin_rhs`;
@@ -113,12 +105,6 @@ class Nomoto2Vessel(CatalogueModel):
     @property
     def speed(self) -> float:
         return self.U
-
-    def body_rates(self, x, u):
-        """(u̇, v̇, ṙ, ẇ): ṙ = (w − (T₁+T₂) r + K T₃ δ)/(T₁T₂), ẇ = K δ − r."""
-        r, delta, w = x[..., 5], x[..., 6], x[..., 7]
-        r_dot = (w - (self.T1 + self.T2) * r + self.K * self.T3 * delta) / (self.T1 * self.T2)
-        return (_zero(x), _zero(x), r_dot, self.K * delta - r)
 
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`~shipgnc.vessels.kernels.nomoto2_rhs`)."""
