@@ -1152,8 +1152,8 @@ class FroudeKrylovWaveLoads:
         from shipgnc.environment.wave_kernel import froude_krylov_sample
 
         self._require_reset()
-        return Kernel(froude_krylov_sample, self._kernel_params(), self._sea.reshape(*tuple(batch_shape), -1),
-                      per_stage=True)
+        state = self._sea.reshape(*tuple(batch_shape), -1)
+        return Kernel(froude_krylov_sample, self._kernel_params(), state, per_stage=True)
 
     def _kernel_params(self) -> np.ndarray:
         """[n_components, L, B, long-crested, i_north, i_east, i_psi] (after :meth:`bind_model`)."""
@@ -1163,7 +1163,7 @@ class FroudeKrylovWaveLoads:
     def _kernel_state(self) -> np.ndarray:
         """Every ship's kernel state (ships, width): the rows of
         :data:`~shipgnc.environment.wave_kernel.ROWS`, zero scratch rows, the arguments' bounds."""
-        from shipgnc.environment.wave_kernel import N_BOUNDS, N_SCRATCH, ROWS, state_width
+        from shipgnc.environment.wave_kernel import N_BOUNDS, state_width
 
         r = self.realisation
         n = r.n_components
@@ -1178,7 +1178,6 @@ class FroudeKrylovWaveLoads:
                   np.maximum(np.maximum(self._half_kL, self._half_kB), np.abs(chi))]
         state[:, len(state[0]) - N_BOUNDS:] = np.stack(
             [np.broadcast_to(np.max(b, axis=-1), self._batch).reshape(-1) for b in bounds], axis=-1)
-        assert len(ROWS) * n + N_SCRATCH * n + N_BOUNDS == state.shape[1]
         return state
 
 
