@@ -42,18 +42,6 @@ def _points(n=300, seed=0, centre=(0.0, 0.0)):
     return rng.uniform(0.0, 5000.0, n), pts
 
 
-@pytest.mark.parametrize("name", FIELDS)
-def test_field_kernel_equals_its_numpy_form(name):
-    field = FIELDS[name]
-    centre = getattr(field, "centre", (0.0, 0.0))
-    t, pts = _points(centre=centre)
-    for t0 in (0.0, 1234.5):
-        fn, p = field.current_kernel(t0=t0)
-        ref = field.velocity(t0 + t, pts[:, 0], pts[:, 1])
-        got = np.array([fn(ti, n, e, p, 0) for ti, (n, e) in zip(t, pts, strict=True)])
-        np.testing.assert_allclose(got, ref, rtol=1e-13, atol=1e-15, err_msg=name)
-
-
 def test_fields_without_a_compiled_form_say_so():
     gridded = F.GriddedCurrent(F.sample_field(F.UniformCurrent(0.5, 0.0), [0.0, 1e5], [0.0, 1e5]))
     for field in (gridded, F.UniformCurrent(0.1, 0.0) + gridded,

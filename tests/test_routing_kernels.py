@@ -1,8 +1,7 @@
 """The router's compiled extremals against their numpy references (notes 002-2.9.1, 002-2.9.4).
 
-* :func:`~shipgnc.environment.fields.field_state` equals every field's numpy ``_velocity`` and ``_jacobian``
-  (analytic terms, sums, tides, a moving vortex, the double gyre, bilinear grids steady and in time,
-  clamped at the grid's edge as the unchecked numpy evaluation is);
+* every analytic field's velocity (the batch of :func:`~shipgnc.environment.fields.field_state`) is
+  its closed form and its Jacobian the velocity's derivative; a grid reproduces an affine field;
 * the RK4 family kernel equals ``integrate_family``'s numpy loop, extremals leaving a grid frozen alike;
 * a polish on the compiled integrator equals the adaptive ``solve_ivp`` polish of the same field (a
   wrapper without a compiled form) to 1e-9, and the sweep finds the same extremals;
@@ -20,7 +19,6 @@ import pytest
 
 from shipgnc.environment import fields as F
 from shipgnc.environment.field_spec import parse_field
-from shipgnc.environment.fields import field_state
 from shipgnc.routing import extremal_kernels as ek
 from shipgnc.routing import pmp
 
@@ -47,18 +45,76 @@ FIELDS = {
 }
 
 
-@pytest.mark.parametrize("name", FIELDS)
-def test_field_state_equals_the_numpy_field(name):
+def _closed_form(name, t, n, e):
+    """(v_N, v_E) of the analytic FIELDS written out from their definitions (note 002-2.9.1)."""
+    if name == "uniform":
+        return np.broadcast_to([0.3, -0.1], (*np.shape(n), 2))
+    if name == "affine":
+        dn, de = n - 1.0, e - 2.0
+        return np.stack([0.1 + 0.01 * dn + 0.02 * de, -0.03 * dn], -1)
+    if name == "rotation":  # v = ω(−r_E, r_N)
+        return np.stack([-0.2 * (e - 1.0), 0.2 * (n - 1.0)], -1)
+    if name in ("lamb-oseen", "moving vortex", "rankine"):
+        if name == "rankine":
+            gamma, rc, cn, ce = 1.0, 1.0, 0.5, 0.5
+        else:
+            gamma, rc = 2.0, 0.5
+            cn, ce = (0.1, 0.2) if name == "lamb-oseen" else (0.1 + 0.01 * t, 0.2 - 0.02 * t)
+        rn, re = n - cn, e - ce
+        r = np.hypot(rn, re)
+        if name == "rankine":  # v_t = Γr/(2πr_c²) inside, Γ/(2πr) outside
+            vt = np.where(r <= rc, gamma * r / (2 * np.pi * rc**2), gamma / (2 * np.pi * r))
+        else:  # v_t = Γ/(2πr)(1 − exp(−r²/r_c²))
+            vt = gamma / (2 * np.pi * r) * -np.expm1(-(r / rc) ** 2)
+        return np.stack([-vt * re / r, vt * rn / r], -1)  # clockwise for Γ > 0
+    if name == "gyre":  # U = 1, L = 1, centre (0.5, 0.5)
+        a, b = np.pi * (e - 0.5), np.pi * (n - 0.5)
+        return np.stack([-np.sin(a) * np.cos(b), np.cos(a) * np.sin(b)], -1)
+    if name == "tidal sum":  # (1 + 0.5 cos(2πt/30 + 0.3)) (shear + rotation)
+        m = 1.0 + 0.5 * np.cos(2 * np.pi * t / 30.0 + 0.3)
+        return m[..., None] * (np.stack([np.zeros_like(n), 0.1 * n], -1)
+                               + _closed_form("rotation", t, n, e))
+    raise KeyError(name)
+
+
+ANALYTIC = ["uniform", "affine", "rotation", "lamb-oseen", "moving vortex", "rankine", "gyre",
+            "tidal sum"]
+
+
+@pytest.mark.parametrize("name", ANALYTIC)
+def test_fields_are_their_closed_forms(name):
+    """Each analytic field's velocity (the batch of its term of ``field_state``) equals its
+    definition, and its Jacobian the velocity's central difference (h = 1e-5 m)."""
     field = FIELDS[name]
-    _, params = field.current_kernel(0.0, grids=True)
     rng = np.random.default_rng(7)
-    worst = 0.0
-    for t, n, e in zip(rng.uniform(-5, 40, 300), rng.uniform(-1, 4, 300), rng.uniform(-1, 4, 300),
-                       strict=True):  # some points off the grids: clamped as _velocity clamps
-        ref = np.concatenate([field._velocity(t, n, e), field._jacobian(t, n, e).ravel()])
-        got = np.array(field_state(t, n, e, params, 0))
-        worst = max(worst, float(np.max(np.abs(got - ref)) / max(1.0, np.max(np.abs(ref)))))
-    assert worst <= 1e-13
+    t, n, e = rng.uniform(-5, 40, 300), rng.uniform(-1, 4, 300), rng.uniform(-1, 4, 300)
+    np.testing.assert_allclose(field.velocity(t, n, e), _closed_form(name, t, n, e), rtol=1e-12,
+                               atol=1e-14)
+    h = 1e-5
+    j = field.jacobian(t, n, e)
+    for col, (dn, de) in enumerate(((h, 0.0), (0.0, h))):
+        fd = (field.velocity(t, n + dn, e + de) - field.velocity(t, n - dn, e - de)) / (2 * h)
+        np.testing.assert_allclose(j[..., :, col], fd, rtol=1e-6, atol=1e-8)
+
+
+@pytest.mark.parametrize("method", ["linear", "cubic"])
+def test_a_grid_reproduces_an_affine_field(method):
+    """Bilinear and bicubic interpolation are exact for an affine field (value and Jacobian), in
+    time too for data linear in time; off the grid the velocity refuses, the unchecked form clamps."""
+    affine = F.AffineCurrent((0.1, -0.2), ((0.01, 0.02), (-0.03, 0.005)), (1.0, 2.0))
+    tidal = F.Modulated(affine, 1.0, 0.0)  # constant factor: the same field, "in time"
+    for field, times in ((affine, None), (tidal, [0.0, 10.0, 25.0])):
+        grid = F.GriddedCurrent(F.sample_field(field, GRID, GRID, times=times), method)
+        rng = np.random.default_rng(2)
+        t, n, e = rng.uniform(0, 25, 200), rng.uniform(-0.4, 3.4, 200), rng.uniform(-0.4, 3.4, 200)
+        np.testing.assert_allclose(grid.velocity(t, n, e), affine.velocity(t, n, e), rtol=1e-12,
+                                   atol=1e-13)
+        np.testing.assert_allclose(grid.jacobian(t, n, e), affine.jacobian(t, n, e), rtol=1e-9,
+                                   atol=1e-11)
+    with pytest.raises(F.FieldDomainError):
+        grid.velocity(0.0, 5.0, 0.0)
+    np.testing.assert_allclose(grid._velocity(0.0, 5.0, 0.0), affine.velocity(0.0, 3.5, 0.0),
+                               rtol=1e-12, atol=1e-13)
 
 
 @pytest.mark.parametrize("name", FIELDS)

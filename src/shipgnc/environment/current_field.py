@@ -296,9 +296,7 @@ class CurrentDisturbance:
                     for j, ts in enumerate((t, t + 0.5 * dt, t + 1.0 * dt)):
                         v = None
                         for f in markov:
-                            s = f.state(ts)
-                            w = np.stack([s[..., 0] * np.cos(s[..., 1]),
-                                          s[..., 0] * np.sin(s[..., 1])], axis=-1)
+                            w = f.velocity(ts, 0.0, 0.0)  # uniform: any point
                             v = w if v is None else v + w
                         out[i, :, 1 + 2 * j:3 + 2 * j] = np.broadcast_to(
                             v, (*tuple(batch_shape), 2)).reshape(n_ships, 2)

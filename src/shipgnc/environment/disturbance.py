@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from shipgnc.derive import per_ship
 from shipgnc.errors import ConfigError, require
 from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
 
@@ -35,9 +36,14 @@ class ConstantDisturbance:
 
     def reset(self, batch_shape, rng: np.random.Generator) -> None:
         self._shape = (*tuple(batch_shape), self.values.shape[-1])
+        self._z = np.ascontiguousarray(np.broadcast_to(self.values, self._shape),
+                                       dtype=float).reshape(-1, self._shape[-1])
 
     def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
-        return np.broadcast_to(self.values, self._shape)
+        """The batch over ships of :func:`copy_state`."""
+        rows = np.empty((self._z.shape[0], 0))  # x and w: not read
+        d = per_ship(copy_state, "t i z p i o")(t, rows, self._z, _NONE, rows, self._shape[-1])
+        return d.reshape(self._shape)
 
     def kernel(self, batch_shape, dt: float | None = None) -> Kernel:
         """The values per ship as the kernel's state (:func:`copy_state`)."""
@@ -122,6 +128,18 @@ class GaussianForceNoise:
             self._x = self.std * rng.standard_normal(self._shape)
 
     def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
+        """The batch over ships of :func:`gaussian_sample` on this step's draws (:meth:`_draw`)."""
+        w = self._draw(t)
+        n = self.std.size
+        gauss_markov = self.form == "gauss-markov"
+        p = flat(n, self.mean, np.ones(n) if gauss_markov else self.std)
+        d = per_ship(gaussian_sample, "t i z p i o")(t, _NONE, np.empty((w[..., 0].size, 0)), p,
+                                                    w.reshape(-1, n), n)
+        return d.reshape(self._shape)
+
+    def _draw(self, t: float) -> np.ndarray:
+        """This step's w (*batch, n) of d = mean + std·w: standard normals, or the Gauss–Markov
+        process x itself (d = mean + x)."""
         assert self._rng is not None, "reset() must be called before sampling"
         previous, self._t = self._t, float(t)
         if self.form == "gauss-markov":
@@ -129,13 +147,13 @@ class GaussianForceNoise:
                 a = math.exp(-(t - previous) / self.time_constant)
                 self._x = a * self._x + (self.std * math.sqrt(1.0 - a * a)) * self._rng.standard_normal(
                     self._shape)
-            return self.mean + self._x
+            return self._x
         if self.form == "white" and previous is not None:
             step = t - previous
             require(abs(step - self.dt) <= 1e-6 * self.dt, "disturbance.dt", self.dt,
                     f"white force noise was built for dt = {self.dt:g} s but the loop steps "
                     f"{step:g} s (its held variance is psd/dt)")
-        return self.mean + self.std * self._rng.standard_normal(self._shape)
+        return self._rng.standard_normal(self._shape)
 
     def kernel(self, batch_shape, dt: float | None = None) -> Kernel:
         """mean + std·w with w drawn in numpy, step by step as :meth:`__call__` draws it (the
@@ -148,11 +166,11 @@ class GaussianForceNoise:
             if dt is None:
                 raise NotCompiled("Gauss-Markov force noise needs the run's step dt")
 
-            def process(k0: int, k1: int) -> np.ndarray:  # the numpy loop's calls, t_k = k·dt
-                values = np.stack([self(k * dt, None) for k in range(k0, k1)])
+            def process(k0: int, k1: int) -> np.ndarray:  # the numpy loop's draws, t_k = k·dt
+                values = np.stack([self._draw(k * dt) for k in range(k0, k1)])
                 return values.reshape(k1 - k0, -1, n)
 
-            return Kernel(gaussian_sample, flat(n, np.zeros(n), np.ones(n)), table=process,
+            return Kernel(gaussian_sample, flat(n, self.mean, np.ones(n)), table=process,
                           n_table=n)
 
         def table(k0: int, k1: int) -> np.ndarray:
@@ -162,17 +180,24 @@ class GaussianForceNoise:
         return Kernel(gaussian_sample, flat(n, self.mean, self.std), table=table, n_table=n)
 
 
+#: an input or parameter a kernel does not read
+_NONE = np.zeros(0)
+
+
 @kernel_function
 def copy_state(t, x, z, p, w, d):
-    """d = the ship's constant values (the first ``len(z)`` entries of ``d``: a force-only
-    disturbance leaves a model's current channels at zero)."""
+    """d = τ_env, the ship's constant values held in ``z`` (the first ``len(z)`` entries of
+    ``d``: a force-only disturbance leaves a model's current channels at zero)."""
     for j in range(min(d.shape[0], z.shape[0])):
         d[j] = z[j]
 
 
 @kernel_function
 def gaussian_sample(t, x, z, p, w, d):
-    """d = mean + std·w, ``p`` = [n, mean (n), std (n)]."""
+    """d = mean + std·w, ``p`` = [n, mean (n), std (n)], ``w`` the step's draws: standard
+    normals (std = √(psd/dt) for band-limited white noise of two-sided spectral density psd,
+    Fossen 2021 §10.2; σ per step for the per-step form), or the Gauss–Markov process
+    x_{k+1} = e^{−h/T} x_k + σ√(1 − e^{−2h/T}) n itself with std = 1 (:class:`GaussianForceNoise`)."""
     n = int(p[0])
     for j in range(n):
         d[j] = p[1 + j] + p[1 + n + j] * w[j]

@@ -12,14 +12,17 @@ One protocol serves the router and the simulation loop:
 ``north`` and ``east`` broadcast against each other (leading batch axes); ``t`` is a scalar or broadcasts
 too. Positive ω and Γ turn clockwise on a north-up chart (positive about NED's down axis).
 
-**Compiled form.** ``current_kernel(t0=0.0)`` → ``(field_velocity, params)``: the field as data for the
-composed loop (:mod:`shipgnc.kernels`): :func:`field_velocity` evaluates ``velocity(t0 + t, north, east)``
-of one point from the flat ``params`` (a list of terms, each one field of this module with an optional tidal
-factor), operation for operation as the numpy methods (which stay the reference). Uniform, affine (shear),
-rigid-rotation, Lamb–Oseen and Rankine fields, their sums and a :class:`Modulated` factor over them have
-it; a factor over a factor raises :class:`~shipgnc.kernels.NotCompiled`, and so does bilinear gridded
-data unless asked for with ``grids=True`` (the router, which watches the domain itself; a ship's current
-off its grid must raise). :func:`field_state` adds the Jacobian (the router's extremals).
+**One source.** Each field's equations are written once, as a term of the scalar kernel
+:func:`field_state` (velocity and Jacobian of one point); ``velocity`` and ``jacobian`` of every field
+that has a compiled form are the batch over points of that kernel (:func:`field_point`,
+:func:`shipgnc.derive.per_ship`), and ``current_kernel(t0=0.0)`` → ``(field_velocity, params)`` hands the
+same kernel to the composed loop (:mod:`shipgnc.kernels`) and the router's extremals. Uniform, affine
+(shear), rigid-rotation, Lamb–Oseen and Rankine fields, the double gyre, bilinear gridded data, their
+sums and a :class:`Modulated` factor over them have it; a factor over a factor and bicubic gridded data
+have not (they are evaluated in numpy: the factor times the field, scipy's spline). ``current_kernel``
+raises :class:`~shipgnc.kernels.NotCompiled` for gridded data unless asked for with ``grids=True`` (the
+router, which watches the domain itself; a ship's current off its grid must raise, so a ship's gridded
+current stays in the numpy loop, whose ``velocity`` checks the domain before the batch).
 """
 
 from __future__ import annotations
@@ -75,10 +78,13 @@ class CurrentField:
     bounds: tuple[tuple[float, float], tuple[float, float]] | None = None
 
     def velocity(self, t, north, east) -> np.ndarray:
-        raise NotImplementedError
+        """(v_N, v_E) (..., 2) [m/s]: the batch of :func:`field_point` over the points."""
+        return self._batch(t, north, east)[..., :2]
 
     def jacobian(self, t, north, east) -> np.ndarray:
-        raise NotImplementedError
+        """J[i, j] = ∂v_i/∂x_j (..., 2, 2) [1/s]: the batch of :func:`field_point`."""
+        out = self._batch(t, north, east)
+        return out[..., 2:].reshape(*out.shape[:-1], 2, 2)
 
     def describe(self) -> str:
         return type(self).__name__
@@ -89,6 +95,34 @@ class CurrentField:
 
     def _jacobian(self, t, north, east) -> np.ndarray:
         return self.jacobian(t, north, east)
+
+    def compiled(self) -> bool:
+        """Whether this field has a compiled form (its ``velocity`` is the kernel's batch)."""
+        return self._params() is not None
+
+    def _params(self):
+        """This field's terms for :func:`field_state` (gridded data included), made once; None
+        without a compiled form."""
+        params = self.__dict__.get("_compiled_params", ())
+        if isinstance(params, tuple):
+            try:
+                params = self.current_kernel(grids=True)[1]
+            except NotCompiled:
+                params = None
+            object.__setattr__(self, "_compiled_params", params)  # frozen dataclasses too
+        return params
+
+    def _batch(self, t, north, east) -> np.ndarray:
+        """(v_N, v_E, J₀₀, J₀₁, J₁₀, J₁₁) (..., 6) at every point: the batch of
+        :func:`field_point` (gridded data clamped to the grid, as ``_velocity``)."""
+        from shipgnc.derive import per_ship
+
+        params = self._params()
+        if params is None:
+            raise NotCompiled(f"current {type(self).__name__} has no compiled form")
+        shape = _shape(t, north, east)
+        t, north, east = (np.asarray(a, dtype=float)[..., None] for a in (t, north, east))
+        return per_ship(field_point, "i i i p o")(t, north, east, params, 6).reshape(*shape, 6)
 
     # --- disturbance protocol (shipgnc.environment.disturbance) ---
     def reset(self, batch_shape=(), rng=None) -> None:
@@ -155,15 +189,6 @@ class UniformCurrent(CurrentField):
         _finite(self.north, "current.north")
         _finite(self.east, "current.east")
 
-    def velocity(self, t, north, east):
-        shape = _shape(t, north, east)
-        out = np.empty((*shape, 2))
-        out[..., 0], out[..., 1] = self.north, self.east
-        return out
-
-    def jacobian(self, t, north, east):
-        return np.zeros((*_shape(t, north, east), 2, 2))
-
     def describe(self):
         return f"uniform current ({self.north:.6g}, {self.east:.6g}) m/s"
 
@@ -187,17 +212,6 @@ class AffineCurrent(CurrentField):
         for name, value in (("v0", self.v0), ("gradient", self.gradient), ("ref", self.ref)):
             arr = np.asarray(value, dtype=float)
             require(bool(np.all(np.isfinite(arr))), f"current.{name}", value, "must be finite")
-
-    def velocity(self, t, north, east):
-        shape = _shape(t, north, east)
-        g = np.asarray(self.gradient, dtype=float)
-        dn = np.broadcast_to(np.asarray(north, float) - self.ref[0], shape)
-        de = np.broadcast_to(np.asarray(east, float) - self.ref[1], shape)
-        return np.stack([self.v0[0] + g[0, 0] * dn + g[0, 1] * de,
-                         self.v0[1] + g[1, 0] * dn + g[1, 1] * de], axis=-1)
-
-    def jacobian(self, t, north, east):
-        return np.broadcast_to(np.asarray(self.gradient, float), (*_shape(t, north, east), 2, 2)).copy()
 
     def describe(self):
         g = np.asarray(self.gradient)
@@ -230,16 +244,6 @@ class RigidRotation(CurrentField):
     def __post_init__(self):
         _finite(self.omega, "rotation.omega")
 
-    def velocity(self, t, north, east):
-        shape = _shape(t, north, east)
-        rn = np.broadcast_to(np.asarray(north, float) - self.centre[0], shape)
-        re = np.broadcast_to(np.asarray(east, float) - self.centre[1], shape)
-        return np.stack([-self.omega * re, self.omega * rn], axis=-1)
-
-    def jacobian(self, t, north, east):
-        j = np.array([[0.0, -self.omega], [self.omega, 0.0]])
-        return np.broadcast_to(j, (*_shape(t, north, east), 2, 2)).copy()
-
     def describe(self):
         return f"rigid rotation ω = {self.omega:.6g} rad/s about {tuple(self.centre)} m"
 
@@ -267,9 +271,6 @@ class _Vortex(CurrentField):
         moving = "" if self.steady else f", drifting at {tuple(self.drift)} m/s"
         return f"at {tuple(self.centre)} m{moving}"
 
-    def _f(self, q):  # returns f(q), f'(q)
-        raise NotImplementedError
-
     @property
     def steady(self) -> bool:
         return self.drift[0] == 0.0 and self.drift[1] == 0.0
@@ -279,39 +280,18 @@ class _Vortex(CurrentField):
         t = np.asarray(t, float)
         return self.centre[0] + self.drift[0] * t, self.centre[1] + self.drift[1] * t
 
-    def _parts(self, t, north, east):
-        shape = _shape(t, north, east)
-        cn, ce = self.centre_at(t) if not self.steady else self.centre
-        rn = np.broadcast_to(np.asarray(north, float) - cn, shape)
-        re = np.broadcast_to(np.asarray(east, float) - ce, shape)
-        return rn, re, *self._f(rn * rn + re * re)
-
-    def velocity(self, t, north, east):
-        rn, re, f, _ = self._parts(t, north, east)
-        return np.stack([-f * re, f * rn], axis=-1)
-
-    def jacobian(self, t, north, east):
-        rn, re, f, df = self._parts(t, north, east)
-        # v = f(q) a, a = (−r_E, r_N), ∇q = 2 (r_N, r_E):  J = f R + a ⊗ (2 f' r)
-        j = np.empty((*rn.shape, 2, 2))
-        j[..., 0, 0] = -re * 2 * df * rn
-        j[..., 0, 1] = -f - re * 2 * df * re
-        j[..., 1, 0] = f + rn * 2 * df * rn
-        j[..., 1, 1] = rn * 2 * df * re
-        return j
-
     def tangential_speed(self, r):
+        """v_t(r) [m/s] at radii ``r`` [m] from the centre (at t = 0): the velocity's east
+        component on the ray due north."""
         r = np.asarray(r, dtype=float)
-        return r * self._f(r * r)[0]
+        return self.velocity(0.0, self.centre[0] + r, self.centre[1])[..., 1]
 
     def rate_bound(self):
         # ‖J‖ depends on r alone and decays as 1/r² outside the core: its peak lies within a few r_c
         # (at r = 0 for Lamb–Oseen, anywhere in the core for Rankine); sampled 4 000 radii to 20 r_c
         r = np.linspace(0.0, 20.0 * self.rc, 4001)
-        f, df = self._f(r * r)
-        # J = f R + a ⊗ 2f'r (jacobian): entries as there, on the ray r_E = 0
-        j = np.stack([np.zeros_like(r), -f, f + 2 * df * r * r, np.zeros_like(r)])
-        return float(np.max(np.sqrt(np.sum(j * j, axis=0))))
+        j = self.jacobian(0.0, self.centre[0] + r, self.centre[1])  # on the ray due north
+        return float(np.max(np.sqrt(np.sum(j * j, axis=(-2, -1)))))
 
 
 @dataclass(frozen=True)
@@ -325,16 +305,6 @@ class LambOseenVortex(_Vortex):
 
     def __post_init__(self):
         self._check("lamb-oseen")
-
-    def _f(self, q):
-        c = self.rc**2
-        a = self.gamma / (2 * math.pi)
-        small = q < 1e-6 * c
-        qs = np.where(small, c, q)
-        e = np.exp(-qs / c)
-        f = np.where(small, (1 - q / (2 * c) + q * q / (6 * c * c)) / c, -np.expm1(-qs / c) / qs)
-        df = np.where(small, -1 / (2 * c * c) + q / (3 * c**3), e / (c * qs) + np.expm1(-qs / c) / qs**2)
-        return a * f, a * df
 
     def describe(self):
         return f"Lamb–Oseen vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m {self._where()}"
@@ -354,13 +324,6 @@ class RankineVortex(_Vortex):
 
     def __post_init__(self):
         self._check("rankine")
-
-    def _f(self, q):
-        c = self.rc**2
-        a = self.gamma / (2 * math.pi)
-        inside = q <= c
-        qs = np.where(inside, c, q)
-        return a * np.where(inside, 1 / c, 1 / qs), a * np.where(inside, 0.0, -1 / qs**2)
 
     def describe(self):
         return f"Rankine vortex Γ = {self.gamma:.6g} m²/s, r_c = {self.rc:.6g} m {self._where()}"
@@ -385,27 +348,6 @@ class DoubleGyre(CurrentField):
     def __post_init__(self):
         _finite(self.speed, "gyre.speed")
         require(_finite(self.length, "gyre.length") > 0, "gyre.length", self.length, "must be > 0 m")
-
-    def _phases(self, t, north, east):
-        shape = _shape(t, north, east)
-        k = math.pi / self.length
-        a = np.broadcast_to(k * (np.asarray(east, float) - self.centre[1]), shape)
-        b = np.broadcast_to(k * (np.asarray(north, float) - self.centre[0]), shape)
-        return k, np.sin(a), np.cos(a), np.sin(b), np.cos(b)
-
-    def velocity(self, t, north, east):
-        _, sa, ca, sb, cb = self._phases(t, north, east)
-        return np.stack([-self.speed * sa * cb, self.speed * ca * sb], axis=-1)
-
-    def jacobian(self, t, north, east):
-        k, sa, ca, sb, cb = self._phases(t, north, east)
-        u = self.speed * k
-        j = np.empty((*sa.shape, 2, 2))
-        j[..., 0, 0] = u * sa * sb
-        j[..., 0, 1] = -u * ca * cb
-        j[..., 1, 0] = u * ca * cb
-        j[..., 1, 1] = -u * sa * sb
-        return j
 
     def rate_bound(self):
         return math.sqrt(2.0) * abs(self.speed) * math.pi / self.length
@@ -433,16 +375,26 @@ class SumField(CurrentField):
             self.bounds = ((max(b[0][0] for b in boxes), min(b[0][1] for b in boxes)),
                            (max(b[1][0] for b in boxes), min(b[1][1] for b in boxes)))
 
+    # the batch of the terms' kernel when every term has one and none is gridded (whose
+    # velocity checks its domain first); else the sum of the fields' own evaluations
     def velocity(self, t, north, east):
+        if self.bounds is None and self.compiled():
+            return super().velocity(t, north, east)
         return sum(f.velocity(t, north, east) for f in self.fields)
 
     def jacobian(self, t, north, east):
+        if self.bounds is None and self.compiled():
+            return super().jacobian(t, north, east)
         return sum(f.jacobian(t, north, east) for f in self.fields)
 
     def _velocity(self, t, north, east):
+        if self.compiled():
+            return super().velocity(t, north, east)
         return sum(f._velocity(t, north, east) for f in self.fields)
 
     def _jacobian(self, t, north, east):
+        if self.compiled():
+            return super().jacobian(t, north, east)
         return sum(f._jacobian(t, north, east) for f in self.fields)
 
     def describe(self):
@@ -513,16 +465,27 @@ class Modulated(CurrentField):
         return (self.mean * (t1 - t0)
                 + self.amplitude / w * (np.sin(w * t1 + self.phase) - np.sin(w * t0 + self.phase)))
 
+    # the batch of the kernel (the factor is part of each term) when the field has one and is not
+    # gridded (whose velocity checks its domain first); else the factor times the field's own
+    # evaluation (a factor over a factor)
     def velocity(self, t, north, east):
+        if self.bounds is None and self.compiled():
+            return super().velocity(t, north, east)
         return np.asarray(self.factor(t))[..., None] * self.field.velocity(t, north, east)
 
     def jacobian(self, t, north, east):
+        if self.bounds is None and self.compiled():
+            return super().jacobian(t, north, east)
         return np.asarray(self.factor(t))[..., None, None] * self.field.jacobian(t, north, east)
 
     def _velocity(self, t, north, east):
+        if self.compiled():
+            return super().velocity(t, north, east)
         return np.asarray(self.factor(t))[..., None] * self.field._velocity(t, north, east)
 
     def _jacobian(self, t, north, east):
+        if self.compiled():
+            return super().jacobian(t, north, east)
         return np.asarray(self.factor(t))[..., None, None] * self.field._jacobian(t, north, east)
 
     def describe(self):
@@ -657,19 +620,24 @@ class GriddedCurrent(CurrentField):
 
     def velocity(self, t, north, east):
         self._check_domain(north, east)
-        return self._eval(t, north, east, deriv=False)
+        return self._velocity(t, north, east)
 
     def jacobian(self, t, north, east):
         self._check_domain(north, east)
-        return self._eval(t, north, east, deriv=True)
+        return self._jacobian(t, north, east)
 
     def _velocity(self, t, north, east):
+        if self._splines is None:
+            return super().velocity(t, north, east)
         return self._eval(t, north, east, deriv=False)
 
     def _jacobian(self, t, north, east):
+        if self._splines is None:
+            return super().jacobian(t, north, east)
         return self._eval(t, north, east, deriv=True)
 
     def _eval(self, t, north, east, deriv):
+        """The bicubic spline's value or gradient, linear in time between slices."""
         shape = _shape(t, north, east)
         (n0, n1), (e0, e1) = self.bounds
         nn = np.clip(np.broadcast_to(np.asarray(north, float), shape), n0, n1).ravel()
@@ -708,23 +676,15 @@ class GriddedCurrent(CurrentField):
         return float(min(np.min(np.diff(self.n)), np.min(np.diff(self.e))))
 
     def _slice(self, k, nn, ee, deriv):
-        if self._splines is not None:
-            sp = self._splines[k]
-            if not deriv:
-                return np.stack([sp[c].ev(nn, ee) for c in range(2)], axis=-1)
-            return np.stack([np.stack([sp[c].ev(nn, ee, dx=1), sp[c].ev(nn, ee, dy=1)], axis=-1)
-                             for c in range(2)], axis=-2)
-        i = np.clip(np.searchsorted(self.n, nn, side="right") - 1, 0, self.n.size - 2)
-        j = np.clip(np.searchsorted(self.e, ee, side="right") - 1, 0, self.e.size - 2)
-        hn, he = self.n[i + 1] - self.n[i], self.e[j + 1] - self.e[j]
-        a, b = ((nn - self.n[i]) / hn)[:, None], ((ee - self.e[j]) / he)[:, None]
-        d = self.data[k]
-        f00, f01, f10, f11 = d[i, j], d[i, j + 1], d[i + 1, j], d[i + 1, j + 1]
+        """Time slice ``k`` at the points (nn, ee) clamped to the grid: the bilinear kernel's batch
+        at t = times[k] (its time weight is exactly 0 or 1 there), or the bicubic spline."""
+        if self._splines is None:
+            return (self._jacobian if deriv else self._velocity)(self.times[k], nn, ee)
+        sp = self._splines[k]
         if not deriv:
-            return (1 - a) * (1 - b) * f00 + (1 - a) * b * f01 + a * (1 - b) * f10 + a * b * f11
-        dn = ((1 - b) * (f10 - f00) + b * (f11 - f01)) / hn[:, None]
-        de = ((1 - a) * (f01 - f00) + a * (f11 - f10)) / he[:, None]
-        return np.stack([dn, de], axis=-1)
+            return np.stack([sp[c].ev(nn, ee) for c in range(2)], axis=-1)
+        return np.stack([np.stack([sp[c].ev(nn, ee, dx=1), sp[c].ev(nn, ee, dy=1)], axis=-1)
+                         for c in range(2)], axis=-2)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -786,8 +746,17 @@ def _bilinear(p, base, k, nt, nn, ne, north, east):
 def field_state(t, north, east, p, o):
     """``velocity`` and ``jacobian`` at ``(t0 + t, north, east)`` of one point, ``(v_N, v_E, J₀₀, J₀₁,
     J₁₀, J₁₁)`` with J[i, j] = ∂v_i/∂x_j, from the terms in ``p[o:]`` = [t0, n, n × (code, 12
-    numbers), gridded data] (:meth:`CurrentField.current_kernel`); each term follows its class's
-    numpy methods operation for operation, a sum adds them in order from 0."""
+    numbers), gridded data] (:meth:`CurrentField.current_kernel`), added in order (note 002-2.9.1):
+
+    * uniform v = c₀; affine v = v₀ + G(x − x_ref), J = G (the shear G = [[0, 0], [k, 0]], 002-2.5);
+    * rigid rotation v = ω(−r_E, r_N), r = x − centre;
+    * vortex v = f(q)(−r_E, r_N), q = r², r from the centre + drift·t, J = f R + (−r_E, r_N) ⊗
+      2f'(q)(r_N, r_E): Lamb–Oseen f = a(1 − e^{−q/c})/q (series for q < 10⁻⁶c), Rankine f = a/c
+      inside q ≤ c, a/q outside (a = Γ/2π, c = r_c²);
+    * double gyre v_N = −U sin(π e′/L) cos(π n′/L), v_E = U cos(π e′/L) sin(π n′/L);
+    * gridded data: bilinear in the cell holding the point (clamped to the grid), its Jacobian the
+      derivative of the same interpolant, linear in time between slices;
+    * a tidal factor m(t) = mean + amplitude·cos(2πt/T + φ) multiplies a term and its Jacobian."""
     tt = p[o] + t
     n = int(p[o + 1])
     vn = 0.0
@@ -875,6 +844,13 @@ def field_velocity(t, north, east, p, o):
     its Jacobian (the ship's current in the composed loop)."""
     vn, ve, _, _, _, _ = field_state(t, north, east, p, o)
     return vn, ve
+
+
+@kernel_function
+def field_point(t, north, east, p, out):
+    """``out`` = (v_N, v_E, J₀₀, J₀₁, J₁₀, J₁₁) at ``(t0 + t[0], north[0], east[0])``:
+    :func:`field_state` for the batch over points (:meth:`CurrentField.velocity`)."""
+    out[0], out[1], out[2], out[3], out[4], out[5] = field_state(t[0], north[0], east[0], p, 0)
 
 
 def sample_field(field: CurrentField, north, east, times=None):

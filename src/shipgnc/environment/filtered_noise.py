@@ -161,9 +161,11 @@ class SecondOrderNoise:
             self._t_end, self._held = t, self._x[..., 1]
             return self._held
         G, L = self.averaged_transition(h)
-        n = self._rng.standard_normal((*self._x.shape[:-1], 3))
-        z = matvec(G, self._x) + matvec(L, n)  # [x(t + h), ∫ w over the step]
-        self._x, self._t_end, self._held = z[..., :2], t + h, z[..., 2] / h
+        batch = self._x.shape[:-1]
+        n = self._rng.standard_normal((*batch, 3))
+        x = self._x.reshape(-1, 2).copy()  # stepped in place by the one step of the recursion
+        held, _ = _averaged_steps(x, n.reshape(1, -1, 3), G[None], L[None], np.array([h]))
+        self._x, self._t_end, self._held = x.reshape(*batch, 2), t + h, held[0].reshape(batch)
         return self._held
 
     def sequence(self, times, batch_shape, rng: np.random.Generator) -> np.ndarray:
@@ -233,10 +235,11 @@ def _same_time_tol(t: float) -> float:
 
 @numba.njit(cache=True, error_model="numpy")  # no fastmath: :func:`matvec`'s products and sums, in order
 def _averaged_steps(x, noise, G, L, steps):
-    """The regular calls of :meth:`SecondOrderNoise.__call__` for ships ``x`` (ships, 2), updated
-    in place: per step k, z = G_k x + L_k n_k as :func:`~shipgnc.batchmath.matvec` forms each
-    row (left to right, the two products added), x ← z[:2], w̄_k = z[2]/h_k. Returns (w̄ (steps,
-    ships), x at the last step's start)."""
+    """Steps of the averaged filter (A11) for ships ``x`` (ships, 2), updated in place — the one
+    source of :meth:`SecondOrderNoise.__call__`'s averaged step and of :meth:`~SecondOrderNoise.at_times`:
+    per step k, [x(t + h_k); ∫w] = z = G_k x + L_k n_k (each row's products left to right, the two
+    added), x ← z[:2], w̄_k = z[2]/h_k (module docstring). Returns (w̄ (steps, ships), x at the
+    last step's start)."""
     held = np.empty((steps.shape[0], x.shape[0]))
     x_start = x.copy()
     for k in range(steps.shape[0]):

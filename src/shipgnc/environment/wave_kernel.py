@@ -1,146 +1,54 @@
-"""Compiled (numba) forms of document 003's wave loads (:class:`FroudeKrylovWaveLoads`).
+"""Document 003's wave loads (:class:`~shipgnc.environment.waves.FroudeKrylovWaveLoads`) written
+once: :func:`froude_krylov_sample`, the per-ship kernel. The composed loop calls it in every RK
+stage; the numpy loop and every other caller call its batch over ships
+(:func:`shipgnc.derive.per_ship`), so there is no second form to keep equal.
 
-The numpy form in :mod:`shipgnc.environment.waves` (``loads_numpy``) is the reference. Two
-compiled forms repeat it:
-
-* :func:`loads` — the twin the numpy loop calls (``__call__``, recorded as ``+wave_kernel``): one
-  (ship, component) pair at a time, so a batch does not allocate a dozen (ships × components)
-  temporaries per RK stage (about 3× faster; one thread: a parallel region's spinning workers
-  would slow the numpy loop around it);
-* :func:`froude_krylov_sample` — the disturbance kernel of the composed loop
-  (:mod:`shipgnc.kernels`), one ship per call, its sea in the ship's kernel state.
-
-Tests hold both equal to the reference to round-off.
+**Cost.** Per component and stage the loads need three sin/cos pairs — of the phase θᵢ and of
+the hull-shape arguments uᵢ, vᵢ — evaluated by :func:`sincos` in one vectorised loop over the
+components (≈ 25 floating-point operations a pair, no libm call); whether every argument lies
+within its fast reduction (:data:`SINCOS_LIMIT`) is one bound per ship and stage
+(|θᵢ| ≤ ω_max|t| + k_max(|n| + |e|) + |φ|_max), not a test per component. Those sin/cos are the
+cost (benchmarks/bench_waves.py). A rotation recurrence of the phase (e^{iθᵢ} advanced by
+e^{iωᵢΔt} from stage to stage) does not remove one: θᵢ = ωᵢt − kᵢ·r + φᵢ moves with the ship's
+position r, and e^{−ikᵢ·Δr} differs per component and stage, so it needs a sin/cos (or a
+polynomial of the same length) of its own; nor do shared reciprocals for sinc and j₁ (one
+division per ship instead of two per component) change the rate measurably.
 """
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
+import numba
+from llvmlite import ir
+from numba.core import cgutils, types
+from numba.core.extending import intrinsic
 
-_KERNEL = None
+from shipgnc.kernels import JIT_OPTIONS, kernel_function
 
-
-def _sin_sinc_j1(u):
-    """Scalar twin of ``waves._sin_sinc_j1``: sin u, sin u/u, j₁(u) (series near 0)."""
-    su = math.sin(u)
-    if abs(u) < 1e-3:
-        u2 = u * u
-        return su, 1.0 - u2 / 6.0, u * (1.0 / 3.0 - u2 / 30.0)
-    sinc = su / u
-    return su, sinc, (sinc - math.cos(u)) / u
-
-
-def _loads(t, north, east, psi, omega, k_north, k_east, phase, half_kL, half_kB, chi,
-           wX, wY, wN, length, beam, long_crested, out):
-    """X, Y, N of every ship (rows of the (ships, components) arrays) into ``out`` (ships, 3)."""
-    for i in range(omega.shape[0]):
-        X = 0.0
-        Y = 0.0
-        N = 0.0
-        cos_b = math.cos(chi[i, 0] - psi[i])  # long-crested: one direction for all components
-        sin_b = math.sin(chi[i, 0] - psi[i])
-        for j in range(omega.shape[1]):
-            theta = omega[i, j] * t - (k_north[i, j] * north[i] + k_east[i, j] * east[i]) + phase[i, j]
-            if not long_crested:
-                cos_b = math.cos(chi[i, j] - psi[i])
-                sin_b = math.sin(chi[i, j] - psi[i])
-            s_u, sinc_u, j1_u = _sin_sinc_j1(half_kL[i, j] * cos_b)
-            s_w, sinc_w, j1_w = _sin_sinc_j1(half_kB[i, j] * sin_b)
-            s = math.sin(theta)
-            X += wX[i, j] * (beam * s_u * sinc_w) * s
-            Y += wY[i, j] * (length * s_w * sinc_u) * s
-            N += wN[i, j] * (length * length * s_w * j1_u - beam * beam * s_u * j1_w) * math.cos(theta)
-        out[i, 0] = X
-        out[i, 1] = Y
-        out[i, 2] = N
-
-
-def available() -> bool:
-    try:
-        import numba  # noqa: F401
-    except Exception:
-        return False
-    return True
-
-
-def loads(t: float, north, east, psi, arrays: dict, length: float, beam: float,
-          long_crested: bool) -> np.ndarray:
-    """Evaluate the loads for flattened ships; ``arrays`` hold (ships, components) float arrays."""
-    global _KERNEL, _sin_sinc_j1
-    if _KERNEL is None:
-        import numba
-
-        _sin_sinc_j1 = numba.njit(cache=True)(_sin_sinc_j1)
-        _KERNEL = numba.njit(cache=True)(_loads)
-    out = np.empty((north.shape[0], 3))
-    _KERNEL(float(t), north, east, psi, arrays["omega"], arrays["k_north"], arrays["k_east"],
-            arrays["phase"], arrays["half_kL"], arrays["half_kB"], arrays["chi"], arrays["wX"],
-            arrays["wY"], arrays["wN"], float(length), float(beam), bool(long_crested), out)
-    return out
-
-
-# ----------------------------------------------------------------------------------------------
-# the disturbance kernel of the composed loop (shipgnc.kernels): one ship, every RK stage
-# ----------------------------------------------------------------------------------------------
-
-import numba  # noqa: E402
-from llvmlite import ir  # noqa: E402
-from numba.core import cgutils, types  # noqa: E402
-from numba.core.extending import intrinsic  # noqa: E402
-
-from shipgnc.kernels import JIT_OPTIONS, kernel_function  # noqa: E402
-
-#: rows of a ship's per-component block in the kernel's state (each ``n_components`` long)
+#: rows of a ship's per-component block in the kernel's state (each ``n_components`` long):
+#: the sea (ωᵢ, φᵢ, kᵢcos χᵢ, kᵢsin χᵢ, ½kᵢL, ½kᵢB, χᵢ), the weights −2g_X ρgDᵢaᵢ, −2g_Y ρgDᵢaᵢ,
+#: g_N ρgDᵢaᵢ
 ROWS = ("omega", "phase", "k_north", "k_east", "half_kL", "half_kB", "chi", "wX", "wY", "wN")
-#: scratch rows after them: the per-component terms of X, Y and N, summed as numpy sums them
+#: scratch rows after them: the per-component terms of X, Y and N, summed by :func:`pairwise_sum3`
 N_SCRATCH = 3
+#: numbers after the scratch rows, bounds of the arguments: [ω_max, max |kᵢcos χᵢ|, |kᵢsin χᵢ|,
+#: |φ|_max, max(½kᵢL, ½kᵢB, |χᵢ|)] (so |θᵢ|, |uᵢ|, |vᵢ|, |βᵢ| are bounded by one number per call)
+N_BOUNDS = 4
 
 
-@kernel_function
-def pairwise_sum(a, lo, n):
-    """Σ a[lo:lo + n] in the order of numpy's ``np.sum`` along a contiguous axis (its pairwise
-    summation: eight interleaved partial sums in blocks of at most 128, halves above that), so the
-    kernel adds the components exactly as :meth:`FroudeKrylovWaveLoads.loads_numpy` does."""
-    if n < 8:
-        res = 0.0
-        for i in range(n):
-            res += a[lo + i]
-        return res
-    if n <= 128:
-        r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
-        r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
-        i = 8
-        end = n - n % 8
-        while i < end:
-            j = lo + i
-            r0 += a[j]
-            r1 += a[j + 1]
-            r2 += a[j + 2]
-            r3 += a[j + 3]
-            r4 += a[j + 4]
-            r5 += a[j + 5]
-            r6 += a[j + 6]
-            r7 += a[j + 7]
-            i += 8
-        res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-        while i < n:
-            res += a[lo + i]
-            i += 1
-        return res
-    n2 = n // 2
-    n2 -= n2 % 8
-    return pairwise_sum(a, lo, n2) + pairwise_sum(a, lo + n2, n - n2)
+def state_width(n_components: int) -> int:
+    """Length of a ship's kernel state for ``n_components`` components."""
+    return (len(ROWS) + N_SCRATCH) * n_components + N_BOUNDS
 
 
 @intrinsic
 def _lane_sums3(typingctx, a, lo, m, stride):
     """Three 8-lane partial-sum blocks at once: for each row k = 0, 1, 2 (starting at
     lo + k·stride) lane l adds a[lo + k·stride + 8i + l] for i = 0 … m − 1 in that order, and the
-    lanes are combined as ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7)) — numpy's block
-    (:func:`pairwise_sum`) written as one 8-wide vector add per step (plain IEEE adds, no
-    reassociation: the same sum to the bit). numba does not SLP-vectorise the scalar form."""
+    lanes are combined as ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7)) — numpy's pairwise
+    block written as one 8-wide vector add per step (plain IEEE adds, no reassociation). numba
+    does not SLP-vectorise the scalar form."""
     if not (isinstance(a, types.Array) and a.ndim == 1 and a.dtype == types.float64
             and a.layout == "C"):
         return None
@@ -174,8 +82,10 @@ def _lane_sums3(typingctx, a, lo, m, stride):
 @kernel_function
 def pairwise_sum3(a, lo, n, stride):
     """(Σ a[lo:lo + n], Σ a[lo + s:lo + s + n], Σ a[lo + 2s:lo + 2s + n]) with s = ``stride``,
-    each exactly as :func:`pairwise_sum` (numpy's order); the three rows' blocks are added side by
-    side, eight lanes per vector add (:func:`_lane_sums3`)."""
+    each in the order of numpy's ``np.sum`` along a contiguous axis (its pairwise summation: eight
+    interleaved partial sums in blocks of at most 128, halves above that; a deterministic order,
+    and accurate to O(log n) roundings); the three rows' blocks are added side by side, eight
+    lanes per vector add (:func:`_lane_sums3`)."""
     if n < 8:
         sx = sy = sz = 0.0
         for i in range(n):
@@ -238,8 +148,8 @@ def sincos(x):
 
 @numba.njit(inline="always", **JIT_OPTIONS)
 def _sinc_j1(s, c, u):
-    """sinc u and j₁(u) from s = sin u, c = cos u, as ``waves._sin_sinc_j1`` (series for
-    |u| < 1e-3), without branches."""
+    """sinc u = sin u/u and j₁(u) = (sin u − u cos u)/u² from s = sin u, c = cos u (series
+    1 − u²/6, u(1/3 − u²/30) for |u| < 1e-3), without branches."""
     small = abs(u) < 1e-3
     us = 1.0 if small else u
     u2 = u * u
@@ -251,7 +161,7 @@ def _sinc_j1(s, c, u):
 
 @numba.njit(inline="always", **JIT_OPTIONS)
 def _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v):
-    """Component j's terms of X, Y, N (:meth:`FroudeKrylovWaveLoads.loads_numpy`'s products)."""
+    """Component j's terms of X, Y and N into the scratch rows at ``o_t``."""
     sinc_u, j1_u = _sinc_j1(s_u, c_u, u)
     sinc_v, j1_v = _sinc_j1(s_v, c_v, v)
     z[o_t + j] = z[7 * n + j] * (beam * s_u * sinc_v) * s
@@ -262,51 +172,58 @@ def _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v):
 @kernel_function
 def froude_krylov_sample(t, x, z, p, w, d):
     """[X_env, Y_env, N_env] of one ship at time ``t`` and stage state ``x``: document 003's
-    seeded Froude–Krylov loads (note 003-3.6; :class:`~shipgnc.environment.waves.FroudeKrylovWaveLoads`),
+    seeded first-order Froude–Krylov loads on a box-shaped hull L × B × T (note 003-3.6; the
+    closed-form integrals of :func:`~shipgnc.environment.waves.box_froude_krylov_transfer` per
+    component, summed):
 
-        θᵢ = ωᵢ t − (k_n,ᵢ n + k_e,ᵢ e) + φᵢ,   βᵢ = χᵢ − ψ,   uᵢ = ½kᵢL cos βᵢ,  vᵢ = ½kᵢB sin βᵢ,
+        θᵢ = ωᵢ t − (kᵢ cos χᵢ · n + kᵢ sin χᵢ · e) + φᵢ,   βᵢ = χᵢ − ψ,
+        uᵢ = ½kᵢL cos βᵢ,   vᵢ = ½kᵢB sin βᵢ,
         X = Σ w_X,ᵢ B sin uᵢ sinc vᵢ sin θᵢ,   Y = Σ w_Y,ᵢ L sin vᵢ sinc uᵢ sin θᵢ,
         N = Σ w_N,ᵢ (L² sin vᵢ j₁(uᵢ) − B² sin uᵢ j₁(vᵢ)) cos θᵢ,
 
-    operation for operation as :meth:`~FroudeKrylovWaveLoads.loads_numpy`, the sums in numpy's
-    order (:func:`pairwise_sum3`). The cost is three sin/cos pairs per component and stage: they
-    are evaluated by :func:`sincos` in one vectorised loop over the components (libm for any
-    argument beyond :data:`SINCOS_LIMIT`). ``z`` holds the ship's sea (:data:`ROWS`) and the
-    scratch rows of the terms; ``p`` = [n_components, L, B, long-crested, i_north, i_east, i_psi]."""
+    with w_X,ᵢ = −2g_X ρgDᵢaᵢ, w_Y,ᵢ = −2g_Y ρgDᵢaᵢ, w_N,ᵢ = g_N ρgDᵢaᵢ, Dᵢ = (1 − e^{−kᵢT})/kᵢ,
+    sinc u = sin u/u, j₁(u) = (sin u − u cos u)/u² (series for |u| < 1e-3), deep water
+    kᵢ = ωᵢ²/g; a long-crested sea has one χ. The sums are taken in numpy's pairwise order
+    (:func:`pairwise_sum3`). Cost and the exact reformulations: the module docstring.
+
+    ``z`` holds the ship's sea (:data:`ROWS`), the scratch rows of the terms and the bounds of
+    the arguments (:data:`N_BOUNDS`); ``p`` = [n_components, L, B, long-crested, i_north, i_east,
+    i_psi]; ``w`` is not read."""
     n = int(p[0])
     length, beam = p[1], p[2]
     north, east, psi = x[int(p[4])], x[int(p[5])], x[int(p[6])]
     L2, B2 = length ** 2, beam ** 2
-    o_t = 10 * n
-    n_big = 0
-    if p[3] != 0.0:  # long-crested: one direction, so β is the ship's
+    o_t = len(ROWS) * n
+    o_b = o_t + N_SCRATCH * n
+    # every argument within the fast reduction (|β| too: ψ of a runaway heading)? one bound
+    bound = max(z[o_b] * abs(t) + z[o_b + 1] * (abs(north) + abs(east)) + z[o_b + 2],
+                z[o_b + 3] + abs(psi))
+    long_crested = p[3] != 0.0
+    if bound <= SINCOS_LIMIT and long_crested:  # one direction: β per ship
         beta = z[6 * n] - psi
         cos_b, sin_b = math.cos(beta), math.sin(beta)
         for j in range(n):
             theta = z[j] * t - (z[2 * n + j] * north + z[3 * n + j] * east) + z[n + j]
             u = z[4 * n + j] * cos_b
             v = z[5 * n + j] * sin_b
-            n_big += max(abs(theta), abs(u), abs(v)) > SINCOS_LIMIT
             s, c = sincos(theta)
             s_u, c_u = sincos(u)
             s_v, c_v = sincos(v)
             _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v)
-    else:
+    elif bound <= SINCOS_LIMIT:
         for j in range(n):
             theta = z[j] * t - (z[2 * n + j] * north + z[3 * n + j] * east) + z[n + j]
-            beta = z[6 * n + j] - psi
-            n_big += max(abs(theta), abs(beta)) > SINCOS_LIMIT
-            sin_b, cos_b = sincos(beta)
+            sin_b, cos_b = sincos(z[6 * n + j] - psi)
             u = z[4 * n + j] * cos_b
             v = z[5 * n + j] * sin_b
             s, c = sincos(theta)
             s_u, c_u = sincos(u)
             s_v, c_v = sincos(v)
             _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v)
-    if n_big:  # arguments beyond the fast reduction (a run of hours, a runaway heading): libm
+    else:  # arguments beyond the fast reduction (a run of hours, a runaway heading): libm
         for j in range(n):
             theta = z[j] * t - (z[2 * n + j] * north + z[3 * n + j] * east) + z[n + j]
-            beta = (z[6 * n] if p[3] != 0.0 else z[6 * n + j]) - psi
+            beta = (z[6 * n] if long_crested else z[6 * n + j]) - psi
             u = z[4 * n + j] * math.cos(beta)
             v = z[5 * n + j] * math.sin(beta)
             _terms(z, j, n, o_t, length, beam, L2, B2, math.sin(theta), math.cos(theta),

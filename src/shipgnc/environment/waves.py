@@ -32,8 +32,8 @@ of ships gets independent seas from one generator in one array operation.
 
 from __future__ import annotations
 
+import contextlib
 import math
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from itertools import pairwise
@@ -985,10 +985,8 @@ class FroudeKrylovWaveLoads:
         require(isinstance(spectrum, WaveSpectrum), "waves.spectrum", type(spectrum).__name__,
                 "must be a WaveSpectrum")
         require(backend in ("auto", "numpy"), "waves.backend", backend,
-                "allowed: auto (compiled kernel when numba is available), numpy")
+                "allowed: auto (the kernel's compiled batch), numpy (its plain-Python form, slow)")
         self.backend = backend
-        self._numpy_only = False
-        self._flat = None
         self.spectrum = spectrum
         self.direction = _angle(direction)
         require(isinstance(n_components, (int, np.integer)) and not isinstance(n_components, bool)
@@ -1031,7 +1029,7 @@ class FroudeKrylovWaveLoads:
         self._half_kL = 0.5 * self.length * r.wavenumber
         self._half_kB = 0.5 * self.beam * r.wavenumber
         self._batch = tuple(batch_shape)
-        self._flat = None  # the compiled kernel's flattened arrays, made on first use
+        self._sea = self._kernel_state()
 
     def _require_reset(self) -> WaveRealisation:
         if self.realisation is None:
@@ -1124,92 +1122,67 @@ class FroudeKrylovWaveLoads:
         return np.sum(r.amplitude * np.cos(r.phase_at(t, north, east)), axis=-1)
 
     def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
-        """[X_env, Y_env, N_env] (*batch, 3) at time t [s] for states ``x`` (*batch, n).
+        """[X_env, Y_env, N_env] (*batch, 3) at time t [s] for states ``x`` (*batch, n): the batch
+        over ships of :func:`~shipgnc.environment.wave_kernel.froude_krylov_sample` (its
+        equations), or its plain-Python form with ``backend="numpy"``."""
+        from shipgnc.derive import per_ship, plain_python
+        from shipgnc.environment.wave_kernel import froude_krylov_sample
 
-        Evaluated by the compiled twin (:mod:`shipgnc.environment.wave_kernel`) when numba is
-        available and ``backend`` allows it, else by :meth:`loads_numpy` (the reference).
-        """
         self._require_reset()
-        if self.evaluator() == "numpy":
-            return self.loads_numpy(t, x)
-        from shipgnc.environment import wave_kernel
-
-        north, east, psi = (np.ascontiguousarray(np.broadcast_to(a, self._batch).reshape(-1),
-                                                 dtype=float) for a in self._state(x))
-        out = wave_kernel.loads(t, north, east, psi, self._flat_arrays(), self.length, self.beam,
-                                self.spreading is None)
+        x = np.asarray(x, dtype=float)
+        require(x.ndim >= 1 and x.shape[-1] > max(self.state_index), "waves.state_index",
+                self.state_index, f"out of range for a state of shape {x.shape}")
+        x = np.broadcast_to(x, (*self._batch, x.shape[-1]))
+        batch = per_ship(froude_krylov_sample, "t i z p i o")
+        with plain_python() if self.evaluator() == "numpy" else contextlib.nullcontext():
+            out = batch(float(t), x, self._sea, self._kernel_params(), _NO_TABLE, 3)
         return out.reshape(*self._batch, 3)
 
     def evaluator(self) -> str:
-        """Which code evaluates the loads in the numpy loop: ``"wave_kernel"`` (numba) or
-        ``"numpy"`` (``backend="numpy"``, inside :meth:`numpy_only`, or without numba); they agree
-        to round-off, not to the bit, so a run records it (``attrs["backend"]``)."""
-        from shipgnc.environment import wave_kernel
-
-        if self.backend == "numpy" or self._numpy_only or not wave_kernel.available():
-            return "numpy"
-        return "wave_kernel"
-
-    @contextmanager
-    def numpy_only(self):
-        """Within the block the loads are :meth:`loads_numpy` whatever ``backend`` says
-        (``simulate(backend="numpy")``: the reference loop keeps every component in numpy)."""
-        before, self._numpy_only = self._numpy_only, True
-        try:
-            yield self
-        finally:
-            self._numpy_only = before
+        """Which code evaluates the loads outside the composed loop: ``"wave_kernel"``, the
+        compiled batch of the kernel, or ``"numpy"`` with ``backend="numpy"``: the kernel's
+        plain-Python form (:func:`shipgnc.derive.plain_python`; slow, for stepping through in a
+        debugger). A run records it (``attrs["backend"]``)."""
+        return "numpy" if self.backend == "numpy" else "wave_kernel"
 
     def kernel(self, batch_shape, dt: float | None = None) -> Kernel:
         """The loads for the composed loop, evaluated in every RK stage
-        (:func:`~shipgnc.environment.wave_kernel.froude_krylov_sample`). The ship's sea is its
-        per-ship state: the rows of :data:`~shipgnc.environment.wave_kernel.ROWS` (ωᵢ, φᵢ,
-        kᵢcos χᵢ, kᵢsin χᵢ, ½kᵢL, ½kᵢB, χᵢ and the weights −2g_X ρgDᵢaᵢ, −2g_Y ρgDᵢaᵢ,
-        g_N ρgDᵢaᵢ, the very arrays :meth:`loads_numpy` reads) and scratch rows; the same seed
-        therefore gives the same sea."""
-        from shipgnc.environment.wave_kernel import N_SCRATCH, ROWS, froude_krylov_sample
+        (:func:`~shipgnc.environment.wave_kernel.froude_krylov_sample`); the ship's sea is its
+        per-ship state, drawn by :meth:`reset`: the same seed gives the same sea."""
+        from shipgnc.environment.wave_kernel import froude_krylov_sample
 
-        r = self._require_reset()
+        self._require_reset()
+        state = self._sea.reshape(*tuple(batch_shape), -1)
+        return Kernel(froude_krylov_sample, self._kernel_params(), state, per_stage=True)
+
+    def _kernel_params(self) -> np.ndarray:
+        """[n_components, L, B, long-crested, i_north, i_east, i_psi] (after :meth:`bind_model`)."""
+        return flat(self.n_components, self.length, self.beam, float(self.spreading is None),
+                    self.state_index)
+
+    def _kernel_state(self) -> np.ndarray:
+        """Every ship's kernel state (ships, width): the rows of
+        :data:`~shipgnc.environment.wave_kernel.ROWS`, zero scratch rows, the arguments' bounds."""
+        from shipgnc.environment.wave_kernel import N_BOUNDS, state_width
+
+        r = self.realisation
         n = r.n_components
-        shape = (*tuple(batch_shape), n)
-        chi = self.direction if self.spreading is None else r.direction
+        shape = (*self._batch, n)
+        chi = np.broadcast_to(self.direction if self.spreading is None else r.direction, shape)
         rows = (r.omega, r.phase, r._k_north, r._k_east, self._half_kL, self._half_kB, chi,
                 *self._weights)
-        state = np.zeros((*tuple(batch_shape), (len(ROWS) + N_SCRATCH) * n))
+        state = np.zeros((math.prod(self._batch), state_width(n)))
         for i, row in enumerate(rows):
-            state[..., i * n:(i + 1) * n] = np.broadcast_to(row, shape)
-        params = flat(n, self.length, self.beam, float(self.spreading is None), self.state_index)
-        return Kernel(froude_krylov_sample, params, state, per_stage=True)
+            state[:, i * n:(i + 1) * n] = np.broadcast_to(row, shape).reshape(-1, n)
+        bounds = [r.omega, np.maximum(np.abs(r._k_north), np.abs(r._k_east)), np.abs(r.phase),
+                  np.maximum(np.maximum(self._half_kL, self._half_kB), np.abs(chi))]
+        state[:, len(state[0]) - N_BOUNDS:] = np.stack(
+            [np.broadcast_to(np.max(b, axis=-1), self._batch).reshape(-1) for b in bounds], axis=-1)
+        return state
 
-    def _flat_arrays(self) -> dict[str, np.ndarray]:
-        """The sea's per-component arrays as (ships, components) rows for the kernel (made once)."""
-        if self._flat is None:
-            r = self._require_reset()
-            n = r.omega.shape[-1]
-            chi = np.broadcast_to(self.direction if self.spreading is None else r.direction,
-                                  r.omega.shape)
 
-            def flat(a):
-                return np.ascontiguousarray(np.broadcast_to(a, r.omega.shape).reshape(-1, n),
-                                            dtype=float)
-
-            self._flat = {"omega": flat(r.omega), "k_north": flat(r._k_north),
-                          "k_east": flat(r._k_east), "phase": flat(r.phase),
-                          "half_kL": flat(self._half_kL), "half_kB": flat(self._half_kB),
-                          "chi": flat(chi), "wX": flat(self._weights[0]),
-                          "wY": flat(self._weights[1]), "wN": flat(self._weights[2])}
-        return self._flat
-
-    def loads_numpy(self, t: float, x: np.ndarray) -> np.ndarray:
-        """The reference numpy form of :meth:`__call__`."""
-        r = self._require_reset()
-        north, east, psi = self._state(x)
-        theta = r.phase_at(t, north, east)
-        fX, fY, fN = self._shape_factors(psi)
-        s, c = np.sin(theta), np.cos(theta)
-        wX, wY, wN = self._weights
-        return np.stack([np.sum(wX * fX * s, axis=-1), np.sum(wY * fY * s, axis=-1),
-                         np.sum(wN * fN * c, axis=-1)], axis=-1)
+#: the kernel's table input: the wave loads draw nothing per step
+_NO_TABLE = np.zeros(0)
 
 
 #: another name of :class:`FroudeKrylovWaveLoads`, the wave-load disturbance of document 003's

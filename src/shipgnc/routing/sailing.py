@@ -43,9 +43,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shipgnc.derive import per_ship
 from shipgnc.environment.fields import field_velocity
 from shipgnc.kernels import Kernel, NotCompiled, kernel_function
-from shipgnc.models.base import Signal
+from shipgnc.models.base import Signal, kernel_derivatives
 from shipgnc.models.fossen3dof import DISTURBANCES, VectoredThrustBoat, boat_rhs
 
 CURRENT = (
@@ -77,12 +78,9 @@ class BoatInCurrent:
         return self.boat.input_limits()
 
     def derivatives(self, x, u, d=None):
-        """ẋ: the boat's own equations with ν_r, plus the current in the kinematics."""
-        xdot = self.boat.derivatives(x, u, None if d is None else d[..., :3])
-        if d is not None:
-            xdot[..., 0] = xdot[..., 0] + d[..., 3]
-            xdot[..., 1] = xdot[..., 1] + d[..., 4]
-        return xdot
+        """ẋ: the batch of :func:`boat_current_rhs` (the boat's own equations with ν_r, plus the
+        current in the kinematics)."""
+        return kernel_derivatives(self, boat_current_rhs, self.boat.kernel().params, x, u, d)
 
     def kernel(self) -> Kernel:
         """:meth:`derivatives` for the composed loop (:func:`boat_current_rhs`)."""
@@ -91,10 +89,15 @@ class BoatInCurrent:
 
 @kernel_function
 def boat_current_rhs(x, u, d, p, xdot):
-    """:meth:`BoatInCurrent.derivatives` for one ship: :func:`boat_rhs` plus d[3:5] in η̇."""
+    """ẋ of :class:`BoatInCurrent` for one ship (Fossen 2021 §10.3, the state's u, v through the
+    water): η̇ = J(ψ) ν_r + [d₃, d₄, 0]ᵀ, and ν̇_r of document 001's equations (9)–(11') with the
+    forces d[0:3] (:func:`~shipgnc.models.fossen3dof.boat_rhs`). Not the boat's own current model
+    (:func:`shipgnc.models.fossen3dof.boat_current_rhs`, whose state is ν over ground); a
+    disturbance of three forces only is still water."""
     boat_rhs(x, u, d, p, xdot)
-    xdot[0] = xdot[0] + d[3]
-    xdot[1] = xdot[1] + d[4]
+    if d.shape[0] >= 5:
+        xdot[0] = xdot[0] + d[3]
+        xdot[1] = xdot[1] + d[4]
 
 
 class FieldCurrent:
@@ -111,6 +114,12 @@ class FieldCurrent:
         pass
 
     def __call__(self, t, x):
+        """The batch of :func:`field_current_sample`; a field without a compiled form (gridded
+        data, whose domain is checked) in numpy: its own ``velocity``."""
+        if self.kernel_reason() is None:
+            x = np.asarray(x, dtype=float)
+            z = np.empty((math.prod(x.shape[:-1]), 0))  # neither z nor w is read
+            return per_ship(field_current_sample, "t i z p i o")(t, x, z, self._params(), z[0], 5)
         v = self.field.velocity(self.t0 + t, x[..., 0], x[..., 1])
         zeros = np.zeros((*v.shape[:-1], 3))
         return np.concatenate([zeros, v], axis=-1)
@@ -139,7 +148,8 @@ class FieldCurrent:
 
 @kernel_function
 def field_current_sample(t, x, z, p, w, d):
-    """:meth:`FieldCurrent.__call__` for one ship."""
+    """d = [0, 0, 0, v_N, v_E]: the field's velocity at the ship's position (north, east) = (x[0],
+    x[1]) at time t0 + t (:func:`~shipgnc.environment.fields.field_velocity`)."""
     vn, ve = field_velocity(t, x[0], x[1], p, 0)
     d[0] = 0.0
     d[1] = 0.0
