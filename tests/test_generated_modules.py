@@ -3,8 +3,11 @@ it, and is keyed by the sources it is compiled from (shipgnc.jit_cache)."""
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
 
+from shipgnc import jit_cache
 from shipgnc.control.open_loop import OpenLoopSchedule
 from shipgnc.derive import per_ship
 from shipgnc.kernels import Kernel, kernel_function
@@ -75,3 +78,29 @@ def test_a_batch_compiled_in_memory_leaves_its_source(tmp_path, monkeypatch):
     np.testing.assert_array_equal(batch(np.array([[1.0], [3.0]]), 1), [[2.0], [6.0]])
     assert batch.source_path is not None and batch.source_path.name.startswith("shipgnc_memory_")
     assert "def serial(" in batch.source_path.read_text()
+
+
+def test_the_key_follows_the_kernels_sources_not_the_whole_package(tmp_path, monkeypatch):
+    """A generated module's key hashes the package files it imports, transitively: editing an
+    unrelated module keeps it; editing a helper module of a kernel's module changes it. (On a
+    copy of the package.)"""
+    copy = tmp_path / "shipgnc"
+    shutil.copytree(jit_cache.PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(jit_cache, "PACKAGE", copy)
+    monkeypatch.setattr(jit_cache, "_FILE_IMPORTS", {})
+    source = "from shipgnc.models.fossen3dof import boat_rhs as kernel\n"
+    files = {p.relative_to(copy).as_posix() for p in jit_cache.source_files(source)}
+    assert {"models/fossen3dof.py", "models/base.py", "kernels.py"} <= files
+    assert "cli.py" not in files and "routing/graph.py" not in files
+    key = jit_cache.module_key(source, ())
+
+    def edited(relative):
+        monkeypatch.setattr(jit_cache, "_FILE_IMPORTS", {})
+        with open(copy / relative, "a") as f:
+            f.write("\n# an edit\n")
+        return jit_cache.module_key(source, ())
+
+    assert edited("cli.py") == key
+    assert edited("routing/graph.py") == key
+    helper = next(f for f in ("kernels.py", "frames.py") if f in files)
+    assert edited(helper) != key
