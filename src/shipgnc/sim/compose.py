@@ -146,8 +146,8 @@ def _generate(*key):
     """The combination's loop: from a module written to the disk cache and compiled with numba's
     cache (loaded in ≈ 0.1 s by later processes) when every kernel is importable by name; else
     compiled in memory, once per process (a kernel defined in a script or a notebook), its source
-    written to the cache all the same (``shipgnc_memory_*.py``: what runs, to read). The loop's
-    ``source_path`` attribute names the file (None when the cache is not writable)."""
+    written to the cache all the same (``shipgnc_memory_*.py``: what runs, to read);
+    :func:`source_path` names the file (None when the cache is not writable)."""
     functions = key[:5]
     importable_by_name = all(importable(fn) for fn in functions)
     source = _source(*key, imports=importable_by_name)
