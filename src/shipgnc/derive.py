@@ -76,6 +76,8 @@ class ShipBatch:
         self.letters = letters
         self.returns = result == "r"
         self._compiled = None
+        #: the file holding the batch's generated source once compiled (None: not writable)
+        self.source_path = None
 
     # ---------------------------------------------------------------- arguments
     def _rows(self, args) -> tuple[tuple[int, ...], int, list]:
@@ -149,12 +151,18 @@ class ShipBatch:
             path = module_file(source, [self.function], prefix="shipgnc_batch") \
                 if importable(self.function) else None
             if path is not None:
+                self.source_path = path
                 module = import_file(path)
                 self._compiled = (module.serial, module.parallel)
-            else:  # a kernel typed into a notebook: compiled in memory, once per process
+            else:  # a kernel typed into a notebook: compiled in memory, once per process, its
+                # source written to the cache all the same (to read, never imported)
+                body = source.replace("CACHE = True", "CACHE = False").split("# kernel\n")[1]
+                path = module_file(source.replace("# kernel\n", "# kernel (bound in memory)\n"),
+                                   [self.function], prefix="shipgnc_memory")
+                self.source_path = path
                 namespace = {"kernel": self.function}
-                exec(compile(source.replace("CACHE = True", "CACHE = False").split("# kernel\n")[1],
-                             "<shipgnc derived batch>", "exec"), namespace)
+                exec(compile("\n" * source.split("# kernel\n")[0].count("\n") + "\n" + body,
+                             str(path) if path else "<shipgnc derived batch>", "exec"), namespace)
                 self._compiled = (namespace["serial"], namespace["parallel"])
         return self._compiled
 

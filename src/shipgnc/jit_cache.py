@@ -4,9 +4,11 @@ numba caches a compiled function on disk only when it is defined in an importabl
 closure, not ``exec``-ed text). The code shipgnc generates — the composed loop of a combination of
 components (:mod:`shipgnc.sim.compose`) and the batch over ships derived from a component's scalar
 kernel (:mod:`shipgnc.derive`) — is therefore written as a small module into :func:`cache_dir`,
-named by a hash of its text and of the sources it calls, imported by name and compiled with numba's
-cache: a later process loads it in well under a second. The written module is plain Python: it is
-exactly what runs, and a user may read it.
+named by a hash of its text and of the sources it calls (:func:`source_files`: the package's
+modules it imports, and theirs, transitively — editing an unrelated module recompiles nothing),
+imported by name and compiled with numba's cache: a later process loads it in well under a second.
+The written module is plain Python: it is exactly what runs, and a user may read it; code compiled
+in memory (kernels defined in a notebook) is written there too, as ``shipgnc_memory_*.py``.
 """
 
 from __future__ import annotations
@@ -15,18 +17,20 @@ import hashlib
 import importlib
 import inspect
 import os
+import re
 import sys
 from pathlib import Path
 
 import numba
 
-#: the package's source folder: generated modules are keyed on every file in it
+#: the package's source folder: a generated module is keyed on the files of it that it imports
 PACKAGE = Path(__file__).resolve().parent
 #: a generated module of another release of the package (other sources or numba) unused this long
 #: is deleted with its compiled files when a new module is written [s]
 STALE_AFTER = 7 * 24 * 3600.0
 _PRUNED: list[bool] = []
-_DIGEST: list[bytes] = []
+#: each package file's imports, read once per process
+_FILE_IMPORTS: dict[Path, list[str]] = {}
 
 
 def cache_dir() -> Path:
@@ -49,17 +53,11 @@ def importable(fn) -> bool:
 
 def module_file(source: str, functions, *, prefix: str) -> Path | None:
     """The module file of ``source`` in :func:`cache_dir`, ``<prefix>_<release>_<hash>.py``, named
-    by a hash of it, of the package's sources (and of a user's kernel files among ``functions``)
-    and of the numba version (an edited kernel gets a new file); written once, atomically
-    (concurrent processes may race to write the same file). None if not writable."""
-    digest = hashlib.sha256(source.encode())
-    digest.update(sources_digest())
-    files = {inspect.getsourcefile(getattr(fn, "py_func", fn)) for fn in functions}
-    for name in sorted(f for f in files if f and not f.startswith(str(PACKAGE))):
-        digest.update(Path(name).read_bytes())  # a user's kernels outside the package
-    digest.update(numba.__version__.encode())
+    by :func:`module_key` (an edited kernel, or a helper it imports, gets a new file); written
+    once, atomically (concurrent processes may race to write the same file). None if not
+    writable."""
     release = release_tag()
-    path = cache_dir() / f"{prefix}_{release}_{digest.hexdigest()[:16]}.py"
+    path = cache_dir() / f"{prefix}_{release}_{module_key(source, functions)}.py"
     try:
         if not path.exists():
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -72,6 +70,84 @@ def module_file(source: str, functions, *, prefix: str) -> Path | None:
     return path
 
 
+def module_key(source: str, functions) -> str:
+    """16 hex digits naming a generated module: a hash of its text, of the package's files it
+    imports transitively (:func:`source_files`, with the modules that define ``functions``: the
+    kernels it calls), of a user's kernel files outside the package, and of numba's version."""
+    digest = hashlib.sha256(source.encode())
+    files = {inspect.getsourcefile(getattr(fn, "py_func", fn)) for fn in functions}
+    own = sorted(Path(f).resolve() for f in files if f and not _in_package(Path(f).resolve()))
+    modules = {getattr(getattr(fn, "py_func", fn), "__module__", "") for fn in functions}
+    for path in sorted(source_files(source, modules)) + own:
+        digest.update(str(path.relative_to(PACKAGE) if _in_package(path) else path).encode())
+        digest.update(path.read_bytes())
+    digest.update(numba.__version__.encode())
+    return digest.hexdigest()[:16]
+
+
+def source_files(source: str, modules=()) -> set[Path]:
+    """The package's source files that ``source`` imports (``import shipgnc.x``, ``from shipgnc.x
+    import y``, ``from shipgnc import x``), with the files of the package's ``modules`` named, and
+    everything those files import within the package, transitively: what a generated module's
+    compiled code may come from. (Not a package's ``__init__`` merely passed through on the way
+    to a submodule: importing it runs, but compiles nothing into the kernel.)"""
+    todo = [f for f in map(_module_path, [*_imports(source, ""), *modules]) if f is not None]
+    seen: set[Path] = set()
+    while todo:
+        path = todo.pop()
+        if path in seen:
+            continue
+        seen.add(path)
+        package = ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+        if path.name != "__init__.py":
+            package = package.rpartition(".")[0]
+        if path not in _FILE_IMPORTS:
+            _FILE_IMPORTS[path] = _imports(path.read_text(), package)
+        for name in _FILE_IMPORTS[path]:
+            found = _module_path(name)
+            if found is not None and found not in seen:
+                todo.append(found)
+    return seen
+
+
+_FROM = re.compile(r"^[ \t]*from[ \t]+([.\w]+)[ \t]+import[ \t]+(\([^)]*\)|[^\n]*)", re.M)
+_IMPORT = re.compile(r"^[ \t]*import[ \t]+([^\n]*)", re.M)
+
+
+def _imports(text: str, package: str) -> list[str]:
+    """Module names imported by ``text`` (a module of ``package``), absolute; each ``from m
+    import a`` also as ``m.a`` (a submodule, if it is one). Read by pattern, not parsed (a
+    line of a docstring that reads like an import only adds a file to the key)."""
+    names = []
+    for line in _IMPORT.findall(text):
+        names += [part.split()[0] for part in line.split("#")[0].split(",") if part.strip()]
+    for base, what in _FROM.findall(text):
+        if base.startswith("."):
+            level = len(base) - len(base.lstrip("."))
+            parts = package.split(".")
+            parent = ".".join(parts[:len(parts) - level + 1])
+            base = f"{parent}.{base.lstrip('.')}" if base.strip(".") else parent
+        names.append(base)
+        items = re.sub(r"#[^\n]*", "", what).strip("()")
+        names += [f"{base}.{item.split()[0]}" for item in items.split(",") if item.strip()]
+    return names
+
+
+def _module_path(name: str) -> Path | None:
+    """The file of the package's module ``name`` (None: not one of the package's modules)."""
+    if name != PACKAGE.name and not name.startswith(PACKAGE.name + "."):
+        return None
+    base = PACKAGE.parent.joinpath(*name.split("."))
+    for path in (base.with_suffix(".py"), base / "__init__.py"):
+        if path.is_file():
+            return path
+    return None
+
+
+def _in_package(path: Path) -> bool:
+    return path.is_relative_to(PACKAGE)
+
+
 def import_file(path: Path):
     """Import a module written by :func:`module_file` (its folder joins ``sys.path`` once)."""
     if str(path.parent) not in sys.path:
@@ -80,11 +156,11 @@ def import_file(path: Path):
 
 
 def release_tag() -> str:
-    """8 hex digits naming the package's sources and numba's version (a generated module's file
+    """8 hex digits naming the package's release and numba's version (a generated module's file
     name carries them, so that the modules of an older release are known)."""
-    digest = hashlib.sha256(sources_digest())
-    digest.update(numba.__version__.encode())
-    return digest.hexdigest()[:8]
+    from shipgnc import __version__
+
+    return hashlib.sha256(f"{__version__} {numba.__version__}".encode()).hexdigest()[:8]
 
 
 def prune_stale_loops(folder: Path, release: str, *, now: float | None = None) -> list[Path]:
@@ -118,16 +194,3 @@ def prune_stale_loops(folder: Path, release: str, *, now: float | None = None) -
         except OSError:  # another process pruned it first, or a read-only cache
             continue
     return deleted
-
-
-def sources_digest() -> bytes:
-    """A hash of every source file of the package (once per process): a kernel's helper may live
-    in another file than the kernel (``paths.track_leg`` in the Mariner's controllers), so any
-    edit of the package gives every generated module a new name."""
-    if not _DIGEST:
-        digest = hashlib.sha256()
-        for path in sorted(PACKAGE.rglob("*.py")):
-            digest.update(str(path.relative_to(PACKAGE)).encode())
-            digest.update(path.read_bytes())
-        _DIGEST.append(digest.digest())
-    return _DIGEST[0]

@@ -41,8 +41,10 @@ disturbance vector are filled once for every force disturbance.
 from __future__ import annotations
 
 import importlib
+import itertools
 import math
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -58,12 +60,49 @@ from shipgnc.jit_cache import (  # noqa: F401  (cache_dir, prune_stale_loops: pu
 from shipgnc.kernels import Kernel, NotCompiled, kernel_function
 
 _LOOPS: dict = {}
+_SOURCES: dict = {}
 #: an event that makes the loop skip a ship (:meth:`Composition.advance`: one not live)
 _SKIP = np.iinfo(np.int64).max
 #: the loop's body (read as source, never imported)
 TEMPLATE = Path(__file__).with_name("loop_template.py")
 #: the navigation step, written before the loop's body (it calls the model's kernel by name)
 NAV_TEMPLATE = Path(__file__).with_name("nav_template.py")
+
+
+class LoopSteps(NamedTuple):
+    """The steps of one call of the loop, ``k0 <= k < k1``: ``k_last`` the step logged whatever
+    ``every`` (the log's period in steps) that ends the run, ``hold`` the control period in steps,
+    ``dt`` the step [s], ``s_base`` the run's sample that the log's first sample holds."""
+
+    k0: int
+    k1: int
+    k_last: int
+    hold: int
+    every: int
+    dt: float
+    s_base: int
+
+
+class LoopParams(NamedTuple):
+    """Each component's parameter rows (one row for every ship, or one per ship; the actuator's
+    one flat row, :meth:`~shipgnc.actuators.Actuator.kernel_params`)."""
+
+    model: np.ndarray
+    actuator: np.ndarray
+    controller: np.ndarray
+    guidance: np.ndarray
+    disturbance: np.ndarray
+    current: np.ndarray
+    navigation: np.ndarray
+
+
+class LoopTables(NamedTuple):
+    """The per-step input tables (step of the call, ship, ·): a noise's draws, a current part's,
+    and the sensors' draws per control sample."""
+
+    disturbance: np.ndarray
+    current: np.ndarray
+    navigation: np.ndarray
 
 
 @kernel_function
@@ -106,20 +145,33 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
 def _generate(*key):
     """The combination's loop: from a module written to the disk cache and compiled with numba's
     cache (loaded in ≈ 0.1 s by later processes) when every kernel is importable by name; else
-    compiled in memory, once per process (a kernel defined in a script or a notebook)."""
+    compiled in memory, once per process (a kernel defined in a script or a notebook), its source
+    written to the cache all the same (``shipgnc_memory_*.py``: what runs, to read);
+    :func:`source_path` names the file (None when the cache is not writable)."""
     functions = key[:5]
     importable_by_name = all(importable(fn) for fn in functions)
     source = _source(*key, imports=importable_by_name)
     slot = key[24]  # an estimator's own kernel ("module:function"): its file keys the loop too
     hashed = (*functions, _resolve(slot)) if slot and ":" in slot else functions
-    path = module_file(source, hashed, prefix="shipgnc_loop") if importable_by_name else None
-    if path is not None:  # importable by name: numba's cache rebuilds the loop's module by name
-        return import_file(path).loop
+    if importable_by_name:  # numba's cache rebuilds the loop's module by name
+        path = module_file(source, hashed, prefix="shipgnc_loop")
+        if path is not None:
+            loop = import_file(path).loop
+            _SOURCES[loop] = path
+            return loop
     namespace = dict(zip(("model_fn", "ctrl_fn", "guid_fn", "dist_fn", "cur_fn"), functions,
                          strict=True))
-    exec(compile(source.replace("CACHE = True", "CACHE = False"), "<shipgnc composed loop>",
-                 "exec"), namespace)
+    source = source.replace("CACHE = True", "CACHE = False")
+    path = module_file(source, hashed, prefix="shipgnc_memory")  # to read, never imported
+    exec(compile(source, str(path) if path else "<shipgnc composed loop>", "exec"), namespace)
+    _SOURCES[namespace["loop"]] = path
     return namespace["loop"]
+
+
+def source_path(loop) -> Path | None:
+    """The file holding the source of a composed ``loop`` (:func:`loop_for`; also
+    :attr:`Composition.source_path`): exactly what runs."""
+    return _SOURCES.get(loop)
 
 
 def _resolve(target: str):
@@ -145,10 +197,8 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
             ("x", "x"), ("lag", "lag"), ("app", "applied"), ("cmd", "cmd"), ("ref", "ref"),
             ("out", "out"), ("sig", "sig"), ("d", "d"), ("done", "done"), ("zc", "zc"),
             ("zg", "zg"), ("zd", "zd"), ("zn", "zn"), ("nsg", "nsg"))},
-        # columns of the log (the order of simulator.log_signals)
-        "c_cmd": nx, "c_app": nx + nu, "c_ref": nx + 2 * nu, "c_err": nx + 2 * nu + nref,
-        "c_out": nx + 2 * nu + nref + nerr, "c_sig": nx + 2 * nu + nref + nerr + nout,
-        "c_nav": nx + 2 * nu + nref + nerr + nout + nsig,
+        **{f"c_{name}": col for name, col in log_columns(
+            nx, nu, nref, nerr, nout, nsig, nnsig).items()},
     }
     lines = ["# generated by shipgnc.sim.compose: the loop of one combination of components",
              "CACHE = True"]
@@ -157,6 +207,8 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
         py = getattr(fn, "py_func", fn)
         if imports:
             lines.append(f"from {py.__module__} import {py.__qualname__} as {alias}")
+        else:  # bound by the compiler's namespace (not importable by name)
+            lines.append(f"# {alias} = {py.__module__}.{py.__qualname__}")
     lines += [f"{name} = {value!r}" for name, value in constants.items()]
     slot = f"\nest_slot = {est_slot or 'no_estimator'}\n"
     if est_slot is not None and ":" in est_slot:  # an estimator's own kernel, by its module
@@ -251,7 +303,7 @@ class Composition:
         zn0 = kn.state_for(n) if kn else np.zeros((n, 0))
         nnsig = kn.n_signals if kn else 0
         continuous = bool(getattr(ctrl, "continuous", False))
-        self.loop = loop_for(
+        self.loop = loop = loop_for(
             km.function, kc.function if kc else _no_controller,
             kg.function if kg else _no_guidance, kd.function if kd else _no_disturbance,
             nx=nx, nu=nu, nd=nd, nref=len(refs), nout=nout, nsig=nsig, nerr=err.shape[0],
@@ -262,6 +314,8 @@ class Composition:
             cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None,
             est_slot=kn.estimator if kn else None, nzn=zn0.shape[1], nnsig=nnsig,
             ne=kn.n_filter if kn else 0)
+        #: the file holding the loop's generated source, exactly what runs (:func:`source_path`)
+        self.source_path = source_path(loop)
         lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd,
                          zc0.shape[1], zg0.shape[1], zd0.shape[1], zn0.shape[1], nnsig)
         self.layout = lay
@@ -282,11 +336,12 @@ class Composition:
         self.S = S
 
         self.signals = log_signals(setup)
-        n_columns = nx + 2 * nu + len(refs) + err.shape[0] + nout + nsig + nnsig
+        cols = log_columns(nx, nu, len(refs), err.shape[0], nout, nsig, nnsig)
+        n_columns = cols["end"]
         if n_columns != len(self.signals):  # the loop's column layout must match the numpy log
             raise RuntimeError(f"compiled loop: {n_columns} log columns for {list(self.signals)}")
         #: log columns of the state and of the applied input
-        self.columns = {"x": 0, "cmd": nx, "applied": nx + nu}
+        self.columns = {"x": cols["x"], "cmd": cols["cmd"], "applied": cols["app"]}
         self.out = np.empty((n_columns, log_length(setup) if log_samples is None else log_samples, n))
         #: the run's sample that ``out[:, 0]`` holds
         self.s_base = 0
@@ -321,11 +376,13 @@ class Composition:
         """Steps ``k0 <= k < k1`` of every ship without an event (``k_last``: the step logged
         whatever ``log_every`` that ends the run); :meth:`prepare` first."""
         setup, table, params = self.setup, self._table, self._params
-        self.loop(k0, k1, k_last, int(setup.hold), int(setup.log_every), float(setup.dt), self.S,
-                  table["W"], params[0], self._pa, params[1], params[2], params[3], self._limits,
-                  self._err, self.out, self.event,
-                  self.done_at if self.done_at is not None else self._no_done, table["Wu"],
-                  self._pu, table["Wn"], self._pn, self.s_base)
+        steps = LoopSteps(int(k0), int(k1), int(k_last), int(setup.hold), int(setup.log_every),
+                          float(setup.dt), int(self.s_base))
+        self.loop(steps, self.S, self.out, self.event,
+                  self.done_at if self.done_at is not None else self._no_done,
+                  LoopParams(params[0], self._pa, params[1], params[2], params[3], self._pu,
+                             self._pn),
+                  LoopTables(table["W"], table["Wu"], table["Wn"]), self._limits, self._err)
 
     def put_state(self, x: np.ndarray) -> None:
         """Each ship's plant state ``x`` (B, n) into its row (e.g. a member's drawn start)."""
@@ -400,20 +457,24 @@ def _param_rows(kernel: Kernel, n_ships: int) -> np.ndarray:
     return rows
 
 
+def offsets(widths: dict[str, int]) -> dict[str, int]:
+    """Where each named block starts when the blocks of ``widths`` follow each other in order."""
+    return dict(zip(widths, itertools.accumulate(widths.values(), initial=0), strict=False))
+
+
 def row_layout(nx, nl, nu, nref, nout, nsig, nd, nzc, nzg, nzd, nzn=0, nnsig=0) -> dict[str, int]:
     """Offsets of a ship's row of ``S``: state, lag, applied input, command, references, guidance
     outputs, controller signals, held disturbance, finished flag, the components' own states,
-    the navigation's state and its held logged signals."""
-    lay = {"x": 0, "lag": nx, "applied": nx + nl, "cmd": nx + nl + nu}
-    lay["ref"] = lay["cmd"] + nu
-    lay["out"] = lay["ref"] + nref
-    lay["sig"] = lay["out"] + nout
-    lay["d"] = lay["sig"] + nsig
-    lay["done"] = lay["d"] + nd
-    lay["zc"] = lay["done"] + 1
-    lay["zg"] = lay["zc"] + nzc
-    lay["zd"] = lay["zg"] + nzg
-    lay["zn"] = lay["zd"] + nzd
-    lay["nsg"] = lay["zn"] + nzn
-    lay["row"] = lay["nsg"] + nnsig
-    return lay
+    the navigation's state and its held logged signals; ``row``: the row's length."""
+    return offsets({"x": nx, "lag": nl, "applied": nu, "cmd": nu, "ref": nref, "out": nout,
+                    "sig": nsig, "d": nd, "done": 1, "zc": nzc, "zg": nzg, "zd": nzd, "zn": nzn,
+                    "nsg": nnsig, "row": 0})
+
+
+def log_columns(nx, nu, nref, nerr, nout, nsig, nnsig) -> dict[str, int]:
+    """First column of each block of the loop's log, in the order of
+    :func:`~shipgnc.sim.simulator.log_signals`: state, command, applied input, references,
+    tracking errors, guidance outputs, controller signals, navigation signals; ``end``: the
+    number of columns."""
+    return offsets({"x": nx, "cmd": nu, "app": nu, "ref": nref, "err": nerr, "out": nout,
+                    "sig": nsig, "nav": nnsig, "end": 0})

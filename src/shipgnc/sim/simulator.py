@@ -577,122 +577,172 @@ def reset_components(setup: SimSetup) -> None:
 
 
 def run_numpy(setup: SimSetup) -> Log:
-    """The reference loop in plain numpy (readable; batched over ships)."""
-    model, act, ctrl, gd = setup.model, setup.actuator, setup.controller, setup.guidance
-    nav = setup.navigation
-    batch = setup.batch_shape
-    dt = setup.dt
-    continuous = bool(getattr(ctrl, "continuous", False))
-    switching = getattr(ctrl, "switch_within_step", None)
+    """The reference loop in plain numpy (readable; batched over ships). Each step ``k``: at a
+    control sample the state seen, the references and the command (:meth:`_NumpyRun.sample`);
+    the actuator's plan of the step and the held disturbance
+    (:func:`~shipgnc.sim.transition.step_start`); the log (every ``log_every``-th step, the last
+    one, and the step where every ship has finished); the observer; the plant over the step
+    (:meth:`_NumpyRun.advance`)."""
     reset_components(setup)
-
-    signals = log_signals(setup)
-    n_log = setup.n_steps // setup.log_every + 2
-    data = {name: np.full((n_log, *batch), np.nan) for name in signals}
-    times = np.full(n_log, np.nan)
-    input_names = names(model.inputs)
-
-    x = setup.x0.copy()
-    command = np.broadcast_to(setup.u0, (*batch, act.n)).copy()
-    applied = act.initial(command)
-    lag = applied.copy() if act.has_lag else None
-    ref = np.zeros((*batch, 0))
-    extra: dict[str, np.ndarray] = {}
-    held_d = None
-    status: dict = {"diverged": 0, "stopped_early": 0, "message": ""}
-    n_logged = 0
-    progress_every = max(1, setup.n_steps // 100)
-    masking = setup.on_divergence == "mask"
-    alive = np.ones(batch, dtype=bool)
-    diverged_at = np.full(batch, np.nan)
-    first_error = None
-
-    t = 0.0
+    run = _NumpyRun.start(setup)
+    n_steps, progress_every = setup.n_steps, max(1, setup.n_steps // 100)
     try:
-        for k in range(setup.n_steps + 1):
-            t = k * dt
-            if k % setup.hold == 0:
-                # the state guidance and controller see: the truth, or navigation's estimate
-                seen = x if nav is None else nav.observe(t, x, applied)
-                if gd is not None:
-                    ref = gd.reference(t, seen)
-                    extra = dict(gd.output_values())
-                if nav is not None:
-                    extra.update(nav.signal_values())
-                if ctrl is not None:
-                    command = (ctrl.law(t, x, ref) if continuous else ctrl.step(t, seen, ref))
-                    command = np.asarray(command, dtype=float)
-                    act.check_command_shape(command)
-                    extra.update(ctrl.signal_values())
-                    if masking:  # a ship whose command is bad stops here, the others run on
-                        bad, error = newly_diverged(setup, t, alive, command=command)
-                        if bad is not None:
-                            first_error = first_error or error
-                            diverged_at[bad] = t
-                            alive &= ~bad
-                        command = np.where(alive[..., None], command, 0.0)
-                    error = None if masking else check_divergence(setup, t, command=command)
-                    if error is not None:
-                        if setup.on_divergence == "raise":
-                            raise error
-                        status.update(diverged=1, message=str(error))
-                        break
-            plan, applied_now, held_d = step_start(setup, t, x, lag, applied, command)
-            last = k == setup.n_steps
-            finished = finished_ships(ctrl, gd)
-            all_done = finished is not None and bool(np.all(finished | ~alive))
-            if k % setup.log_every == 0 or last or all_done:
-                times[n_logged] = t
-                for i, s in enumerate(model.states):
-                    data[s.name][n_logged] = x[..., i]
-                for i, name in enumerate(input_names):
-                    data[f"{name}_cmd"][n_logged] = command[..., i]
-                    data[name][n_logged] = applied_now[..., i]
-                if gd is not None:
-                    for i, s in enumerate(gd.references):
-                        data[s.name][n_logged] = ref[..., i]
-                for name, value in extra.items():
-                    data[name][n_logged] = value
-                if gd is not None:  # errors of the current state against the held reference
-                    for name, value in tracking_errors(setup, x, ref).items():
-                        data[name][n_logged] = value
-                n_logged += 1
-            if setup.observer is not None:
-                try:
-                    setup.observer(t, x, command, applied_now)
-                except StopSimulation as stop:
-                    status.update(stopped_early=1, message=str(stop) or "stopped by observer")
-                    break
-            if setup.progress is not None and (k % progress_every == 0 or last):
-                setup.progress(k, setup.n_steps)
-            if last or all_done:
+        for k in range(n_steps + 1):
+            t = k * setup.dt
+            if k % setup.hold == 0 and not run.sample(t):
                 break
-            x_before, lag_before = x, lag
-            x, lag, applied = step_end(setup, t, x, lag, plan, command, ref, held_d)
-            if switching is not None:
-                x = switch_within_step(setup, t, x_before, x, command, held_d)
-            if masking:  # a ship whose state is bad stops here; a stopped ship's state is held
-                bad, error = newly_diverged(setup, t + dt, alive, x=x)
-                if bad is not None:
-                    first_error = first_error or error
-                    diverged_at[bad] = t + dt
-                    alive &= ~bad
-                held = ~alive[..., None]
-                x = np.where(held, x_before, x)
-                lag = None if lag is None else np.where(held, lag_before, lag)
-                applied = act.input_at(plan, 1.0, lag)
-            error = None if masking else check_divergence(setup, t + dt, x)
-            if error is not None:
-                if setup.on_divergence == "raise":
-                    raise error
-                status.update(diverged=1, message=str(error))
+            plan, applied_now, held_d = step_start(setup, t, run.x, run.lag, run.applied,
+                                                   run.command)
+            last = k == n_steps
+            finished = finished_ships(setup.controller, setup.guidance)
+            all_done = finished is not None and bool(np.all(finished | ~run.alive))
+            if k % setup.log_every == 0 or last or all_done:
+                run.log(t, applied_now)
+            if setup.observer is not None and not run.observe(t, applied_now):
+                break
+            if setup.progress is not None and (k % progress_every == 0 or last):
+                setup.progress(k, n_steps)
+            if last or all_done or not run.advance(t, plan, held_d):
                 break
     except KeyboardInterrupt:  # Ctrl-C: keep the samples logged so far (see simulate)
-        last = float(times[n_logged - 1]) if n_logged else 0.0
-        status.update(stopped_early=1, interrupted=1, message=f"interrupted at t = {last:.6g} s")
-    log = Log(time=times[:n_logged], data={k: v[:n_logged] for k, v in data.items()},
-              signals=signals, status=status)
-    return mask_diverged(log, diverged_at, first_error, dt) if masking else log
+        run.interrupted()
+    return run.result()
+
+
+@dataclass
+class _NumpyRun:
+    """The numpy loop's carried state (:func:`run_numpy`): the plant state ``x``, command,
+    applied input, actuator ``lag``, references, the extra logged signals, which ships are
+    ``alive`` (``on_divergence="mask"``), and the log being written."""
+
+    setup: SimSetup
+    x: np.ndarray
+    command: np.ndarray
+    applied: np.ndarray
+    lag: np.ndarray | None
+    data: dict[str, np.ndarray]
+    times: np.ndarray
+    ref: np.ndarray
+    alive: np.ndarray
+    diverged_at: np.ndarray
+    extra: dict[str, np.ndarray] = field(default_factory=dict)
+    status: dict = field(default_factory=lambda: {"diverged": 0, "stopped_early": 0,
+                                                  "message": ""})
+    first_error: DivergenceError | None = None
+    n_logged: int = 0
+
+    @classmethod
+    def start(cls, setup: SimSetup) -> _NumpyRun:
+        batch, act = setup.batch_shape, setup.actuator
+        n_log = setup.n_steps // setup.log_every + 2
+        command = np.broadcast_to(setup.u0, (*batch, act.n)).copy()
+        applied = act.initial(command)
+        return cls(setup, x=setup.x0.copy(), command=command, applied=applied,
+                   lag=applied.copy() if act.has_lag else None,
+                   data={name: np.full((n_log, *batch), np.nan) for name in log_signals(setup)},
+                   times=np.full(n_log, np.nan), ref=np.zeros((*batch, 0)),
+                   alive=np.ones(batch, dtype=bool), diverged_at=np.full(batch, np.nan))
+
+    @property
+    def masking(self) -> bool:
+        return self.setup.on_divergence == "mask"
+
+    def sample(self, t: float) -> bool:
+        """A control sample: the state guidance and controller see (the truth, or navigation's
+        estimate), the references, the command; False when a bad command ends the run."""
+        setup = self.setup
+        nav, gd, ctrl = setup.navigation, setup.guidance, setup.controller
+        seen = self.x if nav is None else nav.observe(t, self.x, self.applied)
+        if gd is not None:
+            self.ref = gd.reference(t, seen)
+            self.extra = dict(gd.output_values())
+        if nav is not None:
+            self.extra.update(nav.signal_values())
+        if ctrl is None:
+            return True
+        continuous = bool(getattr(ctrl, "continuous", False))
+        command = ctrl.law(t, self.x, self.ref) if continuous else ctrl.step(t, seen, self.ref)
+        command = np.asarray(command, dtype=float)
+        setup.actuator.check_command_shape(command)
+        self.extra.update(ctrl.signal_values())
+        if self.masking:  # a ship whose command is bad stops here, the others run on
+            self._stop_ships(*newly_diverged(setup, t, self.alive, command=command), t)
+            command = np.where(self.alive[..., None], command, 0.0)
+        self.command = command
+        return self._go_on(None if self.masking else check_divergence(setup, t, command=command))
+
+    def log(self, t: float, applied_now: np.ndarray) -> None:
+        """The sample at ``t`` (the state, command, input applied at the step's start, references,
+        the extra signals, the tracking errors of the state against the held reference)."""
+        setup, data, n = self.setup, self.data, self.n_logged
+        self.times[n] = t
+        for i, s in enumerate(setup.model.states):
+            data[s.name][n] = self.x[..., i]
+        for i, name in enumerate(names(setup.model.inputs)):
+            data[f"{name}_cmd"][n] = self.command[..., i]
+            data[name][n] = applied_now[..., i]
+        if setup.guidance is not None:
+            for i, s in enumerate(setup.guidance.references):
+                data[s.name][n] = self.ref[..., i]
+        for name, value in self.extra.items():
+            data[name][n] = value
+        if setup.guidance is not None:
+            for name, value in tracking_errors(setup, self.x, self.ref).items():
+                data[name][n] = value
+        self.n_logged += 1
+
+    def observe(self, t: float, applied_now: np.ndarray) -> bool:
+        """The setup's observer; False when it stops the run."""
+        try:
+            self.setup.observer(t, self.x, self.command, applied_now)
+        except StopSimulation as stop:
+            self.status.update(stopped_early=1, message=str(stop) or "stopped by observer")
+            return False
+        return True
+
+    def advance(self, t: float, plan, held_d) -> bool:
+        """The plant over the step from ``t``; False when a bad state ends the run."""
+        setup = self.setup
+        x_before, lag_before = self.x, self.lag
+        x, lag, applied = step_end(setup, t, self.x, self.lag, plan, self.command, self.ref,
+                                   held_d)
+        if getattr(setup.controller, "switch_within_step", None) is not None:
+            x = switch_within_step(setup, t, x_before, x, self.command, held_d)
+        if self.masking:  # a ship whose state is bad stops here; a stopped ship's state is held
+            self._stop_ships(*newly_diverged(setup, t + setup.dt, self.alive, x=x), t + setup.dt)
+            held = ~self.alive[..., None]
+            x = np.where(held, x_before, x)
+            lag = None if lag is None else np.where(held, lag_before, lag)
+            applied = setup.actuator.input_at(plan, 1.0, lag)
+        self.x, self.lag, self.applied = x, lag, applied
+        return self._go_on(None if self.masking else check_divergence(setup, t + setup.dt, x))
+
+    def _stop_ships(self, bad, error, t: float) -> None:
+        if bad is not None:
+            self.first_error = self.first_error or error
+            self.diverged_at[bad] = t
+            self.alive &= ~bad
+
+    def _go_on(self, error) -> bool:
+        if error is None:
+            return True
+        if self.setup.on_divergence == "raise":
+            raise error
+        self.status.update(diverged=1, message=str(error))
+        return False
+
+    def interrupted(self) -> None:
+        last = float(self.times[self.n_logged - 1]) if self.n_logged else 0.0
+        self.status.update(stopped_early=1, interrupted=1,
+                           message=f"interrupted at t = {last:.6g} s")
+
+    def result(self) -> Log:
+        n = self.n_logged
+        log = Log(time=self.times[:n], data={k: v[:n] for k, v in self.data.items()},
+                  signals=log_signals(self.setup), status=self.status)
+        if not self.masking:
+            return log
+        return mask_diverged(log, self.diverged_at, self.first_error, self.setup.dt)
 
 
 def finished_ships(controller, guidance):
