@@ -24,7 +24,7 @@ def _by_hand(t, x, omega):
     return np.stack([c * x[..., 0] - s * x[..., 1], s * x[..., 0] + c * x[..., 1]], axis=-1)
 
 
-@pytest.mark.parametrize("n", [1, 7, PARALLEL_FROM + 3])
+@pytest.mark.parametrize("n", [1, 7, PARALLEL_FROM + 3])  # serial, serial, parallel
 def test_the_batch_is_the_kernel_on_every_ship_serial_parallel_and_plain_python(n):
     rng = np.random.default_rng(3)
     x = rng.normal(size=(n, 2))
