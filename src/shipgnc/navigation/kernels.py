@@ -10,7 +10,8 @@ through the model's kernel by name (a numba function passed as an argument would
 uncacheable); both then call the same kernels here.
 
 Every flat array is declared by name in a :class:`~shipgnc.navigation.layout.Layout` below; the
-kernels read fields through the offsets the layouts compute.
+kernels read fields through the offsets the layouts compute (module constants, and ``<LAYOUT>_SIZE``
+for a layout's fixed head: numba freezes module integers, not the layout objects).
 
 :meth:`shipgnc.navigation.Navigation.kernel` packs a navigation system into one parameter array
 (:data:`NAV` then one :data:`PLACE` per sensor, the sensors' blocks, the channels, the
@@ -80,10 +81,8 @@ PARAMS_AT, STATE_AT, DRAWS_AT, SIGNALS_AT = PLACE.at("params_at", "state_at", "d
 #: one measured state: its index in the model's state and where its sensor's state holds it
 CHANNEL = Layout("channel", ("state", 1), ("held_at", 1), ("valid_at", 1), ("fresh_at", 1),
                  ("variance", 1))
-CHANNEL_SIZE = CHANNEL.size
 #: the navigation system's per-ship state head, then the sensors' states and the estimator's
 NAV_STATE = Layout("navigation state", ("first", 1), tail="the sensors' states, the estimator's")
-NAV_STATE_SIZE = NAV_STATE.size
 FIRST, = NAV_STATE.at("first")
 
 #: a sensor's parameters (:meth:`Sensor.kernel_params`)
@@ -221,7 +220,6 @@ OBSERVER = Layout("passive observer", ("velocity_model", 1), ("substeps", 1), ("
                   ("eta_index", 3), ("nu_index", 3), ("held_at", 3), ("valid_at", 3),
                   ("minus_w0_sq", 3), ("two_zeta_w0", 3), ("K1a", 3), ("K1b", 3), ("K2", 3),
                   ("T_b", 3), ("K3", 9), ("K4", 9), ("D", 9), ("Minv", 9), ("M", 9))
-OBSERVER_SIZE = OBSERVER.size
 (OB_MODEL, OB_SUBSTEPS, OB_TS, OB_ETA, OB_NU, OB_HELD, OB_VALID, OB_W0SQ, OB_2ZW0, OB_K1A,
  OB_K1B, OB_K2, OB_TB, OB_K3, OB_K4, OB_D, OB_MINV, OB_M) = OBSERVER.at(
     "velocity_model", "substeps", "Ts", "eta_index", "nu_index", "held_at", "valid_at",
@@ -320,7 +318,6 @@ def observer_outputs(z, p, seen, sig):
 
 #: a Gaussian filter's state after ẑ (n) and P (n × n, row-major)
 FILTER_TAIL = Layout("Gaussian filter state after ẑ, P", ("nis", 1), ("nis_dim", 1))
-FILTER_TAIL_SIZE = FILTER_TAIL.size
 F_NIS, F_NIS_DIM = FILTER_TAIL.at("nis", "nis_dim")
 #: a Gaussian filter's map of its states to the model's (:meth:`GaussianFilter.kernel_map`)
 MAP = Layout("filter map", ("n", 1), ("n_mapped", 1), tail="MAP_ENTRY × n_mapped")
