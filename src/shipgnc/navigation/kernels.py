@@ -230,6 +230,10 @@ OBSERVER_STATE = Layout("passive observer state", ("xi1", 3), ("xi2", 3), ("eta"
 OBSERVER_STATE_SIZE = OBSERVER_STATE.size
 XI1, XI2, ETA, BIAS, NU, TAU = OBSERVER_STATE.at("xi1", "xi2", "eta", "b", "nu", "tau")
 OBS_S = TAU
+#: the observer's logged signals (:meth:`PassiveObserver.signals`, in this order)
+OBSERVER_SIGNALS = Layout("passive observer signals", ("eta_hat", 3), ("nu_hat", 3),
+                          ("w_hat", 3), ("b_hat", 3))
+OS_ETA, OS_NU, OS_WAVE, OS_BIAS = OBSERVER_SIGNALS.at("eta_hat", "nu_hat", "w_hat", "b_hat")
 
 
 @kernel_function
@@ -306,10 +310,10 @@ def observer_outputs(z, p, seen, sig):
     for q in range(3):
         seen[int(p[OB_ETA + q])] = z[ETA + q]
         seen[int(p[OB_NU + q])] = z[NU + q]
-        sig[q] = z[ETA + q]
-        sig[3 + q] = z[NU + q]
-        sig[6 + q] = z[XI2 + q]
-        sig[9 + q] = z[BIAS + q]
+        sig[OS_ETA + q] = z[ETA + q]
+        sig[OS_NU + q] = z[NU + q]
+        sig[OS_WAVE + q] = z[XI2 + q]
+        sig[OS_BIAS + q] = z[BIAS + q]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -319,6 +323,10 @@ def observer_outputs(z, p, seen, sig):
 #: a Gaussian filter's state after ẑ (n) and P (n × n, row-major)
 FILTER_TAIL = Layout("Gaussian filter state after ẑ, P", ("nis", 1), ("nis_dim", 1))
 F_NIS, F_NIS_DIM = FILTER_TAIL.at("nis", "nis_dim")
+#: a Gaussian filter's logged signals after <s>_hat × n and <s>_std × n (GaussianFilter.signals)
+FILTER_SIGNALS = Layout("Gaussian filter signals after the estimates and their std",
+                        ("nees", 1), ("nis", 1), ("nis_dim", 1))
+FS_NEES, FS_NIS, FS_NIS_DIM = FILTER_SIGNALS.at("nees", "nis", "nis_dim")
 #: a Gaussian filter's map of its states to the model's (:meth:`GaussianFilter.kernel_map`)
 MAP = Layout("filter map", ("n", 1), ("n_mapped", 1), tail="MAP_ENTRY × n_mapped")
 MAP_SIZE = MAP.size
@@ -486,9 +494,10 @@ def gaussian_outputs(x, z, pmap, seen, sig, work):
     for i in range(n):
         sig[i] = z[i]
         sig[n + i] = math.sqrt(max(z[n + i * n + i], 0.0))
-    sig[2 * n] = filter_nees(x, z, pmap, work)
-    sig[2 * n + 1] = z[n + n * n + F_NIS]
-    sig[2 * n + 2] = z[n + n * n + F_NIS_DIM]
+    tail = 2 * n                     # after <s>_hat × n, <s>_std × n
+    sig[tail + FS_NEES] = filter_nees(x, z, pmap, work)
+    sig[tail + FS_NIS] = z[n + n * n + F_NIS]
+    sig[tail + FS_NIS_DIM] = z[n + n * n + F_NIS_DIM]
 
 
 #: the linear Kalman filter's parameters (:meth:`KalmanFilter.kernel_block`)
