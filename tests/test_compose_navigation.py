@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from shipgnc import navigation as nav
+from shipgnc.navigation import kernels as nk
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.runner import build
 from shipgnc.sim import compose
@@ -154,8 +155,9 @@ def test_navigation_kernel_reads_the_numpy_state(kind):
     n.reset((), np.random.default_rng(1), s.model, 0.05)
     k = n.kernel((), dt=0.05, x0=s.x0)
     z = k.state_for(1)[0]
-    gnss_block = 1                               # after the first-sample flag
-    assert np.allclose(z[gnss_block + 6:gnss_block + 8], n.sensors[0].bias)
-    ez = int(k.params[5])
-    assert z[ez + (6 if kind == "observer" else 0)] == pytest.approx(
+    gnss = int(k.params[nk.NAV.size + nk.STATE_AT])       # the first sensor's state
+    bias = gnss + nk.SENSOR_STATE.size + 2                # after its two held values
+    assert np.allclose(z[bias:bias + 2], n.sensors[0].bias)
+    ez = int(k.params[nk.ESTIMATOR_STATE_AT])
+    assert z[ez + (nk.ETA if kind == "observer" else 0)] == pytest.approx(
         s.x0[0] + (0.0 if kind == "observer" else 3.0))

@@ -3,7 +3,8 @@
 The checks that can fail: the Kalman filter's steady-state gain is python-control's
 ``dlqe``; an EKF started 50 m and 30° wrong converges; the EKF's NEES over a batched Monte Carlo
 lies in its 95 % χ² band; dead reckoning through a GNSS dropout; the passive observer removes the
-wave-frequency heading; perfect sensors give the true-state run; seeds; bad configurations.
+wave-frequency heading; perfect sensors give the true-state run; seeds; bad configurations; the
+numpy loop's navigation (the batch of the kernels) equals the kernels' plain-Python forms.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import pytest
 from scipy import signal, stats
 
 from shipgnc.control.heading_speed import HeadingSpeedAutopilot
+from shipgnc.derive import plain_python
 from shipgnc.environment.disturbance import GaussianForceNoise
 from shipgnc.errors import ConfigError
 from shipgnc.guidance.los import LOSGuidance
@@ -317,3 +319,34 @@ def test_estimator_needing_an_unmeasured_state_is_refused():
     with pytest.raises(ConfigError, match=r"estimator kf needs a sensor measuring r"):
         simulate(NomotoModel(K=0.1, T=5.0, U=5.0), np.zeros(4), t_end=1.0, dt=0.1,
                  navigation=Navigation([Compass()], kf), backend="numpy")
+
+
+# ---- one source: the batch of the kernels against their plain-Python forms --------------------
+@pytest.mark.parametrize("estimator", ["ekf", "observer", "kf"])
+def test_navigation_kernels_batch_equals_their_plain_python(estimator):
+    """The numpy loop's sensors and estimators are the batch of the kernels of
+    :mod:`shipgnc.navigation.kernels` (:func:`shipgnc.derive.per_ship`); run as the kernels'
+    plain-Python ``py_func`` (:func:`shipgnc.derive.plain_python`) the same run gives the same
+    numbers up to the compiled form's fused multiply-adds (1e-9 relative, 1e-12 absolute), with
+    every sensor error (GNSS Gauss–Markov bias, latency, dropout; gyro bias walk) and the EKF's
+    delayed update."""
+
+    def make():
+        sensors = [GNSS(1.0, bias_std=0.5, bias_time_constant=60.0, rate_hz=2.0, latency=2,
+                        dropouts=[(1.0, 1.6)]),
+                   Compass(math.radians(0.5), bias=0.01), RateGyro(math.radians(0.1),
+                                                                   bias_walk=1e-4)]
+        if estimator == "kf":
+            return Navigation(sensors[1:], heading_wave_kf(-0.5, 2.0, 1.0, gyro=True,
+                                                           rudder="alpha"))
+        est = (ExtendedKalmanFilter(x0_offset={"north": 3.0}) if estimator == "ekf"
+               else PassiveObserver(1.0, velocity_model="model"))
+        return Navigation(sensors, est)
+
+    compiled = _los_run(make(), n=2, t_end=2.0)
+    with plain_python():
+        plain = _los_run(make(), n=2, t_end=2.0)
+    for var in compiled.data_vars:
+        np.testing.assert_allclose(plain[var].values, compiled[var].values, rtol=1e-9,
+                                   atol=1e-12, err_msg=var)
+    assert float(np.nanmax(compiled["compass_valid"].values)) == 1.0

@@ -73,12 +73,28 @@ def test_mariner_jacobian_equals_central_differences():
     np.testing.assert_allclose(got, central_differences(ship, x, u, None), rtol=1e-6, atol=1e-8)
 
 
-@pytest.mark.parametrize("model,jacobian", [(VectoredThrustBoat.from_preset("otter"),
-                                              boat_current_rhs_jacobian),
-                                             (MarinerWitOppe(), mariner_rhs_jacobian)])
-def test_the_composed_loop_finds_each_models_jacobian_kernel(model, jacobian):
-    """The EKF of the composed loop linearises with the kernel ``state_jacobian`` is the batch of."""
-    assert jacobian_kernel(model.kernel().function) is jacobian
+@pytest.mark.parametrize("which", ["boat", "boat-current", "mariner"])
+def test_the_loop_finds_each_jacobian_kernel_and_it_equals_central_differences(which):
+    """The composed loop's EKF finds the model kernel's ``<name>_jacobian`` beside it, and that
+    kernel, called for one ship as the loop calls it, is ∂f/∂x by central differences."""
+    rng = np.random.default_rng(3)
+    if which == "mariner":
+        model, (x, u), nd = MarinerWitOppe(), mariner_states(rng, 8), 3
+    else:
+        model, (x, u) = VectoredThrustBoat.from_preset("otter"), boat_states(rng, 8)
+        nd = 5 if which == "boat-current" else 3
+    d = np.zeros((x.shape[0], nd))
+    if nd == 5:
+        d[:, 3:5] = (-0.2, 0.5)
+    kernel = model.kernel()
+    jac = jacobian_kernel(kernel.function)
+    assert jac is (mariner_rhs_jacobian if which == "mariner" else boat_current_rhs_jacobian)
+    n = x.shape[1]
+    want = central_differences(model, x, u, d if nd == 5 else None)
+    for i in range(x.shape[0]):
+        A = np.empty(n * n)
+        jac(x[i], u[i], d[i], kernel.params, A)
+        np.testing.assert_allclose(A.reshape(n, n), want[i], rtol=1e-6, atol=1e-8)
 
 
 def test_models_without_an_analytic_jacobian_fall_back_to_central_differences():

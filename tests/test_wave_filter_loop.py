@@ -62,15 +62,14 @@ def test_gains_that_break_the_structure_or_the_rule_are_refused():
 
 # ---- the wave filter against its closed form ---------------------------------------------------
 def _implementation_jacobian(obs):
-    """(A, B_ψ) of the implementation's own right-hand side (``PassiveObserver._rhs``, the code
-    that runs) by central differences about rest, input the measured heading."""
-    obs._tau = np.zeros(3)
+    """(A, B_ψ) of the implementation's own right-hand side (the kernel ``observer_rhs``, the
+    code that runs, through ``PassiveObserver._rate``) by central differences about rest, input
+    the measured heading."""
 
     def f(z, y):
-        s = tuple(z[3 * k: 3 * k + 3] for k in range(5))
-        out = obs._rhs(s, y, np.ones(3, dtype=bool), math.cos(y[2]), math.sin(y[2]),
-                       np.array([0.0, 0.0]))
-        return np.concatenate(out)
+        rot = np.array([[math.cos(y[2]), math.sin(y[2])]])
+        return obs._rate(z[None, :], y[None, :], np.ones((1, 3)), rot, np.zeros((1, 2)),
+                         np.zeros((1, 3)))[0]
 
     h = 1e-7
     z0, y0 = np.zeros(15), np.zeros(3)

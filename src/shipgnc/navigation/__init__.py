@@ -29,13 +29,15 @@ The interface the simulation loop calls (:func:`shipgnc.sim.simulator.simulate`,
 
 No navigation (``navigation=None``) is today's loop unchanged: the controller reads the truth.
 
-Both loops run navigation: :meth:`Navigation.kernel` hands the sensors and the estimator (passive
-observer, EKF, KF) to the composed compiled loop (:mod:`shipgnc.navigation.kernels`,
-:mod:`shipgnc.sim.nav_template`) with the sensors' draws taken from the same child streams, so a
-seed gives the same run in both. Sensors and estimators are slots of that loop: the sensor
-kernel computes every sensor whose errors are its model (``Sensor.kernel_errors``), an
-estimator's ``kernel_block`` names its slot's function; a sensor or an estimator without them
-runs in the numpy loop (``unsupported_reason`` names it).
+Both loops run navigation, and its arithmetic is written once: each sensor's and estimator's
+per-ship step is a scalar kernel of :mod:`shipgnc.navigation.kernels`, whose batch over ships
+(:func:`shipgnc.derive.per_ship`) the numpy classes call, and which the composed compiled loop
+calls ship by ship (:mod:`shipgnc.sim.nav_template`; :meth:`Navigation.kernel` packs the blocks,
+declared by named fields in :mod:`shipgnc.navigation.layout`), with the sensors' draws taken from
+the same child streams, so a seed gives the same run in both. Sensors and estimators are slots
+of that loop: the sensor kernel computes every sensor whose errors are its model
+(``Sensor.kernel_errors``), an estimator's ``kernel_block`` names its slot's function; a sensor or
+an estimator without them runs in the numpy loop (``unsupported_reason`` names it).
 
 Each sensor and estimator module declares its registry record beside its class
 (:mod:`shipgnc.navigation.records`; e.g. :data:`~shipgnc.navigation.sensors.GNSS_SENSOR`), which

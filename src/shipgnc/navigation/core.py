@@ -182,29 +182,33 @@ class Navigation:
         batch = tuple(batch_shape)
         n = int(np.prod(batch, dtype=np.int64))
         hold = max(1, round(self.Ts / dt))
-        ns = len(self.sensors)
-        header = [float(ns), 0.0, 0.0, 0.0, 0.0, 0.0, -1.0] + [0.0] * ns
-        params: list[float] = list(header)
-        z_rows = [np.ones((n, 1))]              # z[0]: the first sample is still to come
-        z_at, w_at, sig_at = 1, 0, 0
+        head = [0.0] * (nk.NAV.size + nk.PLACE.size * len(self.sensors))
+        params: list[float] = list(head)
+        z_rows = [np.ones((n, nk.NAV_STATE.size))]   # "first": the first sample is still to come
+        z_at, w_at, sig_at = nk.NAV_STATE.size, 0, 0
         channels = {}                           # state name -> (held, valid, fresh) z offsets
         for s_i, sensor in enumerate(self.sensors):
             k = len(sensor.measures)
-            params[nk.HEADER + s_i] = float(len(params))
-            params += [*sensor.kernel_params(), float(z_at), float(w_at), float(sig_at)]
-            params += sensor.kernel_tail()
+            place = nk.NAV.size + nk.PLACE.size * s_i
+            params[place:place + nk.PLACE.size] = nk.PLACE.pack(
+                params_at=len(params), state_at=z_at, draws_at=w_at, signals_at=sig_at)
+            params += sensor.kernel_params()
             zs = sensor.kernel_state(n)
             for c, name in enumerate(sensor.measures):
-                channels[name] = (z_at + c, z_at + k, z_at + k + 1)
+                channels[name] = (z_at + nk.SENSOR_STATE.size + c, z_at + nk.Z_VALID,
+                                  z_at + nk.Z_FRESH)
             z_rows.append(zs)
             z_at += zs.shape[1]
             w_at += 2 * k
             sig_at += k + 1
-        params[1] = float(len(channels))
-        params[2] = float(len(params))
+        params[nk.N_SENSORS] = float(len(self.sensors))
+        params[nk.N_CHANNELS] = float(len(channels))
+        params[nk.CHANNELS_AT] = float(len(params))
         for name, (held, valid, fresh) in channels.items():
-            params += [float(self.state_names.index(name)), float(held), float(valid),
-                       float(fresh), float(self.measured[name])]
+            params += nk.CHANNEL.pack(state=self.state_names.index(name), held_at=held,
+                                      valid_at=valid, fresh_at=fresh,
+                                      variance=self.measured[name])
+        params[nk.MAP_AT] = -1.0
         slot = "no_estimator"
         if self.estimator is not None:
             x_start = np.broadcast_to(np.asarray(x0, dtype=float),
@@ -212,13 +216,13 @@ class Navigation:
             # the estimator starts at the first control sample from the true initial state
             self.estimator.start(x_start, self._est_rng)
             slot, block, z_est, gmap = self.estimator.kernel_block(channels, n)
-            params[3] = float(len(params))
+            params[nk.ESTIMATOR_AT] = float(len(params))
             params += [float(v) for v in block]
-            params[4] = float(sig_at)
-            params[5] = float(z_at)
+            params[nk.ESTIMATOR_SIGNALS_AT] = float(sig_at)
+            params[nk.ESTIMATOR_STATE_AT] = float(z_at)
             z_rows.append(np.asarray(z_est, dtype=float).reshape(n, -1))
             if gmap is not None:
-                params[6] = float(len(params))
+                params[nk.MAP_AT] = float(len(params))
                 params += [float(v) for v in gmap]
         state = np.ascontiguousarray(np.concatenate(z_rows, axis=1))
         sensors, n_w = self.sensors, w_at

@@ -53,8 +53,8 @@ Larsen's M* = Π F (I − K c)) and every correction (g ← g − K c g). When y
 covariance of the error. Several pending samples (north and east of one fix, or a latency longer
 than the sample period) are correlated: Cov(ν_a, ν_b) = c_b g_a when b is taken, and applying a
 carries g_b ← g_b − g_a Cov(ν_a, ν_b)/S_a. The composed loop keeps the pending samples in fixed
-slots of the filter's state (:meth:`ExtendedKalmanFilter.kernel_state`; ``ekf_delayed`` of
-:mod:`shipgnc.sim.nav_template`).
+slots of the filter's state (:func:`shipgnc.navigation.kernels.ekf_delayed`, in the numpy loop
+and the composed loop alike).
 
 NIS: the sum over the scalar updates of one sample of ν²/S (sequential scalar updates of
 independent measurements: the joint νᵀS⁻¹ν), with ``nis_dim`` the number of rows.
@@ -69,7 +69,6 @@ from pydantic import Field
 
 from shipgnc.config_types import Finite, NonNegative, Positive, Strict
 from shipgnc.errors import require
-from shipgnc.frames import wrap_angle
 from shipgnc.models.base import names
 from shipgnc.navigation.estimator import GaussianFilter, as_std_vector
 from shipgnc.navigation.records import EstimatorKind
@@ -187,6 +186,7 @@ class ExtendedKalmanFilter(GaussianFilter):
             lat = sensor.latency if (sensor is not None and self.sensor_errors) else 0
             every = sensor.every if sensor is not None else 1
             self.rows.append((c, s, self.measurement_variance(s, var), s == "psi", lat, every))
+        self._params = np.asarray(self._block(), dtype=float)
 
     def use_sensors(self, sensors) -> None:
         """The sensors that feed the filter (:meth:`Navigation.reset`, before :meth:`prepare`):
@@ -244,58 +244,54 @@ class ExtendedKalmanFilter(GaussianFilter):
             at += k
         return out
 
-    def kernel_state(self, n_ships: int) -> np.ndarray:
-        """Rows ``[ẑ, P, NIS, NIS dimension, sample count, pending slots]``: a slot (a delayed
-        sample not yet arrived) ``[active, taken at, h, S, g × n, Cov(ν, ν_other) × slots]``
-        (:meth:`_delayed`)."""
-        n = len(self.state_names)
-        total = sum(k for _at, k in self._slots())
-        return np.concatenate([super().kernel_state(n_ships),
-                               np.zeros((n_ships, 1 + total * (4 + n + total)))], axis=1)
+    def _state_size(self) -> int:
+        """[ẑ, P, NIS, NIS dimension, sample count, pending slots]: a slot (a delayed sample not
+        yet arrived) ``[active, taken at, h, S, g × n, Cov(ν, ν_other) × slots]``
+        (:data:`~shipgnc.navigation.kernels.SLOT`)."""
+        from shipgnc.navigation.kernels import ekf_state_size
 
-    def kernel_block(self, channels, n_ships: int):
-        """(kind, parameters, per-ship state, map) for the composed loop after :meth:`start`:
-        ``[substeps, Ts, held, n_rows, n_aug, n_slots, (state, held offset, fresh offset, R,
-        angle, bias state or −1, latency, period, first slot, slots) × n_rows, Q_c diagonal,
-        (driven state or −1, λ) × n_aug]``; the model's derivatives are its kernel in the
-        loop."""
+        return ekf_state_size(len(self.state_names), sum(k for _at, k in self._slots()))
+
+    def _block(self, channels=None) -> list[float]:
+        """The filter's parameters (:data:`~shipgnc.navigation.kernels.EKF`); ``channels``: where
+        the composed loop's sensors hold each measured state (None: the numpy loop's rows)."""
+        from shipgnc.navigation.kernels import AUGMENTED, EKF, EKF_ROW
 
         slots = self._slots()
-        block = [float(self.substeps), self.Ts, float(self.noise == "held"), float(len(self.rows)),
-                 float(self.n_aug), float(sum(k for _at, k in slots))]
+        block = EKF.pack(n=self.nx + self.n_aug, nx=self.nx, substeps=self.substeps, Ts=self.Ts,
+                         held=self.noise == "held", n_rows=len(self.rows), n_aug=self.n_aug,
+                         n_slots=sum(k for _at, k in slots))
         for (c, s, var, angle, lat, every), (at, k) in zip(self.rows, slots, strict=True):
-            j = int(np.flatnonzero(c)[0])
-            jb = int(np.flatnonzero(c)[1]) if np.count_nonzero(c) > 1 else -1
-            block += [float(j), float(channels[s][0]), float(channels[s][2]), float(var),
-                      float(angle), float(jb), float(lat), float(every), float(at), float(k)]
+            hit = np.flatnonzero(c)
+            held, _valid, fresh = channels[s] if channels is not None else (-1, -1, -1)
+            block += EKF_ROW.pack(state=hit[0], bias_state=hit[1] if hit.size > 1 else -1,
+                                  held_at=held, fresh_at=fresh, R=var, angle=angle, latency=lat,
+                                  every=every, first_slot=at, slots=k)
         block += [float(v) for v in np.diagonal(self.Qc)]
         for a in range(self.n_aug):  # augmented states: the model state driven, decay rate
             hit = np.flatnonzero(self.Daug[a])
-            block += [float(hit[0]) if hit.size else -1.0, float(self.lam[a])]
-        return "ekf_slot", block, self.kernel_state(n_ships), self.kernel_map()
+            block += AUGMENTED.pack(driven=hit[0] if hit.size else -1, decay=self.lam[a])
+        return block
+
+    def kernel_block(self, channels, n_ships: int):
+        """(slot, parameters, per-ship state, map) for the composed loop after :meth:`start`
+        (:func:`shipgnc.navigation.kernels.ekf_update`; the model's derivatives are its kernel in
+        the loop)."""
+        return "ekf_slot", self._block(channels), self.kernel_state(n_ships), self.kernel_map()
 
     def _f(self, x, u):
         return self.model.derivatives(x, u, None)
 
     def _f_aug(self, z, u):
-        """The augmented state's derivative: [f(x, u) + D d, −λ b] (module docstring)."""
-        if not self.n_aug:
-            return self._f(z, u)
-        nx = self.nx
-        b = z[..., nx:]
-        fx = self._f(z[..., :nx], u) + b @ self.Daug
-        return np.concatenate([fx, -b * self.lam], axis=-1)
+        """The augmented state's derivative: the model's, then the batch of
+        :func:`~shipgnc.navigation.kernels.ekf_rates` (module docstring)."""
+        from shipgnc.derive import per_ship
+        from shipgnc.navigation.kernels import ekf_rates
 
-    def jacobian_aug(self, z, u) -> np.ndarray:
-        """∂f/∂z of the augmented state: [[A, Dᵀ], [0, −diag λ]]."""
+        fx = self._f(z[..., :self.nx], u)
         if not self.n_aug:
-            return self.jacobian(z, u)
-        nx, n = self.nx, self.nx + self.n_aug
-        A = np.zeros((*z.shape[:-1], n, n))
-        A[..., :nx, :nx] = self.jacobian(z[..., :nx], u)
-        A[..., :nx, nx:] = self.Daug.T
-        A[..., nx:, nx:] = np.diag(-self.lam)
-        return A
+            return fx
+        return per_ship(ekf_rates, "i i p o")(z, fx, self._params, self.nx + self.n_aug)
 
     def jacobian(self, x, u) -> np.ndarray:
         """A = ∂f/∂x at (x, u): the model's analytic ``state_jacobian(x, u, d)`` when it has one
@@ -319,6 +315,7 @@ class ExtendedKalmanFilter(GaussianFilter):
         return np.swapaxes(diff, -1, -2)
 
     def propagate(self, x, u) -> np.ndarray:
+        """x̂⁻ = Φ(x̂, u): RK4 on the augmented model, ``substeps`` per Ts."""
         h = self.Ts / self.substeps
         for _ in range(self.substeps):
             k1 = self._f_aug(x, u)
@@ -329,82 +326,25 @@ class ExtendedKalmanFilter(GaussianFilter):
         return x
 
     def update(self, t, u, meas, first) -> None:
-        self.begin_sample()
-        if first:
-            self._k = 0
-            self._pending = []
-        else:
-            self._k += 1
-            with np.errstate(all="ignore"):
-                A = self.jacobian_aug(self.z, u)
-                At = A * self.Ts
-                n = At.shape[-1]
-                F = np.eye(n) + At
-                term = At
-                for k in (2, 3, 4):
-                    term = term @ At / k
-                    F = F + term
-                Qc, Ts = self.Qc, self.Ts
-                if self.noise == "held":  # Γ (Q_c/Ts) Γᵀ, Γ = ∫₀^Ts e^{As} ds
-                    G = Ts * (np.eye(n) + At / 2 + At @ At / 6)
-                    Qd = G @ Qc @ np.swapaxes(G, -1, -2) / Ts
-                else:
-                    AQ = A @ Qc
-                    Qd = Qc * Ts + (AQ + np.swapaxes(AQ, -1, -2)) * Ts**2 / 2 + \
-                        AQ @ np.swapaxes(A, -1, -2) * Ts**3 / 3
-                self.z = self.propagate(self.z, u)
-                self.P = F @ self.P @ np.swapaxes(F, -1, -2) + Qd
-                self.P = 0.5 * (self.P + np.swapaxes(self.P, -1, -2))
-                for entry in self._pending:          # Larsen's M*: g ← F g
-                    entry["g"] = (F @ entry["g"][..., None])[..., 0]
-        carried = [entry["g"] for entry in self._pending]
-        for c, s, var, angle, lat, _every in self.rows:
-            if lat == 0:
-                gs = self.correct_row(c, meas[s][0], var, meas[s][1], angle, carried)
-                for entry, g in zip(self._pending, gs, strict=True):
-                    entry["g"] = g
-                carried = gs
-        if any(row[4] > 0 for row in self.rows):
-            self._delayed(meas)
+        """Predict (unless ``first``: the model's Jacobian and RK4 here, through the model's
+        batch), then the batch of :func:`~shipgnc.navigation.kernels.ekf_update` (covariance
+        prediction, corrections, delayed samples)."""
+        from shipgnc.derive import per_ship
+        from shipgnc.navigation.kernels import ekf_update, ekf_work_size
 
-    def _delayed(self, meas) -> None:
-        """Larsen et al. (1998): apply the delayed samples delivered now, then record the ones
-        the delayed sensors take now (module docstring)."""
-        k = self._k
-        for _c, s, _var, angle, lat, _every in self.rows:
-            if lat == 0:
-                continue
-            for entry in [e for e in self._pending if e["row"] == s and e["k"] <= k - lat]:
-                self._pending.remove(entry)
-                fresh = meas[s][1] if entry["k"] == k - lat else np.zeros_like(meas[s][1])
-                ok = fresh & (entry["S"] > 0)
-                if not np.any(ok):
-                    continue
-                S = np.where(ok, entry["S"], 1.0)
-                innov = meas[s][0] - entry["h"]
-                if angle:
-                    innov = wrap_angle(innov)
-                innov = np.where(ok, innov, 0.0)
-                g = np.where(ok[..., None], entry["g"], 0.0)
-                self.nis = self.nis + innov * innov / S
-                self.nis_dim = self.nis_dim + ok
-                self.z = self.z + g * (innov / S)[..., None]
-                P_new = self.P - g[..., :, None] * g[..., None, :] / S[..., None, None]
-                self.P = 0.5 * (P_new + np.swapaxes(P_new, -1, -2))
-                for other in self._pending:
-                    rho = other["rho"].get(entry["id"])
-                    if rho is not None:
-                        other["g"] = other["g"] - g * (rho / S)[..., None]
-        for c, s, var, _angle, lat, every in self.rows:
-            if lat == 0 or k % every != 0:
-                continue
-            Pc = self.P @ c
-            entry = {"id": (s, k), "row": s, "k": k, "h": self.z @ c, "S": Pc @ c + var,
-                     "g": Pc, "rho": {}}
-            for other in self._pending:          # Cov(ν_new, ν_other) = c g_other
-                entry["rho"][other["id"]] = other["g"] @ c
-                other["rho"][entry["id"]] = entry["rho"][other["id"]]
-            self._pending.append(entry)
+        n_ships, n = self._state.shape[0], self.nx + self.n_aug
+        y, fresh = self._measured_rows(meas, [row[1] for row in self.rows])
+        if first:
+            Ax, xpred = np.zeros((n_ships, self.nx * self.nx)), np.zeros((n_ships, n))
+        else:
+            z = self.z
+            uu = np.broadcast_to(u, (*self._batch, np.shape(u)[-1]))
+            with np.errstate(all="ignore"):
+                Ax = self._rows(self.jacobian(z[..., :self.nx], uu).reshape(
+                    *self._batch, self.nx * self.nx))
+                xpred = self._rows(self.propagate(z, uu))
+        per_ship(ekf_update, "t i i i i z p o")(float(first), Ax, xpred, y, fresh, self._state,
+                                                self._params, ekf_work_size(n))
 
 
 def force_psd_to_state_psd(model, force_psd) -> dict[str, float]:

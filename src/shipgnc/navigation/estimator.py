@@ -16,7 +16,6 @@ import math
 import numpy as np
 
 from shipgnc.errors import ConfigError, require
-from shipgnc.frames import wrap_angle
 from shipgnc.models.base import Signal, names
 
 #: measurement dictionary handed to :meth:`Estimator.update`: state name → (held value (*batch,),
@@ -129,42 +128,66 @@ class GaussianFilter(Estimator):
         if self.sample_initial:  # the model states' errors; an internal state starts at z0
             draw = np.asarray(rng.standard_normal((*batch, n)), dtype=float)
             z = z + self.P0_std * np.where(self.sampled, draw, 0.0)
+        self._batch = tuple(batch)
+        self._state = np.zeros((math.prod(batch), self._state_size()))
         self.z = z
-        self.P = np.broadcast_to(np.diag(self.P0_std**2), (*batch, n, n)).copy()
-        self.begin_sample()
+        self.P = np.broadcast_to(np.diag(self.P0_std**2), (*batch, n, n))
 
-    def begin_sample(self) -> None:
-        """Zero this control sample's normalised innovation squared (NIS) and its dimension."""
-        batch = self.z.shape[:-1]
-        self.nis = np.zeros(batch)
-        self.nis_dim = np.zeros(batch)
+    # ---- the filter's state: the kernels' layout [ẑ, P (row-major), NIS, NIS dimension, ...] --
+    def _state_size(self) -> int:
+        from shipgnc.navigation.kernels import FILTER_TAIL
 
-    # ---- the measurement update ---------------------------------------------------------------
-    def correct_row(self, c: np.ndarray, y: np.ndarray, var: float, fresh: np.ndarray,
-                    angle: bool, carried=()) -> list:
-        """Scalar update with y = c·z + v, v ~ N(0, var), for the ships where ``fresh``
-        (sequential processing of independent measurements equals the joint update). Adds ν²/S
-        to this sample's NIS. ``carried``: vectors g (*batch, n), cross-covariances of the error
-        with a pending delayed innovation (:mod:`shipgnc.navigation.ekf`), returned as
-        g − K c g."""
-        if not np.any(fresh):
-            return list(carried)
-        Pc = self.P @ c                                   # (*batch, n)
-        S = Pc @ c + var                                  # (*batch,)
-        ok = fresh & (S > 0)
-        S = np.where(ok, S, 1.0)
-        K = Pc / S[..., None]
-        innov = y - self.z @ c
-        if angle:
-            innov = wrap_angle(innov)
-        innov = np.where(ok, innov, 0.0)
-        self.nis = self.nis + innov * innov / S
-        self.nis_dim = self.nis_dim + ok
-        self.z = self.z + K * innov[..., None]
-        P_new = self.P - K[..., :, None] * Pc[..., None, :]
-        P_new = 0.5 * (P_new + np.swapaxes(P_new, -1, -2))
-        self.P = np.where(ok[..., None, None], P_new, self.P)
-        return [np.where(ok[..., None], g - K * (g @ c)[..., None], g) for g in carried]
+        n = len(self.state_names)
+        return n + n * n + FILTER_TAIL.size
+
+    def _rows(self, x) -> np.ndarray:
+        """``x`` (*batch, ...) as one row per ship (the kernels' batch)."""
+        x = np.asarray(x, dtype=float)
+        return np.broadcast_to(x, (*self._batch, x.shape[-1])).reshape(self._state.shape[0], -1)
+
+    @property
+    def z(self) -> np.ndarray:
+        """The estimate ẑ (*batch, n)."""
+        n = len(self.state_names)
+        return self._state[:, :n].reshape(*self._batch, n)
+
+    @z.setter
+    def z(self, value) -> None:
+        self._state[:, :len(self.state_names)] = self._rows(value)
+
+    @property
+    def P(self) -> np.ndarray:
+        """The covariance P (*batch, n, n)."""
+        n = len(self.state_names)
+        return self._state[:, n:n + n * n].reshape(*self._batch, n, n)
+
+    @P.setter
+    def P(self, value) -> None:
+        n = len(self.state_names)
+        value = np.broadcast_to(np.asarray(value, dtype=float), (*self._batch, n, n))
+        self._state[:, n:n + n * n] = value.reshape(-1, n * n)
+
+    def _tail(self, field: str) -> np.ndarray:
+        from shipgnc.navigation.kernels import FILTER_TAIL
+
+        n = len(self.state_names)
+        return self._state[:, n + n * n + FILTER_TAIL[field]].reshape(self._batch)
+
+    @property
+    def nis(self) -> np.ndarray:
+        """This control sample's normalised innovation squared Σ ν²/S over its scalar updates."""
+        return self._tail("nis")
+
+    @property
+    def nis_dim(self) -> np.ndarray:
+        """The number of scalar updates in :attr:`nis`."""
+        return self._tail("nis_dim")
+
+    def _measured_rows(self, meas, states) -> tuple[np.ndarray, np.ndarray]:
+        """The held values and fresh flags of the measured ``states``, one row per ship."""
+        y = np.stack([np.broadcast_to(meas[s][0], self._batch) for s in states], axis=-1)
+        fresh = np.stack([np.broadcast_to(meas[s][1], self._batch) for s in states], axis=-1)
+        return self._rows(y), self._rows(fresh.astype(float))
 
     def measurement_variance(self, name: str, default: float) -> float:
         if self._meas_std_arg and name in self._meas_std_arg:
@@ -173,17 +196,17 @@ class GaussianFilter(Estimator):
 
     # ---- the compiled loop --------------------------------------------------------------------
     def kernel_state(self, n_ships: int) -> np.ndarray:
-        """Rows ``[ẑ, P (row-major), NIS, NIS dimension]`` after :meth:`start`."""
-        n = len(self.state_names)
-        return np.concatenate([self.z.reshape(n_ships, n), self.P.reshape(n_ships, n * n),
-                               np.zeros((n_ships, 2))], axis=1)
+        """The filter's state for the composed loop after :meth:`start` (its own, a copy)."""
+        return self._state.reshape(n_ships, -1).copy()
 
     def kernel_map(self) -> list[float]:
-        """``[n, n_mapped, (filter index, model index, angle) × n_mapped]`` (the estimates the
-        controller sees, and the NEES block)."""
-        out = [float(len(self.state_names)), float(len(self.map))]
+        """The map of the filter's states to the model's (:data:`~shipgnc.navigation.kernels.
+        MAP`): the estimates the controller sees, and the NEES block."""
+        from shipgnc.navigation.kernels import MAP, MAP_ENTRY
+
+        out = MAP.pack(n=len(self.state_names), n_mapped=len(self.map))
         for i, j in self.map.items():
-            out += [float(i), float(j), float(bool(self.angles[i]))]
+            out += MAP_ENTRY.pack(filter_index=i, model_index=j, angle=bool(self.angles[i]))
         return out
 
     # ---- outputs ------------------------------------------------------------------------------
@@ -196,21 +219,15 @@ class GaussianFilter(Estimator):
         return len(self.map)
 
     def nees(self, x_true: np.ndarray) -> np.ndarray:
-        """(x − x̂)ᵀ P⁻¹ (x − x̂) over the filter states that are model states (the marginal
-        covariance of that block; angles wrapped). For a consistent filter it is χ²-distributed
-        with :attr:`nees_dim` degrees of freedom (Bar-Shalom, Li & Kirubarajan 2001, §5.4.2)."""
-        idx = list(self.map)
-        err = np.stack([x_true[..., self.map[i]] - self.z[..., i] for i in idx], axis=-1)
-        for k, i in enumerate(idx):
-            if self.angles[i]:
-                err[..., k] = wrap_angle(err[..., k])
-        Psub = self.P[..., idx, :][..., :, idx]
-        with np.errstate(all="ignore"):
-            try:
-                sol = np.linalg.solve(Psub, err[..., None])[..., 0]
-            except np.linalg.LinAlgError:
-                return np.full(err.shape[:-1], np.nan)
-        return np.sum(err * sol, axis=-1)
+        """(x − x̂)ᵀ P⁻¹ (x − x̂) over the filter states that are model states: the batch of
+        :func:`~shipgnc.navigation.kernels.filter_nees` (χ²-distributed with :attr:`nees_dim`
+        degrees of freedom for a consistent filter)."""
+        from shipgnc.derive import per_ship
+        from shipgnc.navigation.kernels import filter_nees, output_work_size
+
+        _work, value = per_ship(filter_nees, "i i p o -> r")(
+            self._rows(x_true), self._state, self.kernel_map(), output_work_size(len(self.map)))
+        return value.reshape(self._batch)
 
     def signals(self) -> tuple[Signal, ...]:
         out = []
@@ -229,7 +246,7 @@ class GaussianFilter(Estimator):
         out = {f"{s}_hat": self.z[..., i] for i, s in enumerate(self.state_names)}
         std = np.sqrt(np.maximum(np.diagonal(self.P, axis1=-2, axis2=-1), 0.0))
         out.update({f"{s}_std": std[..., i] for i, s in enumerate(self.state_names)})
-        out["nees"] = self.nees(x_true) if self.map else np.full(x_true.shape[:-1], np.nan)
+        out["nees"] = self.nees(x_true)
         out["nis"] = self.nis
         out["nis_dim"] = self.nis_dim
         return out

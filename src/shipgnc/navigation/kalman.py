@@ -176,6 +176,7 @@ class KalmanFilter(GaussianFilter):
             raise ConfigError(f"kf.state_names = {self._names}: none is a state of "
                               f"{type(model).__name__} ({', '.join(names(model.states))}); "
                               "the filter would estimate nothing the controller reads")
+        self._params = np.asarray(self._block(), dtype=float)
 
     def gain(self) -> np.ndarray:
         """K = P Cᵀ (C P Cᵀ + R)⁻¹ from the current covariance (a priori before a correction)."""
@@ -190,33 +191,37 @@ class KalmanFilter(GaussianFilter):
         K = P @ self.C.T @ np.linalg.inv(self.C @ P @ self.C.T + np.diag(self._R))
         return P, K
 
-    def kernel_block(self, channels, n_ships: int):
-        """(kind, parameters, per-ship state, map) for the composed loop after :meth:`start`:
-        ``[n, n_inputs, n_rows, A, B, input indices, Q, (held offset, fresh offset, R, angle) ×
-        n_rows, C]`` (:func:`shipgnc.navigation.kernels.kf_step`)."""
+    def _block(self, channels=None) -> list[float]:
+        """The filter's parameters (:data:`~shipgnc.navigation.kernels.KF`); ``channels``: where
+        the composed loop's sensors hold each measured state (None: the numpy loop's rows)."""
+        from shipgnc.navigation.kernels import KF, KF_ROW
 
         n = len(self.state_names)
-        block = [float(n), float(len(self.input_index)), float(len(self.measured))]
+        block = KF.pack(n=n, n_inputs=len(self.input_index), n_rows=len(self.measured))
         for m in (self.A, self.B):
             block += [float(v) for v in np.asarray(m, dtype=float).ravel()]
         block += [float(i) for i in self.input_index]
         block += [float(v) for v in np.asarray(self.Q, dtype=float).ravel()]
         for i, s in enumerate(self.measured):
-            block += [float(channels[s][0]), float(channels[s][2]), float(self._R[i]),
-                      float(s == "psi")]
+            held, _valid, fresh = channels[s] if channels is not None else (-1, -1, -1)
+            block += KF_ROW.pack(held_at=held, fresh_at=fresh, R=self._R[i], angle=s == "psi")
         block += [float(v) for v in np.asarray(self.C, dtype=float).ravel()]
-        return "kf_slot", block, self.kernel_state(n_ships), self.kernel_map()
+        return block
+
+    def kernel_block(self, channels, n_ships: int):
+        """(slot, parameters, per-ship state, map) for the composed loop after :meth:`start`
+        (:func:`shipgnc.navigation.kernels.kf_step`)."""
+        return "kf_slot", self._block(channels), self.kernel_state(n_ships), self.kernel_map()
 
     def update(self, t, u, meas, first) -> None:
-        self.begin_sample()
-        if not first:
-            uu = u[..., self.input_index]
-            self.z = self.z @ self.A.T + uu @ self.B.T
-            self.P = self.A @ self.P @ self.A.T + self.Q
-        for i, s in enumerate(self.measured):
-            y, fresh = meas[s][0], meas[s][1]
-            angle = s == "psi"
-            self.correct_row(self.C[i], y, float(self._R[i]), fresh, angle)
+        """Predict (unless ``first``) and correct: the batch of
+        :func:`~shipgnc.navigation.kernels.kf_step`."""
+        from shipgnc.derive import per_ship
+        from shipgnc.navigation.kernels import kf_step
+
+        y, fresh = self._measured_rows(meas, self.measured)
+        per_ship(kf_step, "t i i i z p")(float(first), self._rows(u), y, fresh, self._state,
+                                         self._params)
 
 
 def heading_wave_kf(K: float, T: float, omega0: float, *, lambda_w: float = 0.1,

@@ -77,7 +77,6 @@ import numpy as np
 
 from shipgnc.config_types import Positive, Strict
 from shipgnc.errors import ConfigError, require
-from shipgnc.frames import wrap_angle
 from shipgnc.models.base import Signal, names
 from shipgnc.navigation.estimator import Estimator
 from shipgnc.navigation.records import EstimatorKind
@@ -230,96 +229,108 @@ class PassiveObserver(Estimator):
         fastest = max(float(np.max(wc)), float(np.max(w0)), float(np.max(self.K1b)),
                       float(np.max(np.abs(np.linalg.eigvals(self.Minv @ self.D)))))
         self.substeps = self._substeps or max(1, math.ceil(self.Ts * fastest / 0.5))
+        self._params = np.asarray(self._block(), dtype=float)
+
+    def _block(self, channels=None) -> list[float]:
+        """The observer's parameters (:data:`~shipgnc.navigation.kernels.OBSERVER`);
+        ``channels``: where the composed loop's sensors hold η's measurements (None: numpy)."""
+        from shipgnc.navigation.kernels import OBSERVER
+
+        held = [channels[s][0] for s in ETA] if channels is not None else [-1] * 3
+        valid = [channels[s][1] for s in ETA] if channels is not None else [-1] * 3
+        return OBSERVER.pack(
+            velocity_model=self.velocity_model == "model", substeps=self.substeps, Ts=self.Ts,
+            eta_index=self.ieta, nu_index=self.inu, held_at=held, valid_at=valid,
+            minus_w0_sq=-self.omega0**2, two_zeta_w0=2 * self.zeta * self.omega0, K1a=self.K1a,
+            K1b=self.K1b, K2=self.K2, T_b=self.T_b, K3=self.K3, K4=self.K4, D=self.D,
+            Minv=self.Minv, M=self.M)
 
     def start(self, x_true, rng) -> None:
-        batch = x_true.shape[:-1]
-        self.xi1 = np.zeros((*batch, 3))
-        self.xi2 = np.zeros((*batch, 3))
-        self.eta = x_true[..., self.ieta].copy()
-        self.nu = x_true[..., self.inu].copy()
-        for k, s in enumerate(ETA):
-            self.eta[..., k] += self._offset.get(s, 0.0)
-        for k, s in enumerate(NU):
-            self.nu[..., k] += self._offset.get(s, 0.0)
-        self.b = np.zeros((*batch, 3))
-        self._x_template = np.broadcast_to(x_true, x_true.shape).copy()
+        """The state (:data:`~shipgnc.navigation.kernels.OBSERVER_STATE`): ξ = 0, b̂ = 0, η̂ and ν̂
+        the true initial ones plus ``x0_offset``, and the true initial state (the model's other
+        states where the observer evaluates the model)."""
+        from shipgnc.navigation import kernels as nk
+
+        self._batch = x_true.shape[:-1]
+        x = np.asarray(x_true, dtype=float).reshape(-1, x_true.shape[-1])
+        self._state = np.zeros((x.shape[0], nk.OBSERVER_STATE.size + x.shape[1]))
+        self._state[:, nk.ETA:nk.ETA + 3] = x[:, self.ieta] + [self._offset.get(s, 0.0)
+                                                              for s in ETA]
+        self._state[:, nk.NU:nk.NU + 3] = x[:, self.inu] + [self._offset.get(s, 0.0) for s in NU]
+        self._state[:, nk.OBSERVER_STATE.size:] = x
+
+    def _part(self, field: str) -> np.ndarray:
+        from shipgnc.navigation.kernels import OBSERVER_STATE
+
+        at = OBSERVER_STATE[field]
+        return self._state[:, at:at + 3].reshape(*self._batch, 3)
+
+    xi1 = property(lambda self: self._part("xi1"), doc="ξ̂₁ (*batch, 3)")
+    xi2 = property(lambda self: self._part("xi2"), doc="ξ̂₂ (*batch, 3): the wave motion η̂_w")
+    eta = property(lambda self: self._part("eta"), doc="η̂ (*batch, 3), low-frequency")
+    b = property(lambda self: self._part("b"), doc="b̂ (*batch, 3), earth-fixed bias")
+    nu = property(lambda self: self._part("nu"), doc="ν̂ (*batch, 3)")
 
     # ---- dynamics -----------------------------------------------------------------------------
-    def _tau_and_f(self, eta, nu, u):
-        """(τ, ν̇ of the model) at the estimated state (the other model states from the last
-        true state template: e.g. the catamaran's thruster angle)."""
-        x = self._x_template.copy()
-        x[..., self.ieta] = eta
-        x[..., self.inu] = nu
-        f = self.model.derivatives(x, u, None)[..., self.inu]
-        f0 = self.model.derivatives(x, np.zeros_like(u), None)[..., self.inu]
-        return (f - f0) @ self.M.T, f
+    def _model_at(self, s, u):
+        """The model's ẋ at the estimated η̂, ν̂ of ``s`` (rows per ship; the model's other states
+        from the true initial state: e.g. the catamaran's thruster angle)."""
+        from shipgnc.navigation import kernels as nk
 
-    def _rhs(self, s, y, valid, cpsi, spsi, u):
-        xi1, xi2, eta, b, nu = s
-        ytil = y - eta - xi2
-        ytil[..., 2] = wrap_angle(ytil[..., 2])
-        ytil = np.where(valid, ytil, 0.0)
-        dxi1 = xi2 + self.K1a * ytil
-        dxi2 = -self.omega0**2 * xi1 - 2 * self.zeta * self.omega0 * xi2 + self.K1b * ytil
-        un, vn, rn = nu[..., 0], nu[..., 1], nu[..., 2]
-        deta = np.stack([cpsi * un - spsi * vn, spsi * un + cpsi * vn, rn], axis=-1) + self.K2 * ytil
-        db = -b / self.T_b + ytil @ self.K3.T
-        inj = b + ytil @ self.K4.T                           # earth-fixed force, to body: Rᵀ
-        body = np.stack([cpsi * inj[..., 0] + spsi * inj[..., 1],
-                         -spsi * inj[..., 0] + cpsi * inj[..., 1], inj[..., 2]], axis=-1)
-        if self.velocity_model == "linear":  # τ held over the sample (computed in update)
-            dnu = (self._tau - nu @ self.D.T + body) @ self.Minv.T
-        else:
-            dnu = self._tau_and_f(eta, nu, u)[1] + body @ self.Minv.T
-        return (dxi1, dxi2, deta, db, dnu)
+        x = self._state[:, nk.OBSERVER_STATE.size:].copy()
+        x[:, self.ieta] = s[:, nk.ETA:nk.ETA + 3]
+        x[:, self.inu] = s[:, nk.NU:nk.NU + 3]
+        return self.model.derivatives(x, u, None)
+
+    def _rate(self, s, y, valid, rot, u, tau):
+        """The batch of :func:`~shipgnc.navigation.kernels.observer_rhs` at ``s`` (a row per
+        ship of the OBS_S integrated numbers)."""
+        from shipgnc.derive import per_ship
+        from shipgnc.navigation.kernels import OBS_S, observer_rhs
+
+        fnu = (self._model_at(s, u)[:, self.inu] if self.velocity_model == "model"
+               else np.zeros((s.shape[0], 3)))
+        return per_ship(observer_rhs, "i i i i i i p o")(s, y, valid, rot, fnu, tau,
+                                                         self._params, OBS_S)
 
     def update(self, t, u, meas, first) -> None:
-        y = np.stack([meas[s][0] for s in ETA], axis=-1)
-        valid = np.stack([meas[s][2] for s in ETA], axis=-1)
+        """RK4 over the control period (``substeps`` steps, y, u and ψ_y held) of the observer's
+        kernel; the linear velocity model's τ (:func:`~shipgnc.navigation.kernels.
+        observer_force`) at the start of the period."""
+        from shipgnc.derive import per_ship
+        from shipgnc.navigation import kernels as nk
+
+        n = self._state.shape[0]
+        y = np.stack([meas[s][0] for s in ETA], axis=-1).reshape(n, 3)
+        valid = np.stack([meas[s][2] for s in ETA], axis=-1).reshape(n, 3)
         y = np.where(valid, y, 0.0)
-        psi_y = np.where(valid[..., 2], y[..., 2], self.eta[..., 2])
-        cpsi, spsi = np.cos(psi_y), np.sin(psi_y)
+        psi_y = np.where(valid[:, 2], y[:, 2], self._state[:, nk.ETA + 2])
         if first:
             return
-        if self.velocity_model == "linear":
-            self._tau = self._tau_and_f(self.eta, self.nu, u)[0]
-        s = (self.xi1, self.xi2, self.eta, self.b, self.nu)
-        h = self.Ts / self.substeps
-
-        def add(a, k, c):
-            return tuple(ai + c * ki for ai, ki in zip(a, k, strict=True))
-
+        rot = np.stack([np.cos(psi_y), np.sin(psi_y)], axis=-1)
+        uu = np.broadcast_to(u, (*self._batch, np.shape(u)[-1])).reshape(n, -1)
+        s = self._state[:, :nk.OBS_S].copy()
         with np.errstate(all="ignore"):
+            if self.velocity_model == "linear":  # τ held over the sample
+                self._state[:, nk.TAU:nk.TAU + 3] = per_ship(nk.observer_force, "i i p o")(
+                    self._model_at(s, uu), self._model_at(s, np.zeros_like(uu)), self._params, 3)
+            tau = self._state[:, nk.TAU:nk.TAU + 3].copy()
+            valid = valid.astype(float)
+            h = self.Ts / self.substeps
             for _ in range(self.substeps):
-                k1 = self._rhs(s, y, valid, cpsi, spsi, u)
-                k2 = self._rhs(add(s, k1, h / 2), y, valid, cpsi, spsi, u)
-                k3 = self._rhs(add(s, k2, h / 2), y, valid, cpsi, spsi, u)
-                k4 = self._rhs(add(s, k3, h), y, valid, cpsi, spsi, u)
-                s = tuple(si + (h / 6) * (a + 2 * b_ + 2 * c + d)
-                          for si, a, b_, c, d in zip(s, k1, k2, k3, k4, strict=True))
-        self.xi1, self.xi2, self.eta, self.b, self.nu = s
+                k1 = self._rate(s, y, valid, rot, uu, tau)
+                k2 = self._rate(s + h / 2 * k1, y, valid, rot, uu, tau)
+                k3 = self._rate(s + h / 2 * k2, y, valid, rot, uu, tau)
+                k4 = self._rate(s + h * k3, y, valid, rot, uu, tau)
+                s = s + (h / 6) * (k1 + 2 * k2 + 2 * k3 + k4)
+        self._state[:, :nk.OBS_S] = s
 
     # ---- the compiled loop --------------------------------------------------------------------
     def kernel_block(self, channels, n_ships: int):
-        """(kind, parameters, per-ship state, None) for the composed loop after :meth:`start`
-        (layout: :mod:`shipgnc.navigation.kernels`, ``OBS_VEC``, ``OBS_STATE``)."""
-        from shipgnc.navigation import kernels as nk
-
-        block = [1.0 if self.velocity_model == "model" else 0.0, float(self.substeps), self.Ts,
-                 *map(float, self.ieta), *map(float, self.inu),
-                 *(float(channels[s][0]) for s in ETA), *(float(channels[s][1]) for s in ETA)]
-        block += [*(-self.omega0**2), *(2 * self.zeta * self.omega0), *self.K1a, *self.K1b,
-                  *self.K2, *self.T_b]
-        for m in (self.K3, self.K4, self.D, self.Minv, self.M):
-            block += [float(v) for v in np.asarray(m, dtype=float).ravel()]
-        nx = self._x_template.shape[-1]
-        z = np.concatenate([np.broadcast_to(a, (*a.shape[:-1], a.shape[-1])).reshape(n_ships, -1)
-                            for a in (self.xi1, self.xi2, self.eta, self.b, self.nu,
-                                      np.zeros((n_ships, 3)),
-                                      self._x_template.reshape(n_ships, nx))], axis=1)
-        assert z.shape[1] == nk.OBS_STATE + nx
-        return "observer_slot", block, z, None
+        """(slot, parameters, per-ship state, None) for the composed loop after :meth:`start`
+        (:data:`~shipgnc.navigation.kernels.OBSERVER`, ``OBSERVER_STATE``)."""
+        return ("observer_slot", self._block(channels),
+                self._state.reshape(n_ships, -1).copy(), None)
 
     # ---- outputs ------------------------------------------------------------------------------
     def model_estimate(self):

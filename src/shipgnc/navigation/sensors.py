@@ -34,7 +34,6 @@ the batch it shares).
 from __future__ import annotations
 
 import math
-from collections import deque
 from typing import Annotated, ClassVar, Literal
 
 import numpy as np
@@ -75,7 +74,10 @@ def sample_every(field: str, rate_hz, Ts: float) -> int:
 
 
 class Sensor:
-    """Common sampling, hold, latency and dropout logic; subclasses define :meth:`_measure`.
+    """Common sampling, hold, latency and dropout logic (the kernel
+    :func:`~shipgnc.navigation.kernels.sensor_sample`); a subclass states its error model
+    (``kernel_errors``, :meth:`_kernel_bias`, :meth:`_kernel_bias_state`, ``noise_std``) or,
+    numpy only, writes :meth:`_measure`.
 
     ``measures``: the model state names this sensor measures, in the order of its output.
     """
@@ -122,13 +124,10 @@ class Sensor:
         self.index = tuple(state_names.index(s) for s in self.measures)
         self.batch_shape = tuple(batch_shape)
         self.rng = rng
-        k = len(self.measures)
-        self.held = np.full((*self.batch_shape, k), np.nan)
-        self.valid = np.zeros(self.batch_shape, dtype=bool)
-        self.fresh = np.zeros(self.batch_shape, dtype=bool)
-        self._pipe: deque = deque()
-        self._j = 0
+        self._first = True
         self._reset_errors()
+        self._params = np.asarray(self.kernel_params(), dtype=float)
+        self._z = self._initial_state(math.prod(self.batch_shape))
 
     def _draw(self, k: int | None = None) -> np.ndarray:
         shape = (*self.batch_shape, len(self.measures) if k is None else k)
@@ -138,34 +137,65 @@ class Sensor:
         pass
 
     def _measure(self, x_true: np.ndarray) -> np.ndarray:
+        """A sensor without ``kernel_errors``: its measurement (*batch, k) of the true measured
+        states, drawing from :meth:`_draw` (the numpy loop only)."""
         raise NotImplementedError
 
-    def in_dropout(self, t: float) -> bool:
-        return any(t0 <= t <= t1 for t0, t1 in self.dropouts)
-
     def sample(self, t: float, x: np.ndarray) -> None:
-        """One control sample at time ``t`` with the true state ``x``: take a measurement when
-        due, deliver the one taken ``latency`` samples ago (``fresh``), hold otherwise. A lost
-        sample (dropout) clears ``valid`` at its delivery time."""
-        due = self._j % self.every == 0
-        value = None
-        if due:  # the error states advance through a dropout too
-            value = self._measure(x[..., list(self.index)])
-            if self.in_dropout(t):
-                value = None
-        self._j += 1
-        self._pipe.append((due, value))
-        self.fresh = np.zeros(self.batch_shape, dtype=bool)
-        if len(self._pipe) > self.latency:
-            was_due, value = self._pipe.popleft()
-            if was_due and value is None:
-                self.valid = np.zeros(self.batch_shape, dtype=bool)
-            elif was_due:
-                self.held = value
-                self.valid = np.ones(self.batch_shape, dtype=bool)
-                self.fresh = np.ones(self.batch_shape, dtype=bool)
+        """One control sample at time ``t`` with the true state ``x``: the batch of the kernel
+        :func:`~shipgnc.navigation.kernels.sensor_sample` (take a measurement when due, deliver
+        the one taken ``latency`` samples ago as ``fresh``, hold otherwise; a lost sample clears
+        ``valid`` at its delivery time), its draws taken from the sensor's stream."""
+        from shipgnc.derive import per_ship
+        from shipgnc.navigation.kernels import Z_COUNT, sensor_sample
 
-    # ---- the compiled loop (navigation.kernels.sensors_observe) --------------------------------
+        n, k = self._z.shape[0], len(self.measures)
+        due = int(self._z[0, Z_COUNT]) % self.every == 0
+        x = np.asarray(x, dtype=float).reshape(n, -1)
+        if self.kernel_errors:
+            w = self.kernel_draws(1, n)[0] if due else np.zeros((n, 2 * k))
+        else:  # a sensor written in numpy: its _measure, sampled and held by the kernel
+            w = np.zeros((n, 2 * k))
+            if due:
+                x = x.copy()
+                seen = x.reshape(*self.batch_shape, -1)[..., list(self.index)]
+                x[:, list(self.index)] = np.asarray(self._measure(seen)).reshape(n, k)
+        per_ship(sensor_sample, "t i z p i o")(float(t), x, self._z, self._params, w, k + 1)
+
+    def _state_column(self, field: str):
+        from shipgnc.navigation import kernels as nk
+
+        return self._z[:, nk.SENSOR_STATE[field]].reshape(self.batch_shape)
+
+    @property
+    def held(self) -> np.ndarray:
+        """The held measurement (*batch, k): NaN before the first delivery."""
+        from shipgnc.navigation.kernels import SENSOR_STATE
+
+        k = len(self.measures)
+        at = SENSOR_STATE.size
+        return self._z[:, at:at + k].reshape(*self.batch_shape, k)
+
+    @property
+    def valid(self) -> np.ndarray:
+        """The held measurement is valid (*batch,): delivered, and the last one not lost."""
+        return self._state_column("valid") != 0.0
+
+    @property
+    def fresh(self) -> np.ndarray:
+        """A measurement was delivered at this sample (*batch,)."""
+        return self._state_column("fresh") != 0.0
+
+    @property
+    def bias_state(self) -> np.ndarray:
+        """The sensor's current bias b (*batch, k) of its error model."""
+        from shipgnc.navigation.kernels import SENSOR_STATE
+
+        k = len(self.measures)
+        at = SENSOR_STATE.size + k
+        return self._z[:, at:at + k].reshape(*self.batch_shape, k)
+
+    # ---- the kernel (navigation.kernels.sensor_sample) -----------------------------------------
     #: its errors are the sensor kernel's model, y = x + b + σ w with b_{j+1} = a b_j + s w_j
     #: (:meth:`_kernel_bias`: σ_b, a, s; :meth:`_kernel_bias_state`: b at reset; ``noise_std``
     #: σ), drawn in :meth:`kernel_draws`'s order; False: a run with it takes the numpy loop
@@ -176,39 +206,44 @@ class Sensor:
         return 0.0, 0.0, 0.0
 
     def kernel_params(self) -> list[float]:
-        """The sensor's parameter block without its offsets (:mod:`shipgnc.navigation.kernels`):
-        ``[0 (reserved), k, every, latency, n_dropouts, noise_std, bias_std, a, b_scale]``, then (after the
-        three offsets the navigation system adds) the state indices and the dropout intervals."""
-        bstd, a, bscale = self._kernel_bias()
-        return [0.0, float(len(self.measures)), float(self.every),
-                float(self.latency), float(len(self.dropouts)), float(self.noise_std), bstd, a,
-                bscale]
+        """The sensor's parameter block (:data:`~shipgnc.navigation.kernels.SENSOR`, then the
+        state indices and the dropout intervals)."""
+        from shipgnc.navigation.kernels import SENSOR
 
-    def kernel_tail(self) -> list[float]:
-        return [float(i) for i in self.index] + [float(v) for pair in self.dropouts for v in pair]
+        _bstd, a, bscale = self._kernel_bias() if self.kernel_errors else (0.0, 0.0, 0.0)
+        noise = self.noise_std if self.kernel_errors else 0.0  # else _measure's own
+        head = SENSOR.pack(k=len(self.measures), every=self.every, latency=self.latency,
+                           n_dropouts=len(self.dropouts), noise_std=noise, a=a, b_scale=bscale)
+        return head + [float(i) for i in self.index] + [float(v) for pair in self.dropouts
+                                                         for v in pair]
+
+    def _initial_state(self, n_ships: int) -> np.ndarray:
+        """The state after :meth:`reset` (:data:`~shipgnc.navigation.kernels.SENSOR_STATE`):
+        nothing held or valid, no sample counted, the bias at its initial value."""
+        from shipgnc.navigation import kernels as nk
+
+        k = len(self.measures)
+        z = np.zeros((n_ships, nk.sensor_state_size(k, self.latency)))
+        z[:, nk.SENSOR_STATE.size:nk.SENSOR_STATE.size + k] = np.nan
+        z[:, nk.Z_FIRST] = 1.0
+        at = nk.SENSOR_STATE.size + k
+        z[:, at:at + k] = np.broadcast_to(self._kernel_bias_state(),
+                                          (*self.batch_shape, k)).reshape(n_ships, k)
+        return z
 
     def kernel_state(self, n_ships: int) -> np.ndarray:
-        """Rows ``[held × k, valid, fresh, j, first, bias × k, pipe]`` after :meth:`reset`."""
-        k = len(self.measures)
-        z = np.zeros((n_ships, 2 * k + 4 + (self.latency + 1) * (2 + k)))
-        z[:, :k] = np.asarray(self.held, dtype=float).reshape(n_ships, k)
-        z[:, k] = np.asarray(self.valid, dtype=float).reshape(n_ships)
-        z[:, k + 1] = np.asarray(self.fresh, dtype=float).reshape(n_ships)
-        z[:, k + 2] = self._j
-        z[:, k + 3] = float(getattr(self, "_first", True))
-        z[:, k + 4:2 * k + 4] = np.broadcast_to(self._kernel_bias_state(), (*self.batch_shape, k)
-                                                ).reshape(n_ships, k)
-        return z
+        """The sensor's state for the composed loop (the numpy sensor's own, a copy)."""
+        return self._z.reshape(n_ships, -1).copy()
 
     def _kernel_bias_state(self):
         return 0.0
 
     def kernel_draws(self, count: int, n_ships: int) -> np.ndarray:
         """The draws of the sensor's next ``count`` due samples, ``(count, n_ships, 2k)``:
-        ``[bias step, noise]`` each, taken from the sensor's stream in the order :meth:`_measure`
-        takes them (zeros where it takes none), in one call per kind of stream: ``count``
-        successive draws of shape ``(*batch, k)`` are one draw of ``(count, *batch, k)`` (per
-        member for :class:`~shipgnc.streams.MemberStreams`)."""
+        ``[bias step, noise]`` each, taken from the sensor's stream in the order of the error
+        model (the first sample draws its noise only; zeros where it takes none), in one call per
+        kind of stream: ``count`` successive draws of shape ``(*batch, k)`` are one draw of
+        ``(count, *batch, k)`` (per member for :class:`~shipgnc.streams.MemberStreams`)."""
         from shipgnc.streams import MemberStreams
 
         k = len(self.measures)
@@ -282,9 +317,13 @@ class GNSS(Sensor):
         self.bias_time_constant = float(T)
 
     def _reset_errors(self) -> None:
-        self.bias = self.bias_std * self._draw() if self.bias_std > 0 else np.zeros(
+        self._bias0 = self.bias_std * self._draw() if self.bias_std > 0 else np.zeros(
             (*self.batch_shape, 2))
-        self._first = True
+
+    @property
+    def bias(self) -> np.ndarray:
+        """The receiver's current position bias (*batch, 2) [m]."""
+        return self.bias_state
 
     kernel_errors = True
 
@@ -295,16 +334,7 @@ class GNSS(Sensor):
         return self.bias_std, a, self.bias_std * math.sqrt(1 - a * a)
 
     def _kernel_bias_state(self):
-        return self.bias
-
-    def _measure(self, p):
-        if self.bias_std > 0:
-            if not self._first:
-                a = math.exp(-self.period / self.bias_time_constant)
-                self.bias = a * self.bias + self.bias_std * math.sqrt(1 - a * a) * self._draw()
-            self._first = False
-        noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
-        return p + self.bias + noise
+        return self._bias0
 
     def variances(self):
         return np.full(2, self.noise_std**2 + self.bias_std**2)
@@ -330,16 +360,12 @@ class Compass(Sensor):
         self.bias_std = _nonneg(f"{self.name}.bias_std", bias_std, " rad")
 
     def _reset_errors(self) -> None:
-        self._b = self.bias + (self.bias_std * self._draw() if self.bias_std > 0 else 0.0)
+        self._bias0 = self.bias + (self.bias_std * self._draw() if self.bias_std > 0 else 0.0)
 
     kernel_errors = True
 
     def _kernel_bias_state(self):
-        return self._b
-
-    def _measure(self, psi):
-        noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
-        return psi + self._b + noise
+        return self._bias0
 
     def variances(self):
         return np.full(1, self.noise_std**2 + self.bias_std**2)
@@ -365,8 +391,7 @@ class RateGyro(Sensor):
         self.bias_walk = _nonneg(f"{self.name}.bias_walk", bias_walk, " rad/s/sqrt(s)")
 
     def _reset_errors(self) -> None:
-        self._b = np.full((*self.batch_shape, 1), self.bias)
-        self._first = True
+        self._bias0 = np.full((*self.batch_shape, 1), self.bias)
 
     kernel_errors = True
 
@@ -375,15 +400,7 @@ class RateGyro(Sensor):
         return 0.0, 1.0, scale
 
     def _kernel_bias_state(self):
-        return self._b
-
-    def _measure(self, r):
-        if self.bias_walk > 0:
-            if not self._first:
-                self._b = self._b + self.bias_walk * math.sqrt(self.period) * self._draw()
-            self._first = False
-        noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
-        return r + self._b + noise
+        return self._bias0
 
     def variances(self):
         return np.full(1, self.noise_std**2)
@@ -407,10 +424,6 @@ class SpeedLog(Sensor):
         self.units = ("m/s",)
 
     kernel_errors = True
-
-    def _measure(self, u):
-        noise = self.noise_std * self._draw() if self.noise_std > 0 else 0.0
-        return u + noise
 
     def variances(self):
         return np.full(1, self.noise_std**2)
