@@ -262,7 +262,7 @@ def stable_arrays(t, error, *, bound, oscillation_tol, reached=True, diverged=Fa
     act = None if actuator is None else np.asarray(actuator, dtype=float).reshape(t.size, -1)
     has_act = act is not None and actuator_max is not None
     limit = float(actuator_max) * (1.0 - 1e-6) if has_act else 0.0
-    act = act if has_act else e[:0]
+    act = np.broadcast_to(act, e.shape) if has_act else e[:0]  # as np.where would broadcast it
     for i0, i1 in zip(starts, ends, strict=True):
         # each ship's own final window: the last fraction of its finite samples in this segment
         t_first, t_last = _segment_span(t, e, i0, i1)
