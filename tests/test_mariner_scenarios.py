@@ -326,3 +326,45 @@ def test_overshoot_and_heading_means_are_robust():
                              delta_max=math.radians(35.0), reached_end=True)
     assert a["overshoot_nm"][0] == 0.0
     assert abs(a["final_heading_error_deg"][0]) > 179.0  # near ±180°, not 0: a circular mean
+
+
+def test_batch_metrics_are_the_masked_time_ordered_sums_of_their_definitions():
+    """The batch scorer's sums, counts and extrema are those of the definitions written as masks
+    over the whole (time, ship) log, each sum the last row of np.cumsum (time order) — to the
+    bit, for ships that switch legs, never switch, stop early (NaN tail) or start on the line."""
+    rng = np.random.default_rng(7)
+    n_t, n = 400, 70  # more ships than one scoring block
+    t = np.arange(n_t) * 6.0
+    y = np.cumsum(rng.standard_normal((n_t, n)), axis=0) * 40.0
+    y[:, 3] = 0.0  # on the path line
+    psi = rng.standard_normal((n_t, n)) * 0.4
+    leg = (np.arange(n_t)[:, None] >= rng.integers(50, 600, n)[None, :]).astype(float)
+    delta = np.clip(rng.standard_normal((n_t, n)) * 0.4, -0.6, 0.6)
+    for col, stop in ((5, 300), (66, 10)):
+        y[stop:, col] = leg[stop:, col] = delta[stop:, col] = psi[stop:, col] = np.nan
+    a = path_tracking_arrays(t, y, psi, leg, delta, delta_max=0.6, reached_end=True)
+
+    def total(mask, values):
+        return np.cumsum(np.where(mask, values, 0.0), axis=0)[-1]
+
+    valid = np.isfinite(y) & np.isfinite(leg)
+    switched = valid & (leg > 0)
+    first = np.where(switched.any(axis=0), switched.argmax(axis=0), n_t)
+    after = valid & (np.arange(n_t)[:, None] >= first)
+    t_last = np.max(np.where(valid, t[:, None], -np.inf), axis=0)
+    final = valid & (t[:, None] >= t_last - 600.0 - 1e-9)
+    applied = valid & np.isfinite(delta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rms = np.where(first < n_t, np.sqrt(total(after, y * y) / after.sum(axis=0)), np.nan)
+        heading = np.degrees(np.arctan2(total(final, np.sin(psi)) / final.sum(axis=0),
+                                        total(final, np.cos(psi)) / final.sum(axis=0)))
+    np.testing.assert_array_equal(a["crosstrack_rms_after_leg1_nm"], rms / NM)
+    np.testing.assert_array_equal(a["final_crosstrack_nm"], total(final, y) / final.sum(axis=0) / NM)
+    np.testing.assert_allclose(a["final_heading_error_deg"], heading, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(a["rudder_rms_deg"], np.degrees(
+        np.sqrt(total(applied, delta * delta) / applied.sum(axis=0))))
+    np.testing.assert_array_equal(a["saturation_fraction"], (
+        applied & (np.abs(delta) >= 0.6 * (1 - 1e-9))).sum(axis=0) / applied.sum(axis=0))
+    np.testing.assert_array_equal(a["crosstrack_max_after_leg1_nm"], np.where(
+        first < n_t, np.max(np.where(after, np.abs(y), -np.inf), axis=0), np.nan) / NM)
+    assert a["overshoot_nm"][3] == 0.0

@@ -12,7 +12,15 @@ stays light.
 from __future__ import annotations
 
 import importlib
+import os
 from typing import Any
+
+# numba's OpenMP workers sleep between parallel regions instead of spinning (unless the user
+# chose): a compiled run is thousands of short kernel calls with Python work between them (input
+# tables, divergence checks), and a spinning worker burns a core through each gap, taking it from
+# that work and from every other process on the machine. Read once, when numba starts its
+# thread pool (the first parallel call), so it is set here, before any kernel runs.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 __version__ = "0.1.0"
 

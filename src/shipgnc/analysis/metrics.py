@@ -14,6 +14,7 @@ from __future__ import annotations
 import itertools
 import math
 
+import numba
 import numpy as np
 
 from shipgnc.batchmath import time_mean, time_sum
@@ -259,39 +260,98 @@ def stable_arrays(t, error, *, bound, oscillation_tol, reached=True, diverged=Fa
     amplitude = np.zeros(n_ships)
     pinned = np.zeros(n_ships, dtype=bool)
     act = None if actuator is None else np.asarray(actuator, dtype=float).reshape(t.size, -1)
+    has_act = act is not None and actuator_max is not None
+    limit = float(actuator_max) * (1.0 - 1e-6) if has_act else 0.0
+    act = np.broadcast_to(act, e.shape) if has_act else e[:0]  # as np.where would broadcast it
     for i0, i1 in zip(starts, ends, strict=True):
-        # each ship's own final window: the last fraction of its samples in this segment
-        seg = np.zeros_like(finite)
-        seg[i0:i1] = finite[i0:i1]
-        t_last = np.max(np.where(seg, t[:, None], -np.inf), axis=0)
-        t_first = np.min(np.where(seg, t[:, None], np.inf), axis=0)
-        window = seg & (t[:, None] >= t_last - final_fraction * (t_last - t_first) - 1e-9)
-        n = time_sum(window)
+        # each ship's own final window: the last fraction of its finite samples in this segment
+        t_first, t_last = _segment_span(t, e, i0, i1)
+        with np.errstate(invalid="ignore"):  # a ship without a finite sample here: no window
+            window_from = t_last - final_fraction * (t_last - t_first) - 1e-9
+            center = 0.5 * (t_first + t_last)
+        n, s_t, s_e, s_tt, s_te, n_high, n_low = _window_sums(t, e, act, has_act, i0, i1,
+                                                              window_from, center, limit)
         if not np.any(n >= 3):
             continue
-        tc = np.where(window, t[:, None] - 0.5 * (t_first + t_last), 0.0)
-        ew = np.where(window, e, 0.0)
-        s_t, s_e, s_tt, s_te = time_sum(tc), time_sum(ew), time_sum(tc * tc), time_sum(tc * ew)
         with np.errstate(invalid="ignore", divide="ignore"):
             det = n * s_tt - s_t * s_t
             slope = np.where(det > 0, (n * s_te - s_t * s_e) / det, 0.0)
             intercept = np.where(n > 0, (s_e - slope * s_t) / n, 0.0)
-        rho = ew - (intercept + slope * tc)
-        half_range = 0.5 * (np.max(np.where(window, rho, -np.inf), axis=0)
-                            - np.min(np.where(window, rho, np.inf), axis=0))
+        rho_max, rho_min = _residual_range(t, e, i0, i1, window_from, center, slope, intercept)
+        half_range = 0.5 * (rho_max - rho_min)
         amplitude = np.maximum(amplitude, np.where(n >= 3, half_range, 0.0))
-        if act is not None and actuator_max is not None:
-            limit = float(actuator_max) * (1.0 - 1e-6)
-            a = np.where(window, act, 0.0)
+        if has_act:
             with np.errstate(invalid="ignore", divide="ignore"):
-                high = time_sum(window & (a >= limit)) / n
-                low = time_sum(window & (a <= -limit)) / n
+                high = n_high / n
+                low = n_low / n
             pinned |= (n >= 3) & (high >= pinned_fraction) & (low >= pinned_fraction)
     reached = np.broadcast_to(np.asarray(reached, dtype=bool), (n_ships,))
     diverged = np.broadcast_to(np.asarray(diverged, dtype=bool), (n_ships,))
     stable = reached & ~diverged & bounded & (amplitude <= oscillation_tol) & ~pinned
     return {"stable": stable, "bounded": bounded, "oscillation": amplitude,
             "saturated_oscillation": pinned}
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _segment_span(t, e, i0, i1):
+    """First and last time of each ship's finite samples ``i0 <= k < i1`` (+∞, −∞ if none)."""
+    n = e.shape[1]
+    t_first, t_last = np.full(n, np.inf), np.full(n, -np.inf)
+    for k in range(i0, i1):
+        for m in range(n):
+            if np.isfinite(e[k, m]):
+                t_first[m] = min(t_first[m], t[k])
+                t_last[m] = max(t_last[m], t[k])
+    return t_first, t_last
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _window_sums(t, e, act, has_act, i0, i1, window_from, center, limit):
+    """Over each ship's final window (its finite samples ``i0 <= k < i1`` from ``window_from``
+    on): the sample count n, Σ tc, Σ e, Σ tc², Σ tc·e (tc = t − ``center``) and the counts of
+    ``act`` ≥ ``limit`` and ≤ −``limit``. Each sum is ``time_sum`` of the masked series over
+    the whole log, to the bit: the samples added in time order, a masked one as +0.0, the first
+    onto −0.0 (the additive identity)."""
+    n_t, n = e.shape
+    out = np.full((7, n), -0.0)
+    if i0 > 0:
+        out += 0.0  # the samples before the segment
+    for k in range(i0, i1):
+        for m in range(n):
+            ek = e[k, m]
+            if np.isfinite(ek) and t[k] >= window_from[m]:
+                tc = t[k] - center[m]
+                out[0, m] += 1.0
+                out[1, m] += tc
+                out[2, m] += ek
+                out[3, m] += tc * tc
+                out[4, m] += tc * ek
+                out[5, m] += 1.0 if has_act and act[k, m] >= limit else 0.0
+                out[6, m] += 1.0 if has_act and act[k, m] <= -limit else 0.0
+            else:
+                for j in range(7):
+                    out[j, m] += 0.0
+    if i1 < n_t:
+        out += 0.0  # the samples after it
+    return out[0], out[1], out[2], out[3], out[4], out[5], out[6]
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _residual_range(t, e, i0, i1, window_from, center, slope, intercept):
+    """Largest and smallest residual ρ = e − (intercept + slope·tc) over each ship's final
+    window (see :func:`_window_sums`; −∞, +∞ if empty; NaN propagates as in ``np.max``)."""
+    n = e.shape[1]
+    high, low = np.full(n, -np.inf), np.full(n, np.inf)
+    for k in range(i0, i1):
+        for m in range(n):
+            ek = e[k, m]
+            if np.isfinite(ek) and t[k] >= window_from[m]:
+                rho = ek - (intercept[m] + slope[m] * (t[k] - center[m]))
+                if not np.isnan(high[m]) and (np.isnan(rho) or rho > high[m]):
+                    high[m] = rho
+                if not np.isnan(low[m]) and (np.isnan(rho) or rho < low[m]):
+                    low[m] = rho
+    return high, low
 
 
 def _segments_of(reference) -> np.ndarray | None:

@@ -29,10 +29,10 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from shipgnc.analysis.metrics import stable_arrays
-from shipgnc.batchmath import time_sum
 from shipgnc.units import MINUTE, NAUTICAL_MILE, to_deg
 
 #: |y_r| below which leg 1 counts as settled [m] (0.05 nm)
@@ -80,49 +80,39 @@ def path_tracking_arrays(time, y_r, psi_r, leg, delta, *, delta_max: float, reac
 
 
 def _path_tracking_block(t, y, psi, lg, d, delta_max: float, reached_end) -> dict:
-    """:func:`path_tracking_arrays` of one block of ships."""
+    """:func:`path_tracking_arrays` of one block of ships.
+
+    The sums run in compiled passes over the samples (:func:`_leg_pass`, :func:`_score_pass`),
+    each added in time order as :func:`~shipgnc.batchmath.time_sum` adds the masked series (the
+    same bits, without a time × block array per mask and figure)."""
     valid = np.isfinite(y) & np.isfinite(lg)
     n_t = y.shape[0]
-    rows = np.arange(n_t)[:, None]
-    switched = valid & (lg > 0)
-    has_switch = switched.any(axis=0)
-    first_switch = np.where(has_switch, switched.argmax(axis=0), n_t)  # first sample of leg 2+
-    leg1 = (rows < first_switch) & valid
-    n_leg1 = leg1.sum(axis=0)
-
-    # settle time: the sample after the last leg-1 sample outside the band
-    outside = leg1 & ~(np.abs(y) < SETTLE_BAND)
-    any_out = outside.any(axis=0)
-    last_out = n_t - 1 - outside[::-1].argmax(axis=0)
-    settle_idx = np.where(any_out, last_out + 1, 0)
-    settled = (settle_idx < n_leg1) & (n_leg1 > 0)
-    settle = np.where(settled, t[np.minimum(settle_idx, n_t - 1)] / MINUTE, np.nan)
-
+    first_switch, t_last = _leg_pass(t, y, lg)
+    has_switch = first_switch < n_t  # a first sample of leg 2+
     y0 = y[0]
     on_line = np.abs(y0) < ON_LINE
-    opposite = np.where(leg1, -np.sign(y0) * y, -np.inf)
-    overshoot = np.where(on_line, 0.0, np.maximum(opposite.max(axis=0), 0.0) / NAUTICAL_MILE)
+    final_from = t_last - FINAL_WINDOW - 1e-9  # the last 10 min of each ship's samples
+    # sin ψ_r, cos ψ_r on the rows that hold a final window (numpy's, as on the whole series)
+    k_min = _first_row_at(t, final_from)
+    s = _score_pass(t, y, lg, d, np.sin(psi[k_min:]), np.cos(psi[k_min:]), k_min, first_switch,
+                    final_from, -np.sign(y0), SETTLE_BAND, delta_max * (1.0 - 1e-9))
+    (n_leg1, last_out, opposite, max_after, sum_after, n_after, n_final, sum_sin, sum_cos, sum_y,
+     sum_abs, sum_d, sum_dd, n_applied, n_saturated) = s
 
-    after = valid & (rows >= first_switch)
+    # settle time: the sample after the last leg-1 sample outside the band
+    settle_idx = np.where(last_out >= 0, last_out + 1, 0)
+    settled = (settle_idx < n_leg1) & (n_leg1 > 0)
+    settle = np.where(settled, t[np.minimum(settle_idx, n_t - 1)] / MINUTE, np.nan)
+    overshoot = np.where(on_line, 0.0, np.maximum(opposite, 0.0) / NAUTICAL_MILE)
     with np.errstate(invalid="ignore", divide="ignore"):
-        abs_after = np.where(after, np.abs(y), np.nan)
-        max_after = np.where(has_switch, np.nanmax(np.where(after, abs_after, -np.inf), axis=0), np.nan)
-        rms_after = np.sqrt(time_sum(np.where(after, y * y, 0.0)) / after.sum(axis=0))
-        rms_after = np.where(has_switch, rms_after, np.nan)
-
-        t_last = np.max(np.where(valid, t[:, None], -np.inf), axis=0)
-        final = valid & (t[:, None] >= t_last - FINAL_WINDOW - 1e-9)
-        count = final.sum(axis=0)
-
-        def final_mean(a):
-            return time_sum(np.where(final, a, 0.0)) / count
-
-        applied = valid & np.isfinite(d)
-        rudder_rms = np.sqrt(time_sum(np.where(applied, d * d, 0.0)) / applied.sum(axis=0))
-        saturated = applied & (np.abs(d) >= delta_max * (1.0 - 1e-9))
-        saturation = saturated.sum(axis=0) / applied.sum(axis=0)
+        max_after = np.where(has_switch, max_after, np.nan)
+        rms_after = np.where(has_switch, np.sqrt(sum_after / n_after), np.nan)
+        rudder_rms = np.sqrt(sum_dd / n_applied)
+        saturation = n_saturated / n_applied
+        final_sin, final_cos = sum_sin / n_final, sum_cos / n_final
+        final_y, final_abs, final_d = sum_y / n_final, sum_abs / n_final, sum_d / n_final
     bound = np.maximum(STABLE_BOUND, 2.0 * np.abs(y0))
-    final_heading = to_deg(np.arctan2(final_mean(np.sin(psi)), final_mean(np.cos(psi))))
+    final_heading = to_deg(np.arctan2(final_sin, final_cos))
     reversed_ = np.abs(final_heading) > REVERSED_DEG  # NaN (no valid sample) compares False
     verdict = stable_arrays(t, np.where(valid, y, np.nan), bound=bound,
                             oscillation_tol=SETTLE_BAND, reached=reached_end,
@@ -133,15 +123,104 @@ def _path_tracking_block(t, y, psi, lg, d, delta_max: float, reached_end) -> dic
         "overshoot_nm": overshoot,
         "crosstrack_max_after_leg1_nm": max_after / NAUTICAL_MILE,
         "crosstrack_rms_after_leg1_nm": rms_after / NAUTICAL_MILE,
-        "final_crosstrack_nm": final_mean(y) / NAUTICAL_MILE,
-        "final_abs_crosstrack_nm": final_mean(np.abs(y)) / NAUTICAL_MILE,
+        "final_crosstrack_nm": final_y / NAUTICAL_MILE,
+        "final_abs_crosstrack_nm": final_abs / NAUTICAL_MILE,
         "final_heading_error_deg": final_heading,
-        "final_rudder_deg": to_deg(final_mean(np.where(np.isfinite(d), d, 0.0))),
+        "final_rudder_deg": to_deg(final_d),
         "rudder_rms_deg": to_deg(rudder_rms),
         "saturation_fraction": saturation,
         "stable": stable,
         "reversed": reversed_,
     }
+
+
+def _first_row_at(t, thresholds) -> int:
+    """The first sample whose time reaches the lowest of ``thresholds`` (0 for none)."""
+    if thresholds.size == 0:
+        return t.size
+    hit = t >= thresholds.min()
+    return int(hit.argmax()) if hit.any() else t.size
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _leg_pass(t, y, lg):
+    """Per ship of ``(time, ship)`` series: the first valid sample past leg 1 (``leg > 0``;
+    ``n_t`` if none) and the time of the last valid sample (−∞ if none); valid: y_r and leg
+    finite."""
+    n_t, n = y.shape
+    first_switch = np.full(n, n_t, dtype=np.int64)
+    t_last = np.full(n, -np.inf)
+    for k in range(n_t):
+        for m in range(n):
+            if np.isfinite(y[k, m]) and np.isfinite(lg[k, m]):
+                if lg[k, m] > 0 and first_switch[m] == n_t:
+                    first_switch[m] = k
+                if t[k] > t_last[m]:
+                    t_last[m] = t[k]
+    return first_switch, t_last
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _score_pass(t, y, lg, d, sin_psi, cos_psi, k_min, first_switch, final_from, side, band,
+                saturated_at):
+    """The counts, extrema and sums of :func:`_path_tracking_block`, per ship, in one pass over
+    the samples. Each sum is that of ``time_sum(np.where(mask, value, 0.0))``: every sample added
+    in time order, a masked one as +0.0, the first onto −0.0 (the additive identity, so the
+    total starts as the first sample's value). ``sin_psi``, ``cos_psi``: rows ``k_min`` on (no
+    final window starts before). Maxima propagate NaN as ``np.max``."""
+    n_t, n = y.shape
+    n_leg1 = np.zeros(n, dtype=np.int64)
+    last_out = np.full(n, -1, dtype=np.int64)
+    opposite = np.full(n, -np.inf)
+    max_after = np.full(n, -np.inf)
+    sum_after = np.full(n, -0.0)
+    n_after = np.zeros(n, dtype=np.int64)
+    n_final = np.zeros(n, dtype=np.int64)
+    sums = np.full((5, n), -0.0)  # sin ψ_r, cos ψ_r, y_r, |y_r|, δ (0 where not finite)
+    sum_dd = np.full(n, -0.0)
+    n_applied = np.zeros(n, dtype=np.int64)
+    n_saturated = np.zeros(n, dtype=np.int64)
+    for k in range(n_t):
+        for m in range(n):
+            yk, dk = y[k, m], d[k, m]
+            valid = np.isfinite(yk) and np.isfinite(lg[k, m])
+            leg1 = valid and k < first_switch[m]
+            after = valid and k >= first_switch[m]
+            if leg1:
+                n_leg1[m] += 1
+                if not (abs(yk) < band):
+                    last_out[m] = k
+                v = side[m] * yk
+                if not np.isnan(opposite[m]) and (np.isnan(v) or v > opposite[m]):
+                    opposite[m] = v
+            if after:
+                n_after[m] += 1
+                if abs(yk) > max_after[m]:
+                    max_after[m] = abs(yk)
+            sum_after[m] += yk * yk if after else 0.0
+            applied = valid and np.isfinite(dk)
+            if applied:
+                n_applied[m] += 1
+                if abs(dk) >= saturated_at:
+                    n_saturated[m] += 1
+            sum_dd[m] += dk * dk if applied else 0.0
+            if k < k_min:
+                for j in range(5):
+                    sums[j, m] += 0.0
+                continue
+            final = valid and t[k] >= final_from[m]
+            if final:
+                n_final[m] += 1
+                sums[0, m] += sin_psi[k - k_min, m]
+                sums[1, m] += cos_psi[k - k_min, m]
+                sums[2, m] += yk
+                sums[3, m] += abs(yk)
+                sums[4, m] += dk if np.isfinite(dk) else 0.0
+            else:
+                for j in range(5):
+                    sums[j, m] += 0.0
+    return (n_leg1, last_out, opposite, max_after, sum_after, n_after, n_final, sums[0], sums[1],
+            sums[2], sums[3], sums[4], sum_dd, n_applied, n_saturated)
 
 
 def _series(ds, name: str) -> np.ndarray:
