@@ -248,3 +248,28 @@ def test_targets_replayed_from_an_ais_log(tmp_path):
     d_cpa, t_cpa = closed_form_cpa(np.array([8000.0, 2500.0]), v)
     assert run.metrics["min_range_m"] == pytest.approx(d_cpa, abs=5.0)
     assert run.metrics["t_min_range_s"] == pytest.approx(t_cpa, abs=2.0)
+
+
+def test_monte_carlo_variants_classify_as_their_type_and_nest():
+    """Every perturbed variant of the standard set is, by COLREG rules 13–17 at t = 0, the
+    situation its type names; each type draws from its own child seed, so the variants of
+    ``mc`` = 5 are the first five of ``mc`` = 10."""
+    from shipgnc.colav.colreg import SITUATIONS
+
+    ten = E.standard_members(["none"], mc=10, seed=3, own_speed=U)
+    five = E.standard_members(["none"], mc=5, seed=3, own_speed=U)
+    scores = E.initial_scores(ten, range(len(ten)))
+    for m, code in zip(ten, scores["situation"], strict=True):
+        assert SITUATIONS[int(code)] == tg.SITUATION_OF[m.situation.encounter_type], m.spec
+    first = [m.spec for m in ten if m.mc < 5]
+    assert first == [m.spec for m in five]
+
+
+def test_trafficgen_current_layout_latitude_longitude():
+    """trafficgen's current files (and the maritime-schema) spell positions latitude/longitude."""
+    ship = {"initial": {"position": {"latitude": 58.0, "longitude": 10.0}, "sog": 10.0,
+                        "cog": 0.0}}
+    target = {"initial": {"position": {"latitude": 58.05, "longitude": 10.0}, "sog": 10.0,
+                          "cog": 180.0}}
+    sit = tg.parse({"ownShip": ship, "targetShips": [target]})
+    assert sit.origin == (58.0, 10.0) and sit.targets[0].north[0] == pytest.approx(5566, abs=5)

@@ -50,6 +50,7 @@ class Member:
     method: str
     mc: int = 0
     beta_deg: float = math.nan
+    spec: tg.EncounterSpec | None = None  # the generated variant (None: read from a file)
 
 
 @dataclass
@@ -80,16 +81,19 @@ def own_frame(sit: tg.Situation) -> tg.Situation:
 def standard_members(methods, *, mc: int = 0, seed: int = 0, own_speed: float = 9.0,
                      specs=tg.STANDARD) -> list[Member]:
     """The standard set (``mc`` = 0) or ``mc`` perturbed variants of each of its situations
-    (:func:`shipgnc.study.trafficgen.perturbed`, drawn from ``seed``), each met with every method."""
-    rng = np.random.default_rng(seed)
+    (:func:`shipgnc.study.trafficgen.variants`, each classifying as its type), each met with every
+    method. Each situation type draws from its own child of ``seed``
+    (``SeedSequence(seed).spawn``), so the variants of ``mc`` = 5 are the first five of 10."""
+    children = np.random.SeedSequence(seed).spawn(len(specs))
     members = []
-    for spec in specs:
-        variants = [spec] if mc == 0 else [tg.perturbed(spec, rng) for _ in range(mc)]
+    for spec, child in zip(specs, children, strict=True):
+        variants = [spec] if mc == 0 else tg.variants(spec, np.random.default_rng(child), mc,
+                                                     own_speed)
         for k, variant in enumerate(variants):
             sit = tg.parse(tg.situation_dict(variant, own_speed), variant.title)
             sit = replace(sit, encounter_type=spec.encounter_type, title=spec.title)
             for method in methods:
-                members.append(Member(sit, method, k, variant.beta_deg))
+                members.append(Member(sit, method, k, variant.beta_deg, variant))
     return members
 
 
@@ -247,19 +251,29 @@ def situation_codes(members, index) -> np.ndarray:
 
 
 def summary(result: SweepResult) -> list[dict]:
-    """One row per (encounter type, method): members, collisions, median and least minimum range,
-    median time lost, median compliance (the least score of the rules invoked, after Woerner)."""
-    rows = []
-    keys = dict.fromkeys((m.situation.encounter_type or m.situation.title, m.method)
-                         for m in result.members)
+    """One row per (COLREG situation computed at t = 0, method): the members' labels
+    (``encounter``), how many of them carry a label of another situation (``label_disagrees``,
+    :data:`shipgnc.study.trafficgen.SITUATION_OF`), members, collisions, median and least minimum
+    range, median time lost, median compliance (the least score of the rules invoked, after
+    Woerner)."""
+    from shipgnc.colav.colreg import SITUATIONS
+
     s = result.scores
+    computed = [SITUATIONS[int(c)] if np.isfinite(c) else "unknown" for c in s["situation"]]
+    rows = []
+    keys = dict.fromkeys((computed[i], m.method) for i, m in enumerate(result.members))
     for kind, method in keys:
-        idx = [i for i, m in enumerate(result.members)
-               if (m.situation.encounter_type or m.situation.title) == kind and m.method == method]
+        idx = [i for i, m in enumerate(result.members) if computed[i] == kind and m.method == method]
+        labels = [result.members[i].situation.encounter_type or result.members[i].situation.title
+                  for i in idx]
+        disagree = sum(1 for label in labels if label in tg.SITUATION_OF
+                       and tg.SITUATION_OF[label] != kind)
         rng = s["min_range_m"][idx]
-        rows.append({"encounter": kind, "method": method, "members": len(idx),
+        rows.append({"situation": kind, "encounter": "/".join(dict.fromkeys(labels)),
+                     "label_disagrees": disagree, "method": method, "members": len(idx),
                      "collisions": int(np.nansum(s["collision"][idx])),
-                     "median_cpa_m": float(np.nanmedian(rng)), "min_cpa_m": float(np.nanmin(rng)),
+                     "median_min_range_m": float(np.nanmedian(rng)),
+                     "min_range_m": float(np.nanmin(rng)),
                      "median_time_lost_s": float(np.nanmedian(s["time_lost_s"][idx]))})
         if "compliance" in s:
             c = s["compliance"][idx]
@@ -275,7 +289,9 @@ def member_rows(result: SweepResult) -> list[dict]:
     rows = []
     for i, m in enumerate(result.members):
         row = {"member": i, "title": m.situation.title, "encounter": m.situation.encounter_type,
-               "method": m.method, "mc": m.mc, "beta_deg": m.beta_deg}
+               "method": m.method, "mc": m.mc, "beta_deg": m.beta_deg,
+               "relative_speed": m.spec.relative_speed if m.spec else math.nan,
+               "vector_time_s": m.spec.vector_time_s if m.spec else math.nan}
         for key, value in result.scores.items():
             row[key] = SITUATIONS[int(value[i])] if key == "situation" else float(value[i])
         rows.append(row)
