@@ -118,3 +118,10 @@ def test_the_batch_runs_each_ship():
 def test_a_bad_config_names_the_field():
     with pytest.raises(ValueError, match="speed_factors"):
         VOConfig(speed_factors=[0.5])
+
+
+def test_a_symmetric_obstacle_is_passed_to_starboard():
+    """A stopped obstacle dead ahead is symmetric: the offsets ±Δχ clear it equally; starboard
+    wins the tie (the side rules 14–16 prefer)."""
+    offsets, _, _, _ = closed_loop([[400.0, 0.0, 0.0, 0.0]], steps=1)
+    assert offsets[0] > 0.0
