@@ -197,7 +197,10 @@ def position_fields(r: PositionReport) -> dict:
             fields["turn"] = -128
         else:
             rot_deg_min = r.rot / DEG_PER_MIN  # pyais encodes ROT_AIS = round(4.733 √|ROT|)
-            fields["turn"] = math.copysign(min(abs(rot_deg_min), 708.0), rot_deg_min)
+            turn = math.copysign(min(abs(rot_deg_min), 708.0), rot_deg_min)
+            if abs(turn) in (127.0, 128.0):  # pyais reads these as the codes ±127/−128: nudge off
+                turn = math.nextafter(turn, 0.0)  # (same ROT_AIS: 4.733 √127 = 53.3, √128: 53.5)
+            fields["turn"] = turn
     else:
         fields["cs"] = 1  # a Class B "CS" (carrier-sense) unit
     return fields
