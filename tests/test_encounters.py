@@ -273,3 +273,16 @@ def test_trafficgen_current_layout_latitude_longitude():
                           "cog": 180.0}}
     sit = tg.parse({"ownShip": ship, "targetShips": [target]})
     assert sit.origin == (58.0, 10.0) and sit.targets[0].north[0] == pytest.approx(5566, abs=5)
+
+
+def test_a_far_away_target_is_refused_with_its_distance():
+    """A target beyond the local plane's 60 km: one line naming it and its geodesic distance."""
+    from pyproj import Geod
+
+    from shipgnc.errors import ConfigError
+
+    own = {"initial": {"position": {"lat": 58.0, "lon": 10.0}, "sog": 15.0, "cog": 0.0}}
+    far = {"initial": {"position": {"lat": 59.0, "lon": 10.0}, "sog": 10.0, "cog": 180.0}}
+    _, _, d = Geod(ellps="WGS84").inv(10.0, 58.0, 10.0, 59.0)
+    with pytest.raises(ConfigError, match=rf"F: targetShips\[0\] is {d / 1000:.0f} km from"):
+        tg.parse({"ownShip": own, "targetShips": [far]}, "F")

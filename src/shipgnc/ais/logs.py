@@ -288,12 +288,14 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
     """The targets of a logged AIS file, one track per MMSI (sorted by MMSI), and the origin.
 
     Positions are in the local plane about ``origin`` (lat, lon) [deg] — given, or the centre of the
-    data's latitude and longitude ranges — the geo router's projection
-    (:class:`shipgnc.ais.plane.LocalPlane`); velocities over ground turned into the plane's axes. Times
-    are seconds after ``t0`` [unix s] (default: the file's earliest message). Names and lengths come
+    data (:func:`shipgnc.ais.plane.centre`, the mean of the reports' earth-centred unit vectors) —
+    the geo router's projection (:class:`shipgnc.ais.plane.LocalPlane`); a ship's report farther
+    than 60 km from it is a ConfigError naming its MMSI and distance. Velocities over ground are
+    turned into the plane's axes. Times are seconds after ``t0`` [unix s] (default: the file's
+    earliest message). Names and lengths come
     from static data (types 5, 24) where the file has them. ``!AIVDO`` tracks (the logging ship) have
     ``source = "ais-own"``, the others ``"ais"``."""
-    from shipgnc.ais.plane import LocalPlane, check_origin
+    from shipgnc.ais.plane import LocalPlane, centre, check_origin, check_range
 
     reports = read_reports(path, skip_unknown=skip_unknown)
     where = f"AIS log {Path(path)}"
@@ -321,9 +323,12 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
     lat_all = np.array([r.msg.lat for rs in by_mmsi.values() for r in rs])
     lon_all = np.array([r.msg.lon for rs in by_mmsi.values() for r in rs])
     if origin is None:
-        origin = (0.5 * (lat_all.min() + lat_all.max()), 0.5 * (lon_all.min() + lon_all.max()))
+        origin = centre(lat_all, lon_all)
     origin = check_origin(origin)
     plane = LocalPlane(origin)
+    for mmsi in sorted(by_mmsi):
+        check_range(origin, [r.msg.lat for r in by_mmsi[mmsi]], [r.msg.lon for r in by_mmsi[mmsi]],
+                    f"{where}: MMSI {mmsi}")
     if t0 is None:
         t0 = min(r.time for r in reports)
     tracks = []

@@ -218,12 +218,15 @@ def parse(data: dict, where: str = "situation") -> Situation:
         raise ConfigError(f"{where}: {field}: {err['msg']} (a trafficgen traffic situation: "
                           "ownShip and targetShips with initial position lat/lon, sog [kn], "
                           "cog [deg])") from None
+    from shipgnc.ais.plane import check_range
     from shipgnc.routing.geo.projection import RouteProjection
 
     o = s.ownShip.initial.position
     plane = RouteProjection((o.lat, o.lon), (o.lat, o.lon))
     targets = []
     for j, ship in enumerate(s.targetShips):
+        check_range((o.lat, o.lon), ship.initial.position.lat, ship.initial.position.lon,
+                    f"{where}: targetShips[{j}]")
         n, e = plane.to_plane(ship.initial.position.lat, ship.initial.position.lon)
         st = ship.static
         targets.append(TargetTrack.constant(float(n), float(e), math.radians(ship.initial.cog),
