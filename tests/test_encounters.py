@@ -286,3 +286,24 @@ def test_a_far_away_target_is_refused_with_its_distance():
     _, _, d = Geod(ellps="WGS84").inv(10.0, 58.0, 10.0, 59.0)
     with pytest.raises(ConfigError, match=rf"F: targetShips\[0\] is {d / 1000:.0f} km from"):
         tg.parse({"ownShip": own, "targetShips": [far]}, "F")
+
+
+def test_bad_seed_own_speed_and_schedule_with_course(tmp_path):
+    """--seed -1 is a usage error; an own ship slower than the frigate's 5–12 m/s (van Amerongen's
+    table) names the file's field in knots; a target with both a schedule and a course is refused."""
+    from shipgnc.errors import ConfigError
+    from shipgnc.scenarios.sections import TargetConfig
+
+    runner = CliRunner()
+    done = runner.invoke(app, ["encounters", "--seed", "-1", "--out", str(tmp_path / "o")])
+    assert done.exit_code == 2 and "Traceback" not in done.output
+    slow = tmp_path / "slow.json"
+    own = {"initial": {"position": {"lat": 58.0, "lon": 10.0}, "sog": 0.5, "cog": 0.0}}
+    target = {"initial": {"position": {"lat": 58.05, "lon": 10.0}, "sog": 10.0, "cog": 180.0}}
+    slow.write_text(json.dumps({"ownShip": own, "targetShips": [target]}))
+    with pytest.raises(ConfigError, match=r"slow\.json: ownShip\.initial\.sog = 0\.5 kn \(own ship "
+                                          r"sails 9\.7–23\.3 kn\)"):
+        E.file_members([slow], ["none"])
+    with pytest.raises(ValueError, match="course_deg with a schedule"):
+        TargetConfig(north=1e3, east=0.0, course_deg=10.0,
+                     schedule=[{"t": 0.0, "course_deg": 60.0, "speed": 6.0}])

@@ -99,9 +99,16 @@ def standard_members(methods, *, mc: int = 0, seed: int = 0, own_speed: float = 
 
 def file_members(paths, methods) -> list[Member]:
     """Situations read from trafficgen files, each met with every method."""
+    from shipgnc.units import KNOT
+    from shipgnc.vessels.frigate import SPEED_RANGE
+
+    low, high = SPEED_RANGE  # the own ship's (OWN_SHIP) valid speeds
     members = []
     for path in paths:
         sit = own_frame(tg.read(path))
+        if not low <= sit.own_speed <= high:
+            raise ConfigError(f"{path}: ownShip.initial.sog = {sit.own_speed / KNOT:g} kn (own ship "
+                              f"sails {low / KNOT:.1f}–{high / KNOT:.1f} kn)")
         bearing = _bearing_deg(sit)
         for method in methods:
             members.append(Member(sit, method, 0, bearing))
