@@ -307,3 +307,30 @@ def test_bad_seed_own_speed_and_schedule_with_course(tmp_path):
     with pytest.raises(ValueError, match="course_deg with a schedule"):
         TargetConfig(north=1e3, east=0.0, course_deg=10.0,
                      schedule=[{"t": 0.0, "course_deg": 60.0, "speed": 6.0}])
+
+
+def test_a_target_is_absent_before_its_first_sample(tmp_path):
+    """Targets first heard at t = 150 s (their first AIS reports; the log's own-ship !AIVDO reports
+    start at 0) are not there before: no report written before, NaN states in the result, no
+    avoidance and no range before 150 s. Dead-reckoned backwards, the head-on one would be met
+    221 s after t = 0 (3100 m at 14 m/s closing), inside SB-MPC's 100 s horizon from t = 121 s;
+    the receding one (12 m/s ahead of the own ship's 9) would be nearest at t = 0 (1050 m)."""
+    from shipgnc.ais.write import write_log
+    from shipgnc.colav.tracks import TargetTrack
+
+    first, origin = 150.0, (58.0, 10.0)
+    head_on = TargetTrack.constant(U * first + 1000.0, 0.0, math.pi, 5.0, t0=first)
+    receding = TargetTrack.constant(U * first + 1500.0, 3000.0, 0.0, 12.0, t0=first)
+    t = np.arange(0.0, 701.0, 10.0)
+    own = {"north": U * t, "east": 0.0 * t, "sog": np.full_like(t, U), "cog": 0.0 * t}
+    path = write_log(tmp_path / "log.nmea", t, own, [head_on, receding], origin, 257000001,
+                     [257000002, 257000003], interval=10.0)
+    log = json.dumps({"path": str(path), "origin": origin})
+    run = _run([], "sbmpc", extra=(f"guidance.ais_log={log}",))
+    ds = run.result
+    before = ds["time"].values < first
+    assert np.all(np.isnan(ds["target_north"].values[before]))
+    assert np.all(np.isfinite(ds["target_north"].values[~before]))
+    np.testing.assert_array_equal(ds["course_cmd"].values[before], ds["course_nominal"].values[before])
+    assert not np.array_equal(ds["course_cmd"].values, ds["course_nominal"].values)  # it does avoid
+    assert run.metrics["t_min_range_s"] >= first

@@ -72,10 +72,10 @@ def _turn_rates(track: TargetTrack) -> np.ndarray:
 
 def report_times(track: TargetTrack, *, t_end: float, t_start: float | None = None, ais_class: str = "A",
                  anchored: bool = False, turning: float = TURNING) -> np.ndarray:
-    """The times [s] a target transmits between ``t_start`` (default its first sample) and ``t_end``
-    inclusive: each report schedules the next one an interval later, the interval set by the speed
-    and rate of turn at the report."""
-    t = float(track.t[0] if t_start is None else t_start)
+    """The times [s] a target transmits between ``t_start`` (default, and at the earliest, its first
+    sample) and ``t_end`` inclusive: each report schedules the next one an interval later, the
+    interval set by the speed and rate of turn at the report."""
+    t = float(track.t[0] if t_start is None else max(t_start, track.t[0]))  # none before it exists
     if not (math.isfinite(t_end) and t_end >= t):
         raise ConfigError(f"t_end = {t_end!r}: must be a finite time ≥ the first report at t = {t:g} s")
     rates = _turn_rates(track)

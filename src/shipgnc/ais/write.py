@@ -119,7 +119,11 @@ def write_log(path, t, own: dict, targets, origin, own_mmsi: int, target_mmsis, 
     lines: list[tuple[float, int, list[str]]] = []
     for j, (ship, mmsi) in enumerate(zip(ships, mmsis, strict=True)):
         is_own = j == 0
-        idx = _report_indices(t, ship["sog"], ship["cog"], interval)
+        present = np.flatnonzero(np.isfinite(ship["north"]))  # a track reports from its first sample
+        if present.size == 0:
+            continue
+        idx = present[_report_indices(t[present], ship["sog"][present], ship["cog"][present],
+                                      interval)]
         lat, lon = plane.to_geo(ship["north"][idx], ship["east"][idx])
         vn, ve = ship["sog"][idx] * np.cos(ship["cog"][idx]), ship["sog"][idx] * np.sin(ship["cog"][idx])
         sog, cog = plane.velocity_to_true(lat, lon, vn, ve)
