@@ -334,3 +334,20 @@ def test_a_target_is_absent_before_its_first_sample(tmp_path):
     np.testing.assert_array_equal(ds["course_cmd"].values[before], ds["course_nominal"].values[before])
     assert not np.array_equal(ds["course_cmd"].values, ds["course_nominal"].values)  # it does avoid
     assert run.metrics["t_min_range_s"] >= first
+
+
+def test_sweep_compliance_thresholds_fit_the_domain_and_horizon():
+    """The sweep's compliance thresholds come from its ship domain and the methods' horizon: a CPA
+    inside the domain (a collision) scores safety 0; a clean SB-MPC pass in the overtaking
+    give-way (closing at 4.5 m/s: the collision enters the 100 s horizon at 200 + 450 = 650 m,
+    inside a fixed 0.5 nm 'too late') is not scored rule_16 = 0."""
+    from shipgnc.colav.compliance import safety_score
+    from shipgnc.colav.sbmpc import SBMPCConfig
+    from shipgnc.colav.vo import VOConfig
+
+    assert SBMPCConfig().horizon == VOConfig().horizon == E.HORIZON
+    c = E.sweep_compliance(0.5 * U)
+    assert (c.r_collision, c.r_early, c.r_late) == (E.SAFETY_RADIUS, 650.0, 425.0)
+    assert safety_score(E.SAFETY_RADIUS - 1e-6, c) == 0.0 < safety_score(E.SAFETY_RADIUS + 1.0, c)
+    sweep = E.run_members(E.standard_members(["sbmpc"], specs=(tg.STANDARD[1],)), backend="numpy")
+    assert sweep.scores["collision"][0] == 0 and sweep.scores["rule_16"][0] > 0.0

@@ -73,10 +73,11 @@ def score(scenario, result, setup) -> dict:
     return out
 
 
-def compliance_arrays(result, members_tracks, codes) -> dict[str, np.ndarray]:
+def compliance_arrays(result, members_tracks, codes, configs=None) -> dict[str, np.ndarray]:
     """COLREG compliance after Woerner (:func:`shipgnc.colav.compliance.compliance_scores`) of
     every member of a batch result: ``members_tracks`` one list of targets per member, ``codes``
-    their situations at t = 0 (member, target). Returns (member,) arrays: each rule's score
+    their situations at t = 0 (member, target), ``configs`` one ComplianceConfig per member (None:
+    the defaults). Returns (member,) arrays: each rule's score
     (``rule_14`` … ``rule_17``, NaN where no encounter invokes it) and ``compliance``, the least
     score of the rules the member's encounters invoke (the safety score is ``safety``)."""
     from shipgnc.colav.compliance import SCORES, compliance_scores
@@ -93,7 +94,8 @@ def compliance_arrays(result, members_tracks, codes) -> dict[str, np.ndarray]:
     out = {name: np.full(len(members_tracks), np.nan) for name in (*SCORES, "compliance")}
     for k, tracks in enumerate(members_tracks):
         scores = compliance_scores(t, north[:, k], east[:, k], course[:, k], speed[:, k], tracks,
-                                   list(codes[k][:len(tracks)]))
+                                   list(codes[k][:len(tracks)]),
+                                   None if configs is None else configs[k])
         for name in SCORES:
             out[name][k] = scores[name]
         rules = [scores[name] for name in SCORES if name != "safety" and not np.isnan(scores[name])]

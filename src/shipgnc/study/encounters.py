@@ -40,6 +40,26 @@ SBMPC = {"d_safe": SAFETY_RADIUS, "speed_factors": [1.0]}
 VO = {"radius": SAFETY_RADIUS, "speed_factors": [1.0]}
 #: the nominal path: north from the origin, long enough for any encounter
 PATH_LENGTH = 40_000.0
+#: the avoidance horizon of both methods [s]: SB-MPC's prediction horizon T and the velocity
+#: obstacles' horizon, their defaults (the sweep keeps them)
+HORIZON = 100.0
+
+
+def sweep_compliance(closing_speed: float):
+    """The compliance thresholds (:class:`shipgnc.colav.compliance.ComplianceConfig`) of a sweep
+    member from the ship domain R = :data:`SAFETY_RADIUS` and the avoidance horizon
+    T = :data:`HORIZON`, ``closing_speed`` v [m/s] the magnitude of the relative velocity at t = 0:
+
+    r_collision = R (a collision is a CPA inside the domain, as the ``collision`` score counts it),
+    r_near_miss = 2 R, r_safe = 4 R; r_early = R + v T — the range at which a collision course
+    enters the horizon, the earliest an avoidance method can act — and r_late = R + v T/2, half the
+    horizon left. Fixed ranges (1 nm, 0.5 nm) would call every action in a slow overtaking late:
+    closing at 4.5 m/s, the collision enters a 100 s horizon at 650 m."""
+    from shipgnc.colav.compliance import ComplianceConfig
+
+    R, v = SAFETY_RADIUS, max(float(closing_speed), 1e-3)
+    return ComplianceConfig(r_collision=R, r_near_miss=2 * R, r_safe=4 * R,
+                            r_early=R + v * HORIZON, r_late=R + v * HORIZON / 2)
 
 
 @dataclass(frozen=True)
@@ -218,8 +238,12 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
         arrays = batch_arrays(result, guidance, SAFETY_RADIUS)
         arrays.update(initial_scores(members, index))
         if compliance:
+            closing = [math.hypot(m.situation.targets[0].v_north[0] - m.situation.own_speed,
+                                  m.situation.targets[0].v_east[0])
+                       for m in (members[i] for i in index)]  # own course 0 at t = 0
             arrays.update(compliance_arrays(result, [members[i].situation.targets for i in index],
-                                            situation_codes(members, index)))
+                                            situation_codes(members, index),
+                                            [sweep_compliance(v) for v in closing]))
         for key, value in arrays.items():
             scores[key][index] = value
         if keep_results:
