@@ -124,7 +124,11 @@ def write_log(path, t, own: dict, targets, origin, own_mmsi: int, target_mmsis, 
             continue
         idx = present[_report_indices(t[present], ship["sog"][present], ship["cog"][present],
                                       interval)]
-        lat, lon = plane.to_geo(ship["north"][idx], ship["east"][idx])
+        # the report's time is the tag block's whole second: the position is interpolated there
+        unix_all = np.round(start_time + t[idx] - t[0])
+        t_rep = unix_all - start_time + t[0]
+        lat, lon = plane.to_geo(np.interp(t_rep, t[present], ship["north"][present]),
+                                np.interp(t_rep, t[present], ship["east"][present]))
         vn, ve = ship["sog"][idx] * np.cos(ship["cog"][idx]), ship["sog"][idx] * np.sin(ship["cog"][idx])
         sog, cog = plane.velocity_to_true(lat, lon, vn, ve)
         hdg = plane.heading_to_true(lat, lon, ship["heading"][idx])
@@ -136,8 +140,8 @@ def write_log(path, t, own: dict, targets, origin, own_mmsi: int, target_mmsis, 
                                             to_port=round(dims[1] / 2), to_starboard=round(dims[1] / 2))
         static = nmea.StaticData(mmsi=mmsi, name=str(names[j]).upper()[:20], msg_type=5, **half)
         last_static = -math.inf
-        for i, k in enumerate(idx):
-            unix = start_time + float(t[k]) - float(t[0])
+        for i in range(idx.size):
+            unix = float(unix_all[i])
             if unix - last_static >= STATIC_EVERY:
                 lines.append((unix, j, nmea.encode_static(static, own=is_own, seq_id=j)))
                 last_static = unix
