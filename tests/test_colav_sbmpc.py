@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from colav_loop import closed_loop as shared_loop
 from shipgnc.colav.sbmpc import (
     SBMPC_MEMORY,
     SBMPCConfig,
@@ -29,26 +30,8 @@ def target_with_course(course_deg, speed=5.0, t_meet=200.0):
 
 
 def closed_loop(targets, steps=150, dt=2.0, config=None):
-    """Commands and ranges of the encounter: returns offsets [deg], speeds, ranges (steps × n),
-    targets' relative bearings [deg] per step."""
-    p = sbmpc_params(config)
-    own = np.array([0.0, 0.0, *NOMINAL])
-    tg = np.array(targets, dtype=float).reshape(-1, 4)
-    z = np.zeros(SBMPC_MEMORY)
-    out = np.zeros(2)
-    offsets, speeds, ranges, bearings = [], [], [], []
-    for k in range(steps):
-        sbmpc_choose(k * dt, own, tg.ravel().copy(), tg.shape[0], NOMINAL, p, z, out)
-        offsets.append(math.degrees(out[0] - NOMINAL[0]))
-        speeds.append(out[1])
-        own[2:] = out
-        own[0] += out[1] * math.cos(out[0]) * dt
-        own[1] += out[1] * math.sin(out[0]) * dt
-        tg[:, :2] += tg[:, 2:] * dt
-        rel = tg[:, :2] - own[:2]
-        ranges.append(np.hypot(rel[:, 0], rel[:, 1]))
-        bearings.append(np.degrees(np.arctan2(rel[:, 1], rel[:, 0]) - own[2]))
-    return np.array(offsets), np.array(speeds), np.array(ranges), (np.array(bearings) + 180) % 360 - 180
+    """Commands and ranges of the encounter (:func:`colav_loop.closed_loop`)."""
+    return shared_loop(sbmpc_choose, sbmpc_params(config), SBMPC_MEMORY, targets, NOMINAL, steps, dt)
 
 
 def test_no_target_gives_the_nominal_exactly():
