@@ -60,14 +60,20 @@ def interval(speed: float, rot: float = 0.0, *, ais_class: str = "A", anchored: 
     return 30.0 if kn <= 14.0 else 15.0 if kn <= 23.0 else 5.0
 
 
-def _turn_rates(track: TargetTrack) -> np.ndarray:
-    """Rate of course change [rad/s] over each sample interval (the last one's for the last sample)."""
-    if track.t.size < 2:
-        return np.zeros(track.t.size)
-    course = np.arctan2(track.v_east, track.v_north)
+def turn_rates(t, course) -> np.ndarray:
+    """Rate of course change [rad/s] over each interval of the samples ``t`` [s], ``course`` [rad]
+    (the last interval's for the last sample; 0 for a single sample)."""
+    t, course = np.asarray(t, float), np.asarray(course, float)
+    if t.size < 2:
+        return np.zeros(t.size)
     dc = np.mod(np.diff(course) + math.pi, 2 * math.pi) - math.pi
-    rate = dc / np.diff(track.t)
+    rate = dc / np.diff(t)
     return np.append(rate, rate[-1])
+
+
+def _turn_rates(track: TargetTrack) -> np.ndarray:
+    """:func:`turn_rates` of a track's samples."""
+    return turn_rates(track.t, np.arctan2(track.v_east, track.v_north))
 
 
 def report_times(track: TargetTrack, *, t_end: float, t_start: float | None = None, ais_class: str = "A",

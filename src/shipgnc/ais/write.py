@@ -24,6 +24,7 @@ import numpy as np
 
 from shipgnc.ais import nmea
 from shipgnc.ais.reporting import interval as ais_interval
+from shipgnc.ais.reporting import turn_rates
 from shipgnc.colav.tracks import TargetTrack
 from shipgnc.errors import ConfigError
 
@@ -70,8 +71,7 @@ def _ship(name: str, t: np.ndarray, ship) -> dict:
 def _report_indices(t: np.ndarray, sog: np.ndarray, cog: np.ndarray, interval: float | None) -> np.ndarray:
     """Sample indices of the reports: the first sample, then each the interval after the last, in
     whole seconds."""
-    dc = np.mod(np.diff(cog) + math.pi, 2 * math.pi) - math.pi
-    rot = np.append(dc / np.diff(t), 0.0) if t.size > 1 else np.zeros(1)
+    rot = turn_rates(t, cog)
     idx, tr = [], float(t[0])
     while tr <= t[-1] + 1e-9:
         k = int(np.searchsorted(t, tr - 1e-9))
@@ -108,8 +108,7 @@ def write_log(path, t, own: dict, targets, origin, own_mmsi: int, target_mmsis, 
     if len(set(mmsis)) != len(mmsis):
         raise ConfigError(f"own_mmsi, target_mmsis = {mmsis}: every ship needs its own MMSI")
     for m in mmsis:
-        if not 0 < m < 10**9:
-            raise ConfigError(f"MMSI {m}: must be a 9-digit number")
+        nmea.check_mmsi(m, "MMSI")
     if names is None:
         names = ["OWN SHIP", *(f"TARGET {i + 1}" for i in range(len(targets)))]
     names = list(names)

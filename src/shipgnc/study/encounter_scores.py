@@ -48,11 +48,16 @@ def colav_arrays(t, range_min, t_range_min, target_range_min, leg, along_track, 
     }
 
 
+def _two(result, name) -> np.ndarray:
+    """The variable ``name`` of a result as (time, member) (a single run: one member)."""
+    a = result[name].values
+    return a.reshape(a.shape[0], -1)
+
+
 def batch_arrays(result, guidance, safety_radius: float) -> dict[str, np.ndarray]:
     """:func:`colav_arrays` of a result with a member dimension (or none: one member)."""
     def two(name):
-        a = result[name].values
-        return a.reshape(a.shape[0], -1)
+        return _two(result, name)
 
     return colav_arrays(result["time"].values, two("range_min"), two("t_range_min"),
                         two("target_range_min"), two("leg"), two("along_track"),
@@ -85,8 +90,7 @@ def compliance_arrays(result, members_tracks, codes, configs=None) -> dict[str, 
     t = result["time"].values
 
     def two(name):
-        a = result[name].values
-        return a.reshape(a.shape[0], -1)
+        return _two(result, name)
 
     north, east, psi, u = two("north"), two("east"), two("psi"), two("u")
     v = two("v") if "v" in result else np.zeros_like(u)

@@ -236,13 +236,14 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
         result = guidance.add_targets(result)
         out.ship_steps += len(index) * round(DURATION / DT)
         arrays = batch_arrays(result, guidance, SAFETY_RADIUS)
-        arrays.update(initial_scores(members, index))
+        codes = situation_codes(members, index)
+        arrays.update(initial_scores(members, index, codes))
         if compliance:
             closing = [math.hypot(m.situation.targets[0].v_north[0] - m.situation.own_speed,
                                   m.situation.targets[0].v_east[0])
                        for m in (members[i] for i in index)]  # own course 0 at t = 0
             arrays.update(compliance_arrays(result, [members[i].situation.targets for i in index],
-                                            situation_codes(members, index),
+                                            codes,
                                             [sweep_compliance(v) for v in closing]))
         for key, value in arrays.items():
             scores[key][index] = value
@@ -252,10 +253,10 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
     return out
 
 
-def initial_scores(members, index) -> dict[str, np.ndarray]:
+def initial_scores(members, index, codes=None) -> dict[str, np.ndarray]:
     """The COLREG situation (code of :data:`shipgnc.colav.colreg.SITUATIONS`) and the closed-form
-    CPA at t = 0 towards each member's first target."""
-    from shipgnc.colav.colreg import situations
+    CPA at t = 0 towards each member's first target (``codes``: :func:`situation_codes`, if
+    already computed)."""
     from shipgnc.colav.geometry import encounter_geometry
 
     own = np.array([[0.0, 0.0, members[i].situation.own_course, members[i].situation.own_speed]
@@ -263,8 +264,9 @@ def initial_scores(members, index) -> dict[str, np.ndarray]:
     target = np.array([[t.north[0], t.east[0], t.v_north[0], t.v_east[0]]
                        for t in (members[i].situation.targets[0] for i in index)])
     geo = encounter_geometry(own, target)
-    return {"situation": situations(own, target).astype(float), "d_cpa0_m": geo["d_cpa"],
-            "t_cpa0_s": geo["t_cpa"]}
+    codes = situation_codes(members, index) if codes is None else codes
+    return {"situation": codes[:, 0].astype(float),
+            "d_cpa0_m": geo["d_cpa"], "t_cpa0_s": geo["t_cpa"]}
 
 
 def situation_codes(members, index) -> np.ndarray:
