@@ -51,7 +51,7 @@ def info(
 
         reports = read_reports(file, skip_unknown=skip_unknown)
         t0 = min(r.time for r in reports) if reports else 0.0
-        tracks, org = read_log(file, origin=_origin(origin), skip_unknown=skip_unknown, t0=t0)
+        tracks, org = read_log(file, origin=_origin(origin), t0=t0, reports=reports)
         t1 = max(r.time for r in reports)
         rows = []
         for tr in tracks:

@@ -283,8 +283,8 @@ def _velocities(t, north, east, vn, ve, lines, mmsi) -> tuple[np.ndarray, np.nda
     return np.where(missing, dn, vn), np.where(missing, de, ve)
 
 
-def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None = None
-             ) -> tuple[list[TargetTrack], tuple[float, float]]:
+def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None = None,
+             reports: list[Report] | None = None) -> tuple[list[TargetTrack], tuple[float, float]]:
     """The targets of a logged AIS file, one track per MMSI (sorted by MMSI), and the origin.
 
     Positions are in the local plane about ``origin`` (lat, lon) [deg] — given, or the centre of the
@@ -294,10 +294,12 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
     turned into the plane's axes. Times are seconds after ``t0`` [unix s] (default: the file's
     earliest message). Names and lengths come
     from static data (types 5, 24) where the file has them. ``!AIVDO`` tracks (the logging ship) have
-    ``source = "ais-own"``, the others ``"ais"``."""
+    ``source = "ais-own"``, the others ``"ais"``. ``reports``: the file's reports if already read
+    (:func:`read_reports`)."""
     from shipgnc.ais.plane import LocalPlane, centre, check_origin, check_range
 
-    reports = read_reports(path, skip_unknown=skip_unknown)
+    if reports is None:
+        reports = read_reports(path, skip_unknown=skip_unknown)
     where = f"AIS log {Path(path)}"
     by_mmsi: dict[int, list[Report]] = {}
     static: dict[int, dict] = {}
