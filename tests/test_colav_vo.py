@@ -82,7 +82,9 @@ def test_head_on_and_give_way_turn_to_starboard_and_pass_the_target_on_port(cour
     k = int(np.argmin(ranges[:, 0]))
     assert np.all(offsets[:k] >= 0)
     assert bearings[k, 0] < 0  # port to port / astern of the crossing target
-    assert ranges[k, 0] > 0.9 * RADIUS  # outside the VO, less what 2-s steps miss
+    # outside the VO: the relative track of a velocity outside the cone stays beyond the radius
+    # (the loop moves both ships exactly over each step), sampled every 2 s or not
+    assert ranges[k, 0] >= RADIUS
 
 
 def test_stand_on_keeps_course_until_the_collision_is_inside_the_horizon():
