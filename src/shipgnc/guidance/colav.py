@@ -237,6 +237,13 @@ class ColavGuidance:
 
 
 @kernel_function
+def course_over_ground(psi, u, v):
+    """χ = ψ + atan2(v, u) [rad]: the course over ground of a ship with heading ψ and body
+    velocities (u, v) (no current); scalars in a kernel, arrays through ``py_func``."""
+    return psi + np.arctan2(v, u)
+
+
+@kernel_function
 def colav_reference(t, x, z, p, ref, out):
     """One sample of :class:`ColavGuidance` for one ship (module docstring): LOS for the nominal
     course, the targets dead-reckoned from their tables, then the avoidance method — called every
@@ -277,7 +284,7 @@ def colav_reference(t, x, z, p, ref, out):
     if method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t)):
         v = x[i_v] if i_v >= 0 else 0.0
         own[0], own[1] = x[i_north], x[i_east]
-        own[2] = x[i_psi] + math.atan2(v, x[i_u])
+        own[2] = course_over_ground(x[i_psi], x[i_u], v)
         own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
         if method == 1:
             sbmpc_choose(t, own, targets, present, nominal, mp, zm, cmd)

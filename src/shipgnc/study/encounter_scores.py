@@ -86,6 +86,7 @@ def compliance_arrays(result, members_tracks, codes, configs=None) -> dict[str, 
     (``rule_14`` … ``rule_17``, NaN where no encounter invokes it) and ``compliance``, the least
     score of the rules the member's encounters invoke (the safety score is ``safety``)."""
     from shipgnc.colav.compliance import SCORES, compliance_scores
+    from shipgnc.guidance.colav import course_over_ground
 
     t = result["time"].values
 
@@ -94,7 +95,7 @@ def compliance_arrays(result, members_tracks, codes, configs=None) -> dict[str, 
 
     north, east, psi, u = two("north"), two("east"), two("psi"), two("u")
     v = two("v") if "v" in result else np.zeros_like(u)
-    course, speed = psi + np.arctan2(v, u), np.hypot(u, v)
+    course, speed = course_over_ground.py_func(psi, u, v), np.hypot(u, v)
     out = {name: np.full(len(members_tracks), np.nan) for name in (*SCORES, "compliance")}
     for k, tracks in enumerate(members_tracks):
         scores = compliance_scores(t, north[:, k], east[:, k], course[:, k], speed[:, k], tracks,
