@@ -4,7 +4,8 @@
 
 Times, back to back in one run, the standard set (five encounter types) with ``--mc`` perturbed
 variants of each, every member a 20-minute encounter (dt 0.5 s) of the frigate under SB-MPC
-(deciding every 5 s, 13 course offsets, a 100 s horizon at 5 s), as one batched run:
+(deciding every 5 s, 13 course offsets, a 100 s horizon at 5 s), as one batched run, the log
+kept every 20th step (10 s; the command keeps every 10th, 5 s):
 
 (a) the composed compiled loop (``backend="auto"``), after a warm-up that compiles or loads the
     loop from its disk cache (its serial form and the parallel one a batch of 256 ships or more

@@ -32,7 +32,7 @@ def test_info_lists_targets(tmp_path):
     assert out["targets"] == 2 and [r["mmsi"] for r in out["tracks"]] == [219000001, 219000002]
     own = out["tracks"][0]
     # 5 m/s = 9.7 kn: a report every 10 s (ITU-R M.1371-5 Table 1, 0–14 kn), 0 … 590 s
-    assert (own["source"], own["reports"], own["span_min"], own["sog_max_kn"]) == ("ais-own", 60, 9.83, 9.7)
+    assert (own["source"], own["reports"], own["span_min"], own["max_sog_kn"]) == ("ais-own", 60, 9.83, 9.7)
     result = runner.invoke(app, ["ais", "info", str(path)])
     assert result.exit_code == 0 and "219000002" in result.stdout and "2 targets" in result.stdout
 

@@ -42,7 +42,12 @@ def test_tag_block_log_to_tracks_with_geodesic_distances(tmp_path):
              tag_block(T0 + 60) + _pos(219000001, 57.705, 10.608, 12.0, 30.0),
              tag_block(T0 + 65) + _pos(219000002, 57.749, 10.699, 8.0, 200.0, msg_type=18)]
     tracks, origin = read_log(_write(tmp_path, lines))
-    assert origin == pytest.approx((57.725, 10.65))  # the centre of the data's ranges
+    # the centre: the mean of the four reports' unit vectors; for points a few km apart, to first
+    # order in their spread, latitude's arithmetic mean and longitude's mean weighted by cos φ
+    lat = np.array([57.7, 57.75, 57.705, 57.749])
+    lon = np.array([10.6, 10.7, 10.608, 10.699])
+    w = np.cos(np.radians(lat))
+    assert origin == pytest.approx((lat.mean(), (w * lon).sum() / w.sum()), abs=1e-5)
     a, b = tracks
     assert (a.mmsi, b.mmsi, a.source) == (219000001, 219000002, "ais")
     assert a.t.tolist() == [0.0, 60.0] and b.t.tolist() == [0.0, 65.0]
@@ -165,3 +170,29 @@ def test_outside_case_orbcomm_tag_block_excerpt(tmp_path):
     (tr,), _ = read_log(_write(tmp_path, [lines[4], lines[3], lines[1]]))  # in time order it reads
     assert tr.t.tolist() == [0.0, 161.0, 552.0]
     assert np.all(np.abs(np.hypot(tr.v_north, tr.v_east) - np.array([1.2, 1.1, 1.2]) * KNOT) < 1e-9)
+
+
+def test_far_apart_ships_are_refused_and_the_centre_spans_the_antimeridian(tmp_path):
+    """A ship beyond the local plane's 60 km (scale 10⁻⁴) is one line naming its MMSI and its
+    geodesic distance; the data's centre is the mean of earth-centred unit vectors, so two ships
+    either side of 180° are centred on it, not at longitude 0."""
+    from shipgnc.ais.plane import centre
+
+    far = tmp_path / "far.csv"
+    far.write_text("MMSI,BaseDateTime,LAT,LON,SOG,COG\n"
+                   "219000010,2023-01-01T00:00:00,57.7,11.9,10,0\n"
+                   "503000001,2023-01-01T00:00:10,-33.86,151.2,10,0\n", encoding="utf-8")
+    _, _, d = GEOD.inv(11.9, 57.7, 151.2, -33.86)
+    _raises(far, r"MMSI 219000010 is \d+ km from the local plane's origin")
+    msg = _raises(far, r"MMSI 503000001 is \d+ km", origin=(57.7, 11.9))
+    assert f"{d / 1000:.0f} km" in msg
+    lat, lon = centre([0.0, 0.0], [179.9, -179.9])
+    assert abs(lat) < 1e-9 and abs(abs(lon) - 180.0) < 1e-9
+    across = tmp_path / "across.csv"
+    across.write_text("MMSI,BaseDateTime,LAT,LON,SOG,COG\n"
+                      "512000001,2023-01-01T00:00:00,-40.0,179.95,10,0\n"
+                      "512000002,2023-01-01T00:00:10,-40.0,-179.95,10,0\n", encoding="utf-8")
+    (a, b), origin = read_log(across)
+    assert abs(abs(origin[1]) - 180.0) < 1e-6
+    _, _, gap = GEOD.inv(179.95, -40.0, -179.95, -40.0)
+    assert math.hypot(a.north[0] - b.north[0], a.east[0] - b.east[0]) == pytest.approx(gap, rel=2e-4)

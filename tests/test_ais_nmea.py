@@ -54,8 +54,9 @@ def test_not_available_values_are_missing_both_ways():
 
 
 def test_rate_of_turn_round_trip():
-    """ROT_AIS = 4.733 √ROT: one raw step is 2·√ROT/4.733 °/min at ROT; pyais rounds to 1 °/min."""
-    for rot_deg_min in (0.0, 10.0, -25.0, 300.0, -700.0):
+    """ROT_AIS = 4.733 √ROT: one raw step is 2·√ROT/4.733 °/min at ROT; pyais rounds to 1 °/min.
+    ±127 and ±128 °/min are rates like any other, not the codes ±127/−128 of the raw field."""
+    for rot_deg_min in (0.0, 10.0, -25.0, 300.0, -700.0, 127.0, -127.0, 128.0, -128.0):
         r = PositionReport(mmsi=244000002, lat=55.0, lon=12.0, sog=3.0, cog=1.0, heading=1.0,
                            rot=rot_deg_min * nmea.DEG_PER_MIN)
         d = nmea.decode(*nmea.encode_position(r))

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from colav_loop import closed_loop as shared_loop
 from shipgnc.colav.sbmpc import (
     SBMPC_MEMORY,
     SBMPCConfig,
@@ -19,6 +20,15 @@ from shipgnc.colav.sbmpc import (
 
 NOMINAL = np.array([0.0, 5.0])  # north at 5 m/s
 D_SAFE = SBMPCConfig().d_safe
+DT_PREDICTION = SBMPCConfig().dt
+
+
+def cleared(relative_speed):
+    """The least range SB-MPC's prediction guarantees: it keeps the predicted range ≥ d_safe at
+    samples Δt apart, and a straight relative track passing at d between two samples s = v Δt/2
+    either side of its closest point has sampled range √(d² + s²): d ≥ √(d_safe² − s²)."""
+    s = relative_speed * DT_PREDICTION / 2
+    return math.sqrt(max(D_SAFE**2 - s * s, 0.0))
 
 
 def target_with_course(course_deg, speed=5.0, t_meet=200.0):
@@ -29,26 +39,8 @@ def target_with_course(course_deg, speed=5.0, t_meet=200.0):
 
 
 def closed_loop(targets, steps=150, dt=2.0, config=None):
-    """Commands and ranges of the encounter: returns offsets [deg], speeds, ranges (steps × n),
-    targets' relative bearings [deg] per step."""
-    p = sbmpc_params(config)
-    own = np.array([0.0, 0.0, *NOMINAL])
-    tg = np.array(targets, dtype=float).reshape(-1, 4)
-    z = np.zeros(SBMPC_MEMORY)
-    out = np.zeros(2)
-    offsets, speeds, ranges, bearings = [], [], [], []
-    for k in range(steps):
-        sbmpc_choose(k * dt, own, tg.ravel().copy(), tg.shape[0], NOMINAL, p, z, out)
-        offsets.append(math.degrees(out[0] - NOMINAL[0]))
-        speeds.append(out[1])
-        own[2:] = out
-        own[0] += out[1] * math.cos(out[0]) * dt
-        own[1] += out[1] * math.sin(out[0]) * dt
-        tg[:, :2] += tg[:, 2:] * dt
-        rel = tg[:, :2] - own[:2]
-        ranges.append(np.hypot(rel[:, 0], rel[:, 1]))
-        bearings.append(np.degrees(np.arctan2(rel[:, 1], rel[:, 0]) - own[2]))
-    return np.array(offsets), np.array(speeds), np.array(ranges), (np.array(bearings) + 180) % 360 - 180
+    """Commands and ranges of the encounter (:func:`colav_loop.closed_loop`)."""
+    return shared_loop(sbmpc_choose, sbmpc_params(config), SBMPC_MEMORY, targets, NOMINAL, steps, dt)
 
 
 def test_no_target_gives_the_nominal_exactly():
@@ -87,7 +79,7 @@ def test_head_on_turns_to_starboard_and_passes_port_to_port():
     assert acted.any() and np.all(offsets[acted] > 0)  # every alteration is to starboard
     k = int(np.argmin(ranges[:, 0]))
     assert bearings[k, 0] < 0  # the target passes on the port side
-    assert ranges[k, 0] > 0.8 * D_SAFE  # clear: d_safe, less what 5-s prediction samples miss
+    assert ranges[k, 0] > cleared(2 * NOMINAL[1])  # closing at 10 m/s: 43.3 m
 
 
 @pytest.mark.parametrize("course_deg", [225.0, 270.0, 290.0])
@@ -123,7 +115,7 @@ def test_stand_on_keeps_course_when_the_give_way_ship_passes_astern():
 def test_overtaking_passes_clear_and_gets_ahead():
     slow = [300.0, 0.0, 2.0, 0.0]  # 300 m ahead on the same track at 2 m/s
     _, _, ranges, bearings = closed_loop([slow], steps=400)
-    assert ranges.min() > 0.8 * D_SAFE
+    assert ranges.min() > cleared(NOMINAL[1] - 2.0)  # closing at 3 m/s: 49.4 m
     assert abs(bearings[-1, 0]) > 90.0  # the target ends abaft the beam: overtaken
 
 

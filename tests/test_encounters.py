@@ -226,8 +226,10 @@ def test_sweep_members_are_their_scenarios():
 def test_targets_replayed_from_an_ais_log(tmp_path):
     """A target written as an NMEA AIS log (reports every 10 s, pyais) and replayed through
     ``guidance.ais_log`` moves as the constant-velocity track it was written from, to the message's
-    quantisation (position 1/10000 arc minute, SOG 0.1 kn, COG 0.1°: metres over the run), and
-    its realised CPA is the closed form's to the same tolerance."""
+    quantisation, and its realised CPA is the closed form's to the same tolerance. The bound: half
+    a position step (1/10000 arc minute: 0.09 m north, 0.05 m east at 58° N) plus 10 s of dead
+    reckoning on half a SOG step (0.05 kn: 0.26 m) and half a COG step (0.05° of 8 m/s: 0.07 m),
+    0.5 m in all; 1 m allowed (the plane's scale error at 8 km is 10⁻⁶, mm)."""
     from shipgnc.ais.write import write_log
     from shipgnc.colav.tracks import TargetTrack
 
@@ -242,9 +244,112 @@ def test_targets_replayed_from_an_ais_log(tmp_path):
     ds = run.result
     n, e, _, _ = true.at(ds["time"].values)
     assert ds.sizes["target"] == 1
-    np.testing.assert_allclose(ds["target_north"].values[:, 0], n, atol=5.0)
-    np.testing.assert_allclose(ds["target_east"].values[:, 0], e, atol=5.0)
+    np.testing.assert_allclose(ds["target_north"].values[:, 0], n, atol=1.0)
+    np.testing.assert_allclose(ds["target_east"].values[:, 0], e, atol=1.0)
     v = 8.0 * np.array([math.cos(course), math.sin(course)]) - np.array([U, 0.0])
     d_cpa, t_cpa = closed_form_cpa(np.array([8000.0, 2500.0]), v)
-    assert run.metrics["min_range_m"] == pytest.approx(d_cpa, abs=5.0)
+    assert run.metrics["min_range_m"] == pytest.approx(d_cpa, abs=1.0)
     assert run.metrics["t_min_range_s"] == pytest.approx(t_cpa, abs=2.0)
+
+
+def test_monte_carlo_variants_classify_as_their_type_and_nest():
+    """Every perturbed variant of the standard set is, by COLREG rules 13–17 at t = 0, the
+    situation its type names; each type draws from its own child seed, so the variants of
+    ``mc`` = 5 are the first five of ``mc`` = 10."""
+    from shipgnc.colav.colreg import SITUATIONS
+
+    ten = E.standard_members(["none"], mc=10, seed=3, own_speed=U)
+    five = E.standard_members(["none"], mc=5, seed=3, own_speed=U)
+    scores = E.initial_scores(ten, range(len(ten)))
+    for m, code in zip(ten, scores["situation"], strict=True):
+        assert SITUATIONS[int(code)] == tg.SITUATION_OF[m.situation.encounter_type], m.spec
+    first = [m.spec for m in ten if m.mc < 5]
+    assert first == [m.spec for m in five]
+
+
+def test_trafficgen_current_layout_latitude_longitude():
+    """trafficgen's current files (and the maritime-schema) spell positions latitude/longitude."""
+    ship = {"initial": {"position": {"latitude": 58.0, "longitude": 10.0}, "sog": 10.0,
+                        "cog": 0.0}}
+    target = {"initial": {"position": {"latitude": 58.05, "longitude": 10.0}, "sog": 10.0,
+                          "cog": 180.0}}
+    sit = tg.parse({"ownShip": ship, "targetShips": [target]})
+    assert sit.origin == (58.0, 10.0) and sit.targets[0].north[0] == pytest.approx(5566, abs=5)
+
+
+def test_a_far_away_target_is_refused_with_its_distance():
+    """A target beyond the local plane's 60 km: one line naming it and its geodesic distance."""
+    from pyproj import Geod
+
+    from shipgnc.errors import ConfigError
+
+    own = {"initial": {"position": {"lat": 58.0, "lon": 10.0}, "sog": 15.0, "cog": 0.0}}
+    far = {"initial": {"position": {"lat": 59.0, "lon": 10.0}, "sog": 10.0, "cog": 180.0}}
+    _, _, d = Geod(ellps="WGS84").inv(10.0, 58.0, 10.0, 59.0)
+    with pytest.raises(ConfigError, match=rf"F: targetShips\[0\] is {d / 1000:.0f} km from"):
+        tg.parse({"ownShip": own, "targetShips": [far]}, "F")
+
+
+def test_bad_seed_own_speed_and_schedule_with_course(tmp_path):
+    """--seed -1 is a usage error; an own ship slower than the frigate's 5–12 m/s (van Amerongen's
+    table) names the file's field in knots; a target with both a schedule and a course is refused."""
+    from shipgnc.errors import ConfigError
+    from shipgnc.scenarios.sections import TargetConfig
+
+    runner = CliRunner()
+    done = runner.invoke(app, ["encounters", "--seed", "-1", "--out", str(tmp_path / "o")])
+    assert done.exit_code == 2 and "Traceback" not in done.output
+    slow = tmp_path / "slow.json"
+    own = {"initial": {"position": {"lat": 58.0, "lon": 10.0}, "sog": 0.5, "cog": 0.0}}
+    target = {"initial": {"position": {"lat": 58.05, "lon": 10.0}, "sog": 10.0, "cog": 180.0}}
+    slow.write_text(json.dumps({"ownShip": own, "targetShips": [target]}))
+    with pytest.raises(ConfigError, match=r"slow\.json: ownShip\.initial\.sog = 0\.5 kn \(own ship "
+                                          r"sails 9\.7–23\.3 kn\)"):
+        E.file_members([slow], ["none"])
+    with pytest.raises(ValueError, match="course_deg with a schedule"):
+        TargetConfig(north=1e3, east=0.0, course_deg=10.0,
+                     schedule=[{"t": 0.0, "course_deg": 60.0, "speed": 6.0}])
+
+
+def test_a_target_is_absent_before_its_first_sample(tmp_path):
+    """Targets first heard at t = 150 s (their first AIS reports; the log's own-ship !AIVDO reports
+    start at 0) are not there before: no report written before, NaN states in the result, no
+    avoidance and no range before 150 s. Dead-reckoned backwards, the head-on one would be met
+    221 s after t = 0 (3100 m at 14 m/s closing), inside SB-MPC's 100 s horizon from t = 121 s;
+    the receding one (12 m/s ahead of the own ship's 9) would be nearest at t = 0 (1050 m)."""
+    from shipgnc.ais.write import write_log
+    from shipgnc.colav.tracks import TargetTrack
+
+    first, origin = 150.0, (58.0, 10.0)
+    head_on = TargetTrack.constant(U * first + 1000.0, 0.0, math.pi, 5.0, t0=first)
+    receding = TargetTrack.constant(U * first + 1500.0, 3000.0, 0.0, 12.0, t0=first)
+    t = np.arange(0.0, 701.0, 10.0)
+    own = {"north": U * t, "east": 0.0 * t, "sog": np.full_like(t, U), "cog": 0.0 * t}
+    path = write_log(tmp_path / "log.nmea", t, own, [head_on, receding], origin, 257000001,
+                     [257000002, 257000003], interval=10.0)
+    log = json.dumps({"path": str(path), "origin": origin})
+    run = _run([], "sbmpc", extra=(f"guidance.ais_log={log}",))
+    ds = run.result
+    before = ds["time"].values < first
+    assert np.all(np.isnan(ds["target_north"].values[before]))
+    assert np.all(np.isfinite(ds["target_north"].values[~before]))
+    np.testing.assert_array_equal(ds["course_cmd"].values[before], ds["course_nominal"].values[before])
+    assert not np.array_equal(ds["course_cmd"].values, ds["course_nominal"].values)  # it does avoid
+    assert run.metrics["t_min_range_s"] >= first
+
+
+def test_sweep_compliance_thresholds_fit_the_domain_and_horizon():
+    """The sweep's compliance thresholds come from its ship domain and the methods' horizon: a CPA
+    inside the domain (a collision) scores safety 0; a clean SB-MPC pass in the overtaking
+    give-way (closing at 4.5 m/s: the collision enters the 100 s horizon at 200 + 450 = 650 m,
+    inside a fixed 0.5 nm 'too late') is not scored rule_16 = 0."""
+    from shipgnc.colav.compliance import safety_score
+    from shipgnc.colav.sbmpc import SBMPCConfig
+    from shipgnc.colav.vo import VOConfig
+
+    assert SBMPCConfig().horizon == VOConfig().horizon == E.HORIZON
+    c = E.sweep_compliance(0.5 * U)
+    assert (c.r_collision, c.r_early, c.r_late) == (E.SAFETY_RADIUS, 650.0, 425.0)
+    assert safety_score(E.SAFETY_RADIUS - 1e-6, c) == 0.0 < safety_score(E.SAFETY_RADIUS + 1.0, c)
+    sweep = E.run_members(E.standard_members(["sbmpc"], specs=(tg.STANDARD[1],)), backend="numpy")
+    assert sweep.scores["collision"][0] == 0 and sweep.scores["rule_16"][0] > 0.0

@@ -51,7 +51,7 @@ def info(
 
         reports = read_reports(file, skip_unknown=skip_unknown)
         t0 = min(r.time for r in reports) if reports else 0.0
-        tracks, org = read_log(file, origin=_origin(origin), skip_unknown=skip_unknown, t0=t0)
+        tracks, org = read_log(file, origin=_origin(origin), t0=t0, reports=reports)
         t1 = max(r.time for r in reports)
         rows = []
         for tr in tracks:
@@ -59,7 +59,7 @@ def info(
             rows.append(dict(mmsi=tr.mmsi, name=tr.name, source=tr.source, reports=int(tr.t.size),
                              first_utc=utc_text(t0 + tr.t[0]), last_utc=utc_text(t0 + tr.t[-1]),
                              span_min=round(float(tr.t[-1] - tr.t[0]) / 60.0, 2),
-                             sog_min_kn=round(min(speed), 1), sog_max_kn=round(max(speed), 1)))
+                             min_sog_kn=round(min(speed), 1), max_sog_kn=round(max(speed), 1)))
         summary = dict(file=str(file), messages=len(reports), targets=len(tracks), first_utc=utc_text(t0),
                        last_utc=utc_text(t1), span_min=round((t1 - t0) / 60.0, 2), origin=list(org))
         if json_:
@@ -68,6 +68,6 @@ def info(
         stdout.print(f"{file}: {len(reports)} messages, {len(tracks)} targets, {summary['first_utc']} to "
                      f"{summary['last_utc']} ({summary['span_min']:g} min); local plane about "
                      f"{org[0]:.5f}°, {org[1]:.5f}°", soft_wrap=True)
-        names = ["name", "source", "reports", "first_utc", "last_utc", "span_min", "sog_min_kn", "sog_max_kn"]
+        names = ["name", "source", "reports", "first_utc", "last_utc", "span_min", "min_sog_kn", "max_sog_kn"]
         print_columns(stdout, "targets", "MMSI", [str(r["mmsi"]) for r in rows],
                      {n: [str(r[n]) for r in rows] for n in names})

@@ -27,7 +27,7 @@ def encounters(
         show_default=False)] = None,
     mc: Annotated[int, typer.Option("--mc", min=0, help="Perturbed variants of each standard "
                                     "situation (0: the standard set itself).")] = 0,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the perturbations.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the perturbations.")] = 0,
     method: Annotated[str, typer.Option("--method", help="Avoidance methods, comma-separated.")]
         = "none",
     out: Annotated[Path, typer.Option("--out", help="Output directory.")] = Path("encounters-out"),
@@ -60,9 +60,16 @@ def encounters(
             for spec in tg.STANDARD:
                 tg.write(tg.situation_dict(spec, members[0].situation.own_speed),
                          folder / f"{spec.title}.json")
+            for m in members:  # each Monte Carlo variant, so that a member can be rerun
+                if mc and m.spec is not None:
+                    tg.write(tg.situation_dict(m.spec, m.situation.own_speed),
+                             folder / f"{m.spec.title}-mc{m.mc}.json")
         result = E.run_members(members, backend=backend, keep_results=figures)
         rows = E.summary(result)
         _print(rows, result)
+        disagree = sum(row["label_disagrees"] for row in rows)
+        print(f"{disagree} of {len(result.members)} members carry a label other than their "
+              "COLREG situation at t = 0 (grouped by the situation)")
         written = write_table(rows, out, "summary") + write_table(E.member_rows(result), out,
                                                                   "members")
         if figures:
@@ -80,7 +87,8 @@ def _print(rows, result) -> None:
                         f"({len(result.members) / max(result.seconds, 1e-9):.0f} encounters/s)",
                   title_justify="left")
     for name in rows[0]:
-        table.add_column(name, justify="left" if name in ("encounter", "method") else "right")
+        table.add_column(name, justify="left" if name in ("situation", "encounter", "method")
+                         else "right")
     for row in rows:
         table.add_row(*(f"{v:.1f}" if isinstance(v, float) else str(v) for v in row.values()))
     Console().print(table)

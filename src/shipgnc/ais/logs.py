@@ -283,19 +283,23 @@ def _velocities(t, north, east, vn, ve, lines, mmsi) -> tuple[np.ndarray, np.nda
     return np.where(missing, dn, vn), np.where(missing, de, ve)
 
 
-def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None = None
-             ) -> tuple[list[TargetTrack], tuple[float, float]]:
+def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None = None,
+             reports: list[Report] | None = None) -> tuple[list[TargetTrack], tuple[float, float]]:
     """The targets of a logged AIS file, one track per MMSI (sorted by MMSI), and the origin.
 
     Positions are in the local plane about ``origin`` (lat, lon) [deg] — given, or the centre of the
-    data's latitude and longitude ranges — the geo router's projection
-    (:class:`shipgnc.ais.plane.LocalPlane`); velocities over ground turned into the plane's axes. Times
-    are seconds after ``t0`` [unix s] (default: the file's earliest message). Names and lengths come
+    data (:func:`shipgnc.ais.plane.centre`, the mean of the reports' earth-centred unit vectors) —
+    the geo router's projection (:class:`shipgnc.ais.plane.LocalPlane`); a ship's report farther
+    than 60 km from it is a ConfigError naming its MMSI and distance. Velocities over ground are
+    turned into the plane's axes. Times are seconds after ``t0`` [unix s] (default: the file's
+    earliest message). Names and lengths come
     from static data (types 5, 24) where the file has them. ``!AIVDO`` tracks (the logging ship) have
-    ``source = "ais-own"``, the others ``"ais"``."""
-    from shipgnc.ais.plane import LocalPlane, check_origin
+    ``source = "ais-own"``, the others ``"ais"``. ``reports``: the file's reports if already read
+    (:func:`read_reports`)."""
+    from shipgnc.ais.plane import LocalPlane, centre, check_origin, check_range
 
-    reports = read_reports(path, skip_unknown=skip_unknown)
+    if reports is None:
+        reports = read_reports(path, skip_unknown=skip_unknown)
     where = f"AIS log {Path(path)}"
     by_mmsi: dict[int, list[Report]] = {}
     static: dict[int, dict] = {}
@@ -321,9 +325,12 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
     lat_all = np.array([r.msg.lat for rs in by_mmsi.values() for r in rs])
     lon_all = np.array([r.msg.lon for rs in by_mmsi.values() for r in rs])
     if origin is None:
-        origin = (0.5 * (lat_all.min() + lat_all.max()), 0.5 * (lon_all.min() + lon_all.max()))
+        origin = centre(lat_all, lon_all)
     origin = check_origin(origin)
     plane = LocalPlane(origin)
+    for mmsi in sorted(by_mmsi):
+        check_range(origin, [r.msg.lat for r in by_mmsi[mmsi]], [r.msg.lon for r in by_mmsi[mmsi]],
+                    f"{where}: MMSI {mmsi}")
     if t0 is None:
         t0 = min(r.time for r in reports)
     tracks = []

@@ -168,6 +168,12 @@ def from_message(msg) -> PositionReport | StaticData:
         second=int(msg.second))
 
 
+def check_mmsi(mmsi: int, what: str) -> None:
+    """An MMSI outside [1, 2^30) (the 30-bit field of every message): ConfigError naming ``what``."""
+    if not 0 < mmsi < 2**30:
+        raise ConfigError(f"{what} = {mmsi}: must be a 9-digit identity in [1, 2^30)")
+
+
 def _check(name: str, value, lo: float, hi: float, unit: str) -> None:
     if value is not None and not (math.isfinite(value) and lo <= value <= hi):
         raise ConfigError(f"AIS report {name} = {value!r}: must be in [{lo:g}, {hi:g}] {unit} or None "
@@ -178,8 +184,7 @@ def position_fields(r: PositionReport) -> dict:
     """The report as pyais message fields (AIS units, the 'not available' codes for ``None``)."""
     if r.msg_type not in POSITION_TYPES:
         raise ConfigError(f"AIS position report msg_type = {r.msg_type}: must be one of {POSITION_TYPES}")
-    if not 0 < r.mmsi < 2**30:
-        raise ConfigError(f"AIS report mmsi = {r.mmsi}: must be a 9-digit identity in [1, 2^30)")
+    check_mmsi(r.mmsi, "AIS report mmsi")
     _check("lat", r.lat, -90.0, 90.0, "deg")
     _check("lon", r.lon, -180.0, 180.0, "deg")
     _check("sog", r.sog, 0.0, 102.2 * KNOT, "m/s")
@@ -197,7 +202,10 @@ def position_fields(r: PositionReport) -> dict:
             fields["turn"] = -128
         else:
             rot_deg_min = r.rot / DEG_PER_MIN  # pyais encodes ROT_AIS = round(4.733 √|ROT|)
-            fields["turn"] = math.copysign(min(abs(rot_deg_min), 708.0), rot_deg_min)
+            turn = math.copysign(min(abs(rot_deg_min), 708.0), rot_deg_min)
+            if abs(turn) in (127.0, 128.0):  # pyais reads these as the codes ±127/−128: nudge off
+                turn = math.nextafter(turn, 0.0)  # (same ROT_AIS: 4.733 √127 = 53.3, √128: 53.5)
+            fields["turn"] = turn
     else:
         fields["cs"] = 1  # a Class B "CS" (carrier-sense) unit
     return fields
@@ -215,8 +223,7 @@ def encode_static(s: StaticData, *, own: bool = False, channel: str = "A", seq_i
     """NMEA sentences of static data: type 5 (two sentences) or, for ``msg_type=24``, parts A and B."""
     from pyais.encode import encode_dict
 
-    if not 0 < s.mmsi < 2**30:
-        raise ConfigError(f"AIS static data mmsi = {s.mmsi}: must be a 9-digit identity in [1, 2^30)")
+    check_mmsi(s.mmsi, "AIS static data mmsi")
     kind = "VDO" if own else "VDM"
     dims = dict(to_bow=min(s.to_bow, 511), to_stern=min(s.to_stern, 511), to_port=min(s.to_port, 63),
                 to_starboard=min(s.to_starboard, 63))

@@ -4,7 +4,8 @@
 With both ends at ``origin`` the router's oblique Mercator has its centre there and grid north is true
 north at the origin; it is conformal with scale k ≈ 1 + y²/(2R²) off its central line (Snyder 1987,
 eq. 9-9 on the sphere), so positions and headings within a few tens of kilometres of the origin are in
-metres and radians to 10⁻⁴. Velocities are turned between true and grid north by the meridian
+metres and radians to 10⁻⁴ (:data:`MAX_RANGE_M`, 60 km; a point farther from the origin is refused by
+:func:`check_range`). Velocities are turned between true and grid north by the meridian
 convergence at each point (:meth:`RouteProjection.rotate`); the scale k is left out of them.
 """
 
@@ -16,6 +17,34 @@ import numpy as np
 
 from shipgnc.errors import ConfigError
 from shipgnc.routing.geo.projection import RouteProjection
+
+#: how far from its origin the local plane is used [m]: scale within 10⁻⁴ (k − 1 ≈ y²/(2R²) = 4.4·10⁻⁵
+#: at 60 km, Snyder 1987 eq. 9-9 with R = 6371 km)
+MAX_RANGE_M = 60_000.0
+
+
+def centre(lat, lon) -> tuple[float, float]:
+    """(lat, lon) [deg] of the mean of the points' unit vectors (earth-centred, on the sphere): the
+    centre of data that straddle the antimeridian too, unlike a mean of longitudes."""
+    la, lo = np.radians(np.asarray(lat, float)), np.radians(np.asarray(lon, float))
+    x, y, z = (np.mean(np.cos(la) * np.cos(lo)), np.mean(np.cos(la) * np.sin(lo)),
+               np.mean(np.sin(la)))
+    return float(np.degrees(np.arctan2(z, np.hypot(x, y)))), float(np.degrees(np.arctan2(y, x)))
+
+
+def check_range(origin, lat, lon, what: str) -> None:
+    """A ConfigError naming ``what`` and its distance when any point (lat, lon) [deg] lies farther
+    than :data:`MAX_RANGE_M` from ``origin`` (geodesic distance on WGS84, pyproj's Geod)."""
+    from pyproj import Geod
+
+    lat, lon = np.atleast_1d(np.asarray(lat, float)), np.atleast_1d(np.asarray(lon, float))
+    _, _, dist = Geod(ellps="WGS84").inv(np.full(lat.shape, origin[1]),
+                                         np.full(lat.shape, origin[0]), lon, lat)
+    far = float(np.max(dist))
+    if far > MAX_RANGE_M:
+        raise ConfigError(f"{what} is {far / 1000:.0f} km from the local plane's origin "
+                          f"({origin[0]:.4f}°, {origin[1]:.4f}°): the plane holds to "
+                          f"{MAX_RANGE_M / 1000:.0f} km")
 
 
 def check_origin(origin, where: str = "origin") -> tuple[float, float]:

@@ -60,22 +60,28 @@ def interval(speed: float, rot: float = 0.0, *, ais_class: str = "A", anchored: 
     return 30.0 if kn <= 14.0 else 15.0 if kn <= 23.0 else 5.0
 
 
-def _turn_rates(track: TargetTrack) -> np.ndarray:
-    """Rate of course change [rad/s] over each sample interval (the last one's for the last sample)."""
-    if track.t.size < 2:
-        return np.zeros(track.t.size)
-    course = np.arctan2(track.v_east, track.v_north)
+def turn_rates(t, course) -> np.ndarray:
+    """Rate of course change [rad/s] over each interval of the samples ``t`` [s], ``course`` [rad]
+    (the last interval's for the last sample; 0 for a single sample)."""
+    t, course = np.asarray(t, float), np.asarray(course, float)
+    if t.size < 2:
+        return np.zeros(t.size)
     dc = np.mod(np.diff(course) + math.pi, 2 * math.pi) - math.pi
-    rate = dc / np.diff(track.t)
+    rate = dc / np.diff(t)
     return np.append(rate, rate[-1])
+
+
+def _turn_rates(track: TargetTrack) -> np.ndarray:
+    """:func:`turn_rates` of a track's samples."""
+    return turn_rates(track.t, np.arctan2(track.v_east, track.v_north))
 
 
 def report_times(track: TargetTrack, *, t_end: float, t_start: float | None = None, ais_class: str = "A",
                  anchored: bool = False, turning: float = TURNING) -> np.ndarray:
-    """The times [s] a target transmits between ``t_start`` (default its first sample) and ``t_end``
-    inclusive: each report schedules the next one an interval later, the interval set by the speed
-    and rate of turn at the report."""
-    t = float(track.t[0] if t_start is None else t_start)
+    """The times [s] a target transmits between ``t_start`` (default, and at the earliest, its first
+    sample) and ``t_end`` inclusive: each report schedules the next one an interval later, the
+    interval set by the speed and rate of turn at the report."""
+    t = float(track.t[0] if t_start is None else max(t_start, track.t[0]))  # none before it exists
     if not (math.isfinite(t_end) and t_end >= t):
         raise ConfigError(f"t_end = {t_end!r}: must be a finite time ≥ the first report at t = {t:g} s")
     rates = _turn_rates(track)

@@ -24,6 +24,7 @@ import numpy as np
 
 from shipgnc.ais import nmea
 from shipgnc.ais.reporting import interval as ais_interval
+from shipgnc.ais.reporting import turn_rates
 from shipgnc.colav.tracks import TargetTrack
 from shipgnc.errors import ConfigError
 
@@ -70,8 +71,7 @@ def _ship(name: str, t: np.ndarray, ship) -> dict:
 def _report_indices(t: np.ndarray, sog: np.ndarray, cog: np.ndarray, interval: float | None) -> np.ndarray:
     """Sample indices of the reports: the first sample, then each the interval after the last, in
     whole seconds."""
-    dc = np.mod(np.diff(cog) + math.pi, 2 * math.pi) - math.pi
-    rot = np.append(dc / np.diff(t), 0.0) if t.size > 1 else np.zeros(1)
+    rot = turn_rates(t, cog)
     idx, tr = [], float(t[0])
     while tr <= t[-1] + 1e-9:
         k = int(np.searchsorted(t, tr - 1e-9))
@@ -108,8 +108,7 @@ def write_log(path, t, own: dict, targets, origin, own_mmsi: int, target_mmsis, 
     if len(set(mmsis)) != len(mmsis):
         raise ConfigError(f"own_mmsi, target_mmsis = {mmsis}: every ship needs its own MMSI")
     for m in mmsis:
-        if not 0 < m < 10**9:
-            raise ConfigError(f"MMSI {m}: must be a 9-digit number")
+        nmea.check_mmsi(m, "MMSI")
     if names is None:
         names = ["OWN SHIP", *(f"TARGET {i + 1}" for i in range(len(targets)))]
     names = list(names)
@@ -119,8 +118,16 @@ def write_log(path, t, own: dict, targets, origin, own_mmsi: int, target_mmsis, 
     lines: list[tuple[float, int, list[str]]] = []
     for j, (ship, mmsi) in enumerate(zip(ships, mmsis, strict=True)):
         is_own = j == 0
-        idx = _report_indices(t, ship["sog"], ship["cog"], interval)
-        lat, lon = plane.to_geo(ship["north"][idx], ship["east"][idx])
+        present = np.flatnonzero(np.isfinite(ship["north"]))  # a track reports from its first sample
+        if present.size == 0:
+            continue
+        idx = present[_report_indices(t[present], ship["sog"][present], ship["cog"][present],
+                                      interval)]
+        # the report's time is the tag block's whole second: the position is interpolated there
+        unix_all = np.round(start_time + t[idx] - t[0])
+        t_rep = unix_all - start_time + t[0]
+        lat, lon = plane.to_geo(np.interp(t_rep, t[present], ship["north"][present]),
+                                np.interp(t_rep, t[present], ship["east"][present]))
         vn, ve = ship["sog"][idx] * np.cos(ship["cog"][idx]), ship["sog"][idx] * np.sin(ship["cog"][idx])
         sog, cog = plane.velocity_to_true(lat, lon, vn, ve)
         hdg = plane.heading_to_true(lat, lon, ship["heading"][idx])
@@ -132,8 +139,8 @@ def write_log(path, t, own: dict, targets, origin, own_mmsi: int, target_mmsis, 
                                             to_port=round(dims[1] / 2), to_starboard=round(dims[1] / 2))
         static = nmea.StaticData(mmsi=mmsi, name=str(names[j]).upper()[:20], msg_type=5, **half)
         last_static = -math.inf
-        for i, k in enumerate(idx):
-            unix = start_time + float(t[k]) - float(t[0])
+        for i in range(idx.size):
+            unix = float(unix_all[i])
             if unix - last_static >= STATIC_EVERY:
                 lines.append((unix, j, nmea.encode_static(static, own=is_own, seq_id=j)))
                 last_static = unix

@@ -38,12 +38,19 @@ the passing is no longer an encounter). Each behaviour is still judged on which 
 target, as in the paper.
 
 Defaults (:class:`SBMPCConfig`): the paper's behaviour set (course offsets and the speed factors it
-keeps); the weights, distances, horizon and sectors are those of the open-source SB-MPC of the
-authors' group (NTNU, PSBMPC library by T. Tengesdal, 2020: T = 100 s, Δt = 5 s, d_close = 1000 m,
+keeps). The other values are ours, not a published parameter file's (the public SB-MPC codes of the
+authors' group carry other numbers, file by file): T = 100 s, Δt = 5 s, d_close = 1000 m,
 d_safe = 50 m, K_coll = 1, κ = 3, k_P = 3, k_ΔP = 2.5, k_χ,sb = 1.3, k_χ,p = 1.6,
-k_Δχ,sb = 0.9, k_Δχ,p = 1.2, φ_AH = φ_OT = φ_CR = 68.5°, φ_HO = 22.5°) and of NTNU's
-colav-simulator (p = 1, q = 4); angles in the costs in radians. d_safe = 50 m suits the small
-vessels of the paper; for ships, scale it with their size.
+k_Δχ,sb = 0.9, k_Δχ,p = 1.2, p = 1, q = 4, φ_AH = φ_OT = φ_CR = 68.5°, φ_HO = 22.5°. The
+reasoning: the sectors are the paper's (68.5° and 22.5°, as in NTNU's public implementations);
+p = 1 and q = 4 are the paper's exponents; T and d_close cover a closing pair of ships at 10 m/s
+for the last kilometre; the weights rank the costs as the paper describes — κ (a COLREG
+violation) above any admissible turn cost, port turns dearer than starboard ones
+(k_χ,p > k_χ,sb), and a change of choice dearer to port than to starboard
+(k_Δχ,p > k_Δχ,sb). Sign convention: χ, and the change χ − χ_last that selects k_Δχ, are
+positive to starboard (NED, clockwise); a code whose course offsets are positive to port swaps the
+two weights. Angles in the costs are in radians. d_safe = 50 m suits the small vessels of the
+paper; for ships, scale it with their size.
 
 The per-ship memory ``z`` = [χ_last, 1 − P_last]: zeros mean "the nominal behaviour last".
 """

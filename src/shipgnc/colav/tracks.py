@@ -5,7 +5,8 @@ from NMEA or a CSV log, or simulated from a true track with the AIS reporting ru
 log all become a :class:`TargetTrack`: time-stamped samples of position and velocity over ground in the
 local NED plane (north, east in metres; SI everywhere). Between samples a target is dead-reckoned from
 the last sample at or before ``t`` (constant velocity), which is exact for a constant-velocity target
-given one sample and is what a ship's collision avoidance does with AIS reports.
+given one sample and is what a ship's collision avoidance does with AIS reports. Before its first
+sample a target is absent: NaN states, left out of the avoidance and the range bookkeeping.
 """
 
 from __future__ import annotations
@@ -66,12 +67,15 @@ class TargetTrack:
 
     def at(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(north, east, v_north, v_east) at times ``t``, dead-reckoned from the last sample at or
-        before each time (the first sample for earlier times)."""
+        before each time; NaN before the first sample (the target is not there yet: an AIS target
+        exists from its first report on)."""
         t = np.asarray(t, dtype=float)
         k = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.t.size - 1)
         dt = t - self.t[k]
-        return (self.north[k] + self.v_north[k] * dt, self.east[k] + self.v_east[k] * dt,
-                self.v_north[k], self.v_east[k])
+        absent = t < self.t[0]
+        return tuple(np.where(absent, np.nan, a) for a in (
+            self.north[k] + self.v_north[k] * dt, self.east[k] + self.v_east[k] * dt,
+            self.v_north[k], self.v_east[k]))
 
     def table(self) -> np.ndarray:
         """The samples as one (n, 5) array ``[t, north, east, v_north, v_east]`` (for kernels)."""

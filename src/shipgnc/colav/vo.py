@@ -79,7 +79,8 @@ def vo_params(config: VOConfig | None = None) -> np.ndarray:
     """Flat parameters of :func:`vo_choose`: [radius, horizon, the 5 of
     :func:`~shipgnc.colav.colreg.colreg_params`, n_offsets, n_factors, offsets (rad), factors]."""
     c = config or VOConfig()
-    offsets = sorted(c.course_offsets_deg, key=abs)
+    # nearest the nominal first; of two equal offsets starboard (+) first, so that it wins ties
+    offsets = sorted(c.course_offsets_deg, key=lambda a: (abs(a), -math.copysign(1.0, a)))
     factors = sorted(c.speed_factors, reverse=True)
     return flat(c.radius, c.horizon, colreg_params(c.colreg), len(offsets), len(factors),
                 np.radians(offsets), factors)

@@ -237,6 +237,13 @@ class ColavGuidance:
 
 
 @kernel_function
+def course_over_ground(psi, u, v):
+    """χ = ψ + atan2(v, u) [rad]: the course over ground of a ship with heading ψ and body
+    velocities (u, v) (no current); scalars in a kernel, arrays through ``py_func``."""
+    return psi + np.arctan2(v, u)
+
+
+@kernel_function
 def colav_reference(t, x, z, p, ref, out):
     """One sample of :class:`ColavGuidance` for one ship (module docstring): LOS for the nominal
     course, the targets dead-reckoned from their tables, then the avoidance method — called every
@@ -256,28 +263,33 @@ def colav_reference(t, x, z, p, ref, out):
     own, nominal, cmd = z[s:s + 4], z[s + 4:s + 6], z[s + 6:s + 8]
     targets = z[s + 8:s + 8 + 4 * n_max]
     nominal[0], nominal[1] = ref[0], ref[1]
+    present = 0  # targets heard by now (before its first sample a target is absent), packed first
     for j in range(n_targets):
         rows = table[j * n_samples * 5:(j + 1) * n_samples * 5]
+        if t < rows[0]:
+            continue
         k = 0
         while k + 1 < n_samples and rows[(k + 1) * 5] <= t:
             k += 1
         dt = t - rows[k * 5]
-        targets[4 * j] = rows[k * 5 + 1] + rows[k * 5 + 3] * dt
-        targets[4 * j + 1] = rows[k * 5 + 2] + rows[k * 5 + 4] * dt
-        targets[4 * j + 2] = rows[k * 5 + 3]
-        targets[4 * j + 3] = rows[k * 5 + 4]
-        d = math.hypot(targets[4 * j] - x[i_north], targets[4 * j + 1] - x[i_east])
+        m = 4 * present
+        targets[m] = rows[k * 5 + 1] + rows[k * 5 + 3] * dt
+        targets[m + 1] = rows[k * 5 + 2] + rows[k * 5 + 4] * dt
+        targets[m + 2] = rows[k * 5 + 3]
+        targets[m + 3] = rows[k * 5 + 4]
+        present += 1
+        d = math.hypot(targets[m] - x[i_north], targets[m + 1] - x[i_east])
         if d < hold[3]:
             hold[3], hold[4], hold[5] = d, t, float(j)
     if method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t)):
         v = x[i_v] if i_v >= 0 else 0.0
         own[0], own[1] = x[i_north], x[i_east]
-        own[2] = x[i_psi] + math.atan2(v, x[i_u])
+        own[2] = course_over_ground(x[i_psi], x[i_u], v)
         own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
         if method == 1:
-            sbmpc_choose(t, own, targets, n_targets, nominal, mp, zm, cmd)
+            sbmpc_choose(t, own, targets, present, nominal, mp, zm, cmd)
         else:
-            vo_choose(t, own, targets, n_targets, nominal, mp, zm, cmd)
+            vo_choose(t, own, targets, present, nominal, mp, zm, cmd)
         hold[0] = t + interval
         hold[1] = wrap(cmd[0] - nominal[0])
         hold[2] = cmd[1] / nominal[1] if nominal[1] > 0.0 else 1.0

@@ -985,6 +985,14 @@ class TargetConfig(Strict):
     length: Positive = 100.0
     beam: Positive = 20.0
 
+    @model_validator(mode="after")
+    def _schedule_or_course(self):
+        given = sorted({"course_deg", "speed"} & self.model_fields_set)
+        if self.schedule is not None and given:
+            raise ValueError(f"{' and '.join(given)} with a schedule: give one or the other "
+                             "(the schedule's entries set course and speed)")
+        return self
+
     def track(self, label: str = "target"):
         """The target as a :class:`~shipgnc.colav.tracks.TargetTrack`: one sample per leg, each
         leg's start reached by sailing the previous leg (exact dead reckoning)."""

@@ -48,11 +48,16 @@ def colav_arrays(t, range_min, t_range_min, target_range_min, leg, along_track, 
     }
 
 
+def _two(result, name) -> np.ndarray:
+    """The variable ``name`` of a result as (time, member) (a single run: one member)."""
+    a = result[name].values
+    return a.reshape(a.shape[0], -1)
+
+
 def batch_arrays(result, guidance, safety_radius: float) -> dict[str, np.ndarray]:
     """:func:`colav_arrays` of a result with a member dimension (or none: one member)."""
     def two(name):
-        a = result[name].values
-        return a.reshape(a.shape[0], -1)
+        return _two(result, name)
 
     return colav_arrays(result["time"].values, two("range_min"), two("t_range_min"),
                         two("target_range_min"), two("leg"), two("along_track"),
@@ -73,27 +78,29 @@ def score(scenario, result, setup) -> dict:
     return out
 
 
-def compliance_arrays(result, members_tracks, codes) -> dict[str, np.ndarray]:
+def compliance_arrays(result, members_tracks, codes, configs=None) -> dict[str, np.ndarray]:
     """COLREG compliance after Woerner (:func:`shipgnc.colav.compliance.compliance_scores`) of
     every member of a batch result: ``members_tracks`` one list of targets per member, ``codes``
-    their situations at t = 0 (member, target). Returns (member,) arrays: each rule's score
+    their situations at t = 0 (member, target), ``configs`` one ComplianceConfig per member (None:
+    the defaults). Returns (member,) arrays: each rule's score
     (``rule_14`` … ``rule_17``, NaN where no encounter invokes it) and ``compliance``, the least
     score of the rules the member's encounters invoke (the safety score is ``safety``)."""
     from shipgnc.colav.compliance import SCORES, compliance_scores
+    from shipgnc.guidance.colav import course_over_ground
 
     t = result["time"].values
 
     def two(name):
-        a = result[name].values
-        return a.reshape(a.shape[0], -1)
+        return _two(result, name)
 
     north, east, psi, u = two("north"), two("east"), two("psi"), two("u")
     v = two("v") if "v" in result else np.zeros_like(u)
-    course, speed = psi + np.arctan2(v, u), np.hypot(u, v)
+    course, speed = course_over_ground.py_func(psi, u, v), np.hypot(u, v)
     out = {name: np.full(len(members_tracks), np.nan) for name in (*SCORES, "compliance")}
     for k, tracks in enumerate(members_tracks):
         scores = compliance_scores(t, north[:, k], east[:, k], course[:, k], speed[:, k], tracks,
-                                   list(codes[k][:len(tracks)]))
+                                   list(codes[k][:len(tracks)]),
+                                   None if configs is None else configs[k])
         for name in SCORES:
             out[name][k] = scores[name]
         rules = [scores[name] for name in SCORES if name != "safety" and not np.isnan(scores[name])]

@@ -40,6 +40,26 @@ SBMPC = {"d_safe": SAFETY_RADIUS, "speed_factors": [1.0]}
 VO = {"radius": SAFETY_RADIUS, "speed_factors": [1.0]}
 #: the nominal path: north from the origin, long enough for any encounter
 PATH_LENGTH = 40_000.0
+#: the avoidance horizon of both methods [s]: SB-MPC's prediction horizon T and the velocity
+#: obstacles' horizon, their defaults (the sweep keeps them)
+HORIZON = 100.0
+
+
+def sweep_compliance(closing_speed: float):
+    """The compliance thresholds (:class:`shipgnc.colav.compliance.ComplianceConfig`) of a sweep
+    member from the ship domain R = :data:`SAFETY_RADIUS` and the avoidance horizon
+    T = :data:`HORIZON`, ``closing_speed`` v [m/s] the magnitude of the relative velocity at t = 0:
+
+    r_collision = R (a collision is a CPA inside the domain, as the ``collision`` score counts it),
+    r_near_miss = 2 R, r_safe = 4 R; r_early = R + v T — the range at which a collision course
+    enters the horizon, the earliest an avoidance method can act — and r_late = R + v T/2, half the
+    horizon left. Fixed ranges (1 nm, 0.5 nm) would call every action in a slow overtaking late:
+    closing at 4.5 m/s, the collision enters a 100 s horizon at 650 m."""
+    from shipgnc.colav.compliance import ComplianceConfig
+
+    R, v = SAFETY_RADIUS, max(float(closing_speed), 1e-3)
+    return ComplianceConfig(r_collision=R, r_near_miss=2 * R, r_safe=4 * R,
+                            r_early=R + v * HORIZON, r_late=R + v * HORIZON / 2)
 
 
 @dataclass(frozen=True)
@@ -50,6 +70,7 @@ class Member:
     method: str
     mc: int = 0
     beta_deg: float = math.nan
+    spec: tg.EncounterSpec | None = None  # the generated variant (None: read from a file)
 
 
 @dataclass
@@ -80,24 +101,34 @@ def own_frame(sit: tg.Situation) -> tg.Situation:
 def standard_members(methods, *, mc: int = 0, seed: int = 0, own_speed: float = 9.0,
                      specs=tg.STANDARD) -> list[Member]:
     """The standard set (``mc`` = 0) or ``mc`` perturbed variants of each of its situations
-    (:func:`shipgnc.study.trafficgen.perturbed`, drawn from ``seed``), each met with every method."""
-    rng = np.random.default_rng(seed)
+    (:func:`shipgnc.study.trafficgen.variants`, each classifying as its type), each met with every
+    method. Each situation type draws from its own child of ``seed``
+    (``SeedSequence(seed).spawn``), so the variants of ``mc`` = 5 are the first five of 10."""
+    children = np.random.SeedSequence(seed).spawn(len(specs))
     members = []
-    for spec in specs:
-        variants = [spec] if mc == 0 else [tg.perturbed(spec, rng) for _ in range(mc)]
+    for spec, child in zip(specs, children, strict=True):
+        variants = [spec] if mc == 0 else tg.variants(spec, np.random.default_rng(child), mc,
+                                                     own_speed)
         for k, variant in enumerate(variants):
             sit = tg.parse(tg.situation_dict(variant, own_speed), variant.title)
             sit = replace(sit, encounter_type=spec.encounter_type, title=spec.title)
             for method in methods:
-                members.append(Member(sit, method, k, variant.beta_deg))
+                members.append(Member(sit, method, k, variant.beta_deg, variant))
     return members
 
 
 def file_members(paths, methods) -> list[Member]:
     """Situations read from trafficgen files, each met with every method."""
+    from shipgnc.units import KNOT
+    from shipgnc.vessels.frigate import SPEED_RANGE
+
+    low, high = SPEED_RANGE  # the own ship's (OWN_SHIP) valid speeds
     members = []
     for path in paths:
         sit = own_frame(tg.read(path))
+        if not low <= sit.own_speed <= high:
+            raise ConfigError(f"{path}: ownShip.initial.sog = {sit.own_speed / KNOT:g} kn (own ship "
+                              f"sails {low / KNOT:.1f}–{high / KNOT:.1f} kn)")
         bearing = _bearing_deg(sit)
         for method in methods:
             members.append(Member(sit, method, 0, bearing))
@@ -205,10 +236,15 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
         result = guidance.add_targets(result)
         out.ship_steps += len(index) * round(DURATION / DT)
         arrays = batch_arrays(result, guidance, SAFETY_RADIUS)
-        arrays.update(initial_scores(members, index))
+        codes = situation_codes(members, index)
+        arrays.update(initial_scores(members, index, codes))
         if compliance:
+            closing = [math.hypot(m.situation.targets[0].v_north[0] - m.situation.own_speed,
+                                  m.situation.targets[0].v_east[0])
+                       for m in (members[i] for i in index)]  # own course 0 at t = 0
             arrays.update(compliance_arrays(result, [members[i].situation.targets for i in index],
-                                            situation_codes(members, index)))
+                                            codes,
+                                            [sweep_compliance(v) for v in closing]))
         for key, value in arrays.items():
             scores[key][index] = value
         if keep_results:
@@ -217,10 +253,10 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
     return out
 
 
-def initial_scores(members, index) -> dict[str, np.ndarray]:
+def initial_scores(members, index, codes=None) -> dict[str, np.ndarray]:
     """The COLREG situation (code of :data:`shipgnc.colav.colreg.SITUATIONS`) and the closed-form
-    CPA at t = 0 towards each member's first target."""
-    from shipgnc.colav.colreg import situations
+    CPA at t = 0 towards each member's first target (``codes``: :func:`situation_codes`, if
+    already computed)."""
     from shipgnc.colav.geometry import encounter_geometry
 
     own = np.array([[0.0, 0.0, members[i].situation.own_course, members[i].situation.own_speed]
@@ -228,8 +264,9 @@ def initial_scores(members, index) -> dict[str, np.ndarray]:
     target = np.array([[t.north[0], t.east[0], t.v_north[0], t.v_east[0]]
                        for t in (members[i].situation.targets[0] for i in index)])
     geo = encounter_geometry(own, target)
-    return {"situation": situations(own, target).astype(float), "d_cpa0_m": geo["d_cpa"],
-            "t_cpa0_s": geo["t_cpa"]}
+    codes = situation_codes(members, index) if codes is None else codes
+    return {"situation": codes[:, 0].astype(float),
+            "d_cpa0_m": geo["d_cpa"], "t_cpa0_s": geo["t_cpa"]}
 
 
 def situation_codes(members, index) -> np.ndarray:
@@ -247,19 +284,29 @@ def situation_codes(members, index) -> np.ndarray:
 
 
 def summary(result: SweepResult) -> list[dict]:
-    """One row per (encounter type, method): members, collisions, median and least minimum range,
-    median time lost, median compliance (the least score of the rules invoked, after Woerner)."""
-    rows = []
-    keys = dict.fromkeys((m.situation.encounter_type or m.situation.title, m.method)
-                         for m in result.members)
+    """One row per (COLREG situation computed at t = 0, method): the members' labels
+    (``encounter``), how many of them carry a label of another situation (``label_disagrees``,
+    :data:`shipgnc.study.trafficgen.SITUATION_OF`), members, collisions, median and least minimum
+    range, median time lost, median compliance (the least score of the rules invoked, after
+    Woerner)."""
+    from shipgnc.colav.colreg import SITUATIONS
+
     s = result.scores
+    computed = [SITUATIONS[int(c)] if np.isfinite(c) else "unknown" for c in s["situation"]]
+    rows = []
+    keys = dict.fromkeys((computed[i], m.method) for i, m in enumerate(result.members))
     for kind, method in keys:
-        idx = [i for i, m in enumerate(result.members)
-               if (m.situation.encounter_type or m.situation.title) == kind and m.method == method]
+        idx = [i for i, m in enumerate(result.members) if computed[i] == kind and m.method == method]
+        labels = [result.members[i].situation.encounter_type or result.members[i].situation.title
+                  for i in idx]
+        disagree = sum(1 for label in labels if label in tg.SITUATION_OF
+                       and tg.SITUATION_OF[label] != kind)
         rng = s["min_range_m"][idx]
-        rows.append({"encounter": kind, "method": method, "members": len(idx),
+        rows.append({"situation": kind, "encounter": "/".join(dict.fromkeys(labels)),
+                     "label_disagrees": disagree, "method": method, "members": len(idx),
                      "collisions": int(np.nansum(s["collision"][idx])),
-                     "median_cpa_m": float(np.nanmedian(rng)), "min_cpa_m": float(np.nanmin(rng)),
+                     "median_min_range_m": float(np.nanmedian(rng)),
+                     "min_range_m": float(np.nanmin(rng)),
                      "median_time_lost_s": float(np.nanmedian(s["time_lost_s"][idx]))})
         if "compliance" in s:
             c = s["compliance"][idx]
@@ -275,7 +322,9 @@ def member_rows(result: SweepResult) -> list[dict]:
     rows = []
     for i, m in enumerate(result.members):
         row = {"member": i, "title": m.situation.title, "encounter": m.situation.encounter_type,
-               "method": m.method, "mc": m.mc, "beta_deg": m.beta_deg}
+               "method": m.method, "mc": m.mc, "beta_deg": m.beta_deg,
+               "relative_speed": m.spec.relative_speed if m.spec else math.nan,
+               "vector_time_s": m.spec.vector_time_s if m.spec else math.nan}
         for key, value in result.scores.items():
             row[key] = SITUATIONS[int(value[i])] if key == "situation" else float(value[i])
         rows.append(row)

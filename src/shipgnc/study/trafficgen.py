@@ -38,12 +38,12 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError
 
 from shipgnc.colav.tracks import TargetTrack
 from shipgnc.errors import ConfigError
+from shipgnc.units import KNOT
 
-KNOT = 1852.0 / 3600.0
 #: the own ship's start of generated situations (trafficgen's examples: Oslofjord)
 ORIGIN = (58.763449, 10.490654)
 
@@ -97,21 +97,70 @@ def place_target(spec: EncounterSpec, own_speed: float) -> tuple[float, float, f
     return float(S[0]), float(S[1]), math.atan2(d[1], d[0]), U_t
 
 
-def perturbed(spec: EncounterSpec, rng: np.random.Generator, *, bearing_deg: float = 5.0,
+#: the COLREG situation (:data:`shipgnc.colav.colreg.SITUATIONS`) each encounter type is
+SITUATION_OF = {"head-on": "head_on", "overtaking-give-way": "overtaking",
+                "overtaking-stand-on": "overtaken", "crossing-give-way": "give_way",
+                "crossing-stand-on": "stand_on"}
+#: the bearing spread of each type's variants [deg]: head-on's sector is only 6° wide on bearing
+#: and on reciprocal course, and with equal speeds the target's course is 2β off the reciprocal
+#: (the triangle own start, meeting point, target start is isosceles), so β stays within 2 ± 1°
+BEARING_SPREAD_DEG = {"head-on": 1.0}
+
+
+def perturbed(spec: EncounterSpec, rng: np.random.Generator, *, bearing_deg: float | None = None,
               time_frac: float = 0.2, speed_frac: float = 0.1) -> EncounterSpec:
-    """``spec`` with uniform perturbations: β ± ``bearing_deg``, the meeting time (hence the range)
-    × (1 ± ``time_frac``), the relative speed × (1 ± ``speed_frac``)."""
+    """``spec`` with uniform perturbations: β ± ``bearing_deg`` (default: 5°, head-on
+    :data:`BEARING_SPREAD_DEG`), the meeting time (hence the range) × (1 ± ``time_frac``), the
+    relative speed × (1 ± ``speed_frac``)."""
+    if bearing_deg is None:
+        bearing_deg = BEARING_SPREAD_DEG.get(spec.encounter_type, 5.0)
     return replace(spec,
                    beta_deg=spec.beta_deg + rng.uniform(-bearing_deg, bearing_deg),
                    vector_time_s=spec.vector_time_s * (1 + rng.uniform(-time_frac, time_frac)),
                    relative_speed=spec.relative_speed * (1 + rng.uniform(-speed_frac, speed_frac)))
 
 
+def classify_spec(spec: EncounterSpec, own_speed: float) -> str:
+    """The COLREG situation (:func:`shipgnc.colav.colreg.situations`) of ``spec`` at t = 0."""
+    from shipgnc.colav.colreg import SITUATIONS, situations
+
+    n, e, course, speed = place_target(spec, own_speed)
+    code = situations([0.0, 0.0, 0.0, own_speed],
+                      [n, e, speed * math.cos(course), speed * math.sin(course)])
+    return SITUATIONS[int(code)]
+
+
+def variants(spec: EncounterSpec, rng: np.random.Generator, n: int, own_speed: float, *,
+             tries: int = 100) -> list[EncounterSpec]:
+    """``n`` perturbed variants of ``spec`` (:func:`perturbed`) that each classify as its type
+    (:data:`SITUATION_OF`): a draw outside the type's sector is drawn again (at most ``tries``
+    times per variant). Drawn in sequence from ``rng``, so the first k of n variants are the
+    k variants."""
+    want = SITUATION_OF.get(spec.encounter_type)
+    out = []
+    for _ in range(n):
+        for _ in range(tries):
+            v = perturbed(spec, rng)
+            try:
+                if want is None or classify_spec(v, own_speed) == want:
+                    break
+            except ConfigError:
+                continue
+        else:
+            raise ConfigError(f"encounter {spec.title}: no perturbed variant in {tries} draws "
+                              f"classifies as {want}")
+        out.append(v)
+    return out
+
+
 # ----------------------------------------------------------------------------- the file format
 class _Position(BaseModel):
+    """``lat``/``lon`` (trafficgen's earlier files) or ``latitude``/``longitude`` (its current
+    files and the maritime-schema)."""
+
     model_config = ConfigDict(extra="ignore")
-    lat: float = Field(ge=-90, le=90)
-    lon: float = Field(ge=-180, le=180)
+    lat: float = Field(ge=-90, le=90, validation_alias=AliasChoices("lat", "latitude"))
+    lon: float = Field(ge=-180, le=180, validation_alias=AliasChoices("lon", "longitude"))
 
 
 class _Initial(BaseModel):
@@ -169,12 +218,15 @@ def parse(data: dict, where: str = "situation") -> Situation:
         raise ConfigError(f"{where}: {field}: {err['msg']} (a trafficgen traffic situation: "
                           "ownShip and targetShips with initial position lat/lon, sog [kn], "
                           "cog [deg])") from None
+    from shipgnc.ais.plane import check_range
     from shipgnc.routing.geo.projection import RouteProjection
 
     o = s.ownShip.initial.position
     plane = RouteProjection((o.lat, o.lon), (o.lat, o.lon))
     targets = []
     for j, ship in enumerate(s.targetShips):
+        check_range((o.lat, o.lon), ship.initial.position.lat, ship.initial.position.lon,
+                    f"{where}: targetShips[{j}]")
         n, e = plane.to_plane(ship.initial.position.lat, ship.initial.position.lon)
         st = ship.static
         targets.append(TargetTrack.constant(float(n), float(e), math.radians(ship.initial.cog),

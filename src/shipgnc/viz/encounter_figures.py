@@ -2,8 +2,8 @@
 
 * ``encounter_tracks.png`` — one panel per situation of the first Monte Carlo draw (one line per
   method): the own ship's and the target's tracks, their outlines every ``outline_every`` seconds
-  (:func:`shipgnc.viz.dashboard.boat_outline`), and the realised CPA (the two positions at the
-  minimum range, joined);
+  (:func:`shipgnc.viz.dashboard.boat_outline`), and the realised CPA as scored (the two positions
+  at ``t_min_range_s``, joined, labelled ``min_range_m``);
 * ``encounter_cpa_polar.png`` — the realised CPA of every member against the target's relative
   bearing at t = 0, one colour per method, the safety radius as a circle.
 """
@@ -66,12 +66,19 @@ def tracks_figure(result, *, outline_every: float = 60.0, window: float = 1500.0
                                      closed=True, fc="none", ec=color, lw=0.7))
                 ax.add_patch(Polygon(boat_outline(tn[j], te[j], tcog[j], target.length, target.beam),
                                      closed=True, fc="none", ec="0.35", lw=0.7))
-            rng = np.hypot(tn - n, te - e)
-            c = int(np.nanargmin(rng))
-            ax.plot([e[c], te[c]], [n[c], tn[c]], color=color, lw=2.0, marker="o", ms=3)
-            ax.annotate(f"CPA {rng[c]:.0f} m", (e[c], n[c]), fontsize=7, color=color,
-                        xytext=(4, -10 - 9 * methods.index(m.method)), textcoords="offset points")
-            centre.append((e[c], n[c]))
+            # the CPA as scored (kept by the guidance at every sample, not the thinned log): own
+            # position interpolated in the log at t_min_range_s, the target's from its track
+            t_cpa = float(result.scores["t_min_range_s"][i])
+            d_cpa = float(result.scores["min_range_m"][i])
+            if math.isfinite(t_cpa):
+                j = int(result.scores["cpa_target"][i])
+                on, oe = np.interp(t_cpa, t, n), np.interp(t_cpa, t, e)
+                pn, pe, _, _ = m.situation.targets[j].at(t_cpa)
+                ax.plot([oe, pe], [on, pn], color=color, lw=2.0, marker="o", ms=3)
+                ax.annotate(f"CPA {d_cpa:.0f} m", (oe, on), fontsize=7, color=color,
+                            xytext=(4, -10 - 9 * methods.index(m.method)),
+                            textcoords="offset points")
+                centre.append((oe, on))
         if centre:  # a window about the CPA, where the outlines are to scale
             ce, cn = np.mean(centre, axis=0)
             ax.set_xlim(ce - window, ce + window)
@@ -110,30 +117,28 @@ def polar_figure(result):
     return fig
 
 
-def write_figures(result, out) -> list:
-    """Both figures as PNG files in ``out``."""
+def _save(result, directory, names, dpi) -> list:
+    """The tracks and polar figures of ``result`` saved as ``names`` in ``directory``."""
+    from pathlib import Path
+
     paths = []
-    for name, fig in (("encounter_tracks.png", tracks_figure(result)),
-                      ("encounter_cpa_polar.png", polar_figure(result))):
-        path = out / name
-        fig.savefig(path, dpi=130)
+    for name, fig in zip(names, (tracks_figure(result), polar_figure(result)), strict=True):
+        path = Path(directory) / name
+        fig.savefig(path, dpi=dpi)
         paths.append(path)
     return paths
+
+
+def write_figures(result, out) -> list:
+    """Both figures as PNG files in ``out``."""
+    return _save(result, out, ("encounter_tracks.png", "encounter_cpa_polar.png"), 130)
 
 
 def document_figures(directory) -> list:
     """The encounters page's figures: the standard set with 20 perturbed variants of each
     situation (seed 1), met with no avoidance, SB-MPC and velocity obstacles."""
-    from pathlib import Path
-
     from shipgnc.study.encounters import run_members, standard_members
 
     result = run_members(standard_members(["none", "sbmpc", "vo"], mc=20, seed=1),
                          keep_results=True)
-    directory = Path(directory)
-    paths = []
-    for name, fig in (("encounters-tracks.png", tracks_figure(result)),
-                      ("encounters-cpa-polar.png", polar_figure(result))):
-        fig.savefig(directory / name, dpi=110)
-        paths.append(directory / name)
-    return paths
+    return _save(result, directory, ("encounters-tracks.png", "encounters-cpa-polar.png"), 110)
