@@ -121,12 +121,12 @@ class ColavGuidance:
         return self.los.speed
 
     def params(self) -> np.ndarray:
-        """One parameter row per member ``(n_members, n_p)`` (shorter rows padded with zeros)::
+        """One parameter row per member, shape ``(n_members, n_p)``, shorter rows padded with zeros.
 
-            [n_los, method, n_targets, n_samples, n_max, i_north, i_east, i_psi, i_u, i_v
-             (-1: none), n_method_params, memory, decision interval,  LOS params (n_los),
-             targets: n_max × n_samples × (t, north, east, v_north, v_east), unused samples at
-             t = +inf,  method params]
+        A row holds, in order, n_los, method, n_targets, n_samples, n_max, i_north, i_east, i_psi,
+        i_u, i_v (−1 for none), n_method_params, memory, the decision interval, the LOS parameters
+        (n_los numbers), the targets (n_max × n_samples × (t, north, east, v_north, v_east), unused
+        samples at t = +inf) and the method's parameters.
         """
         los = self.los.kernel(self._batch_shape).params
         rows = []

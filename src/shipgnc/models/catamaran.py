@@ -58,7 +58,7 @@ from shipgnc.params import Params
 
 #: resistance fit R_K(V) = a0 + a1 V + a2 V² [kN, one hull] of eq. (8)
 RK_COEFFS = (8.1, -8.436, 2.536)
-#: speed of the fit's minimum [m/s]: below it the continued resistance is used (note 004-4.3 [A])
+#: speed of the fit's minimum [m/s]; below it the continued resistance is used (note 004-4.3 [A])
 V_MIN_FIT = -RK_COEFFS[1] / (2.0 * RK_COEFFS[2])
 
 CORIOLIS = {"printed": 1.0, "consistent": -1.0}
