@@ -70,7 +70,7 @@ def per_ship(function: Callable, spec: str) -> ShipBatch:
 class ShipBatch:
     """Call with the kernel's arguments in order: numbers for ``t``, arrays for ``i``/``z``/``p``,
     the width (an int) for each ``o``. Returns the outputs (one array, or a tuple in order), then
-    the per-ship return value when the spec has ``-> r``."""
+    the per-ship return value when ``spec`` ends in ``-> r``."""
 
     def __init__(self, function: Callable, spec: str):
         letters, _, result = spec.replace(" ", "").partition("->")

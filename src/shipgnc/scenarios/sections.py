@@ -1033,10 +1033,11 @@ class ColavConfig(Strict):
     ``method`` turns it away from the ``targets`` (``none``: the nominal, the baseline)."""
 
     field_units: ClassVar[dict[str, str]] = {"waypoints": "m", "lookahead": "m", "speed": "m/s",
-                                             "switch_radius": "m", "safety_radius": "m"}
+                                             "switch_radius": "m", "safety_radius": "m",
+                                             "decision_interval": "s"}
 
     type: Literal["colav"]
-    #: ``none`` (the nominal course: the baseline), ``sbmpc`` (simulation-based MPC) or ``vo``
+    #: ``none`` (the nominal course, the baseline), ``sbmpc`` (simulation-based MPC) or ``vo``
     #: (velocity obstacles with COLREG constraints)
     method: Literal["none", "sbmpc", "vo"] = "none"
     #: SB-MPC's behaviour set, horizon and weights (Johansen, Perez & Cristofaro 2016)
@@ -1049,11 +1050,11 @@ class ColavConfig(Strict):
     waypoints: Annotated[list[tuple[Finite, Finite]], Field(min_length=2)]
     #: lookahead distance Δ of the nominal LOS
     lookahead: Positive = 500.0
-    #: nominal speed over ground (null: the vessel's straight-run speed)
+    #: nominal speed over ground (null = the vessel's straight-run speed)
     speed: Positive | None = None
     #: switch to the next leg within this distance of the waypoint
     switch_radius: NonNegative = 0.0
-    #: the ship domain of the ``colav`` metrics: a target closer than this is a collision
+    #: the ship domain of the ``colav`` metrics (a target closer than this is a collision)
     safety_radius: Positive = 200.0
     #: the target ships
     targets: list[TargetConfig] = Field(default_factory=list)
