@@ -1,12 +1,14 @@
 """Compiled components: the record a component hands to the composed loop, and the scalar helpers
 every component kernel shares.
 
-A component (vessel model, controller, guidance law, disturbance) keeps its numpy code as the
-readable reference and adds one method that returns a :class:`Kernel`: its per-ship arithmetic as
-a small numba function over a flat float64 parameter array and a slice of per-ship state. The
-composed loop (:mod:`shipgnc.sim.compose`) calls these functions inside one compiled loop over
-ships and time; a component without a kernel (or whose ``kernel`` raises :class:`NotCompiled`)
-makes the run fall back to numpy, and the reason names the component.
+A component (vessel model, controller, guidance law, disturbance) writes its per-ship arithmetic
+once, as a small numba function over a flat float64 parameter array and a slice of per-ship state,
+and hands it over in a :class:`Kernel`. The composed loop (:mod:`shipgnc.sim.compose`) calls these
+functions inside one compiled loop over ships and time; the component's numpy methods, which the
+numpy loop, linearisation and design call, are the batch :func:`shipgnc.derive.per_ship` derives
+from the same function (its plain-Python ``py_func`` is the debugging form). A component written
+only in numpy still runs, in the numpy loop: a component without a kernel (or whose ``kernel``
+raises :class:`NotCompiled`) makes the run fall back to numpy, and the reason names the component.
 
 Signatures, by kind (``x`` the ship's state, ``p`` the parameters, ``z`` the component's own
 per-ship state, mutated in place; every array is a 1-D float64 slice of one ship):
