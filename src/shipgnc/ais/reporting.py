@@ -3,18 +3,18 @@ position noise, lost reports, and every value quantised by the message.
 
 Reporting intervals (ITU-R M.1371-5, Annex 1, Table 1 for Class A; Table 2 for Class B):
 
-====================================================  ==========  ===========  ===========
-ship's dynamic condition                              Class A     Class B "SO" Class B "CS"
-====================================================  ==========  ===========  ===========
-at anchor or moored, not faster than 3 kn             3 min       —            —
-at anchor or moored, faster than 3 kn                 10 s        —            —
-not faster than 2 kn (Class B)                        —           3 min        3 min
-0–14 kn (Class B: 2–14 kn)                            10 s        30 s         30 s
-0–14 kn and changing course                           3⅓ s        30 s         30 s
-14–23 kn                                              6 s         15 s         30 s
-14–23 kn and changing course                          2 s         15 s         30 s
-faster than 23 kn (changing course or not)            2 s         5 s          30 s
-====================================================  ==========  ===========  ===========
+==========================================  =======  ============  ============
+ship's dynamic condition                    Class A  Class B "SO"  Class B "CS"
+==========================================  =======  ============  ============
+at anchor or moored, not faster than 3 kn   3 min    —             —
+at anchor or moored, faster than 3 kn       10 s     —             —
+not faster than 2 kn (Class B)              —        3 min         3 min
+0–14 kn (Class B: 2–14 kn)                  10 s     30 s          30 s
+0–14 kn and changing course                 3⅓ s     30 s          30 s
+14–23 kn                                    6 s      15 s          30 s
+14–23 kn and changing course                2 s      15 s          30 s
+faster than 23 kn (changing course or not)  2 s      5 s           30 s
+==========================================  =======  ============  ============
 
 "Changing course" is a rate of turn above ``turning`` (default 5° per 30 s, the rate beyond which
 the message's ROT field reads "turning, more than 5°/30 s", ITU-R M.1371-5 Annex 8 Table 45); the

@@ -6,7 +6,7 @@ Between the path guidance and the autopilot: the guidance wants course χ_n and 
 picks a course offset χ from a finite set (−90°…+90° in 15° steps) and a speed factor P from
 {1, ½, 0}, and commands χ_n + χ, P·U_n. Each of the candidate behaviours k is scored by predicting
 the own ship on the straight line at that course and speed, and each target i at constant
-velocity, at t_j = j·Δt, j = 1…T/Δt (the paper's hazard):
+velocity, at t_j = j·Δt, j = 1…T/Δt (the paper's hazard)::
 
     H_k = max_i max_j [ C_k^i R_k^i(t_j) + κ μ_k^i(t_j) ] + f(P, χ) + g(P, χ)
 
@@ -67,7 +67,7 @@ from shipgnc.config_types import NonNegative, Positive, Strict
 from shipgnc.derive import per_ship
 from shipgnc.kernels import flat, kernel_function, wrap
 
-#: length of the per-ship memory z: [last course offset (rad), 1 − last speed factor]
+#: length of the per-ship memory z = [last course offset (rad), 1 − last speed factor]
 SBMPC_MEMORY = 2
 _N_FIXED = 21  # parameters before the behaviour set (sbmpc_params)
 

@@ -49,7 +49,7 @@ from shipgnc.config_types import Positive, Strict
 from shipgnc.derive import per_ship
 from shipgnc.kernels import flat, kernel_function, wrap
 
-#: length of the per-ship memory z: [last course offset (rad)]
+#: length of the per-ship memory z = [last course offset (rad)]
 VO_MEMORY = 1
 _N_FIXED = 9  # parameters before the candidate grid (vo_params)
 
