@@ -5,15 +5,15 @@ Read and written: position reports of Class A (message types 1, 2, 3) and Class 
 (types 5 and 24, parts A and B). Field meanings and resolutions are those of ITU-R M.1371-5, Annex 8
 (the gpsd "AIVDM/AIVDO protocol decoding" page sets them out field by field):
 
-========  ==============================  =================  ============================
-field     message                         resolution         not available
-========  ==============================  =================  ============================
-latitude  1/10 000 min (1/600 000 deg)    ±90°               91° (181° longitude)
-SOG       0.1 kn                          0 … 102.2 kn       102.3 kn (raw 1023)
-COG       0.1°, clockwise from true N     0 … 359.9°         360.0° (raw 3600)
-heading   1°, true                        0 … 359°           511
+========  ===============================  =================  ============================
+field     message                          resolution         not available
+========  ===============================  =================  ============================
+latitude  1/10 000 min (1/600 000 deg)     ±90°               91° (181° longitude)
+SOG       0.1 kn                           0 … 102.2 kn       102.3 kn (raw 1023)
+COG       0.1°, clockwise from true N      0 … 359.9°         360.0° (raw 3600)
+heading   1°, true                         0 … 359°           511
 ROT       ROT_AIS = 4.733 √abs(ROT) °/min  ±126 ↔ ±708 °/min  −128; ±127: > 5°/30 s, no TI
-========  ==============================  =================  ============================
+========  ===============================  =================  ============================
 
 Here: speeds in m/s (1 kn = 1852/3600 m/s), angles in radians, course and heading clockwise from true
 north in [0, 2π), rate of turn in rad/s (positive to starboard); a field that is not available is
