@@ -77,13 +77,19 @@ def _turn_rates(track: TargetTrack) -> np.ndarray:
 
 
 def report_times(track: TargetTrack, *, t_end: float, t_start: float | None = None, ais_class: str = "A",
-                 anchored: bool = False, turning: float = TURNING) -> np.ndarray:
+                 anchored: bool = False, turning: float = TURNING,
+                 every: float | None = None) -> np.ndarray:
     """The times [s] a target transmits between ``t_start`` (default, and at the earliest, its first
     sample) and ``t_end`` inclusive: each report schedules the next one an interval later, the
-    interval set by the speed and rate of turn at the report."""
+    interval set by the speed and rate of turn at the report — or ``every`` [s], a fixed interval
+    (None: the standard's)."""
     t = float(track.t[0] if t_start is None else max(t_start, track.t[0]))  # none before it exists
     if not (math.isfinite(t_end) and t_end >= t):
         raise ConfigError(f"t_end = {t_end!r}: must be a finite time ≥ the first report at t = {t:g} s")
+    if every is not None:
+        if not (math.isfinite(every) and every > 0):
+            raise ConfigError(f"every = {every!r}: must be a fixed reporting interval > 0 s, or None")
+        return t + every * np.arange(math.floor((t_end - t) / every + 1e-9) + 1)
     rates = _turn_rates(track)
     times = []
     while t <= t_end + 1e-9:
@@ -97,15 +103,18 @@ def report_times(track: TargetTrack, *, t_end: float, t_start: float | None = No
 
 def observe(track: TargetTrack, *, seed: int, position_noise_m: float = 0.0, dropout: float = 0.0,
             t_end: float, t_start: float | None = None, ais_class: str = "A", anchored: bool = False,
-            origin=(0.0, 0.0), turning: float = TURNING) -> TargetTrack:
+            origin=(0.0, 0.0), turning: float = TURNING, every: float | None = None,
+            lost_ok: bool = False) -> TargetTrack | None:
     """The target as the own ship's AIS receiver sees it.
 
-    Reports at :func:`report_times`; each is lost with probability ``dropout`` (independently); the
+    Reports at :func:`report_times` (``every``: a fixed interval [s] instead of the standard's);
+    each is lost with probability ``dropout`` (independently); the
     position of a received one is the true one plus Gaussian noise of standard deviation
     ``position_noise_m`` [m] in north and in east; then position, speed and course go through the
     message (:func:`shipgnc.ais.nmea.encode_position` → ``decode``, positions placed on the earth with
     the local plane about ``origin``), so they carry the message's resolution (1/10 000 min, 0.1 kn,
-    0.1°). The same ``seed`` gives the same reports. Raises ConfigError if every report is lost."""
+    0.1°). The same ``seed`` (an int or a ``numpy.random.SeedSequence``) gives the same reports.
+    Every report lost: None with ``lost_ok``, else a ConfigError."""
     from shipgnc.ais import nmea
     from shipgnc.ais.plane import LocalPlane
 
@@ -114,12 +123,14 @@ def observe(track: TargetTrack, *, seed: int, position_noise_m: float = 0.0, dro
     if not (0.0 <= dropout < 1.0):
         raise ConfigError(f"dropout = {dropout!r}: must be a probability in [0, 1)")
     times = report_times(track, t_end=t_end, t_start=t_start, ais_class=ais_class, anchored=anchored,
-                         turning=turning)
+                         turning=turning, every=every)
     rng = np.random.default_rng(seed)
     kept = rng.random(times.size) >= dropout
     noise = rng.normal(0.0, 1.0, (times.size, 2)) * position_noise_m
     times, noise = times[kept], noise[kept]
     if times.size == 0:
+        if lost_ok:
+            return None
         raise ConfigError(f"target {track.label}: every one of its AIS reports was lost "
                           f"(dropout = {dropout:g})")
     north, east, vn, ve = track.at(times)
@@ -143,3 +154,19 @@ def observe(track: TargetTrack, *, seed: int, position_noise_m: float = 0.0, dro
     v_n, v_e = plane.velocity_to_plane(out[:, 0], out[:, 1], out[:, 2], out[:, 3])
     return TargetTrack(t=times, north=n, east=e, v_north=v_n, v_east=v_e, mmsi=track.mmsi,
                        name=track.name, length=track.length, beam=track.beam, source="ais")
+
+
+def seen_tracks(tracks, *, seed: int, t_end: float, member: int = 0, **options) -> list:
+    """What the own ship's AIS receiver makes of each of ``tracks`` (:func:`observe` with
+    ``options``) up to ``t_end`` [s]: one :class:`TargetTrack` per target, or None for a target
+    every one of whose reports was lost (never heard, so never avoided). Target ``j`` of batch
+    member ``member`` draws from ``SeedSequence([seed, member, j])``: the same seed gives the same
+    reports, and adding a target or a member leaves the others' reports as they were."""
+    out = []
+    for j, track in enumerate(tracks):
+        if track.t[0] > t_end:  # appears after the run: never heard
+            out.append(None)
+            continue
+        rng_seed = np.random.SeedSequence([int(seed), int(member), j])
+        out.append(observe(track, seed=rng_seed, t_end=t_end, lost_ok=True, **options))
+    return out

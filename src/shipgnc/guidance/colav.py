@@ -8,7 +8,10 @@ Each sample the guidance
    the last sample at or before t, moved on at constant velocity) to its position and velocity
    over ground at t, and keeps the least range to any target so far (``range_min``, its time and
    target: the realised closest point of approach, at every guidance sample whatever the log's
-   thinning);
+   thinning); with ``seen`` tracks (the targets as the own ship's AIS receiver hears them,
+   :func:`shipgnc.ais.reporting.seen_tracks`) the avoidance is handed the seen targets —
+   the last report received, dead-reckoned from its SOG and COG, absent until first heard —
+   while ``range_min`` (and so the scores) stays the true tracks';
 3. hands the own ship ``[north, east, χ, U]`` (course and speed over ground,
    χ = ψ + atan2(v, u), U = √(u² + v²)), the targets and the nominal ``[χ_n, U_n]`` to the
    avoidance method, which returns the commanded course and speed; with ``method = none`` the
@@ -43,7 +46,7 @@ from shipgnc.models.base import Signal, state_index
 #: avoidance methods by name → the kernel's method code
 METHODS = {"none": 0, "sbmpc": 1, "vo": 2}
 #: header of a parameter row (see :meth:`ColavGuidance.params`)
-_HEADER = 13
+_HEADER = 14
 #: the LOS part of the per-ship state, then [next decision time, course offset, speed factor,
 #: least range so far, its time, its target]
 _LOS_STATE = 6
@@ -67,7 +70,8 @@ def method_parts(method: str, config=None) -> tuple[np.ndarray, int]:
 class ColavGuidance:
     """LOS toward the waypoints, then collision avoidance against ``encounters`` (module
     docstring): ``encounters`` is one list of :class:`TargetTrack` per batch member (a list of
-    tracks alone: the same targets for every member)."""
+    tracks alone: the same targets for every member). ``seen``: the targets as the avoidance sees
+    them, the same shape (None for a target never heard); None: the true tracks."""
 
     references = (
         Signal("psi_d", "rad", "desired heading: the commanded course", angle=True, tracks="psi"),
@@ -84,7 +88,7 @@ class ColavGuidance:
     )
 
     def __init__(self, los: LOSGuidance, encounters, *, method: str = "none", methods=None,
-                 configs=None, decision_interval: float = 5.0):
+                 configs=None, decision_interval: float = 5.0, seen=None):
         methods = [method] if methods is None else list(methods)
         for m in methods:
             require(m in METHODS, "guidance.method", m, f"allowed: {', '.join(METHODS)}")
@@ -108,6 +112,9 @@ class ColavGuidance:
         self.memory = max(memory for _, memory in self.parts.values())
         self.n_max = max(1, max(len(t) for t in members))
         self.n_samples = max([1] + [tr.t.size for tracks in members for tr in tracks])
+        self.seen = None if seen is None else _seen_members(seen, members)
+        self.n_seen = 0 if self.seen is None else max(
+            [1] + [tr.t.size for tracks in self.seen for tr in tracks if tr is not None])
         self._z = None
         self._outputs: dict[str, np.ndarray] = {}
 
@@ -124,9 +131,10 @@ class ColavGuidance:
         """One parameter row per member, shape ``(n_members, n_p)``, shorter rows padded with zeros.
 
         A row holds, in order, n_los, method, n_targets, n_samples, n_max, i_north, i_east, i_psi,
-        i_u, i_v (−1 for none), n_method_params, memory, the decision interval, the LOS parameters
-        (n_los numbers), the targets (n_max × n_samples × (t, north, east, v_north, v_east), unused
-        samples at t = +inf) and the method's parameters.
+        i_u, i_v (−1 for none), n_method_params, memory, the decision interval, n_seen (the seen
+        tables' sample count, 0: the avoidance sees the true tables), the LOS parameters (n_los
+        numbers), the targets (n_max × n_samples × (t, north, east, v_north, v_east), unused
+        samples at t = +inf), the method's parameters and the seen targets (n_max × n_seen × 5).
         """
         los = self.los.kernel(self._batch_shape).params
         rows = []
@@ -135,13 +143,12 @@ class ColavGuidance:
             tracks = self.members[m % len(self.members)]
             method = self.methods[m % len(self.methods)]
             mp, _ = self.parts[method]
-            table = np.zeros((self.n_max, self.n_samples, 5))
-            table[:, :, 0] = np.inf
-            for j, track in enumerate(tracks):
-                table[j, :track.t.size] = track.table()
+            table = _tables(tracks, self.n_max, self.n_samples)
+            seen = _tables(self.seen[m % len(self.seen)], self.n_max, self.n_seen) \
+                if self.seen is not None else np.zeros(0)
             rows.append(flat(los.size, METHODS[method], len(tracks), self.n_samples,
                              self.n_max, *self._index, mp.size, self.memory,
-                             self.decision_interval, los, table, mp))
+                             self.decision_interval, self.n_seen, los, table, mp, seen))
         width = max(r.size for r in rows)
         return np.vstack([np.pad(r, (0, width - r.size)) for r in rows])
 
@@ -197,20 +204,23 @@ class ColavGuidance:
         return Kernel(colav_reference, self._params, self._z.copy(), restore=restore)
 
     # ------------------------------------------------------------------ results
-    def target_states(self, t: np.ndarray) -> dict[str, np.ndarray]:
+    def target_states(self, t: np.ndarray, *, seen: bool = False) -> dict[str, np.ndarray]:
         """Every member's targets at times ``t``: ``target_north``, ``target_east`` [m],
         ``target_sog`` [m/s], ``target_cog`` [rad], each ``(time, member, target)`` (NaN where a
-        member has fewer targets)."""
+        member has fewer targets); ``seen``: as the avoidance saw them, keys ``target_seen_*``
+        (NaN before a target is first heard)."""
         t = np.asarray(t, dtype=float)
         shape = (t.size, len(self.members), self.n_max)
-        out = {k: np.full(shape, np.nan) for k in ("target_north", "target_east", "target_sog",
-                                                    "target_cog")}
-        for m, tracks in enumerate(self.members):
+        prefix = "target_seen_" if seen else "target_"
+        out = {prefix + k: np.full(shape, np.nan) for k in ("north", "east", "sog", "cog")}
+        for m, tracks in enumerate(self.seen if seen else self.members):
             for j, track in enumerate(tracks):
+                if track is None:
+                    continue
                 n, e, vn, ve = track.at(t)
-                out["target_north"][:, m, j], out["target_east"][:, m, j] = n, e
-                out["target_sog"][:, m, j] = np.hypot(vn, ve)
-                out["target_cog"][:, m, j] = np.mod(np.arctan2(ve, vn), 2 * np.pi)
+                out[prefix + "north"][:, m, j], out[prefix + "east"][:, m, j] = n, e
+                out[prefix + "sog"][:, m, j] = np.hypot(vn, ve)
+                out[prefix + "cog"][:, m, j] = np.mod(np.arctan2(ve, vn), 2 * np.pi)
         return out
 
     def add_targets(self, result):
@@ -218,10 +228,12 @@ class ColavGuidance:
         a batch result; none for one ship)."""
         time = result["time"].values
         states = self.target_states(time)
+        if self.seen is not None:
+            states.update(self.target_states(time, seen=True))
         ship_dims = [d for d in result["north"].dims if d != "time"]
         names = [tr.label for tr in self.members[0]] + [""] * (self.n_max - len(self.members[0]))
-        units = {"target_north": "m", "target_east": "m", "target_sog": "m/s",
-                 "target_cog": "rad"}
+        units = {f"target_{s}{k}": u for s in ("", "seen_") for k, u in
+                 (("north", "m"), ("east", "m"), ("sog", "m/s"), ("cog", "rad"))}
         for key, value in states.items():
             if ship_dims:
                 dims = ("time", *ship_dims, "target")
@@ -244,6 +256,19 @@ def course_over_ground(psi, u, v):
 
 
 @kernel_function
+def last_sample(rows, n_samples, t):
+    """Index of the last sample at or before ``t`` of a track table (``n_samples`` rows of
+    ``[t, north, east, v_north, v_east]`` flattened, unused rows at t = +inf); −1 before the
+    first (the target is not there yet, or not yet heard)."""
+    if t < rows[0]:
+        return -1
+    k = 0
+    while k + 1 < n_samples and rows[(k + 1) * 5] <= t:
+        k += 1
+    return k
+
+
+@kernel_function
 def colav_reference(t, x, z, p, ref, out):
     """One sample of :class:`ColavGuidance` for one ship (module docstring): LOS for the nominal
     course, the targets dead-reckoned from their tables, then the avoidance method — called every
@@ -252,11 +277,13 @@ def colav_reference(t, x, z, p, ref, out):
     n_los, method, n_targets = int(p[0]), int(p[1]), int(p[2])
     n_samples, n_max = int(p[3]), int(p[4])
     i_north, i_east, i_psi, i_u, i_v = int(p[5]), int(p[6]), int(p[7]), int(p[8]), int(p[9])
-    n_mp, memory, interval = int(p[10]), int(p[11]), p[12]
+    n_mp, memory, interval, n_seen = int(p[10]), int(p[11]), p[12], int(p[13])
     h = _HEADER
     finished = los_reference(t, x, z[:_LOS_STATE], p[h:h + n_los], ref, out)
     table = p[h + n_los:h + n_los + n_max * n_samples * 5]
     mp = p[h + n_los + n_max * n_samples * 5:h + n_los + n_max * n_samples * 5 + n_mp]
+    s_seen = h + n_los + n_max * n_samples * 5 + n_mp
+    seen = p[s_seen:s_seen + n_max * n_seen * 5]
     hold = z[_LOS_STATE:_LOS_STATE + _HOLD]
     zm = z[_LOS_STATE + _HOLD:_LOS_STATE + _HOLD + memory]
     s = _LOS_STATE + _HOLD + memory  # scratch
@@ -266,11 +293,18 @@ def colav_reference(t, x, z, p, ref, out):
     present = 0  # targets heard by now (before its first sample a target is absent), packed first
     for j in range(n_targets):
         rows = table[j * n_samples * 5:(j + 1) * n_samples * 5]
-        if t < rows[0]:
+        k = last_sample(rows, n_samples, t)
+        if k >= 0:  # the true target: the range bookkeeping (the scores)
+            dt = t - rows[k * 5]
+            d = math.hypot(rows[k * 5 + 1] + rows[k * 5 + 3] * dt - x[i_north],
+                           rows[k * 5 + 2] + rows[k * 5 + 4] * dt - x[i_east])
+            if d < hold[3]:
+                hold[3], hold[4], hold[5] = d, t, float(j)
+        if n_seen > 0:  # the target as the avoidance sees it
+            rows = seen[j * n_seen * 5:(j + 1) * n_seen * 5]
+            k = last_sample(rows, n_seen, t)
+        if k < 0:
             continue
-        k = 0
-        while k + 1 < n_samples and rows[(k + 1) * 5] <= t:
-            k += 1
         dt = t - rows[k * 5]
         m = 4 * present
         targets[m] = rows[k * 5 + 1] + rows[k * 5 + 3] * dt
@@ -278,9 +312,6 @@ def colav_reference(t, x, z, p, ref, out):
         targets[m + 2] = rows[k * 5 + 3]
         targets[m + 3] = rows[k * 5 + 4]
         present += 1
-        d = math.hypot(targets[m] - x[i_north], targets[m + 1] - x[i_east])
-        if d < hold[3]:
-            hold[3], hold[4], hold[5] = d, t, float(j)
     if method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t)):
         v = x[i_v] if i_v >= 0 else 0.0
         own[0], own[1] = x[i_north], x[i_east]
@@ -298,6 +329,31 @@ def colav_reference(t, x, z, p, ref, out):
     out[3], out[4], out[5] = nominal[0], ref[0], ref[1]
     out[6], out[7], out[8] = hold[3], hold[4], hold[5]
     return finished
+
+
+def _tables(tracks, n_max: int, n_samples: int) -> np.ndarray:
+    """The tracks as one ``(n_max, n_samples, 5)`` table (unused rows at t = +inf; a None track,
+    never heard, all unused)."""
+    table = np.zeros((n_max, n_samples, 5))
+    table[:, :, 0] = np.inf
+    for j, track in enumerate(tracks):
+        if track is not None:
+            table[j, :track.t.size] = track.table()
+    return table
+
+
+def _seen_members(seen, members) -> list[list]:
+    """``seen`` in the shape of ``members`` (one list per member), checked against it."""
+    seen = [list(seen)] if not seen or isinstance(seen[0], (TargetTrack, type(None))) \
+        else [list(m) for m in seen]
+    if len(seen) != len(members) or any(len(a) != len(b) for a, b in zip(seen, members, strict=True)):
+        raise ConfigError(f"seen: {[len(a) for a in seen]} targets per member for "
+                          f"{[len(b) for b in members]} true ones (one seen track, or None, each)")
+    for m, tracks in enumerate(seen):
+        for track in tracks:
+            if track is not None and not isinstance(track, TargetTrack):
+                raise ConfigError(f"seen targets of member {m}: {track!r} is not a TargetTrack")
+    return seen
 
 
 def check_clear(track: TargetTrack, own, safety_radius: float, where: str) -> None:

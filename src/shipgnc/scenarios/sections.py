@@ -1027,6 +1027,31 @@ class AISLogConfig(Strict):
                   Annotated[float, Field(ge=-180, le=180)]] | None = None
 
 
+class AISAwarenessConfig(Strict):
+    """How the own ship hears its targets with ``awareness: ais``
+    (:func:`shipgnc.ais.reporting.seen_tracks`): each target's reports at the ITU-R M.1371-5
+    intervals of its speed and rate of turn (or every ``interval``), each lost with probability
+    ``dropout``, its position off by Gaussian noise of ``position_noise_m`` in north and in east,
+    every value through the message's resolution; between reports the last one is dead-reckoned
+    from its SOG and COG. Target j draws from ``SeedSequence([seed, 0, j])``."""
+
+    field_units: ClassVar[dict[str, str]] = {"position_noise_m": "m", "dropout": "1",
+                                             "interval": "s", "seed": "1"}
+
+    #: seed of the noise and the dropouts (the same seed, the same reports)
+    seed: Annotated[int, Field(ge=0)] = 0
+    #: standard deviation of the reported position's error, in north and in east
+    position_noise_m: NonNegative = 0.0
+    #: probability that a report is lost
+    dropout: Annotated[float, Field(ge=0, lt=1)] = 0.0
+    #: the targets' AIS class, ``A``, ``B-SO`` or ``B-CS`` (their reporting intervals)
+    ais_class: Literal["A", "B-SO", "B-CS"] = "A"
+    #: the targets report as at anchor or moored (Class A every 3 min when not faster than 3 kn)
+    anchored: bool = False
+    #: a fixed reporting interval instead of the standard's (null = the standard's)
+    interval: Positive | None = None
+
+
 class ColavConfig(Strict):
     """Collision avoidance between the path guidance and the autopilot
     (:mod:`shipgnc.guidance.colav`): lookahead LOS along ``waypoints`` gives the nominal course,
@@ -1060,6 +1085,11 @@ class ColavConfig(Strict):
     targets: list[TargetConfig] = Field(default_factory=list)
     #: more targets, replayed from a logged AIS file
     ais_log: AISLogConfig | None = None
+    #: what the avoidance sees of the targets, ``truth`` (their true tracks) or ``ais`` (their
+    #: AIS reports as ``ais`` sets them); the ``colav`` scores are against the truth either way
+    awareness: Literal["truth", "ais"] = "truth"
+    #: the AIS reception of ``awareness: ais``
+    ais: AISAwarenessConfig = Field(default_factory=AISAwarenessConfig)
 
 
 # the navigation sections live with their components, beside their registry records

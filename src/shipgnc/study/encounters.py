@@ -170,8 +170,23 @@ def colav_guidance(g, scenario):
                 continue
             check_clear(track, own, g.safety_radius, f"guidance.ais_log: MMSI {track.mmsi}")
             tracks.append(track)
+    seen = None
+    if g.awareness == "ais":
+        seen = seen_tracks(tracks, g.ais, t_end=scenario.simulation.t_end,
+                           origin=g.ais_log.origin if g.ais_log and g.ais_log.origin else (0.0, 0.0))
     return ColavGuidance(los, tracks, method=g.method, configs={"sbmpc": g.sbmpc, "vo": g.vo},
-                         decision_interval=g.decision_interval)
+                         decision_interval=g.decision_interval, seen=seen)
+
+
+def seen_tracks(tracks, ais, *, t_end: float, member: int = 0, origin=(0.0, 0.0)) -> list:
+    """The ``tracks`` as the own ship hears them through AIS set by ``ais`` (a
+    :class:`~shipgnc.scenarios.sections.AISAwarenessConfig`) up to ``t_end`` [s]
+    (:func:`shipgnc.ais.reporting.seen_tracks`)."""
+    from shipgnc.ais.reporting import seen_tracks as observed
+
+    return observed(tracks, seed=ais.seed, t_end=t_end, member=member, origin=origin,
+                    position_noise_m=ais.position_noise_m, dropout=ais.dropout,
+                    ais_class=ais.ais_class, anchored=ais.anchored, every=ais.interval)
 
 
 def check_members(members: list[Member], safety_radius: float = SAFETY_RADIUS) -> None:
