@@ -144,6 +144,10 @@ def run_command(
         "--overwrite", help="Write into --out even when it holds files that are not a shipgnc run: "
                             "they are kept, only an earlier run's files are replaced (a directory "
                             "of an earlier run alone is always replaced whole).")] = False,
+    ais_log: Annotated[Path | None, typer.Option(
+        "--ais-log", help="guidance colav: also write the run as an NMEA AIS log (own ship !AIVDO, "
+                          "targets !AIVDM); several runs: one file each, -<run> before the suffix.",
+        show_default=False)] = None,
 ) -> None:
     """Run a scenario: write result.nc, metrics.json and figures; print the metrics.
 
@@ -169,6 +173,9 @@ def run_command(
 
             figure_process = stack.enter_context(FigureProcess())  # imports matplotlib meanwhile
         sc = load_scenario(scenario, set_ or [])
+        if ais_log is not None and (sc.guidance is None or sc.guidance.type != "colav"):
+            raise ConfigError(f"--ais-log: scenario {sc.name!r} has no ships to meet (it needs "
+                              "guidance type colav)")
         if live and (sc.vessel.model != "vectored-thrust-boat" or sc.controllers is not None):
             raise ConfigError(f"--live: the live dashboard shows the vectored-thrust boat; scenario "
                               f"{sc.name!r} ({sc.vessel.model}) writes its figures after the run")
@@ -213,6 +220,12 @@ def run_command(
                      f"({', '.join(p.name for p in written)} to {out_dir})")
             raise typer.Exit(130)
         stderr.print(f"wrote {', '.join(p.name for p in written)} to {out_dir}", soft_wrap=True)
+        if ais_log is not None and run.result is not None:
+            from shipgnc.study.ais_out import scenario_logs
+
+            logs = scenario_logs(run, ais_log)
+            stderr.print(f"wrote the AIS log{'s' * (len(logs) > 1)} {', '.join(map(str, logs))}",
+                         soft_wrap=True)
         if run.interrupted:
             say_once(run.interrupted)
             raise typer.Exit(130)

@@ -2,6 +2,7 @@
 own ship with each collision-avoidance method, as one batched run, scored.
 
     shipgnc encounters [SITUATION.json ...] [--mc N] [--seed S] [--method none,...] [--out DIR]
+                       [--ais-log PATH [--ais-member K]]
 
 Without files: the standard set (:data:`shipgnc.study.trafficgen.STANDARD`: head-on, overtaking
 give-way and stand-on, crossing give-way and stand-on), written as trafficgen traffic situations to
@@ -9,8 +10,11 @@ give-way and stand-on, crossing give-way and stand-on), written as trafficgen tr
 (:func:`shipgnc.study.trafficgen.perturbed`) from ``--seed``. Prints a summary per encounter type
 and method (members, collisions, median and least CPA, median time lost) and writes
 ``summary.csv/.md``, ``members.csv/.md`` (every member's scores) and the figures (tracks with ship
-outlines and the CPA marked; CPA by target bearing). A situation file of the wrong schema, or a
-target inside the safety radius at t = 0: one line naming the field, exit 2.
+outlines and the CPA marked; CPA by target bearing); ``--ais-log PATH``: member K's run (own ship
+``!AIVDO``, its targets ``!AIVDM``, :mod:`shipgnc.study.ais_out`; run again alone, logged every
+step) as an NMEA AIS log, one encounter per file so that a chart plotter shows one own ship. A
+situation file of the wrong schema, or a target inside the safety radius at t = 0: one line naming
+the field, exit 2.
 """
 
 from __future__ import annotations
@@ -34,6 +38,11 @@ def encounters(
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write the figures.")]
         = True,
     backend: Annotated[str, typer.Option("--backend", help="auto (compiled) or numpy.")] = "auto",
+    ais_log: Annotated[Path | None, typer.Option(
+        "--ais-log", help="Write one member's run as an NMEA AIS log (own ship !AIVDO, targets "
+                          "!AIVDM) to this file.", show_default=False)] = None,
+    ais_member: Annotated[int, typer.Option(
+        "--ais-member", min=0, help="The member --ais-log writes (see members.csv).")] = 0,
 ) -> None:
     """Run the standard encounter set (or trafficgen situation files) with each avoidance method."""
     from shipgnc.cli import friendly_errors
@@ -53,6 +62,9 @@ def encounters(
             raise ConfigError("--mc perturbs the standard set; it does not apply to situation files")
         members = E.file_members(situations, methods) if situations else \
             E.standard_members(methods, mc=mc, seed=seed)
+        if ais_log is not None and ais_member >= len(members):
+            raise ConfigError(f"--ais-member {ais_member}: the sweep has members 0 to "
+                              f"{len(members) - 1}")
         out.mkdir(parents=True, exist_ok=True)
         if not situations:
             folder = out / "situations"
@@ -76,6 +88,12 @@ def encounters(
             from shipgnc.viz.encounter_figures import write_figures
 
             written += write_figures(result, out)
+        if ais_log is not None:
+            from shipgnc.study.ais_out import member_log
+
+            log = member_log(ais_log, members[ais_member], backend=backend)
+            print(f"wrote the AIS log {log} (member {ais_member}: {members[ais_member].situation.title}, "
+                  f"{members[ais_member].method})")
         print(f"wrote {', '.join(p.name for p in written)} to {out}")
 
 

@@ -71,6 +71,7 @@ class Member:
     mc: int = 0
     beta_deg: float = math.nan
     spec: tg.EncounterSpec | None = None  # the generated variant (None: read from a file)
+    rotation: float = 0.0  # [rad] the situation as its file gave it is this turn of ``situation``
 
 
 @dataclass
@@ -125,13 +126,14 @@ def file_members(paths, methods) -> list[Member]:
     low, high = SPEED_RANGE  # the own ship's (OWN_SHIP) valid speeds
     members = []
     for path in paths:
-        sit = own_frame(tg.read(path))
+        given = tg.read(path)
+        sit = own_frame(given)
         if not low <= sit.own_speed <= high:
             raise ConfigError(f"{path}: ownShip.initial.sog = {sit.own_speed / KNOT:g} kn (own ship "
                               f"sails {low / KNOT:.1f}–{high / KNOT:.1f} kn)")
         bearing = _bearing_deg(sit)
         for method in methods:
-            members.append(Member(sit, method, 0, bearing))
+            members.append(Member(sit, method, 0, bearing, rotation=given.own_course))
     return members
 
 
