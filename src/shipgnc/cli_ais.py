@@ -40,6 +40,9 @@ def info(
     skip_unknown: Annotated[bool, typer.Option(
         "--skip-unknown", help="Leave out sentences and AIS message types that are not read "
                                "(default: they are an error).")] = False,
+    untimed: Annotated[str, typer.Option(
+        "--untimed", help="A message without a time: refuse, or previous (the latest line's "
+                          "time before it).")] = "refuse",
     json_: Annotated[bool, typer.Option("--json", help="Print JSON on stdout.")] = False,
 ) -> None:
     """The targets of a logged AIS file: MMSI, name, reports, time span, speeds."""
@@ -49,7 +52,7 @@ def info(
         from shipgnc.ais.logs import read_log, read_reports, utc_text
         from shipgnc.units import KNOT
 
-        reports = read_reports(file, skip_unknown=skip_unknown)
+        reports = read_reports(file, skip_unknown=skip_unknown, untimed=untimed)
         t0 = min(r.time for r in reports) if reports else 0.0
         tracks, org = read_log(file, origin=_origin(origin), t0=t0, reports=reports)
         t1 = max(r.time for r in reports)

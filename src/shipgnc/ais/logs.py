@@ -51,7 +51,7 @@ from shipgnc.errors import ConfigError
 from shipgnc.units import KNOT
 
 _CHK = re.compile(r"\*[0-9A-Fa-f]{2}")
-_AIS_HEAD = re.compile(r"^!([A-Z]{2})(VDM|VDO),")
+_AIS_HEAD = re.compile(r"^!([A-Z0-9]{2})(VDM|VDO),")  # talkers: AI, BS, B1, B2, ...
 
 
 @dataclass(frozen=True)
@@ -116,17 +116,22 @@ def _split_nmea_line(raw: str, where: str) -> tuple[str, float | None]:
     return line, time
 
 
-def _read_nmea(lines: list[str], skip_unknown: bool) -> list[Report]:
+def _read_nmea(lines: list[str], skip_unknown: bool, untimed: str = "refuse") -> list[Report]:
     import pyais
     from pyais.exceptions import AISBaseException
 
     out: list[Report] = []
+    last_time = None  # the latest line's time: an untimed message's with untimed = "previous"
     pending: dict[tuple, tuple[int, float | None, list[str]]] = {}
     for no, raw in enumerate(lines, start=1):
         if not raw.strip() or raw.lstrip().startswith("#"):
             continue
         where = f"line {no}"
         sentence, time = _split_nmea_line(raw, where)
+        if time is not None:
+            last_time = time
+        elif untimed == "previous":
+            time = last_time
         head = _AIS_HEAD.match(sentence)
         if head is None:
             if skip_unknown:
@@ -169,7 +174,9 @@ def _read_nmea(lines: list[str], skip_unknown: bool) -> list[Report]:
                               "lines out)") from None
         if time is None:
             raise ConfigError(f"{where}: no time for this message: put an NMEA 4.0 tag block "
-                              "'\\c:<unix time>*hh\\' or a leading time before the sentence")
+                              "'\\c:<unix time>*hh\\' or a leading time before the sentence"
+                              + (" (untimed = 'previous': no line before it has one)"
+                                 if untimed == "previous" else ""))
         out.append(Report(line=msg_line, time=time, msg=decoded, own=head.group(2) == "VDO"))
     if pending:
         line, _, frags = min(pending.values())
@@ -249,8 +256,15 @@ def _read_csv(lines: list[str]) -> list[Report]:
     return out
 
 
-def read_reports(path, *, skip_unknown: bool = False) -> list[Report]:
-    """Every message of a logged AIS file (NMEA or CSV, see the module) in file order."""
+def read_reports(path, *, skip_unknown: bool = False, untimed: str = "refuse") -> list[Report]:
+    """Every message of a logged AIS file (NMEA or CSV, see the module) in file order.
+
+    ``untimed``: a message with no time of its own is refused (``"refuse"``), or takes the time
+    of the latest line before it that has one (``"previous"``: a feed that stamps most lines, such
+    as the Norwegian Coastal Administration's, where about one line in eight comes without a tag
+    block; its time is then late or early by the feed's spacing, a second or so)."""
+    if untimed not in ("refuse", "previous"):
+        raise ConfigError(f"untimed = {untimed!r}: allowed: refuse, previous")
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8", errors="strict")
@@ -266,7 +280,7 @@ def read_reports(path, *, skip_unknown: bool = False) -> list[Report]:
     try:
         if "mmsi" in first.lower() and "!" not in first:
             return _read_csv(lines)
-        return _read_nmea(lines, skip_unknown)
+        return _read_nmea(lines, skip_unknown, untimed)
     except ConfigError as exc:
         raise ConfigError(f"AIS log {p}: {exc}") from None
 
@@ -284,7 +298,8 @@ def _velocities(t, north, east, vn, ve, lines, mmsi) -> tuple[np.ndarray, np.nda
 
 
 def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None = None,
-             reports: list[Report] | None = None) -> tuple[list[TargetTrack], tuple[float, float]]:
+             reports: list[Report] | None = None,
+             untimed: str = "refuse") -> tuple[list[TargetTrack], tuple[float, float]]:
     """The targets of a logged AIS file, one track per MMSI (sorted by MMSI), and the origin.
 
     Positions are in the local plane about ``origin`` (lat, lon) [deg] — given, or the centre of the
@@ -295,11 +310,11 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
     earliest message). Names and lengths come
     from static data (types 5, 24) where the file has them. ``!AIVDO`` tracks (the logging ship) have
     ``source = "ais-own"``, the others ``"ais"``. ``reports``: the file's reports if already read
-    (:func:`read_reports`)."""
+    (:func:`read_reports`); ``untimed``: as :func:`read_reports` takes it."""
     from shipgnc.ais.plane import LocalPlane, centre, check_origin, check_range
 
     if reports is None:
-        reports = read_reports(path, skip_unknown=skip_unknown)
+        reports = read_reports(path, skip_unknown=skip_unknown, untimed=untimed)
     where = f"AIS log {Path(path)}"
     by_mmsi: dict[int, list[Report]] = {}
     static: dict[int, dict] = {}
