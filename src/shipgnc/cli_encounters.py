@@ -2,6 +2,7 @@
 own ship with each collision-avoidance method, as one batched run, scored.
 
     shipgnc encounters [SITUATION.json ...] [--mc N] [--seed S] [--method none,...] [--out DIR]
+                       [--awareness ais [--ais-noise M] [--ais-dropout P]]
                        [--ais-log PATH [--ais-member K]]
 
 Without files: the standard set (:data:`shipgnc.study.trafficgen.STANDARD`: head-on, overtaking
@@ -10,7 +11,9 @@ give-way and stand-on, crossing give-way and stand-on), written as trafficgen tr
 (:func:`shipgnc.study.trafficgen.perturbed`) from ``--seed``. Prints a summary per encounter type
 and method (members, collisions, median and least CPA, median time lost) and writes
 ``summary.csv/.md``, ``members.csv/.md`` (every member's scores) and the figures (tracks with ship
-outlines and the CPA marked; CPA by target bearing); ``--ais-log PATH``: member K's run (own ship
+outlines and the CPA marked; CPA by target bearing); ``--awareness ais``: the avoidance sees the
+targets through AIS (reporting intervals of ITU-R M.1371-5, ``--ais-noise`` [m], ``--ais-dropout``,
+seeded by ``--seed``), the scores against the truth; ``--ais-log PATH``: member K's run (own ship
 ``!AIVDO``, its targets ``!AIVDM``, :mod:`shipgnc.study.ais_out`; run again alone, logged every
 step) as an NMEA AIS log, one encounter per file so that a chart plotter shows one own ship. A
 situation file of the wrong schema, or a target inside the safety radius at t = 0: one line naming
@@ -38,6 +41,14 @@ def encounters(
     figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write the figures.")]
         = True,
     backend: Annotated[str, typer.Option("--backend", help="auto (compiled) or numpy.")] = "auto",
+    awareness: Annotated[str, typer.Option(
+        "--awareness", help="What the avoidance sees of the targets: truth, or ais (their reports "
+                            "at the AIS intervals; scores against the truth).")] = "truth",
+    ais_noise: Annotated[float, typer.Option(
+        "--ais-noise", help="With --awareness ais: the reported position's noise, standard "
+                            "deviation [m] in north and in east.")] = 0.0,
+    ais_dropout: Annotated[float, typer.Option(
+        "--ais-dropout", help="With --awareness ais: the probability that a report is lost.")] = 0.0,
     ais_log: Annotated[Path | None, typer.Option(
         "--ais-log", help="Write one member's run as an NMEA AIS log (own ship !AIVDO, targets "
                           "!AIVDM) to this file.", show_default=False)] = None,
@@ -62,6 +73,7 @@ def encounters(
             raise ConfigError("--mc perturbs the standard set; it does not apply to situation files")
         members = E.file_members(situations, methods) if situations else \
             E.standard_members(methods, mc=mc, seed=seed)
+        ais = _awareness(awareness, ais_noise, ais_dropout, seed)
         if ais_log is not None and ais_member >= len(members):
             raise ConfigError(f"--ais-member {ais_member}: the sweep has members 0 to "
                               f"{len(members) - 1}")
@@ -76,7 +88,7 @@ def encounters(
                 if mc and m.spec is not None:
                     tg.write(tg.situation_dict(m.spec, m.situation.own_speed),
                              folder / f"{m.spec.title}-mc{m.mc}.json")
-        result = E.run_members(members, backend=backend, keep_results=figures)
+        result = E.run_members(members, backend=backend, keep_results=figures, ais=ais)
         rows = E.summary(result)
         _print(rows, result)
         disagree = sum(row["label_disagrees"] for row in rows)
@@ -91,10 +103,33 @@ def encounters(
         if ais_log is not None:
             from shipgnc.study.ais_out import member_log
 
-            log = member_log(ais_log, members[ais_member], backend=backend)
+            log = member_log(ais_log, members[ais_member], backend=backend, ais=ais,
+                             number=ais_member)
             print(f"wrote the AIS log {log} (member {ais_member}: {members[ais_member].situation.title}, "
                   f"{members[ais_member].method})")
         print(f"wrote {', '.join(p.name for p in written)} to {out}")
+
+
+def _awareness(awareness: str, noise: float, dropout: float, seed: int):
+    """The AIS reception of ``--awareness ais`` (None: the truth); bad values one line each."""
+    from pydantic import ValidationError
+
+    from shipgnc.errors import ConfigError
+    from shipgnc.scenarios.sections import AISAwarenessConfig
+
+    if awareness not in ("truth", "ais"):
+        raise ConfigError(f"--awareness {awareness!r}: allowed: truth, ais")
+    if awareness == "truth":
+        if noise or dropout:
+            raise ConfigError("--ais-noise and --ais-dropout need --awareness ais")
+        return None
+    try:
+        return AISAwarenessConfig(seed=seed, position_noise_m=noise, dropout=dropout)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        flag = {"position_noise_m": "--ais-noise", "dropout": "--ais-dropout"}.get(
+            str(err["loc"][0]), str(err["loc"][0]))
+        raise ConfigError(f"{flag} = {err['input']!r}: {err['msg']}") from None
 
 
 def _print(rows, result) -> None:

@@ -218,9 +218,13 @@ def own_scenario(own_speed: float, method: str):
 
 
 def run_members(members: list[Member], *, backend: str = "auto", log_every: int = 10,
-                keep_results: bool = False, compliance: bool = True) -> SweepResult:
+                keep_results: bool = False, compliance: bool = True, ais=None,
+                numbers=None) -> SweepResult:
     """Run every member (one batch per own-ship speed) and score it (``compliance``: with the
-    COLREG compliance scores, from the log at every ``log_every``-th step)."""
+    COLREG compliance scores, from the log at every ``log_every``-th step). ``ais``: an
+    :class:`~shipgnc.scenarios.sections.AISAwarenessConfig` — the avoidance sees the targets
+    through AIS (:func:`seen_tracks`, member k drawing as member ``numbers[k]``, default k, so a
+    member run again alone sees what it saw in the sweep), scored against the truth."""
     import time
 
     from shipgnc.colav.compliance import SCORES
@@ -243,9 +247,13 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
         setup = build(scenario)
         g0 = setup.guidance
         g = scenario.guidance
+        seen = None if ais is None else [
+            seen_tracks(members[i].situation.targets, ais, t_end=DURATION,
+                        member=i if numbers is None else numbers[i],
+                        origin=members[i].situation.origin) for i in index]
         guidance = ColavGuidance(g0.los, [list(members[i].situation.targets) for i in index],
                                  methods=methods, configs={"sbmpc": g.sbmpc, "vo": g.vo},
-                                 decision_interval=g.decision_interval)
+                                 decision_interval=g.decision_interval, seen=seen)
         x0 = np.tile(setup.x0, (len(index), 1))
         result = simulate(setup.model, x0, t_end=DURATION, dt=DT, controller=setup.controller,
                           actuator=setup.actuator, guidance=guidance, u0=setup.u0,
