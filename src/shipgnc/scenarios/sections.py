@@ -1033,7 +1033,8 @@ class AISAwarenessConfig(Strict):
     intervals of its speed and rate of turn (or every ``interval``), each lost with probability
     ``dropout``, its position off by Gaussian noise of ``position_noise_m`` in north and in east,
     every value through the message's resolution; between reports the last one is dead-reckoned
-    from its SOG and COG. Target j draws from ``SeedSequence([seed, 0, j])``."""
+    from its SOG and COG; positions go through the message about ``ais_log.origin`` (else
+    0°, 0°). Target j draws from ``SeedSequence([seed, 0, j])``."""
 
     field_units: ClassVar[dict[str, str]] = {"position_noise_m": "m", "dropout": "1",
                                              "interval": "s", "seed": "1"}

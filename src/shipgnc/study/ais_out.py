@@ -9,8 +9,9 @@ local plane about ``origin`` (lat, lon) [deg]; a situation turned to the sweep's
 is turned back by ``rotation``, so the log shows it as the file gave it.
 
 Identities: a target keeps its MMSI if it has one (a logged or trafficgen target), else it and the
-own ship take MMSIs of MID 100, which is allocated to no country (ITU-R M.585), so no real ship
-carries them: the own ship 100000000, target j 100000001 + j.
+own ship take MMSIs of MID 100 — Maritime Identification Digits run from 201 to 775 (ITU-R M.585,
+the ITU's MID table), so no country, and no real ship, has them: the own ship 100000000, target j
+100000001 + j.
 """
 
 from __future__ import annotations
