@@ -26,9 +26,11 @@ FSM. The comparison's baselines of record are designed for the FSM's bandwidth:
   command pushes further).
 
 All are stateless continuous laws (their integral is the physical δ), like the FSM laws, so the
-comparison runs them in the same ``continuous`` mode. Each has a kernel for the composed compiled
-loop (:func:`yaw_rate_pi_step`, :func:`heading_lqr_step`; ω* and the heading capture's latch by
-:func:`~shipgnc.control.finite_state.rate_value`, as the FSM laws).
+comparison runs them in the same ``continuous`` mode. Each is written once, as a scalar kernel
+(:func:`yaw_rate_pi_step`, :func:`pole_placement_step`, :func:`designed_pi_step`,
+:func:`heading_lqr_step`; ω* and the heading capture's latch by
+:func:`~shipgnc.control.finite_state.rate_value`, as the FSM laws): the composed loop calls it, and
+the numpy ``law`` is its batch (:func:`~shipgnc.control.finite_state.rate_law`).
 """
 
 from __future__ import annotations
@@ -167,7 +169,7 @@ PI_SOURCE = 2 + N_KERNEL_PARAMS
 @kernel_function
 def yaw_rate_pi_step(t, x, ref, z, p, cmd, sig):
     """One :meth:`YawRatePI.law` for one ship: δ̇ = K_i (ω* − ω) − K_p Φ₃ (law (20) with
-    cos δ = 1, note 004-4.11.3), operation for operation."""
+    cos δ = 1, note 004-4.11.3); the numpy law is its batch."""
     z[0] += 1.0
     w = rate_value(t, x, ref, p, PI_SOURCE, z, 2)
     u = p[0] * (w - x[R]) - p[1] * catamaran_yaw_acceleration(x, p, 2)
@@ -243,7 +245,7 @@ class HeadingLQR:
 
 @kernel_function
 def heading_lqr_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`HeadingLQR.law` for one ship, operation for operation: the ramp ψ_r = K(t₀) +
+    """:meth:`HeadingLQR.law` for one ship (the numpy law is its batch): the ramp ψ_r = K(t₀) +
     sign(ΔK) ω_c clip(t − t₀, 0, t* − t₀) and ω* of the capture (17), then
     δ̇ = −K [v, r − ω*, wrap(ψ − ψ_r), δ] summed left to right (:func:`~shipgnc.batchmath.row_dot`)."""
     z[0] += 1.0
@@ -374,7 +376,7 @@ PLACE_SOURCE = PLACE_MODEL + N_KERNEL_PARAMS
 
 @kernel_function
 def pole_placement_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`PolePlacementRate.law` for one ship, operation for operation:
+    """:meth:`PolePlacementRate.law` for one ship (the numpy law is its batch):
     δ̇ = −k_v v̇ − k_r ṙ − k_ξ (r − ω*) with v̇, ṙ of :func:`~shipgnc.models.catamaran.catamaran_rhs`
     (no disturbance)."""
     z[0] += 1.0
@@ -433,7 +435,7 @@ DPI_SOURCE = DPI_MODEL + N_KERNEL_PARAMS
 
 @kernel_function
 def designed_pi_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`DesignedPI.law` for one ship, operation for operation: δ̇ = K_i (ω* − r) − K_p Φ₃,
+    """:meth:`DesignedPI.law` for one ship (the numpy law is its batch): δ̇ = K_i (ω* − r) − K_p Φ₃,
     set to 0 when |δ| ≥ δ_max and sign(δ̇) = sign(δ) (anti-windup)."""
     z[0] += 1.0
     w = rate_value(t, x, ref, p, DPI_SOURCE, z, 2)

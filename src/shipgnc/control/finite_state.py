@@ -36,13 +36,14 @@ The laws are stateless functions of (t, measured state, reference) — their "in
 physical δ — so they run in ``continuous`` mode (evaluated inside every RK stage, as the document
 does) or sampled every ``Ts`` with a hold.
 
-**Compiled** (:mod:`shipgnc.kernels`): :meth:`YawRateFSM.kernel` is the law for the composed loop
-(:func:`yaw_rate_fsm_step`), the references' ω* is :func:`rate_value` (one kernel for the three
-sources, used by the laws and by the references as guidance, :func:`rate_reference`). The per-ship
-kernel state holds what the numpy objects mutate, in the same calls: the heading capture's latch
-K(t₀), the last ω* and u (``signal_values``) and, per event kind, the index of the first law call
-(samples and RK stages counted alike), its time and the ship's |ω*| or |δ| there, from which
-``restore`` rebuilds ``events`` with the batch-wide values of numpy's messages.
+**Written once** (:mod:`shipgnc.kernels`): each law is one scalar kernel (:func:`yaw_rate_fsm_step`,
+and the ω* of the three sources :func:`rate_value`, also the references' kernel as guidance,
+:func:`rate_reference`); :meth:`YawRateFSM.kernel` hands it to the composed loop and the numpy
+``law`` — which the numpy loop, design and figures call — is its batch over ships
+(:func:`rate_law`, :func:`shipgnc.derive.per_ship`). The per-ship kernel state holds what the
+numpy objects keep: the heading capture's latch K(t₀), the last ω* and u (``signal_values``) and,
+per event kind, the index of the first law call (samples and RK stages counted alike), its time
+and the ship's |ω*| or |δ| there, from which ``events`` are written with the batch-wide values.
 """
 
 from __future__ import annotations
@@ -424,7 +425,7 @@ def rate_law(law, t: float, x, reference) -> tuple[np.ndarray, np.ndarray, np.nd
 
 @kernel_function
 def rate_value(t, x, ref, p, o, z, oz):
-    """ω*(t) of one ship, operation for operation as the numpy sources' ``value``: ``p[o:]`` a
+    """ω*(t) of one ship, the one source of the sources' ``value`` (their batch): ``p[o:]`` a
     parameter block of :meth:`_RateReference.rate_block`, ``z[oz:]`` its per-ship state (the
     heading capture (17) latches K(t₀) there at the first call with t ≥ t₀, as
     :class:`HeadingCapture` does); ``ref`` the held guidance references (source
@@ -696,7 +697,7 @@ def _first(z, j, t, value):
 
 @kernel_function
 def yaw_rate_fsm_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`YawRateFSM.law` for one ship, operation for operation: ω* of the source,
+    """:meth:`YawRateFSM.law` for one ship (the one source; the numpy law is its batch): ω* of the source,
     law (20) u = (ω* − ω − h Φ₃)/(T_u W₃₇) or (21) u = (ω* − ω)/(T_u W₃₇) with W₃₇ = h L T_v
     cos δ / J (eq. (19)); cos δ frozen beyond δ_f; u = 0 pushing |δ| beyond δ_max; the command
     u or v_a = (δ + T_a u)/k_a (eq. (23)). Events recorded in ``z`` (see :meth:`YawRateFSM.kernel`)."""
