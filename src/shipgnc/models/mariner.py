@@ -458,6 +458,8 @@ class MarinerDisturbance:
                 mode, path = 2, current.tracker.path
                 legs = flat(leg_table(path), -current.d_y * np.sin(path.leg_angles),
                             current.d_y * np.cos(path.leg_angles))
+                require(current.tracker.leg is not None, "disturbance", "MarinerDisturbance",
+                        "call reset(batch_shape, rng) first")
                 leg = np.broadcast_to(current.tracker.leg, shape).astype(float)
         return flat(self.b_r, mode, d_y, i_north, i_east, self.waves is not None, legs), leg
 
