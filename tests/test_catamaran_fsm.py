@@ -13,16 +13,17 @@ from shipgnc.control.finite_state import (
     HeadingCapture,
     SineRate,
     YawRateFSM,
+    _RateReference,
     actuator_inverse,
     default_gains,
     fsm_control,
     law20,
     law21,
     thruster_lag_rate,
-    w37,
 )
 from shipgnc.errors import ConfigError
 from shipgnc.models.catamaran import DELTA, PSI, Catamaran, R
+from shipgnc.models.catamaran import preset as preset_params
 from shipgnc.sim.simulator import simulate
 
 X0 = np.array([0, 0, 0, 4.0, 0, 0, 0])  # north, east, psi, u, v, r, delta
@@ -37,7 +38,12 @@ def test_w37_and_initial_thruster_rate_both_presets():
         model = Catamaran.from_preset(name)
         T_u, h = default_gains(name)
         p = model.params
-        assert float(w37(p, 0.0, h)) == pytest.approx(h * p.L * p.T_v / p.J)
+        # law (21) is (ω* − ω)/(T_u W₃₇) with W₃₇ = h L T_v cos δ / J (eq. (19)), in closed form
+        x = np.tile(X0, (3, 1))
+        x[:, R], x[:, DELTA] = [0.0, 0.01, -0.02], [0.0, math.pi / 3, -1.2]
+        w37 = h * p.L * p.T_v * np.cos(x[:, DELTA]) / p.J
+        np.testing.assert_allclose(law21(model, x, 0.05, T_u, h), (0.05 - x[:, R]) / (T_u * w37),
+                                   rtol=1e-14)
         for law in (law20, law21):
             u0 = float(law(model, X0, 0.08, T_u, h))
             assert math.degrees(u0) == pytest.approx(10.19, abs=0.005)  # check 14, S3
@@ -150,3 +156,84 @@ def test_clamp_and_frozen_gain():
     x[DELTA] = math.radians(83.0)
     u = float(ctrl.law(2.0, x, np.zeros(0))[0])
     assert u == pytest.approx(float(law21(model, np.where(np.arange(7) == DELTA, math.radians(80), x), 0.08, 2.5, 2.5)))
+
+
+def _per_ship_model(J_factor):
+    return Catamaran(preset_params("si", J_factor=np.asarray(J_factor, dtype=float)), "si")
+
+
+def test_laws_with_factors_along_two_batch_axes_are_each_ships_law():
+    """Per-ship J along two batch axes: the law's batch broadcasts the factors against the states;
+    each ship's command is law (20)/(21) of its own plant (the scalar model) and law (21) is the
+    closed form (ω* − ω) J/(T_u h L T_v cos δ)."""
+    J = np.array([[0.8, 1.0, 1.2], [0.9, 1.1, 1.3]])
+    many = _per_ship_model(J)
+    rng = np.random.default_rng(3)
+    x = np.tile(X0, (2, 3, 1))
+    x[..., R], x[..., DELTA] = rng.uniform(-0.05, 0.05, (2, 3)), rng.uniform(-1.0, 1.0, (2, 3))
+    for law in (20, 21):
+        ctrl = YawRateFSM(many, law, T_u=2.5, h=2.5, omega_ref=0.05)
+        assert ctrl.kernel_reason() is not None  # the composed loop takes one ship axis
+        ctrl.reset((2, 3))
+        u = ctrl.law(0.0, x, np.zeros(0))[..., 0]
+        assert u.shape == (2, 3)
+        for i, j in np.ndindex(2, 3):
+            one = YawRateFSM(_per_ship_model(J[i, j]), law, T_u=2.5, h=2.5, omega_ref=0.05)
+            one.reset(())
+            assert u[i, j] == pytest.approx(float(one.law(0.0, x[i, j], np.zeros(0))[0]), rel=1e-13)
+    p = many.params
+    closed = (0.05 - x[..., R]) * p.J / (2.5 * 2.5 * p.L * p.T_v * np.cos(x[..., DELTA]))
+    np.testing.assert_allclose(u, closed, rtol=1e-13)
+
+
+def test_per_ship_plant_along_one_axis_compiled_as_numpy():
+    """Per-ship factors along one axis: the compiled law reads each ship's own row (the numpy
+    batch's parameters), so the composed loop and the numpy loop agree ship by ship."""
+    model = _per_ship_model([0.8, 1.0, 1.2])
+    x0 = np.tile(X0, (3, 1))
+    runs = [simulate(model, x0, t_end=20.0, dt=0.25, backend=backend,
+                     controller=YawRateFSM(model, 21, T_u=2.5, h=2.5, omega_ref=0.05))
+            for backend in ("numpy", "compiled")]
+    assert float(np.ptp(runs[0].r.values[-1])) > 1e-4  # the ships differ
+    np.testing.assert_allclose(runs[1].r.values, runs[0].r.values, rtol=1e-9, atol=1e-12)
+
+
+class _NumpyRate(ConstantRate):
+    """A user's ω* source written in numpy only (no rate_block): ω* = 0.04 − 0.0001 t."""
+
+    rate_block = _RateReference.rate_block
+
+    def value(self, t, x):
+        return np.full(np.shape(x)[:-1], 0.04 - 1e-4 * t)
+
+
+def test_user_source_in_numpy_runs_the_kernels_batch():
+    """A ω* source without a kernel: no compiled law (the reason names it), and the numpy law is
+    the kernel's batch fed the source's values, i.e. the closed form (ω* − ω)/(T_u W₃₇)."""
+    model = Catamaran.from_preset("si")
+    ctrl = YawRateFSM(model, 21, T_u=2.5, h=2.5, omega_ref=_NumpyRate(0.0))
+    assert "omega_ref" in ctrl.kernel_reason()
+    ctrl.reset((2,))
+    x = np.tile(X0, (2, 1))
+    x[:, R], x[:, DELTA] = [0.01, -0.02], [0.3, -0.6]
+    u = ctrl.law(10.0, x, np.zeros(0))[:, 0]
+    p = model.params
+    w37 = 2.5 * p.L * p.T_v * np.cos(x[:, DELTA]) / p.J
+    np.testing.assert_allclose(u, (0.039 - x[:, R]) / (2.5 * w37), rtol=1e-14)
+    np.testing.assert_allclose(ctrl.signal_values()["omega_ref"], 0.039, rtol=1e-15)
+
+
+def test_guidance_reference_missing_is_one_line():
+    ctrl = YawRateFSM(Catamaran.from_preset("si"), 21, T_u=2.5, h=2.5)
+    ctrl.reset(())
+    with pytest.raises(ConfigError, match="guidance") as info:
+        ctrl.law(0.0, X0, np.zeros(0))
+    assert "\n" not in str(info.value)
+
+
+def test_sine_source_value_closed_form():
+    sine = SineRate(0.0072, 375.0)
+    sine.reset((2,))
+    for t in (0.0, 10.0, 93.75, 200.0):
+        np.testing.assert_allclose(sine.value(t, np.zeros((2, 7))), 0.0072 * math.sin(2 * math.pi * t / 375.0),
+                                   rtol=1e-14, atol=1e-18)

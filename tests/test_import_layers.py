@@ -9,8 +9,10 @@ last::
     sim        sim
     gnc        guidance, control, navigation
     physics    models, actuators, environment
-    core       errors, units, frames, paths, timeseries, streams, batchmath, params, kernels, outputs,
-               interrupts, lifeline, memory, user_files, config_types
+    paths      paths (waypoint paths, the leg tracker: its batch derived from its kernel)
+    derive     derive (the batch over ships derived from a scalar kernel)
+    core       errors, units, frames, timeseries, streams, batchmath, params, kernels, jit_cache,
+               outputs, interrupts, lifeline, memory, user_files, config_types
 
 import-linter checks the contract (its ``exhaustive`` option: every package and top-level module
 has a layer). What it cannot see is checked here too: a ``"shipgnc.module:function"`` string, the

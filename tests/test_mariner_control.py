@@ -476,3 +476,33 @@ def test_parameters_of_the_toolkit_mariner_model_fit():
         b.reset((1,))
         np.testing.assert_allclose(a.step(0.0, x, refs(STRAIGHT, x)), b.step(0.0, x, refs(STRAIGHT, x)),
                                    rtol=1e-9)
+
+
+def test_disturbance_cross_current_of_the_active_leg():
+    """d = [b_r, d_y·(−sin ψ_r0), d_y·cos ψ_r0] with ψ_r0 the leg the switching rule A6 makes active
+    (note 000-A10): north leg then east leg, the tracker kept in the current's object; a current
+    written in numpy only fills its own columns."""
+    from shipgnc.environment.current import CrossCurrent
+    from shipgnc.models.mariner import MarinerDisturbance
+
+    path = WaypointPath(np.array([[0.0, 0.0], [1000.0, 0.0], [1000.0, 1000.0]]))
+    dist = MarinerDisturbance(2e-5, CrossCurrent(0.5, path))
+    dist.reset((3,), np.random.default_rng(0))
+    x = np.zeros((3, 5))
+    x[:, 0], x[:, 1] = [10.0, 999.0, 1500.0], [0.0, 3.0, 20.0]
+    d = dist(0.0, x)
+    np.testing.assert_array_equal(dist.current.tracker.leg, [0, 0, 1])
+    np.testing.assert_allclose(d[:, 0], 2e-5)
+    np.testing.assert_allclose(d[:, 1:], [[0.0, 0.5], [0.0, 0.5], [-0.5, 0.0]], atol=1e-15)
+
+    class Numpy:
+        def reset(self, batch_shape, rng):
+            pass
+
+        def __call__(self, t, x):
+            return np.stack([x[..., 0] * 0.0 + 0.1, x[..., 1] * 0.01], axis=-1)
+
+    own = MarinerDisturbance(2e-5, Numpy())
+    assert own.kernel_reason() is not None
+    own.reset((3,), np.random.default_rng(0))
+    np.testing.assert_allclose(own(0.0, x), np.column_stack([np.full(3, 2e-5), np.full(3, 0.1), x[:, 1] * 0.01]))

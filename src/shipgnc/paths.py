@@ -1,5 +1,7 @@
 """Waypoint paths: straight legs between waypoints in NED, with the path-fixed frame; the leg
-tracker of document 000 (A6) and its scalar form for component kernels (:func:`track_leg`)."""
+tracker of document 000 (A6), written once as a scalar kernel (:func:`track_leg`) that component
+kernels call and whose batch over ships (:func:`shipgnc.derive.per_ship`) is
+:meth:`LegTracker.update`."""
 
 from __future__ import annotations
 
@@ -7,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shipgnc.derive import per_ship
 from shipgnc.errors import require
 from shipgnc.frames import path_frame
 from shipgnc.kernels import flat, kernel_function
@@ -53,7 +56,8 @@ class LegTracker:
 
     Switching rule of document 000 (A6): leg i + 1 becomes active once x_r ≥ |P_i P_{i+1}| on leg i
     (the ship crosses the normal through P_{i+1}); several switches in one sample are allowed;
-    the last leg is a half-line. Batched: one leg index per ship.
+    the last leg is a half-line. Batched: one leg index per ship; :meth:`update` is the batch of
+    the scalar kernel :func:`track_leg` (:func:`leg_update`), which component kernels call.
     """
 
     def __init__(self, path: WaypointPath):
@@ -61,6 +65,7 @@ class LegTracker:
                 "must be a WaypointPath")
         self.path = path
         self.leg: np.ndarray | None = None
+        self._table = leg_table(path)
 
     def reset(self, batch_shape) -> None:
         self.leg = np.zeros(tuple(batch_shape), dtype=int)
@@ -68,19 +73,13 @@ class LegTracker:
     def update(self, north, east) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Switch legs where due; return along-track x_r, cross-track y_r [m] and the leg angle ψ_r0."""
         require(self.leg is not None, "controller", "LegTracker", "call reset(batch_shape) first")
-        path = self.path
-        last = path.n_legs - 1
-        leg = np.broadcast_to(self.leg, np.shape(north)).copy()
-        for _ in range(path.n_legs):
-            x_r, y_r = path.project(north, east, leg)
-            switch = (leg < last) & (x_r >= path.leg_lengths[leg])
-            if not np.any(switch):
-                break
-            leg = np.where(switch, leg + 1, leg)
-        else:
-            x_r, y_r = path.project(north, east, leg)
-        self.leg = leg
-        return np.asarray(x_r, dtype=float), np.asarray(y_r, dtype=float), path.leg_angles[leg]
+        shape = np.shape(north)
+        position = np.stack(np.broadcast_arrays(np.asarray(north, dtype=float),
+                                                np.asarray(east, dtype=float)), axis=-1)
+        z = np.array(np.broadcast_to(self.leg, shape), dtype=float).reshape(-1, 1)
+        out = per_ship(leg_update, "i z p o")(position, z, self._table, 3)
+        self.leg = z[:, 0].astype(int).reshape(shape)
+        return out[..., 0], out[..., 1], out[..., 2]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -128,3 +127,15 @@ def leg_value(p, o, column, leg):
     """Column ``column`` (:data:`LEG_COS`, :data:`LEG_ANGLE`, ...) of leg ``leg`` in the
     :func:`leg_table` block ``p[o:]``."""
     return p[o + 1 + column * int(p[o]) + leg]
+
+
+@kernel_function
+def leg_update(position, z, p, out):
+    """:meth:`LegTracker.update` for one ship at ``position`` = [north, east]: its leg ``z[0]``
+    after any due switches (:func:`track_leg`), ``out`` = [x_r, y_r, π_p of the leg]; ``p`` a
+    :func:`leg_table` block."""
+    leg, x_r, y_r = track_leg(position[0], position[1], int(z[0]), p, 0)
+    z[0] = leg
+    out[0] = x_r
+    out[1] = y_r
+    out[2] = leg_value(p, 0, LEG_ANGLE, leg)

@@ -26,9 +26,11 @@ FSM. The comparison's baselines of record are designed for the FSM's bandwidth:
   command pushes further).
 
 All are stateless continuous laws (their integral is the physical δ), like the FSM laws, so the
-comparison runs them in the same ``continuous`` mode. Each has a kernel for the composed compiled
-loop (:func:`yaw_rate_pi_step`, :func:`heading_lqr_step`; ω* and the heading capture's latch by
-:func:`~shipgnc.control.finite_state.rate_value`, as the FSM laws).
+comparison runs them in the same ``continuous`` mode. Each is written once, as a scalar kernel
+(:func:`yaw_rate_pi_step`, :func:`pole_placement_step`, :func:`designed_pi_step`,
+:func:`heading_lqr_step`; ω* and the heading capture's latch by
+:func:`~shipgnc.control.finite_state.rate_value`, as the FSM laws): the composed loop calls it, and
+the numpy ``law`` is its batch (:func:`~shipgnc.control.finite_state.rate_law`).
 """
 
 from __future__ import annotations
@@ -37,17 +39,19 @@ import math
 
 import numpy as np
 
-from shipgnc.batchmath import row_dot
 from shipgnc.control.finite_state import (
     N_RATE_STATE,
     HeadingCapture,
     as_rate_reference,
+    law_columns,
+    law_params,
+    per_ship_value,
+    rate_law,
     rate_value,
     source_reason,
 )
 from shipgnc.errors import require
-from shipgnc.frames import wrap_angle
-from shipgnc.kernels import Kernel, NotCompiled, clip, flat, kernel_function, sign, wrap
+from shipgnc.kernels import Kernel, NotCompiled, clip, kernel_function, sign, wrap
 from shipgnc.models.base import Signal
 from shipgnc.models.catamaran import (
     DELTA,
@@ -59,7 +63,6 @@ from shipgnc.models.catamaran import (
     V,
     _hull_forces,
     catamaran_yaw_acceleration,
-    kernel_params,
     kernel_params_reason,
     linearize,
     straight_running_state,
@@ -71,17 +74,16 @@ def pi_gains(params, T_u: float, h: float) -> tuple[float, float]:
     k = params.J / (params.L * params.T_v)
     return k / (T_u * h), k / T_u
 
-def rate_source_kernel(controller, function, batch_shape, *params, source=None,
-                       signal: str = "omega_ref") -> Kernel:
-    """The :class:`Kernel` of a law fed by a reference source (``source``, default
-    ``controller.omega_ref``): parameters ``[*params, source block]``, per-ship state
-    ``[calls, last reference, source state]``; its ``restore`` hands the last reference (logged
-    as ``signal``) and the source's state back to the numpy objects."""
-    source = controller.omega_ref if source is None else source
+def rate_source_kernel(controller, function, batch_shape, *, signal: str = "omega_ref") -> Kernel:
+    """The :class:`Kernel` of a law fed by a reference source (``controller.rate_source()``):
+    parameters ``controller.law_pieces(model, source block)``, per-ship state ``[calls, last
+    reference, source state]``; its ``restore`` hands the last reference (logged as ``signal``) and
+    the source's state back to the numpy objects."""
+    source = controller.rate_source()
     batch_shape = tuple(batch_shape)
     block, block_state = source.rate_block(batch_shape)
-    state = np.zeros((*batch_shape, 2 + N_RATE_STATE))
-    state[..., 2:] = block_state
+    columns = law_columns(controller)
+    params = law_params(*controller.law_pieces(columns, block), lead=columns.shape[:-1])
 
     def restore(z: np.ndarray) -> None:
         z = z.reshape(-1, 2 + N_RATE_STATE)
@@ -89,13 +91,17 @@ def rate_source_kernel(controller, function, batch_shape, *params, source=None,
             controller._last = {signal: z[:, 1].reshape(batch_shape).copy()}
         source.restore_block(z[:, 2:], batch_shape)
 
-    return Kernel(function, flat(*params, block), state, restore=restore,
+    return Kernel(function, params, controller.law_state(batch_shape, block_state), restore=restore,
                   continuous=controller.continuous)
 
 
 class _RateSourceLaw:
     """What the yaw-rate laws fed by a ω* source share: the source, the sampling (``Ts`` None:
-    continuous, evaluated in every RK stage), the logged ω*, no events of their own."""
+    continuous, evaluated in every RK stage), the logged ω*, no events of their own; the numpy
+    ``law`` is the batch of the kernel (:func:`~shipgnc.control.finite_state.rate_law`)."""
+
+    #: the law reads the plant's parameters (``model``) in its kernel
+    uses_model = True
 
     def _init_rate_source(self, omega_ref, Ts) -> None:
         self.omega_ref = as_rate_reference(omega_ref)
@@ -105,11 +111,28 @@ class _RateSourceLaw:
         self._last: dict = {}
 
     def reset(self, batch_shape) -> None:
-        self.omega_ref.reset(batch_shape)
+        self.rate_source().reset(batch_shape)
         self.events = []
+
+    def law(self, t, x, reference):
+        command, signals, _ = rate_law(self, t, x, reference)
+        self._last = {self.signals[0].name: signals[..., 0]}
+        return command
+
+    def step(self, t, x, reference):
+        return self.law(t, x, reference)
 
     def signal_values(self):
         return dict(self._last)
+
+    def rate_source(self):
+        return self.omega_ref
+
+    def law_state(self, lead, source_state) -> np.ndarray:
+        """The kernel's initial per-ship state ``[calls, last reference, source state]``."""
+        state = np.zeros((*lead, 2 + N_RATE_STATE))
+        state[..., 2:] = source_state
+        return state
 
 
 class YawRatePI(_RateSourceLaw):
@@ -121,14 +144,6 @@ class YawRatePI(_RateSourceLaw):
         self.K_i, self.K_p = pi_gains(model.params, T_u, h)
         self._init_rate_source(omega_ref, Ts)
 
-    def law(self, t, x, reference):
-        w = self.omega_ref.value(t, x)
-        u = self.K_i * (w - x[..., R]) - self.K_p * self.model.yaw_acceleration(x)
-        self._last = {"omega_ref": w}
-        return u[..., None]
-
-    step = law
-
     def kernel_reason(self) -> str | None:
         """Why :meth:`kernel` cannot compile this controller (None when it can)."""
         return kernel_params_reason(self.model.params) or source_reason(self.omega_ref)
@@ -139,8 +154,12 @@ class YawRatePI(_RateSourceLaw):
         reason = self.kernel_reason()
         if reason:
             raise NotCompiled(reason)
-        return rate_source_kernel(self, yaw_rate_pi_step, batch_shape, self.K_i, self.K_p,
-                                  kernel_params(self.model.params))
+        return rate_source_kernel(self, yaw_rate_pi_step, batch_shape)
+
+    law_kernel = property(lambda self: yaw_rate_pi_step)
+
+    def law_pieces(self, columns, block) -> list:
+        return [per_ship_value(self.K_i), per_ship_value(self.K_p), columns, block]
 
 
 #: offset of the ω* source's parameters in :meth:`YawRatePI.kernel`
@@ -150,7 +169,7 @@ PI_SOURCE = 2 + N_KERNEL_PARAMS
 @kernel_function
 def yaw_rate_pi_step(t, x, ref, z, p, cmd, sig):
     """One :meth:`YawRatePI.law` for one ship: δ̇ = K_i (ω* − ω) − K_p Φ₃ (law (20) with
-    cos δ = 1, note 004-4.11.3), operation for operation."""
+    cos δ = 1, note 004-4.11.3); the numpy law is its batch."""
     z[0] += 1.0
     w = rate_value(t, x, ref, p, PI_SOURCE, z, 2)
     u = p[0] * (w - x[R]) - p[1] * catamaran_yaw_acceleration(x, p, 2)
@@ -186,19 +205,10 @@ class HeadingLQR:
         self.capture.reset(batch_shape)
         self.events = []
 
-    def heading_reference(self, t, x):
-        r_ref = self.capture.value(t, x)
-        cap = self.capture
-        diff = wrap_angle(cap.psi_target - cap.psi0)
-        t_star = cap.switch_time()
-        psi_ref = cap.psi0 + np.sign(diff) * cap.omega_c * np.clip(t - cap.t0, 0.0, t_star - cap.t0)
-        return psi_ref, r_ref
-
     def law(self, t, x, reference):
-        psi_ref, r_ref = self.heading_reference(t, x)
-        err = np.stack([x[..., V], x[..., R] - r_ref, wrap_angle(x[..., PSI] - psi_ref), x[..., DELTA]], -1)
-        self._last = {"psi_ref": psi_ref}
-        return -row_dot(err, self.K)[..., None]
+        command, signals, _ = rate_law(self, t, x, reference)
+        self._last = {"psi_ref": signals[..., 0]}
+        return command
 
     step = law
 
@@ -217,13 +227,25 @@ class HeadingLQR:
         reason = self.kernel_reason()
         if reason:
             raise NotCompiled(reason)
-        return rate_source_kernel(self, heading_lqr_step, batch_shape, np.ravel(self.K),
-                                  source=self.capture, signal="psi_ref")
+        return rate_source_kernel(self, heading_lqr_step, batch_shape, signal="psi_ref")
+
+    # --- what the kernel and its batch share (:func:`~shipgnc.control.finite_state.rate_law`) ---
+    uses_model = False
+    law_kernel = property(lambda self: heading_lqr_step)
+    law_state = _RateSourceLaw.law_state
+
+    def rate_source(self):
+        return self.capture
+
+    def law_pieces(self, columns, block) -> list:
+        require(np.size(self.K) == 4, "controller.gain", np.ravel(self.K).tolist(),
+                "need 4 values (v, r, heading error, delta)")
+        return [np.ravel(self.K), block]
 
 
 @kernel_function
 def heading_lqr_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`HeadingLQR.law` for one ship, operation for operation: the ramp ψ_r = K(t₀) +
+    """:meth:`HeadingLQR.law` for one ship (the numpy law is its batch): the ramp ψ_r = K(t₀) +
     sign(ΔK) ω_c clip(t − t₀, 0, t* − t₀) and ω* of the capture (17), then
     δ̇ = −K [v, r − ω*, wrap(ψ − ψ_r), δ] summed left to right (:func:`~shipgnc.batchmath.row_dot`)."""
     z[0] += 1.0
@@ -325,15 +347,6 @@ class PolePlacementRate(_RateSourceLaw):
         self.K = place_rate_gain(model, T_u, h) if gain is None else np.asarray(gain, dtype=float)
         self._init_rate_source(omega_ref, Ts)
 
-    def law(self, t, x, reference):
-        w = self.omega_ref.value(t, x)
-        xdot = self.model.derivatives(x, np.zeros((*np.shape(x)[:-1], 1)))
-        u = -self.K[0] * xdot[..., V] - self.K[1] * xdot[..., R] - self.K[2] * (x[..., R] - w)
-        self._last = {"omega_ref": w}
-        return u[..., None]
-
-    step = law
-
     def kernel_reason(self) -> str | None:
         """Why :meth:`kernel` cannot compile this controller (None when it can)."""
         if self.model.params.delta_row != "rate":
@@ -346,8 +359,14 @@ class PolePlacementRate(_RateSourceLaw):
         reason = self.kernel_reason()
         if reason:
             raise NotCompiled(reason)
-        return rate_source_kernel(self, pole_placement_step, batch_shape, self.K,
-                                  kernel_params(self.model.params))
+        return rate_source_kernel(self, pole_placement_step, batch_shape)
+
+    law_kernel = property(lambda self: pole_placement_step)
+
+    def law_pieces(self, columns, block) -> list:
+        require(np.size(self.K) == 3, "controller.gain", np.ravel(self.K).tolist(),
+                "need 3 values (k_v, k_r, k_xi)")
+        return [np.ravel(self.K), columns, block]
 
 
 #: offsets in :meth:`PolePlacementRate.kernel`'s parameters: the model's, the ω* source's
@@ -357,7 +376,7 @@ PLACE_SOURCE = PLACE_MODEL + N_KERNEL_PARAMS
 
 @kernel_function
 def pole_placement_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`PolePlacementRate.law` for one ship, operation for operation:
+    """:meth:`PolePlacementRate.law` for one ship (the numpy law is its batch):
     δ̇ = −k_v v̇ − k_r ṙ − k_ξ (r − ω*) with v̇, ṙ of :func:`~shipgnc.models.catamaran.catamaran_rhs`
     (no disturbance)."""
     z[0] += 1.0
@@ -390,17 +409,6 @@ class DesignedPI(_RateSourceLaw):
         self.delta_max = delta_max
         self._init_rate_source(omega_ref, Ts)
 
-    def law(self, t, x, reference):
-        w = self.omega_ref.value(t, x)
-        u = self.K_i * (w - x[..., R]) - self.K_p * self.model.yaw_acceleration(x)
-        if self.delta_max is not None:
-            delta = x[..., DELTA]
-            u = np.where((np.abs(delta) >= self.delta_max) & (np.sign(u) == np.sign(delta)), 0.0, u)
-        self._last = {"omega_ref": w}
-        return u[..., None]
-
-    step = law
-
     def kernel_reason(self) -> str | None:
         """Why :meth:`kernel` cannot compile this controller (None when it can)."""
         return kernel_params_reason(self.model.params) or source_reason(self.omega_ref)
@@ -411,9 +419,13 @@ class DesignedPI(_RateSourceLaw):
         reason = self.kernel_reason()
         if reason:
             raise NotCompiled(reason)
-        return rate_source_kernel(self, designed_pi_step, batch_shape, self.K_i, self.K_p,
-                                  float(self.delta_max is not None), self.delta_max or 0.0,
-                                  kernel_params(self.model.params))
+        return rate_source_kernel(self, designed_pi_step, batch_shape)
+
+    law_kernel = property(lambda self: designed_pi_step)
+
+    def law_pieces(self, columns, block) -> list:
+        return [per_ship_value(self.K_i), per_ship_value(self.K_p), float(self.delta_max is not None),
+                self.delta_max or 0.0, columns, block]
 
 
 #: offsets in :meth:`DesignedPI.kernel`'s parameters: the model's, the ω* source's
@@ -423,7 +435,7 @@ DPI_SOURCE = DPI_MODEL + N_KERNEL_PARAMS
 
 @kernel_function
 def designed_pi_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`DesignedPI.law` for one ship, operation for operation: δ̇ = K_i (ω* − r) − K_p Φ₃,
+    """:meth:`DesignedPI.law` for one ship (the numpy law is its batch): δ̇ = K_i (ω* − r) − K_p Φ₃,
     set to 0 when |δ| ≥ δ_max and sign(δ̇) = sign(δ) (anti-windup)."""
     z[0] += 1.0
     w = rate_value(t, x, ref, p, DPI_SOURCE, z, 2)

@@ -36,13 +36,14 @@ The laws are stateless functions of (t, measured state, reference) — their "in
 physical δ — so they run in ``continuous`` mode (evaluated inside every RK stage, as the document
 does) or sampled every ``Ts`` with a hold.
 
-**Compiled** (:mod:`shipgnc.kernels`): :meth:`YawRateFSM.kernel` is the law for the composed loop
-(:func:`yaw_rate_fsm_step`), the references' ω* is :func:`rate_value` (one kernel for the three
-sources, used by the laws and by the references as guidance, :func:`rate_reference`). The per-ship
-kernel state holds what the numpy objects mutate, in the same calls: the heading capture's latch
-K(t₀), the last ω* and u (``signal_values``) and, per event kind, the index of the first law call
-(samples and RK stages counted alike), its time and the ship's |ω*| or |δ| there, from which
-``restore`` rebuilds ``events`` with the batch-wide values of numpy's messages.
+**Written once** (:mod:`shipgnc.kernels`): each law is one scalar kernel (:func:`yaw_rate_fsm_step`,
+and the ω* of the three sources :func:`rate_value`, also the references' kernel as guidance,
+:func:`rate_reference`); :meth:`YawRateFSM.kernel` hands it to the composed loop and the numpy
+``law`` — which the numpy loop, design and figures call — is its batch over ships
+(:func:`rate_law`, :func:`shipgnc.derive.per_ship`). The per-ship kernel state holds what the
+numpy objects keep: the heading capture's latch K(t₀), the last ω* and u (``signal_values``) and,
+per event kind, the index of the first law call (samples and RK stages counted alike), its time
+and the ship's |ω*| or |δ| there, from which ``events`` are written with the batch-wide values.
 """
 
 from __future__ import annotations
@@ -52,6 +53,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from shipgnc.derive import per_ship
 from shipgnc.errors import ConfigError, require
 from shipgnc.frames import wrap_angle
 from shipgnc.kernels import Kernel, NotCompiled, clip, flat, kernel_function, sign, wrap
@@ -64,6 +66,7 @@ from shipgnc.models.catamaran import (
     R,
     U,
     V,
+    _kernel_columns,
     kernel_params,
     kernel_params_reason,
     yaw_acceleration_of,
@@ -212,8 +215,21 @@ class _RateReference:
 
         return Kernel(rate_reference, params, state, restore=restore)
 
-    def value(self, t: float, x: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
-        raise NotImplementedError
+    def value(self, t: float, x: np.ndarray) -> np.ndarray:
+        """ω*(t) for a batch of ships (..., 7): the batch of :func:`rate_reference` on the source's
+        :meth:`rate_block`, its per-ship state handed back by :meth:`restore_block` (a user's
+        source written in numpy overrides this method instead)."""
+        x = np.asarray(x, dtype=float)
+        lead = np.broadcast_shapes(x.shape[:-1], self._value_shape())
+        params, state = self.rate_block(lead)
+        z = np.array(np.broadcast_to(state, (*lead, N_RATE_STATE)).reshape(-1, N_RATE_STATE))
+        ref = per_ship(rate_reference, "t i z p o o -> r")(t, _to_batch(x, lead), z, params, 1, 0)[0]
+        self.restore_block(z, lead)
+        return ref[..., 0]
+
+    def _value_shape(self) -> tuple[int, ...]:
+        """The batch shape the source's own values have (one ω* or K(t₀) per ship)."""
+        return ()
 
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
         return np.broadcast_to(self.value(t, x), x.shape[:-1])[..., None].copy()
@@ -236,8 +252,8 @@ class ConstantRate(_RateReference):
         self.omega = float(value) if np.ndim(value) == 0 else value
         self.t_start = float(t_start)
 
-    def value(self, t, x):
-        return self.omega if t >= self.t_start else 0.0 * self.omega
+    def _value_shape(self):
+        return np.shape(self.omega)
 
     def rate_block(self, batch_shape):
         state = np.zeros((*batch_shape, N_RATE_STATE))
@@ -259,9 +275,6 @@ class SineRate(_RateReference):
         """Fig. 7's 0.0072 sin(8πt/t_f) (``reading="pi"``) or sin(8t/t_f) (``"literal"``)."""
         require(reading in ("pi", "literal"), "omega_ref.reading", reading, "allowed: pi, literal")
         return cls(amplitude, t_f / 4.0 if reading == "pi" else 2.0 * math.pi * t_f / 8.0)
-
-    def value(self, t, x):
-        return self.amplitude * math.sin(2.0 * math.pi * t / self.period)
 
     def rate_block(self, batch_shape):
         return _block(RATE_SINE, self.amplitude, self.period), np.zeros((*batch_shape, N_RATE_STATE))
@@ -292,10 +305,6 @@ class HeadingCapture(_RateReference):
         super().reset(batch_shape)
         self.psi0 = self._psi0_given
 
-    def _latch(self, t, x):
-        if self.psi0 is None and t >= self.t0:
-            self.psi0 = np.array(x[..., PSI], dtype=float, copy=True)
-
     def switch_time(self):
         """t* per ship (needs K(t₀): after the first evaluation or with ``psi0``)."""
         if self.psi0 is None:
@@ -303,17 +312,8 @@ class HeadingCapture(_RateReference):
         diff = wrap_angle(self.psi_target - self.psi0)
         return self.t0 + np.abs(diff) / self.omega_c
 
-    def value(self, t, x):
-        self._latch(t, x)
-        if self.psi0 is None:
-            return np.zeros(x.shape[:-1])
-        diff = wrap_angle(self.psi_target - self.psi0)
-        t_star = self.t0 + np.abs(diff) / self.omega_c
-        if self.ramp_s > 0:
-            frac = np.clip((t_star + self.ramp_s / 2 - t) / self.ramp_s, 0.0, 1.0)
-        else:
-            frac = np.where(t < t_star, 1.0, 0.0)
-        return np.broadcast_to(np.sign(diff) * self.omega_c * frac, x.shape[:-1]).copy()
+    def _value_shape(self):
+        return np.shape(self.psi0) if self.psi0 is not None else ()
 
     def rate_block(self, batch_shape):
         state = np.zeros((*batch_shape, N_RATE_STATE))
@@ -350,9 +350,82 @@ def _block(kind: float, *values: float) -> np.ndarray:
     return out
 
 
+# --- a law's numpy form: the batch derived from its kernel ------------------------------------------
+def law_params(*pieces, lead: tuple[int, ...] = ()) -> np.ndarray:
+    """A law kernel's parameters from ``pieces`` in order: numbers and flat blocks (shared by every
+    ship) and per-ship blocks (..., k) (arrays of two or more dimensions, e.g. a plant's
+    :func:`~shipgnc.models.catamaran.kernel_params` columns with per-ship mass factors). One flat
+    array when every piece is shared, else one row per ship of the batch ``lead`` (C order)."""
+    arrays = [np.asarray(piece, dtype=float) for piece in pieces]
+    if all(a.ndim <= 1 for a in arrays):
+        return flat(*arrays)
+    blocks = [np.broadcast_to(a.reshape(-1) if a.ndim <= 1 else a, (*lead, a.shape[-1] if a.ndim else 1))
+              for a in arrays]
+    rows = np.concatenate(blocks, axis=-1)
+    return np.ascontiguousarray(rows.reshape(-1, rows.shape[-1]))
+
+
+def _to_batch(x: np.ndarray, lead: tuple[int, ...]) -> np.ndarray:
+    """States ``x`` (..., k) over the batch ``lead``: as given when they cover it, else a copy."""
+    return x if x.shape[:-1] == lead else np.array(np.broadcast_to(x, (*lead, x.shape[-1])))
+
+
+def per_ship_value(value) -> np.ndarray:
+    """A number shared by every ship as is; one per ship (an array (...,)) as a block (..., 1)."""
+    a = np.asarray(value, dtype=float)
+    return a[..., None] if a.ndim else a
+
+
+def law_columns(law, columns=None) -> np.ndarray:
+    """The plant's :func:`~shipgnc.models.catamaran.kernel_params` columns of a law that reads its
+    model (``law.model``; zeros when it reads none: ``law.uses_model`` False). ``columns`` the
+    function forming them (default :func:`~shipgnc.models.catamaran.kernel_params`: refused
+    along more than one batch axis, as the composed loop needs)."""
+    if not getattr(law, "uses_model", True):
+        return np.zeros(N_KERNEL_PARAMS)
+    return (columns or kernel_params)(law.model.params)
+
+
+def rate_law(law, t: float, x, reference) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Evaluate the yaw-rate law ``law`` on a batch of ships by the batch
+    :func:`~shipgnc.derive.per_ship` derives from its kernel (``law.law_kernel``, signature
+    ``step(t, x, ref, z, p, cmd, sig)``): the numpy loop, design and figures run the kernel's
+    arithmetic, written once. Returns ``(command (..., 1), signals (..., n), kernel state (n_ships,
+    k))`` after handing the ω* source's state back to its object (the heading capture's latch).
+
+    ``law`` provides ``model`` (or None), ``rate_source()`` (the ω* source or None: the guidance's
+    first reference), ``law_state(lead, source_state)`` (the kernel's per-ship state) and
+    ``law_pieces(columns, block)`` (its parameters, :func:`law_params`). Every setting runs: the
+    plant's per-ship factors along any number of batch axes (the batch is the broadcast of the
+    factors and the states, one row per ship), and a user's ω* source written only in numpy (no
+    ``rate_block``): its ``value(t, x)`` is fed to the kernel as the guidance's reference."""
+    x = np.asarray(x, dtype=float)
+    reference = np.asarray(reference, dtype=float)
+    columns = law_columns(law, _kernel_columns)
+    lead = np.broadcast_shapes(x.shape[:-1], columns.shape[:-1], reference.shape[:-1])
+    x = _to_batch(x, lead)
+    source = law.rate_source()
+    if source is not None and source_reason(source) is None:
+        block, source_state = source.rate_block(lead)
+    else:
+        block, source_state = _block(RATE_GUIDANCE), np.zeros((*lead, N_RATE_STATE))
+        if source is not None:  # a source written in numpy: its ω* as the guidance's reference
+            reference = np.broadcast_to(np.asarray(source.value(t, x), dtype=float), lead)[..., None]
+        elif reference.shape[-1] < 1:
+            raise ConfigError(f"guidance: none; {type(law).__name__} without omega_ref needs a "
+                              "yaw-rate reference from the guidance")
+    z = np.array(law.law_state(lead, source_state).reshape(math.prod(lead), -1))
+    params = law_params(*law.law_pieces(columns, block), lead=lead)
+    command, signals = per_ship(law.law_kernel, "t i i z p o o")(t, x, reference, z, params, 1,
+                                                                 len(law.signals))
+    if source is not None and source_reason(source) is None:
+        source.restore_block(z[:, -N_RATE_STATE:], lead)
+    return command, signals, z
+
+
 @kernel_function
 def rate_value(t, x, ref, p, o, z, oz):
-    """ω*(t) of one ship, operation for operation as the numpy sources' ``value``: ``p[o:]`` a
+    """ω*(t) of one ship, the one source of the sources' ``value`` (their batch): ``p[o:]`` a
     parameter block of :meth:`_RateReference.rate_block`, ``z[oz:]`` its per-ship state (the
     heading capture (17) latches K(t₀) there at the first call with t ≥ t₀, as
     :class:`HeadingCapture` does); ``ref`` the held guidance references (source
@@ -403,20 +476,24 @@ def as_rate_reference(omega_ref) -> _RateReference | None:
 
 
 # --- the yaw-rate laws -------------------------------------------------------------------------------
-def w37(params, delta, h: float):
-    """W₃₇ = h L T_v cos δ / J (eq. (19))."""
-    return h * params.L * params.T_v * np.cos(delta) / params.J
-
-
 def law20(model: Catamaran, x, omega_ref, T_u: float, h: float):
-    """u = (ω* − ω − h Φ₃)/(T_u W₃₇), eq. (20)."""
-    omega_bar = x[..., R] + h * model.yaw_acceleration(x)
-    return (omega_ref - omega_bar) / (T_u * w37(model.params, x[..., DELTA], h))
+    """u = (ω* − ω − h Φ₃)/(T_u W₃₇), W₃₇ = h L T_v cos δ / J, eq. (19)–(20), for a batch of states
+    ``x`` (..., 7) and references ``omega_ref`` (broadcast): :func:`yaw_rate_fsm_step`'s batch."""
+    return _bare_law(model, 20, x, omega_ref, T_u, h)
 
 
 def law21(model: Catamaran, x, omega_ref, T_u: float, h: float):
-    """u = (ω* − ω)/(T_u W₃₇), eq. (21): needs only L, J, T_v, ω and δ."""
-    return (omega_ref - x[..., R]) / (T_u * w37(model.params, x[..., DELTA], h))
+    """u = (ω* − ω)/(T_u W₃₇), eq. (21): needs only L, J, T_v, ω and δ (:func:`law20`)."""
+    return _bare_law(model, 21, x, omega_ref, T_u, h)
+
+
+def _bare_law(model: Catamaran, law: int, x, omega_ref, T_u: float, h: float):
+    """The law without guards, actuator or ω* source: ω* handed over as the guidance's reference."""
+    controller = YawRateFSM(model, law, T_u=T_u, h=h, check_feasibility=False)
+    x = np.asarray(x, dtype=float)
+    lead = np.broadcast_shapes(x.shape[:-1], np.shape(omega_ref))
+    reference = np.broadcast_to(np.asarray(omega_ref, dtype=float), lead)[..., None]
+    return rate_law(controller, 0.0, x, reference)[0][..., 0]
 
 
 class YawRateFSM:
@@ -505,40 +582,17 @@ class YawRateFSM:
                 "the reference is not reached")
 
     def law(self, t: float, x: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        if self.omega_ref is not None:
-            w_ref = self.omega_ref.value(t, x)
-        else:
-            require(reference.shape[-1] >= 1, "guidance", "none",
-                    "YawRateFSM without omega_ref needs a yaw-rate reference from the guidance")
-            w_ref = reference[..., 0]
-        if np.any(np.isnan(w_ref)):
+        """The command for a batch of ships: :func:`yaw_rate_fsm_step`'s batch (:func:`rate_law`);
+        the events of this call read from the kernel's per-ship records."""
+        command, signals, z = rate_law(self, t, x, reference)
+        if np.any(np.isnan(signals[..., 0])):
             raise ConfigError("omega_ref = nan: the yaw-rate reference must be finite")
-        if self.omega_max is not None and np.max(np.abs(w_ref)) > self.omega_max:
-            self._event(t, "omega_ref_above_max",
-                        self._message("omega_ref_above_max", float(np.max(np.abs(w_ref)))))
-        delta = x[..., DELTA]
-        delta_peak = float(np.max(np.abs(delta)))
-        if delta_peak >= math.pi / 2:
-            self._event(t, "delta_reached_90", self._message("delta_reached_90", delta_peak))
-        if self.gain_freeze is not None:  # W37 with cos(delta) frozen beyond gain_freeze
-            frozen = np.clip(delta, -self.gain_freeze, self.gain_freeze)
-            scale = np.cos(delta) / np.cos(frozen)
-        if self.law_number == 20:
-            u = law20(self.model, x, w_ref, self.T_u, self.h)
-        else:
-            u = law21(self.model, x, w_ref, self.T_u, self.h)
-        if self.gain_freeze is not None:
-            u = u * scale
-        if self.delta_max is not None:
-            outward = (np.abs(delta) >= self.delta_max) & (np.sign(u) == np.sign(delta))
-            if np.any(outward):
-                self._event(t, "delta_clamped", self._message("delta_clamped", 0.0))
-            u = np.where(outward, 0.0, u)
-        self._last = {"omega_ref": w_ref, "fsm_u": u}
-        if self.actuator is not None:
-            T_a, k_a = self.actuator
-            return actuator_inverse(delta, u, T_a, k_a)[..., None]
-        return u[..., None]
+        for j, kind in enumerate(FSM_EVENTS):  # in the order the law checks them
+            fired = z[:, 1 + j] >= 0.0
+            if np.any(fired):
+                self._event(t, kind, self._message(kind, float(z[fired, 7 + j].max())))
+        self._last = {"omega_ref": signals[..., 0], "fsm_u": signals[..., 1]}
+        return command
 
     def step(self, t, x, reference):
         return self.law(t, x, reference)
@@ -564,27 +618,45 @@ class YawRateFSM:
         if reason:
             raise NotCompiled(reason)
         batch_shape = tuple(batch_shape)
-        p = self.model.params
+        columns = law_columns(self)
         source = self.omega_ref
         if source is None:
             block, block_state = _block(RATE_GUIDANCE), np.zeros((*batch_shape, N_RATE_STATE))
         else:
             block, block_state = source.rate_block(batch_shape)
-        T_a, k_a = self.actuator if self.actuator is not None else (1.0, 1.0)
-        params = flat(float(self.law_number == 20), self.T_u, self.h, self.h * p.L * p.T_v,
-                      kernel_params(p)[2], self.omega_max is not None,
-                      self.omega_max if self.omega_max is not None else 0.0,
-                      self.gain_freeze is not None, self.gain_freeze or 0.0,
-                      self.delta_max is not None, self.delta_max or 0.0,
-                      self.actuator is not None, T_a, k_a, 0.0, 0.0, kernel_params(p), block)
-        state = np.zeros((*batch_shape, FSM_STATE))
-        state[..., 1:4] = -1.0
-        state[..., FSM_STATE - N_RATE_STATE:] = block_state
+        params = law_params(*self.law_pieces(columns, block), lead=columns.shape[:-1])
+        state = self.law_state(batch_shape, block_state)
 
         def restore(z: np.ndarray) -> None:
             self._restore(z.reshape(-1, FSM_STATE), batch_shape)
 
         return Kernel(yaw_rate_fsm_step, params, state, restore=restore, continuous=self.continuous)
+
+    # --- what the kernel and its batch share (:func:`rate_law`) ----------------------------------
+    @property
+    def law_kernel(self):
+        return yaw_rate_fsm_step
+
+    def rate_source(self):
+        return self.omega_ref
+
+    def law_state(self, lead, source_state) -> np.ndarray:
+        """The kernel's initial per-ship state: no call, no event yet, the source's state."""
+        state = np.zeros((*lead, FSM_STATE))
+        state[..., 1:4] = -1.0
+        state[..., FSM_STATE - N_RATE_STATE:] = source_state
+        return state
+
+    def law_pieces(self, columns, block) -> list:
+        """The kernel's parameters (:meth:`kernel`) from the plant's columns (..., 18)."""
+        p = self.model.params
+        T_a, k_a = self.actuator if self.actuator is not None else (1.0, 1.0)
+        return [float(self.law_number == 20), self.T_u, self.h, self.h * p.L * p.T_v,
+                columns[..., 2:3], self.omega_max is not None,
+                self.omega_max if self.omega_max is not None else 0.0,
+                self.gain_freeze is not None, self.gain_freeze or 0.0,
+                self.delta_max is not None, self.delta_max or 0.0,
+                self.actuator is not None, T_a, k_a, 0.0, 0.0, columns, block]
 
     def _restore(self, z: np.ndarray, batch_shape) -> None:
         """``events``, ``signal_values`` and the ω* source as the numpy loop leaves them."""
@@ -625,7 +697,7 @@ def _first(z, j, t, value):
 
 @kernel_function
 def yaw_rate_fsm_step(t, x, ref, z, p, cmd, sig):
-    """One :meth:`YawRateFSM.law` for one ship, operation for operation: ω* of the source,
+    """:meth:`YawRateFSM.law` for one ship (the one source; the numpy law is its batch): ω* of the source,
     law (20) u = (ω* − ω − h Φ₃)/(T_u W₃₇) or (21) u = (ω* − ω)/(T_u W₃₇) with W₃₇ = h L T_v
     cos δ / J (eq. (19)); cos δ frozen beyond δ_f; u = 0 pushing |δ| beyond δ_max; the command
     u or v_a = (δ + T_a u)/k_a (eq. (23)). Events recorded in ``z`` (see :meth:`YawRateFSM.kernel`)."""

@@ -58,6 +58,7 @@ from types import MappingProxyType
 import numpy as np
 
 from shipgnc.actuators import Actuator
+from shipgnc.derive import per_ship
 from shipgnc.environment.fields import field_velocity
 from shipgnc.errors import ConfigError, require
 from shipgnc.kernels import Kernel, NotCompiled, flat, kernel_function
@@ -365,23 +366,41 @@ class MarinerDisturbance:
             self.waves.reset(batch_shape, rng)
 
     def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
-        yaw = np.full(x.shape[:-1], self.b_r)
-        if self.waves is not None:
-            yaw = yaw + self.waves(t, x)
-        if self.current is None:
-            return np.stack([yaw, np.zeros_like(yaw), np.zeros_like(yaw)], axis=-1)
-        return np.concatenate([yaw[..., None], self.current(t, x)], axis=-1)
+        """d (..., 3) for a batch of ships: the batch of :func:`mariner_disturbance` (the path
+        current's leg tracker handed back to the current's object); the waves' value drawn in numpy
+        as the kernel's table row. A current written only in numpy (no kernel) is its own call."""
+        x = np.asarray(x, dtype=float)
+        shape = x.shape[:-1]
+        own = self.current is not None and self._current_reason() is not None
+        params, leg = self._kernel_parts(shape, with_current=not own)
+        z = np.array(leg, dtype=float).reshape(-1, 1)
+        w = (np.asarray(self.waves(t, x), dtype=float)[..., None] if self.waves is not None
+             else np.zeros(1))
+        d = per_ship(mariner_disturbance, "t i z p i o")(t, x, z, params, w, 3)
+        if own:
+            d[..., 1:] = self.current(t, x)
+        elif params[1] == 2.0:
+            self.current.tracker.leg = z[:, 0].astype(int).reshape(shape)
+        return d
 
-    def kernel_reason(self) -> str | None:
-        """None when :meth:`kernel` covers this disturbance, else why not (the run then uses numpy)."""
+    def _current_reason(self) -> str | None:
+        """Why the current has no kernel (None when it has one, or there is none)."""
         from shipgnc.environment.current import CrossCurrent
-        from shipgnc.environment.filtered_noise import SecondOrderNoise
 
         if self.current is not None and type(self.current) is not CrossCurrent:
             try:
                 _field_kernel(self.current)
             except NotCompiled as exc:
                 return str(exc)
+        return None
+
+    def kernel_reason(self) -> str | None:
+        """None when :meth:`kernel` covers this disturbance, else why not (the run then uses numpy)."""
+        from shipgnc.environment.filtered_noise import SecondOrderNoise
+
+        reason = self._current_reason()
+        if reason:
+            return reason
         if self.waves is not None:
             if type(self.waves) is not SecondOrderNoise:
                 return f"waves {type(self.waves).__name__} have no kernel (only SecondOrderNoise)"
@@ -400,24 +419,10 @@ class MarinerDisturbance:
         step ``dt``), so it draws from the run's generator exactly as the numpy loop does (same
         seed, same sea) and the filter ends in the same state.
         """
-        from shipgnc.environment.current import CrossCurrent
-
         current, waves = self.current, self.waves
         shape = tuple(batch_shape)
-        leg = np.zeros(shape)
-        mode, d_y, i_north, i_east, legs = 0, 0.0, 0, 0, np.zeros(0)
-        if current is not None and type(current) is not CrossCurrent:
-            mode, legs = 3, _field_kernel(current)  # raises NotCompiled
-        elif current is not None:
-            d_y, (i_north, i_east) = current.d_y, current._i
-            if current.frame == "global":
-                mode = 1
-            else:  # d_y·[−sin ψ_r0, cos ψ_r0] of each leg, as CrossCurrent.__call__ forms it
-                mode, path = 2, current.tracker.path
-                legs = flat(leg_table(path), -current.d_y * np.sin(path.leg_angles),
-                            current.d_y * np.cos(path.leg_angles))
-                leg = current.tracker.leg.astype(float)
-        params = flat(self.b_r, mode, d_y, i_north, i_east, waves is not None, legs)
+        params, leg = self._kernel_parts(shape)  # raises NotCompiled for a field without a kernel
+        mode = params[1]
         table, restore = None, None
         if waves is not None:
             if dt is None:
@@ -431,8 +436,32 @@ class MarinerDisturbance:
             def restore(z: np.ndarray) -> None:
                 current.tracker.leg = z[:, 0].astype(int).reshape(shape)
 
-        return Kernel(mariner_disturbance, params, leg[..., None], table=table,
+        return Kernel(mariner_disturbance, params, np.asarray(leg)[..., None], table=table,
                       n_table=int(waves is not None), restore=restore)
+
+
+    def _kernel_parts(self, shape, with_current: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """(parameters of :func:`mariner_disturbance`, per-ship leg of the path current) for the
+        batch ``shape``; ``with_current`` False: the yaw channel alone (zeros for the current)."""
+        from shipgnc.environment.current import CrossCurrent
+
+        current = self.current if with_current else None
+        leg = np.zeros(shape)
+        mode, d_y, i_north, i_east, legs = 0, 0.0, 0, 0, np.zeros(0)
+        if current is not None and type(current) is not CrossCurrent:
+            mode, legs = 3, _field_kernel(current)  # raises NotCompiled
+        elif current is not None:
+            d_y, (i_north, i_east) = current.d_y, current._i
+            if current.frame == "global":
+                mode = 1
+            else:  # d_y·[−sin ψ_r0, cos ψ_r0] of each leg, as CrossCurrent.__call__ forms it
+                mode, path = 2, current.tracker.path
+                legs = flat(leg_table(path), -current.d_y * np.sin(path.leg_angles),
+                            current.d_y * np.cos(path.leg_angles))
+                require(current.tracker.leg is not None, "disturbance", "MarinerDisturbance",
+                        "call reset(batch_shape, rng) first")
+                leg = np.broadcast_to(current.tracker.leg, shape).astype(float)
+        return flat(self.b_r, mode, d_y, i_north, i_east, self.waves is not None, legs), leg
 
 
 class MarinerYawDisturbance(MarinerDisturbance):

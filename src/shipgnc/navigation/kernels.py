@@ -679,123 +679,183 @@ def ekf_update(first, Ax, xpred, y, fresh, z, p, work):
     triangle only and mirrored. ``z`` the EKF's state (ẑ, P, :data:`EKF_TAIL`, slots), ``p`` its
     :data:`EKF` block, ``work`` :func:`ekf_work_size` numbers."""
     n = int(p[E_N])
-    nx = int(p[E_NX])
-    nne = n * n
-    Ts = p[E_TS]
-    nrows = int(p[E_ROWS])
-    nslt = int(p[E_SLOTS])
-    q0 = EKF_SIZE + EKF_ROW_SIZE * nrows      # Q_c diagonal
-    a0 = q0 + n                               # augmented states
-    tail = n + nne
-    sb = tail + EKF_TAIL_SIZE                 # the slots
-    ssz = SLOT_SIZE + n + nslt
-    zh = z[0:n]
-    P = z[n:n + nne]
+    tail = n + n * n
     if first != 0.0:
         z[tail + E_COUNT] = 0.0
     else:
         z[tail + E_COUNT] += 1.0
-        A, at = _carve(work, 0, nne)
-        At, at = _carve(work, at, nne)
-        B2, at = _carve(work, at, nne)       # At², then T = F P
-        C, at = _carve(work, at, nne)        # At/6 + At²/24, then Γ
-        E, at = _carve(work, at, nne)        # F − I
-        Qd, at = _carve(work, at, nne)       # Q_d, then P⁻ (upper triangles)
-        Pl, at = _carve(work, at, nne)
-        q, at = _carve(work, at, n)
-        xp, at = _carve(work, at, n)
+        ekf_predict(Ax, xpred, z, p, work)
+    zh = z[0:n]
+    P = z[n:tail]
+    nslt = int(p[E_SLOTS])
+    slots = z[tail + EKF_TAIL_SIZE:]
+    nis, nisd = _ekf_fresh_rows(zh, P, y, fresh, slots, p, work[0:n])
+    if nslt > 0:
+        nis, nisd = ekf_delayed(zh, P, y, fresh, slots, p, int(z[tail + E_COUNT]), nis, nisd)
+    z[tail + E_NIS] = nis
+    z[tail + E_NIS_DIM] = nisd
+
+
+@kernel_function
+def ekf_predict(Ax, xpred, z, p, work):
+    """The prediction of :func:`ekf_update`: A from the model's Jacobian ``Ax`` and the augmented
+    states, F − I = E, Q_d, then ẑ⁻ = ``xpred``, P⁻ = F P Fᵀ + Q_d and every pending delayed
+    sample's g ← F g (the formulas of :func:`ekf_update`)."""
+    n = int(p[E_N])
+    nne = n * n
+    Ts = p[E_TS]
+    A, at = _carve(work, 0, nne)
+    At, at = _carve(work, at, nne)
+    B2, at = _carve(work, at, nne)       # At², then T = F P
+    C, at = _carve(work, at, nne)        # At/6 + At²/24, then Γ
+    E, at = _carve(work, at, nne)        # F − I
+    Qd, at = _carve(work, at, nne)       # Q_d, then P⁻ (upper triangles)
+    Pl, at = _carve(work, at, nne)
+    q, at = _carve(work, at, n)
+    xp, at = _carve(work, at, n)
+    q0 = EKF_SIZE + EKF_ROW_SIZE * int(p[E_ROWS])   # Q_c diagonal
+    for j in range(n):
+        q[j] = p[q0 + j]
+    _ekf_system(Ax, p, q0 + n, A)
+    _ekf_transition(At, A, Ts, B2, C, E)
+    if p[E_HELD] != 0.0:
+        _ekf_noise_held(At, B2, q, Ts, C, Qd)
+    else:
+        _ekf_noise_continuous(A, q, Ts, Qd)
+    for i in range(n):
+        z[i] = xpred[i]
+    _ekf_covariance(z[n:n + nne], E, Pl, B2, Qd)
+    nslt = int(p[E_SLOTS])
+    sb = n + nne + EKF_TAIL_SIZE
+    ssz = SLOT_SIZE + n + nslt
+    for sl in range(nslt):      # Larsen's M*: g ← F g = g + E g
+        if z[sb + sl * ssz + SL_ACTIVE] != 0.0:
+            _ekf_propagate_gain(z, sb + sl * ssz + SLOT_SIZE, E, xp)
+
+
+@kernel_function
+def _ekf_system(Ax, p, a0, A):
+    """A = [[Ax, Dᵀ], [0, −diag λ]] (n × n, row-major) from the model's Jacobian ``Ax`` (nx × nx)
+    and the augmented states' block at ``p[a0:]`` (:data:`AUGMENTED`)."""
+    n = int(p[E_N])
+    nx = int(p[E_NX])
+    for i in range(n):
         for j in range(n):
-            q[j] = p[q0 + j]
-        for i in range(n):
-            for j in range(n):
-                A[i * n + j] = Ax[i * nx + j] if (i < nx and j < nx) else 0.0
-        for a in range(n - nx):     # [[A, Dᵀ], [0, −diag λ]]
-            o = a0 + AUGMENTED_SIZE * a
-            tgt = int(p[o + AU_DRIVEN])
-            if tgt >= 0:
-                A[tgt * n + nx + a] = 1.0
-            A[(nx + a) * n + nx + a] = -p[o + AU_DECAY]
-        for i in range(nne):
-            At[i] = A[i] * Ts
-        for i in range(n):   # At², At/6 + At²/24
-            for j in range(n):
-                acc = 0.0
-                for m in range(n):
-                    acc += At[i * n + m] * At[m * n + j]
-                B2[i * n + j] = acc
-                C[i * n + j] = At[i * n + j] / 6 + acc / 24
-        for i in range(n):   # E = F − I = At + At²/2 + At² (At/6 + At²/24)
-            for j in range(n):
-                acc = 0.0
-                for m in range(n):
-                    acc += B2[i * n + m] * C[m * n + j]
-                E[i * n + j] = At[i * n + j] + B2[i * n + j] / 2 + acc
-        if p[E_HELD] != 0.0:  # Γ (Q_c/Ts) Γᵀ, Γ = Ts (I + At/2 + At²/6)
-            for i in range(n):
-                for j in range(n):
-                    C[i * n + j] = Ts * ((1.0 if i == j else 0.0) + At[i * n + j] / 2
-                                         + B2[i * n + j] / 6)
-            for i in range(n):
-                for j in range(i, n):
-                    acc = 0.0
-                    for m in range(n):
-                        acc += C[i * n + m] * q[m] * C[j * n + m]
-                    Qd[i * n + j] = acc / Ts
-        else:  # Q_c Ts + (A Q_c + Q_c Aᵀ) Ts²/2 + A Q_c Aᵀ Ts³/3
-            Ts2 = Ts**2
-            Ts3 = Ts**3
-            for i in range(n):
-                for j in range(i, n):
-                    acc = 0.0
-                    for m in range(n):
-                        acc += A[i * n + m] * q[m] * A[j * n + m]
-                    x_ = ((A[i * n + j] * q[j] + A[j * n + i] * q[i]) * Ts2) / 2
-                    qc = q[i] if i == j else 0.0
-                    Qd[i * n + j] = qc * Ts + x_ + (acc * Ts3) / 3
-        for i in range(n):
-            zh[i] = xpred[i]
-        # P⁻ = F P Fᵀ + Q_d: T = P + E P, then the upper triangle of T + T Eᵀ + Q_d, mirrored
-        for i in range(nne):
-            Pl[i] = P[i]
-        for i in range(n):
-            for j in range(n):
-                acc = Pl[i * n + j]
-                for m in range(n):
-                    acc += E[i * n + m] * Pl[m * n + j]
-                B2[i * n + j] = acc
-        for i in range(n):
-            for j in range(i, n):
-                acc = B2[i * n + j]
-                for m in range(n):
-                    acc += B2[i * n + m] * E[j * n + m]
-                Qd[i * n + j] = acc + Qd[i * n + j]
-                P[i * n + j] = Qd[i * n + j]
-                P[j * n + i] = Qd[i * n + j]
-        for sl in range(nslt):      # Larsen's M*: g ← F g = g + E g
-            g0 = sb + sl * ssz + SLOT_SIZE
-            if z[sb + sl * ssz + SL_ACTIVE] != 0.0:
-                for i in range(n):
-                    acc = z[g0 + i]
-                    for m in range(n):
-                        acc += E[i * n + m] * z[g0 + m]
-                    xp[i] = acc
-                for i in range(n):
-                    z[g0 + i] = xp[i]
+            A[i * n + j] = Ax[i * nx + j] if (i < nx and j < nx) else 0.0
+    for a in range(n - nx):
+        o = a0 + AUGMENTED_SIZE * a
+        tgt = int(p[o + AU_DRIVEN])
+        if tgt >= 0:
+            A[tgt * n + nx + a] = 1.0
+        A[(nx + a) * n + nx + a] = -p[o + AU_DECAY]
+
+
+@kernel_function
+def _ekf_transition(At, A, Ts, B2, C, E):
+    """At = A Ts, B2 = At², C = At/6 + At²/24 and E = F − I = At + At²/2 + At² C (Paterson &
+    Stockmeyer: two products instead of three)."""
+    n = int(math.sqrt(A.shape[0]) + 0.5)
+    for i in range(n * n):
+        At[i] = A[i] * Ts
+    for i in range(n):
+        for j in range(n):
+            acc = 0.0
+            for m in range(n):
+                acc += At[i * n + m] * At[m * n + j]
+            B2[i * n + j] = acc
+            C[i * n + j] = At[i * n + j] / 6 + acc / 24
+    for i in range(n):
+        for j in range(n):
+            acc = 0.0
+            for m in range(n):
+                acc += B2[i * n + m] * C[m * n + j]
+            E[i * n + j] = At[i * n + j] + B2[i * n + j] / 2 + acc
+
+
+@kernel_function
+def _ekf_noise_held(At, B2, q, Ts, C, Qd):
+    """Q_d = Γ (Q_c/Ts) Γᵀ, Γ = Ts (I + At/2 + At²/6) (noise held over Ts), upper triangle;
+    Γ is formed in ``C``."""
+    n = q.shape[0]
+    for i in range(n):
+        for j in range(n):
+            C[i * n + j] = Ts * ((1.0 if i == j else 0.0) + At[i * n + j] / 2 + B2[i * n + j] / 6)
+    for i in range(n):
+        for j in range(i, n):
+            acc = 0.0
+            for m in range(n):
+                acc += C[i * n + m] * q[m] * C[j * n + m]
+            Qd[i * n + j] = acc / Ts
+
+
+@kernel_function
+def _ekf_noise_continuous(A, q, Ts, Qd):
+    """Q_d = Q_c Ts + (A Q_c + Q_c Aᵀ) Ts²/2 + A Q_c Aᵀ Ts³/3 (continuous noise), upper triangle."""
+    n = q.shape[0]
+    Ts2 = Ts**2
+    Ts3 = Ts**3
+    for i in range(n):
+        for j in range(i, n):
+            acc = 0.0
+            for m in range(n):
+                acc += A[i * n + m] * q[m] * A[j * n + m]
+            x_ = ((A[i * n + j] * q[j] + A[j * n + i] * q[i]) * Ts2) / 2
+            qc = q[i] if i == j else 0.0
+            Qd[i * n + j] = qc * Ts + x_ + (acc * Ts3) / 3
+
+
+@kernel_function
+def _ekf_covariance(P, E, Pl, B2, Qd):
+    """P⁻ = F P Fᵀ + Q_d in place: T = P + E P (in ``B2``), then the upper triangle of
+    T + T Eᵀ + Q_d (in ``Qd``), mirrored into ``P``."""
+    n = int(math.sqrt(P.shape[0]) + 0.5)
+    for i in range(n * n):
+        Pl[i] = P[i]
+    for i in range(n):
+        for j in range(n):
+            acc = Pl[i * n + j]
+            for m in range(n):
+                acc += E[i * n + m] * Pl[m * n + j]
+            B2[i * n + j] = acc
+    for i in range(n):
+        for j in range(i, n):
+            acc = B2[i * n + j]
+            for m in range(n):
+                acc += B2[i * n + m] * E[j * n + m]
+            Qd[i * n + j] = acc + Qd[i * n + j]
+            P[i * n + j] = Qd[i * n + j]
+            P[j * n + i] = Qd[i * n + j]
+
+
+@kernel_function
+def _ekf_propagate_gain(z, g0, E, xp):
+    """A pending delayed sample's g (``z[g0:g0 + n]``) ← F g = g + E g (Larsen's M*)."""
+    n = xp.shape[0]
+    for i in range(n):
+        acc = z[g0 + i]
+        for m in range(n):
+            acc += E[i * n + m] * z[g0 + m]
+        xp[i] = acc
+    for i in range(n):
+        z[g0 + i] = xp[i]
+
+
+@kernel_function
+def _ekf_fresh_rows(zh, P, y, fresh, slots, p, Pc):
+    """One scalar correction per row whose sensor delivered now without latency
+    (:func:`ekf_correct`); returns the summed NIS and the number of rows it sums."""
     nis = 0.0
     nisd = 0.0
-    Pc = work[0:n]
-    for r in range(nrows):
+    nslt = int(p[E_SLOTS])
+    for r in range(int(p[E_ROWS])):
         o = EKF_SIZE + EKF_ROW_SIZE * r
         if p[o + ER_LATENCY] == 0.0 and fresh[r] != 0.0:  # no latency, fresh
             v = ekf_correct(zh, P, int(p[o + ER_STATE]), int(p[o + ER_BIAS]), y[r], p[o + ER_R],
-                            p[o + ER_ANGLE] != 0.0, z[sb:], nslt, Pc)
+                            p[o + ER_ANGLE] != 0.0, slots, nslt, Pc)
             if v >= 0.0:
                 nis += v
                 nisd += 1.0
-    if nslt > 0:
-        nis, nisd = ekf_delayed(zh, P, y, fresh, z[sb:], p, int(z[tail + E_COUNT]), nis, nisd)
-    z[tail + E_NIS] = nis
-    z[tail + E_NIS_DIM] = nisd
+    return nis, nisd
 
 
 @kernel_function
