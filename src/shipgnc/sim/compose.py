@@ -67,6 +67,8 @@ _SKIP = np.iinfo(np.int64).max
 TEMPLATE = Path(__file__).with_name("loop_template.py")
 #: the navigation step, written before the loop's body (it calls the model's kernel by name)
 NAV_TEMPLATE = Path(__file__).with_name("nav_template.py")
+#: the in-loop scoring step, written after the loop's body (it reads the log's column layout)
+SCORE_TEMPLATE = Path(__file__).with_name("score_template.py")
 
 
 class LoopSteps(NamedTuple):
@@ -94,6 +96,21 @@ class LoopParams(NamedTuple):
     disturbance: np.ndarray
     current: np.ndarray
     navigation: np.ndarray
+
+
+class ScoreArrays(NamedTuple):
+    """The in-loop scoring step's accumulators (:mod:`shipgnc.sim.score_template`): ``ops``
+    (m, 2) int64 log column and kind, ``span`` (m, 4) window start and end [s] and two arguments,
+    ``acc`` (ships, 3 m) each ship's numbers. No accumulator (m = 0): nothing is scored."""
+
+    ops: np.ndarray
+    span: np.ndarray
+    acc: np.ndarray
+
+
+def no_scoring(n_ships: int) -> ScoreArrays:
+    """The scoring step's arrays when nothing is scored in the loop."""
+    return ScoreArrays(np.zeros((0, 2), dtype=np.int64), np.zeros((0, 4)), np.zeros((n_ships, 0)))
 
 
 class LoopTables(NamedTuple):
@@ -217,6 +234,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
     elif est_slot is not None and not est_slot.isidentifier():
         raise ValueError(f"est_slot = {est_slot!r}: not a slot of the navigation template")
     return ("\n".join(lines) + "\n" + NAV_TEMPLATE.read_text() + slot + "\n" + TEMPLATE.read_text()
+            + "\n" + SCORE_TEMPLATE.read_text()
             + '\nloop = numba.njit(parallel=True, **{**JIT_OPTIONS, "cache": CACHE})(loop)\n')
 
 
@@ -359,6 +377,22 @@ class Composition:
         self._kn = kn
         self._pu = _param_rows(ku or empty, n)
         self._pn = _param_rows(kn or empty, n)
+        #: the in-loop scoring step's accumulators (none unless :meth:`score_in_loop`)
+        self.score = no_scoring(n)
+
+    def score_in_loop(self, ops: np.ndarray, span: np.ndarray, acc: np.ndarray) -> None:
+        """Score every step in the loop into ``acc`` (ships, 3 m), updated in place
+        (:class:`ScoreArrays`; :mod:`shipgnc.sim.scored`)."""
+        n = self.S.shape[0]
+        ops = np.ascontiguousarray(ops, dtype=np.int64).reshape(-1, 2)
+        span = np.ascontiguousarray(span, dtype=np.float64).reshape(-1, 4)
+        if acc.shape != (n, 3 * ops.shape[0]) or acc.dtype != np.float64 or not acc.flags.c_contiguous:
+            raise ValueError(f"score_in_loop: acc must be C-contiguous float64 of shape "
+                             f"({n}, {3 * ops.shape[0]}), not {acc.dtype} {acc.shape}")
+        if ops.shape[0] and not (0 <= ops[:, 0].min() and ops[:, 0].max() < len(self.signals)):
+            raise ValueError(f"score_in_loop: log columns {ops[:, 0].tolist()} outside "
+                             f"0 … {len(self.signals) - 1}")
+        self.score = ScoreArrays(ops, span, acc)
 
     def prepare(self, k0: int, k1: int) -> None:
         """The input tables of steps ``k0 … k1 − 1`` (a noise's draws, the sensors' draws)."""
@@ -382,7 +416,8 @@ class Composition:
                   self.done_at if self.done_at is not None else self._no_done,
                   LoopParams(params[0], self._pa, params[1], params[2], params[3], self._pu,
                              self._pn),
-                  LoopTables(table["W"], table["Wu"], table["Wn"]), self._limits, self._err)
+                  LoopTables(table["W"], table["Wu"], table["Wn"]), self._limits, self._err,
+                  self.score)
 
     def put_state(self, x: np.ndarray) -> None:
         """Each ship's plant state ``x`` (B, n) into its row (e.g. a member's drawn start)."""

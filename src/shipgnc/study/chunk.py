@@ -243,6 +243,68 @@ def _alone(setup, i: int):
     return replace(setup, model=model.subset(i, i + 1)) if isinstance(model, PerShipModel) else setup
 
 
+def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str) -> dict[str, np.ndarray] | None:
+    """Every member's metrics scored inside the compiled loop (:mod:`shipgnc.analysis.accumulated`),
+    in :func:`~shipgnc.scenarios.runner.metric_arrays`' key order; None when the metric set, the
+    backend or the setup needs the logged series, or when a member diverged (the chunk is then run
+    again with its log, where a diverged member is run alone up to its divergence)."""
+    from shipgnc.analysis.accumulated import plan_for
+    from shipgnc.sim.scored import run_scored
+    from shipgnc.sim.simulator import _validate, log_signals
+
+    if backend not in ("compiled", "compiled-or-numpy") or sim.integrator != "rk4":
+        return None
+    n_steps = round(sim.t_end / sim.dt)
+    run = _validate(setup.model, x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
+                    actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
+                    u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
+                    atol=sim.atol, seed=MemberStreams(seeds), on_divergence="mask", observer=None,
+                    progress=None, log_every=max(1, n_steps), navigation=setup.navigation)
+    plan = plan_for(scenario, setup, list(log_signals(run)), run.n_steps, run.dt)
+    if plan is None:
+        return None
+    scored = run_scored(run, plan.ops, plan.span, plan.init)
+    if scored is None or (scored.event >= 0).any():
+        return None
+    arrays = plan.finish(scored.acc)
+    arrays["diverged"] = np.zeros(x0.shape[0])
+    return arrays
+
+
+def scored_from_log(scenario, setup, sim, x0, seeds, backend: str, route: bool):
+    """The chunk's members run with a log of every step and scored from it (see
+    :func:`run_chunk`): their metric arrays, the loops that ran, the result and, for a route, each
+    member's completion time."""
+    import xarray as xr
+
+    from shipgnc.scenarios.runner import compute_metrics, metric_arrays
+
+    size = x0.shape[0]
+    result, done_at = _run_batch(setup, sim, x0, seeds, backend, route, "mask")
+    diverged = np.isfinite(result["diverged_at"].values)
+    result = result.drop_vars("diverged_at")
+    arrays = None
+    if diverged.any():
+        runs = [_run_batch(_alone(setup, i), sim, x0[i:i + 1], seeds[i:i + 1], backend, route)
+                if diverged[i] else _survivor(result, done_at, i) for i in range(size)]
+        ran_on = {r.attrs.get("backend") for r, _ in runs}
+        members = [r.isel(member=0) for r, _ in runs]
+        result = xr.concat([r for r, _ in runs], dim="member", join="outer")
+        done_at = np.concatenate([d for _, d in runs]) if route else None
+    else:
+        ran_on = {result.attrs.get("backend")}
+        arrays = metric_arrays(scenario, result, setup)  # every member scored at once
+        members = [result.isel(member=i) for i in range(size)] if arrays is None else []
+    if route and arrays is None:  # each member scored on its own run, which ends at its completion
+        members = [m.isel(time=slice(0, round(d / sim.dt) + 1)) if np.isfinite(d) else m
+                   for m, d in zip(members, done_at, strict=True)]
+    if arrays is None:
+        rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
+        keys = list(dict.fromkeys(k for row in rows for k in row))
+        arrays = {k: np.array([row.get(k, math.nan) for row in rows]) for k in keys}
+    return arrays, ran_on, result, done_at
+
+
 def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """Run one chunk; an ``xarray.Dataset`` with a ``member`` dimension: every scalar metric, and
     with ``study.series`` every time series; ``attrs["backend"]`` says which code ran it.
@@ -261,7 +323,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """
     import xarray as xr
 
-    from shipgnc.scenarios.runner import build, compute_metrics, metric_arrays, simulation_of
+    from shipgnc.scenarios.runner import build, simulation_of
 
     scenario = study.scenario_at(study.points[chunk.point])
     check_sweepable(scenario)
@@ -273,28 +335,13 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     seeds = study.member_seeds(chunk.start, chunk.stop, 1)  # made when a disturbance draws
     route = ends_early(setup)
     sim = simulation_of(scenario, setup)
-    result, done_at = _run_batch(setup, sim, x0, seeds, backend, route, "mask")
-    diverged = np.isfinite(result["diverged_at"].values)
-    result = result.drop_vars("diverged_at")
-    arrays = None
-    if diverged.any():
-        runs = [_run_batch(_alone(setup, i), sim, x0[i:i + 1], seeds[i:i + 1], backend, route)
-                if diverged[i] else _survivor(result, done_at, i) for i in range(chunk.size)]
-        ran_on = {r.attrs.get("backend") for r, _ in runs}
-        members = [r.isel(member=0) for r, _ in runs]
-        result = xr.concat([r for r, _ in runs], dim="member", join="outer")
-        done_at = np.concatenate([d for _, d in runs]) if route else None
+    arrays = None if route or study.series else scored_in_loop(scenario, setup, sim, x0, seeds,
+                                                                backend)
+    if arrays is not None:  # no series: the members' figures are all the chunk keeps
+        ran_on, result, done_at = {"compiled"}, None, None
     else:
-        ran_on = {result.attrs.get("backend")}
-        arrays = metric_arrays(scenario, result, setup)  # every member scored at once
-        members = [result.isel(member=i) for i in range(chunk.size)] if arrays is None else []
-    if route and arrays is None:  # each member scored on its own run, which ends at its completion
-        members = [m.isel(time=slice(0, round(d / sim.dt) + 1)) if np.isfinite(d) else m
-                   for m, d in zip(members, done_at, strict=True)]
-    if arrays is None:
-        rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
-        keys = list(dict.fromkeys(k for row in rows for k in row))
-        arrays = {k: np.array([row.get(k, math.nan) for row in rows]) for k in keys}
+        arrays, ran_on, result, done_at = scored_from_log(scenario, setup, sim, x0, seeds,
+                                                          backend, route)
     # copies: a metric that is a view of the log (a final value) would keep the chunk's whole
     # log alive until the study ends (≈ 190 MB per 1 000 boats of boat-autopilot)
     data = {k: ("member", np.array(v, dtype=float)) for k, v in arrays.items()}
