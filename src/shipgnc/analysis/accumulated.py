@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from shipgnc.frames import wrap_angle
+from shipgnc.sim.result import time_coordinate
 from shipgnc.units import to_deg
 
 # the kinds of shipgnc.sim.score_template (its module constants; that module is source only)
@@ -78,7 +79,7 @@ def plan_for(scenario, setup, signals, n_steps: int, dt: float) -> Accumulators 
     run with navigation, whose estimate errors are scored from the series)."""
     if scenario.metrics not in IN_LOOP_SETS or setup.navigation is not None:
         return None
-    t = np.arange(n_steps + 1) * dt  # the sample times of a log of every step
+    t = time_coordinate(np.arange(n_steps + 1) * dt)  # the sample times of a log of every step
     return heading_steps(signals, t, setup.guidance.step_times)
 
 
@@ -103,7 +104,7 @@ def heading_steps(signals, t: np.ndarray, step_times, tolerance_deg: float = 2.0
         a = acc.reshape(acc.shape[0], -1, 3)
         settling, overshoot = [], []
         for t_k, band, up, down, first, before in windows:
-            settle_at = a[:, band, 1] - t_k
+            settle_at = time_coordinate(a[:, band, 1]) - t_k
             settling.append(np.where(a[:, band, 0] == 0.0, 0.0, settle_at))
             prior = np.where(a[:, before, 1] != 0.0, a[:, before, 0], a[:, first_psi_d, 0])
             direction = np.sign(wrap_angle(a[:, first, 0] - prior))

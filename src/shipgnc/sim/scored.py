@@ -36,7 +36,8 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray) -> Sc
     reset_components(setup)
     comp = Composition(setup)
     n = comp.S.shape[0]
-    acc = np.ascontiguousarray(np.broadcast_to(np.asarray(init, dtype=np.float64), (n, len(init))))
+    acc = np.empty((n, len(init)))
+    acc[:] = np.asarray(init, dtype=np.float64)
     comp.score_in_loop(ops, span, acc)
     stop = drive(setup, comp.call, comp.S, comp.event, prepare=comp.prepare, done_at=comp.done_at)
     if stop.interrupted:
