@@ -57,6 +57,9 @@ def _both(metric_set, overrides, perturb, members=6):
     seeds = study.member_seeds(0, members, 1)
     sim = simulation_of(scenario, setup)
     in_loop = scored_in_loop(scenario, setup, sim, x0, seeds, "compiled-or-numpy")
+    if in_loop is not None:
+        in_loop, diverged = in_loop
+        assert not diverged.any()
     logged, ran_on, _, _ = scored_from_log(scenario, setup, sim, x0, seeds, "compiled-or-numpy",
                                            False)
     return in_loop, logged, ran_on, round(sim.t_end / sim.dt) + 1
@@ -101,10 +104,12 @@ def test_a_chunk_without_series_keeps_the_figures_of_one_with_series():
         np.testing.assert_allclose(plain[key].values, series[key].values, rtol=1e-12, err_msg=key)
 
 
-def test_a_chunk_with_a_diverged_member_is_scored_from_its_log(monkeypatch):
-    """In-loop scoring gives up on a chunk in which a member diverged (None): the chunk is then run
-    with its log, where the member is run alone up to its divergence (``run_chunk``)."""
+def test_a_diverged_member_is_scored_alone_from_its_log_and_the_others_in_the_loop(monkeypatch):
+    """A member that diverged in the chunk's scored loop is run again alone with its log (as a
+    chunk scored from its log does), the others keep their in-loop figures: neither depends on
+    the chunk the member shares."""
     import shipgnc.sim.scored as scored
+    from shipgnc.study import chunk as chunk_module
 
     real = scored.run_scored
 
@@ -113,13 +118,30 @@ def test_a_chunk_with_a_diverged_member_is_scored_from_its_log(monkeypatch):
         out.event[1] = 2 * 10 + 1  # as if member 1's state went bad after step 10
         return out
 
-    study = Study("boat-autopilot", members=3, seed=1, overrides=("simulation.t_end=5",))
+    study = Study("boat-autopilot", members=3, seed=1, overrides=("simulation.t_end=5",),
+                  perturb=(Perturbation.parse("psi_deg=uniform:-20,20"),))
+    reference = run_chunk(study, Chunk(0, 0, 3))
+    alone = []
+    real_alone = chunk_module._run_batch
+
+    def recorded(setup, sim, x0, *args):
+        alone.append(x0.copy())
+        return real_alone(setup, sim, x0, *args)
+
+    monkeypatch.setattr(scored, "run_scored", one_diverged)
+    monkeypatch.setattr(chunk_module, "_run_batch", recorded)
+    ds = run_chunk(study, Chunk(0, 0, 3))
+    assert len(alone) == 1 and alone[0].shape[0] == 1  # member 1, alone
+    for key in ds.data_vars:  # here it did not truly diverge: its own run gives its figures
+        np.testing.assert_allclose(ds[key].values, reference[key].values, rtol=1e-12, err_msg=key)
+    np.testing.assert_array_equal(ds["heading_rmse_deg"].values[[0, 2]],
+                                  reference["heading_rmse_deg"].values[[0, 2]])
+
+
+def test_the_numpy_backend_is_scored_from_its_log():
+    study = Study("boat-autopilot", members=2, seed=1, overrides=("simulation.t_end=5",))
     scenario = study.scenario_at(study.points[0])
     setup = build(scenario, seed=study.seed)
-    x0 = member_initial_states(study, setup.x0, setup.model, Chunk(0, 0, 3))
-    args = (scenario, setup, simulation_of(scenario, setup), x0, study.member_seeds(0, 3, 1),
-            "compiled-or-numpy")
-    assert scored_in_loop(*args) is not None
-    monkeypatch.setattr(scored, "run_scored", one_diverged)
-    assert scored_in_loop(*args) is None
-    assert scored_in_loop(*args[:-1], "numpy") is None  # the numpy loop logs every step
+    x0 = member_initial_states(study, setup.x0, setup.model, Chunk(0, 0, 2))
+    assert scored_in_loop(scenario, setup, simulation_of(scenario, setup), x0,
+                          study.member_seeds(0, 2, 1), "numpy") is None

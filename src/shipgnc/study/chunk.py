@@ -243,11 +243,11 @@ def _alone(setup, i: int):
     return replace(setup, model=model.subset(i, i + 1)) if isinstance(model, PerShipModel) else setup
 
 
-def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str) -> dict[str, np.ndarray] | None:
+def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str):
     """Every member's metrics scored inside the compiled loop (:mod:`shipgnc.analysis.accumulated`),
-    in :func:`~shipgnc.scenarios.runner.metric_arrays`' key order; None when the metric set, the
-    backend or the setup needs the logged series, or when a member diverged (the chunk is then run
-    again with its log, where a diverged member is run alone up to its divergence)."""
+    in :func:`~shipgnc.scenarios.runner.metric_arrays`' key order, and which members diverged
+    (their figures NaN here: :func:`run_chunk` runs each again alone with its log); None when the
+    metric set, the backend or the setup needs the logged series."""
     from shipgnc.analysis.accumulated import plan_for
     from shipgnc.sim.scored import run_scored
     from shipgnc.sim.simulator import _validate, log_signals
@@ -264,11 +264,27 @@ def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str) -> dict[str, n
     if plan is None:
         return None
     scored = run_scored(run, plan.ops, plan.span, plan.init)
-    if scored is None or (scored.event >= 0).any():
+    if scored is None:
         return None
-    arrays = plan.finish(scored.acc)
+    diverged = scored.event >= 0
+    arrays = {k: np.where(diverged, math.nan, v) for k, v in plan.finish(scored.acc).items()}
     arrays["diverged"] = np.zeros(x0.shape[0])
-    return arrays
+    return arrays, diverged
+
+
+def diverged_alone(scenario, setup, sim, x0, seeds, backend: str, arrays: dict, diverged) -> set:
+    """Each ``diverged`` member run again alone up to its divergence, with its log, and scored
+    there into its row of ``arrays``; the loops that ran."""
+    from shipgnc.scenarios.runner import compute_metrics
+
+    ran_on = set()
+    for i in np.flatnonzero(diverged):
+        alone, _ = _run_batch(_alone(setup, i), sim, x0[i:i + 1], seeds[i:i + 1], backend, False)
+        ran_on.add(alone.attrs.get("backend"))
+        row = numeric_metrics(compute_metrics(scenario, alone.isel(member=0), setup))
+        for key, values in arrays.items():
+            values[i] = row.get(key, math.nan)
+    return ran_on
 
 
 def scored_from_log(scenario, setup, sim, x0, seeds, backend: str, route: bool):
@@ -335,10 +351,12 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     seeds = study.member_seeds(chunk.start, chunk.stop, 1)  # made when a disturbance draws
     route = ends_early(setup)
     sim = simulation_of(scenario, setup)
-    arrays = None if route or study.series else scored_in_loop(scenario, setup, sim, x0, seeds,
-                                                                backend)
-    if arrays is not None:  # no series: the members' figures are all the chunk keeps
-        ran_on, result, done_at = {"compiled"}, None, None
+    in_loop = None if route or study.series else scored_in_loop(scenario, setup, sim, x0, seeds,
+                                                                 backend)
+    if in_loop is not None:  # no series: the members' figures are all the chunk keeps
+        (arrays, diverged), result, done_at = in_loop, None, None
+        ran_on = {"compiled"} | diverged_alone(scenario, setup, sim, x0, seeds, backend, arrays,
+                                               diverged)
     else:
         arrays, ran_on, result, done_at = scored_from_log(scenario, setup, sim, x0, seeds,
                                                           backend, route)
