@@ -2,8 +2,9 @@
 body (:mod:`shipgnc.sim.loop_template`, whose free names it shares: the log columns ``c_*``, the
 sizes ``nx``, ``nu``, ...). At every step, where the log would take its sample, each ship's
 accumulators are updated from the values that sample would hold, so that a study scores its
-members without logging every step (:mod:`shipgnc.sim.scored` runs it, :mod:`shipgnc.analysis.
-accumulated` says which accumulators a metric set needs and finishes its formulas from them).
+members without logging every step (:mod:`shipgnc.sim.scored` runs it;
+:mod:`shipgnc.analysis.accumulated` says which accumulators a metric set needs and finishes its
+formulas from them).
 
 An accumulator ``m`` reads log column ``ops[m, 0]`` in the time window ``span[m, 0] <= t <
 span[m, 1]`` and keeps three numbers ``acc[3 m: 3 m + 3]`` of the ship; its kind ``ops[m, 1]``:

@@ -325,9 +325,11 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """Run one chunk; an ``xarray.Dataset`` with a ``member`` dimension: every scalar metric, and
     with ``study.series`` every time series; ``attrs["backend"]`` says which code ran it.
 
-    The batch runs in one call of the loop, logged at every step: the metrics see every step,
-    and only the series kept with ``study.series`` are thinned to ``simulation.log_every``. A
-    member that diverges stops alone (``on_divergence="mask"``: the others run on, each its own
+    The batch runs in one call of the loop. Without ``study.series``, a metric set with
+    accumulators (:mod:`shipgnc.analysis.accumulated`) is scored inside the compiled loop at
+    every step and nothing else is logged (:func:`scored_in_loop`); otherwise the batch is logged
+    at every step: the metrics see every step, and only the series kept with ``study.series`` are
+    thinned to ``simulation.log_every``. A member that diverges stops alone (``on_divergence="mask"``: the others run on, each its own
     run whatever chunk it shares) and is run again by itself up to its divergence, so that it is
     flagged ``diverged = 1`` with its figures up to then.
 
