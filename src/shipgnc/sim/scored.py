@@ -2,9 +2,10 @@
 (:mod:`shipgnc.sim.score_template`) updated at every step, and no log beyond the first and the last
 sample, so that a study member keeps only the numbers it is scored on.
 
-:func:`run_scored` is :func:`shipgnc.sim.compose.run` with :meth:`Composition.score_in_loop` and a
-log period of the whole run; it returns None when the compiled loop does not cover the setup (the
-caller then logs every step and scores the series).
+:func:`run_scored` is :func:`shipgnc.sim.compose.run` with
+:meth:`~shipgnc.sim.compose.Composition.score_in_loop` and a log period of the whole run; it
+returns None when the compiled loop does not cover the setup (the caller then logs every step and
+scores the series).
 """
 
 from __future__ import annotations

@@ -329,9 +329,10 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     accumulators (:mod:`shipgnc.analysis.accumulated`) is scored inside the compiled loop at
     every step and nothing else is logged (:func:`scored_in_loop`); otherwise the batch is logged
     at every step: the metrics see every step, and only the series kept with ``study.series`` are
-    thinned to ``simulation.log_every``. A member that diverges stops alone (``on_divergence="mask"``: the others run on, each its own
-    run whatever chunk it shares) and is run again by itself up to its divergence, so that it is
-    flagged ``diverged = 1`` with its figures up to then.
+    thinned to ``simulation.log_every``. A member that diverges stops alone
+    (``on_divergence="mask"``: the others run on, each its own run whatever chunk it shares) and
+    is run again by itself up to its divergence, so that it is flagged ``diverged = 1`` with its
+    figures up to then.
 
     A route (guidance that finishes at its last waypoint) ends a batch when its last member
     completes; the others keep sailing until then, and the step the batch ends on depends on its
