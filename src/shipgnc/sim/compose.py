@@ -141,7 +141,8 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
              nd: int, nref: int, nout: int, nsig: int, nerr: int, nzc: int, nzg: int, nzd: int,
              has_ctrl: bool, continuous: bool, has_guid: bool, has_dist: bool, per_stage: bool,
              has_lag: bool, rate_limited: bool, hold_mode: bool, has_cur: bool = False,
-             est_slot: str | None = None, nzn: int = 0, nnsig: int = 0, ne: int = 0):
+             est_slot: str | None = None, nzn: int = 0, nnsig: int = 0, ne: int = 0,
+             has_score: bool = False):
     """The composed loop of one combination (compiled on first use, memoised per process).
     ``cur_fn``: a disturbance's current part (``kernel_current``), called right after ``dist_fn``
     with the same arguments and its own parameters, table and (empty) state. ``est_slot``: None
@@ -150,10 +151,12 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
     ``kf_slot``; or an estimator's own kernel function ``"module:function"`` with the slots'
     signature; :meth:`Navigation.kernel`) that runs after the sensors at each control sample
     with ``nzn`` numbers of state per ship and ``nnsig`` logged signals; ``ne`` the EKF's state
-    dimension (the model's ``nx`` plus its augmented states; 0: ``nx``)."""
+    dimension (the model's ``nx`` plus its augmented states; 0: ``nx``). ``has_score``: the loop
+    with the in-loop scoring step (:mod:`shipgnc.sim.score_template`), a loop of its own so that
+    the others compile without it."""
     key = (model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
            nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx)
+           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx, has_score)
     if key not in _LOOPS:
         _LOOPS[key] = _generate(*key)
     return _LOOPS[key]
@@ -198,7 +201,7 @@ def _resolve(target: str):
 
 def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
             nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-            hold_mode, has_cur, est_slot, nzn, nnsig, ne, *, imports: bool):
+            hold_mode, has_cur, est_slot, nzn, nnsig, ne, has_score=False, *, imports: bool):
     """Source of the combination's module: constants, the components' kernels, the navigation
     step, the loop body."""
     nl = nu if has_lag else 0
@@ -210,6 +213,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
         "has_dist": has_dist, "per_stage": per_stage, "has_lag": has_lag,
         "rate_limited": rate_limited, "hold_mode": hold_mode, "has_cur": has_cur,
         "has_nav": est_slot is not None, "nzn": nzn, "nnsig": nnsig, "ne": ne,
+        "has_score": has_score,
         **{f"o_{name}": lay[key] for name, key in (
             ("x", "x"), ("lag", "lag"), ("app", "applied"), ("cmd", "cmd"), ("ref", "ref"),
             ("out", "out"), ("sig", "sig"), ("d", "d"), ("done", "done"), ("zc", "zc"),
@@ -282,15 +286,15 @@ class Composition:
     (:class:`~shipgnc.sim.transition.Transition`, an agent's episode) a control period at a time
     (:meth:`advance`, :meth:`carried`, :meth:`put_state`), with a log of
     ``log_samples`` samples from sample :attr:`s_base` (set before each call) instead of the whole
-    run's."""
+    run's. ``scored``: the loop with the in-loop scoring step (:meth:`score_in_loop`)."""
 
-    def __init__(self, setup, log_samples: int | None = None):
+    def __init__(self, setup, log_samples: int | None = None, scored: bool = False):
         from shipgnc.sim.compiled import log_length
         from shipgnc.sim.simulator import log_signals
 
         model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller,
                                       setup.guidance, setup.disturbance)
-        self.setup = setup
+        self.setup, self.scored = setup, scored
         batch = setup.batch_shape
         n = math.prod(batch)
         try:
@@ -331,7 +335,7 @@ class Composition:
             rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold",
             cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None,
             est_slot=kn.estimator if kn else None, nzn=zn0.shape[1], nnsig=nnsig,
-            ne=kn.n_filter if kn else 0)
+            ne=kn.n_filter if kn else 0, has_score=scored)
         #: the file holding the loop's generated source, exactly what runs (:func:`source_path`)
         self.source_path = source_path(loop)
         lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd,
@@ -383,6 +387,8 @@ class Composition:
     def score_in_loop(self, ops: np.ndarray, span: np.ndarray, acc: np.ndarray) -> None:
         """Score every step in the loop into ``acc`` (ships, 3 m), updated in place
         (:class:`ScoreArrays`; :mod:`shipgnc.sim.scored`)."""
+        if not self.scored:
+            raise ValueError("score_in_loop: the Composition was built without scored=True")
         n = self.S.shape[0]
         ops = np.ascontiguousarray(ops, dtype=np.int64).reshape(-1, 2)
         span = np.ascontiguousarray(span, dtype=np.float64).reshape(-1, 4)

@@ -108,7 +108,7 @@ def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err, op
         if il == 0 or k == k_last:
             log_sample(out, s, i, x, cmd, u, ref, gout, sig, nsg, err)
             s += 1
-        if ops.shape[0]:  # a study's in-loop scoring: every step's sample into its accumulators
+        if has_score:  # a study's in-loop scoring: every step's sample into its accumulators
             score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc)
         if k == k_last:
             break

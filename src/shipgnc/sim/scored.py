@@ -35,7 +35,7 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray) -> Sc
     if unsupported_reason(setup):
         return None
     reset_components(setup)
-    comp = Composition(setup)
+    comp = Composition(setup, scored=True)
     n = comp.S.shape[0]
     acc = np.empty((n, len(init)))
     acc[:] = np.asarray(init, dtype=np.float64)
