@@ -43,7 +43,9 @@ def sweep(
     scheduler: Annotated[str | None, typer.Option(
         "--scheduler", help="Address of a running dask scheduler, tcp://HOST:PORT.")] = None,
     chunk_size: Annotated[int, typer.Option("--chunk-size", help="Members per task.")] = 1000,
-    series: Annotated[bool, typer.Option("--series", help="Keep every member's time series.")] = False,
+    series: Annotated[bool, typer.Option("--series", help=(
+        "Keep every member's time series (each chunk then logs every step; without it, the "
+        "members are scored inside the compiled loop where their metric set allows)."))] = False,
     max_memory: Annotated[str | None, typer.Option(
         "--max-memory", help="Memory the study may hold, e.g. 4G or 500M (default: the memory "
                              "available now); a larger estimate is refused before any work.")] = None,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import copy
+import functools
 import os
 import re
 from importlib import resources
@@ -42,6 +44,12 @@ def list_scenarios() -> list[Scenario]:
     return [load_scenario(name) for name in builtin_names()]
 
 
+@functools.lru_cache(maxsize=32)
+def _parsed(text: str, source: str) -> object:
+    """The YAML ``text`` parsed (memoised: a study loads its scenario once per chunk)."""
+    return _read_yaml(text, source)
+
+
 def raw_scenario(name_or_path: str) -> tuple[dict, str]:
     """The unvalidated mapping of a built-in name or a YAML path, and a label for messages."""
     builtins = _builtin_files()
@@ -58,7 +66,7 @@ def raw_scenario(name_or_path: str) -> tuple[dict, str]:
     else:
         raise ConfigError(f"unknown scenario {name_or_path!r}; built-in scenarios: "
                           f"{', '.join(sorted(builtins))} (or give a path to a .yaml file)")
-    data = _read_yaml(text, source)
+    data = copy.deepcopy(_parsed(text, source))  # the caller may write into its mapping
     if not isinstance(data, dict):
         raise ConfigError(f"scenario {source}: expected a mapping of fields at the top level, "
                           f"got {type(data).__name__}")

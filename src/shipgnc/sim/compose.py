@@ -67,6 +67,8 @@ _SKIP = np.iinfo(np.int64).max
 TEMPLATE = Path(__file__).with_name("loop_template.py")
 #: the navigation step, written before the loop's body (it calls the model's kernel by name)
 NAV_TEMPLATE = Path(__file__).with_name("nav_template.py")
+#: the in-loop scoring step, written after the loop's body (it reads the log's column layout)
+SCORE_TEMPLATE = Path(__file__).with_name("score_template.py")
 
 
 class LoopSteps(NamedTuple):
@@ -94,6 +96,21 @@ class LoopParams(NamedTuple):
     disturbance: np.ndarray
     current: np.ndarray
     navigation: np.ndarray
+
+
+class ScoreArrays(NamedTuple):
+    """The in-loop scoring step's accumulators (:mod:`shipgnc.sim.score_template`): ``ops``
+    (m, 2) int64 log column and kind, ``span`` (m, 4) window start and end [s] and two arguments,
+    ``acc`` (ships, 3 m) each ship's numbers. No accumulator (m = 0): nothing is scored."""
+
+    ops: np.ndarray
+    span: np.ndarray
+    acc: np.ndarray
+
+
+def no_scoring(n_ships: int) -> ScoreArrays:
+    """The scoring step's arrays when nothing is scored in the loop."""
+    return ScoreArrays(np.zeros((0, 2), dtype=np.int64), np.zeros((0, 4)), np.zeros((n_ships, 0)))
 
 
 class LoopTables(NamedTuple):
@@ -124,7 +141,8 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
              nd: int, nref: int, nout: int, nsig: int, nerr: int, nzc: int, nzg: int, nzd: int,
              has_ctrl: bool, continuous: bool, has_guid: bool, has_dist: bool, per_stage: bool,
              has_lag: bool, rate_limited: bool, hold_mode: bool, has_cur: bool = False,
-             est_slot: str | None = None, nzn: int = 0, nnsig: int = 0, ne: int = 0):
+             est_slot: str | None = None, nzn: int = 0, nnsig: int = 0, ne: int = 0,
+             has_score: bool = False):
     """The composed loop of one combination (compiled on first use, memoised per process).
     ``cur_fn``: a disturbance's current part (``kernel_current``), called right after ``dist_fn``
     with the same arguments and its own parameters, table and (empty) state. ``est_slot``: None
@@ -133,10 +151,12 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
     ``kf_slot``; or an estimator's own kernel function ``"module:function"`` with the slots'
     signature; :meth:`Navigation.kernel`) that runs after the sensors at each control sample
     with ``nzn`` numbers of state per ship and ``nnsig`` logged signals; ``ne`` the EKF's state
-    dimension (the model's ``nx`` plus its augmented states; 0: ``nx``)."""
+    dimension (the model's ``nx`` plus its augmented states; 0: ``nx``). ``has_score``: the loop
+    with the in-loop scoring step (:mod:`shipgnc.sim.score_template`), a loop of its own so that
+    the others compile without it."""
     key = (model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
            nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx)
+           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx, has_score)
     if key not in _LOOPS:
         _LOOPS[key] = _generate(*key)
     return _LOOPS[key]
@@ -181,7 +201,7 @@ def _resolve(target: str):
 
 def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
             nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-            hold_mode, has_cur, est_slot, nzn, nnsig, ne, *, imports: bool):
+            hold_mode, has_cur, est_slot, nzn, nnsig, ne, has_score=False, *, imports: bool):
     """Source of the combination's module: constants, the components' kernels, the navigation
     step, the loop body."""
     nl = nu if has_lag else 0
@@ -193,6 +213,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
         "has_dist": has_dist, "per_stage": per_stage, "has_lag": has_lag,
         "rate_limited": rate_limited, "hold_mode": hold_mode, "has_cur": has_cur,
         "has_nav": est_slot is not None, "nzn": nzn, "nnsig": nnsig, "ne": ne,
+        "has_score": has_score,
         **{f"o_{name}": lay[key] for name, key in (
             ("x", "x"), ("lag", "lag"), ("app", "applied"), ("cmd", "cmd"), ("ref", "ref"),
             ("out", "out"), ("sig", "sig"), ("d", "d"), ("done", "done"), ("zc", "zc"),
@@ -217,6 +238,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
     elif est_slot is not None and not est_slot.isidentifier():
         raise ValueError(f"est_slot = {est_slot!r}: not a slot of the navigation template")
     return ("\n".join(lines) + "\n" + NAV_TEMPLATE.read_text() + slot + "\n" + TEMPLATE.read_text()
+            + "\n" + SCORE_TEMPLATE.read_text()
             + '\nloop = numba.njit(parallel=True, **{**JIT_OPTIONS, "cache": CACHE})(loop)\n')
 
 
@@ -264,15 +286,15 @@ class Composition:
     (:class:`~shipgnc.sim.transition.Transition`, an agent's episode) a control period at a time
     (:meth:`advance`, :meth:`carried`, :meth:`put_state`), with a log of
     ``log_samples`` samples from sample :attr:`s_base` (set before each call) instead of the whole
-    run's."""
+    run's. ``scored``: the loop with the in-loop scoring step (:meth:`score_in_loop`)."""
 
-    def __init__(self, setup, log_samples: int | None = None):
+    def __init__(self, setup, log_samples: int | None = None, scored: bool = False):
         from shipgnc.sim.compiled import log_length
         from shipgnc.sim.simulator import log_signals
 
         model, act, ctrl, gd, dist = (setup.model, setup.actuator, setup.controller,
                                       setup.guidance, setup.disturbance)
-        self.setup = setup
+        self.setup, self.scored = setup, scored
         batch = setup.batch_shape
         n = math.prod(batch)
         try:
@@ -313,7 +335,7 @@ class Composition:
             rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold",
             cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None,
             est_slot=kn.estimator if kn else None, nzn=zn0.shape[1], nnsig=nnsig,
-            ne=kn.n_filter if kn else 0)
+            ne=kn.n_filter if kn else 0, has_score=scored)
         #: the file holding the loop's generated source, exactly what runs (:func:`source_path`)
         self.source_path = source_path(loop)
         lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd,
@@ -359,6 +381,24 @@ class Composition:
         self._kn = kn
         self._pu = _param_rows(ku or empty, n)
         self._pn = _param_rows(kn or empty, n)
+        #: the in-loop scoring step's accumulators (none unless :meth:`score_in_loop`)
+        self.score = no_scoring(n)
+
+    def score_in_loop(self, ops: np.ndarray, span: np.ndarray, acc: np.ndarray) -> None:
+        """Score every step in the loop into ``acc`` (ships, 3 m), updated in place
+        (:class:`ScoreArrays`; :mod:`shipgnc.sim.scored`)."""
+        if not self.scored:
+            raise ValueError("score_in_loop: the Composition was built without scored=True")
+        n = self.S.shape[0]
+        ops = np.ascontiguousarray(ops, dtype=np.int64).reshape(-1, 2)
+        span = np.ascontiguousarray(span, dtype=np.float64).reshape(-1, 4)
+        if acc.shape != (n, 3 * ops.shape[0]) or acc.dtype != np.float64 or not acc.flags.c_contiguous:
+            raise ValueError(f"score_in_loop: acc must be C-contiguous float64 of shape "
+                             f"({n}, {3 * ops.shape[0]}), not {acc.dtype} {acc.shape}")
+        if ops.shape[0] and not (0 <= ops[:, 0].min() and ops[:, 0].max() < len(self.signals)):
+            raise ValueError(f"score_in_loop: log columns {ops[:, 0].tolist()} outside "
+                             f"0 … {len(self.signals) - 1}")
+        self.score = ScoreArrays(ops, span, acc)
 
     def prepare(self, k0: int, k1: int) -> None:
         """The input tables of steps ``k0 … k1 − 1`` (a noise's draws, the sensors' draws)."""
@@ -382,7 +422,8 @@ class Composition:
                   self.done_at if self.done_at is not None else self._no_done,
                   LoopParams(params[0], self._pa, params[1], params[2], params[3], self._pu,
                              self._pn),
-                  LoopTables(table["W"], table["Wu"], table["Wn"]), self._limits, self._err)
+                  LoopTables(table["W"], table["Wu"], table["Wn"]), self._limits, self._err,
+                  self.score)
 
     def put_state(self, x: np.ndarray) -> None:
         """Each ship's plant state ``x`` (B, n) into its row (e.g. a member's drawn start)."""

@@ -32,13 +32,15 @@ from shipgnc.kernels import JIT_OPTIONS, clip, wrap
 inline = numba.njit(inline="always", **{**JIT_OPTIONS, "cache": False})
 
 
-def loop(steps, S, out, event, done_at, params, tables, limits, err):
+def loop(steps, S, out, event, done_at, params, tables, limits, err, score):
     """Steps ``steps.k0 <= k < steps.k1`` of every ship whose ``event`` is unset (the arguments:
     :class:`shipgnc.sim.compose.Composition.call`)."""
+    ops, span, acc = score.ops, score.span, score.acc  # the scoring step's (see score_step)
     for i in numba.prange(S.shape[0]):
         if event[i] >= 0:  # stopped by its divergence (on_divergence="mask"): skipped
             continue
-        run_ship(np.int64(i), steps, S[i], out, event, done_at, params, tables, limits, err)
+        run_ship(np.int64(i), steps, S[i], out, event, done_at, params, tables, limits, err, ops,
+                 span, acc[i])
 
 
 @inline
@@ -48,7 +50,7 @@ def pick(rows, ship):
 
 
 @inline
-def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err):
+def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err, ops, span, scores):
     """Steps ``k0 … k1 − 1`` of ship ``i`` (its state carried in ``row``); sets ``event[i]`` (a
     bad command 2k, a bad state after step k 2k + 1) and ``done_at[i]``."""
     k0, k1, k_last, hold, every, dt = (steps.k0, steps.k1, steps.k_last, steps.hold, steps.every,
@@ -82,6 +84,7 @@ def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err):
     xs, kx, ax = np.empty(nx), np.empty(nx), np.empty(nx)
     ls, kl, al = np.empty(nl), np.empty(nl), np.empty(nl)
     done = row[o_done]
+    acc = scores.copy()  # the ship's accumulators of the scoring step (see score_step)
     j0 = (k0 + hold - 1) // hold  # the chunk's first control sample (row 0 of the navigation table)
     ic = k0 % hold
     il = k0 % every
@@ -105,6 +108,8 @@ def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err):
         if il == 0 or k == k_last:
             log_sample(out, s, i, x, cmd, u, ref, gout, sig, nsg, err)
             s += 1
+        if has_score:  # a study's in-loop scoring: every step's sample into its accumulators
+            score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc)
         if k == k_last:
             break
         # classic RK4 (sim.integrators.rk4_step) of z = [x, lag]; stage states in their own
@@ -143,6 +148,7 @@ def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err):
     row[o_zn:o_zn + nzn] = zn
     row[o_nsg:o_nsg + nnsig] = nsg
     row[o_done] = done
+    scores[:] = acc
 
 
 # the constant flags pick each call at compile time (an array chosen by a conditional expression

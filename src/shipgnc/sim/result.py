@@ -18,6 +18,12 @@ from shipgnc.errors import ConfigError
 from shipgnc.outputs import write_netcdf
 
 
+def time_coordinate(t):
+    """Sample times ``k·dt`` as the ``time`` coordinate holds them: k·dt carries float noise
+    (121.05000000000001), rounded to 1e-9 s so that times read and select cleanly."""
+    return np.round(t, 9)
+
+
 def build_dataset(log, batch_shape: tuple[int, ...], batch_dims: tuple[str, ...] | None,
                   attrs: dict) -> xr.Dataset:
     """Turn a loop's :class:`~shipgnc.sim.simulator.Log` into a labelled Dataset."""
@@ -25,8 +31,7 @@ def build_dataset(log, batch_shape: tuple[int, ...], batch_dims: tuple[str, ...]
     dims = ("time", *batch_dims)
     variables = {name: (dims, values, log.signals[name].attrs())
                  for name, values in log.data.items()}
-    # k·dt carries float noise (121.05000000000001): round to 1e-9 s so times read and select cleanly
-    time = np.round(log.time, 9)
+    time = time_coordinate(log.time)
     coords = {"time": ("time", time, {"units": "s", "long_name": "time"})}
     for dim, size in zip(batch_dims, batch_shape, strict=True):
         coords[dim] = (dim, np.arange(size))

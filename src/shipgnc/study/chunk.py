@@ -243,15 +243,96 @@ def _alone(setup, i: int):
     return replace(setup, model=model.subset(i, i + 1)) if isinstance(model, PerShipModel) else setup
 
 
+def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str):
+    """Every member's metrics scored inside the compiled loop (:mod:`shipgnc.analysis.accumulated`),
+    in :func:`~shipgnc.scenarios.runner.metric_arrays`' key order, and which members diverged
+    (their figures NaN here: :func:`run_chunk` runs each again alone with its log); None when the
+    metric set, the backend or the setup needs the logged series."""
+    from shipgnc.analysis.accumulated import plan_for
+    from shipgnc.sim.scored import run_scored
+    from shipgnc.sim.simulator import _validate, log_signals
+
+    if backend not in ("compiled", "compiled-or-numpy") or sim.integrator != "rk4":
+        return None
+    n_steps = round(sim.t_end / sim.dt)
+    run = _validate(setup.model, x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
+                    actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
+                    u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
+                    atol=sim.atol, seed=MemberStreams(seeds), on_divergence="mask", observer=None,
+                    progress=None, log_every=max(1, n_steps), navigation=setup.navigation)
+    plan = plan_for(scenario, setup, list(log_signals(run)), run.n_steps, run.dt)
+    if plan is None:
+        return None
+    scored = run_scored(run, plan.ops, plan.span, plan.init)
+    if scored is None:
+        return None
+    diverged = scored.event >= 0
+    arrays = {k: np.where(diverged, math.nan, v) for k, v in plan.finish(scored.acc).items()}
+    arrays["diverged"] = np.zeros(x0.shape[0])
+    return arrays, diverged
+
+
+def diverged_alone(scenario, setup, sim, x0, seeds, backend: str, arrays: dict, diverged) -> set:
+    """Each ``diverged`` member run again alone up to its divergence, with its log, and scored
+    there into its row of ``arrays``; the loops that ran."""
+    from shipgnc.scenarios.runner import compute_metrics
+
+    ran_on = set()
+    for i in np.flatnonzero(diverged):
+        alone, _ = _run_batch(_alone(setup, i), sim, x0[i:i + 1], seeds[i:i + 1], backend, False)
+        ran_on.add(alone.attrs.get("backend"))
+        row = numeric_metrics(compute_metrics(scenario, alone.isel(member=0), setup))
+        for key, values in arrays.items():
+            values[i] = row.get(key, math.nan)
+    return ran_on
+
+
+def scored_from_log(scenario, setup, sim, x0, seeds, backend: str, route: bool):
+    """The chunk's members run with a log of every step and scored from it (see
+    :func:`run_chunk`): their metric arrays, the loops that ran, the result and, for a route, each
+    member's completion time."""
+    import xarray as xr
+
+    from shipgnc.scenarios.runner import compute_metrics, metric_arrays
+
+    size = x0.shape[0]
+    result, done_at = _run_batch(setup, sim, x0, seeds, backend, route, "mask")
+    diverged = np.isfinite(result["diverged_at"].values)
+    result = result.drop_vars("diverged_at")
+    arrays = None
+    if diverged.any():
+        runs = [_run_batch(_alone(setup, i), sim, x0[i:i + 1], seeds[i:i + 1], backend, route)
+                if diverged[i] else _survivor(result, done_at, i) for i in range(size)]
+        ran_on = {r.attrs.get("backend") for r, _ in runs}
+        members = [r.isel(member=0) for r, _ in runs]
+        result = xr.concat([r for r, _ in runs], dim="member", join="outer")
+        done_at = np.concatenate([d for _, d in runs]) if route else None
+    else:
+        ran_on = {result.attrs.get("backend")}
+        arrays = metric_arrays(scenario, result, setup)  # every member scored at once
+        members = [result.isel(member=i) for i in range(size)] if arrays is None else []
+    if route and arrays is None:  # each member scored on its own run, which ends at its completion
+        members = [m.isel(time=slice(0, round(d / sim.dt) + 1)) if np.isfinite(d) else m
+                   for m, d in zip(members, done_at, strict=True)]
+    if arrays is None:
+        rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
+        keys = list(dict.fromkeys(k for row in rows for k in row))
+        arrays = {k: np.array([row.get(k, math.nan) for row in rows]) for k in keys}
+    return arrays, ran_on, result, done_at
+
+
 def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """Run one chunk; an ``xarray.Dataset`` with a ``member`` dimension: every scalar metric, and
     with ``study.series`` every time series; ``attrs["backend"]`` says which code ran it.
 
-    The batch runs in one call of the loop, logged at every step: the metrics see every step,
-    and only the series kept with ``study.series`` are thinned to ``simulation.log_every``. A
-    member that diverges stops alone (``on_divergence="mask"``: the others run on, each its own
-    run whatever chunk it shares) and is run again by itself up to its divergence, so that it is
-    flagged ``diverged = 1`` with its figures up to then.
+    The batch runs in one call of the loop. Without ``study.series``, a metric set with
+    accumulators (:mod:`shipgnc.analysis.accumulated`) is scored inside the compiled loop at
+    every step and nothing else is logged (:func:`scored_in_loop`); otherwise the batch is logged
+    at every step: the metrics see every step, and only the series kept with ``study.series`` are
+    thinned to ``simulation.log_every``. A member that diverges stops alone
+    (``on_divergence="mask"``: the others run on, each its own run whatever chunk it shares) and
+    is run again by itself up to its divergence, so that it is flagged ``diverged = 1`` with its
+    figures up to then.
 
     A route (guidance that finishes at its last waypoint) ends a batch when its last member
     completes; the others keep sailing until then, and the step the batch ends on depends on its
@@ -261,7 +342,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """
     import xarray as xr
 
-    from shipgnc.scenarios.runner import build, compute_metrics, metric_arrays, simulation_of
+    from shipgnc.scenarios.runner import build, simulation_of
 
     scenario = study.scenario_at(study.points[chunk.point])
     check_sweepable(scenario)
@@ -273,28 +354,15 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     seeds = study.member_seeds(chunk.start, chunk.stop, 1)  # made when a disturbance draws
     route = ends_early(setup)
     sim = simulation_of(scenario, setup)
-    result, done_at = _run_batch(setup, sim, x0, seeds, backend, route, "mask")
-    diverged = np.isfinite(result["diverged_at"].values)
-    result = result.drop_vars("diverged_at")
-    arrays = None
-    if diverged.any():
-        runs = [_run_batch(_alone(setup, i), sim, x0[i:i + 1], seeds[i:i + 1], backend, route)
-                if diverged[i] else _survivor(result, done_at, i) for i in range(chunk.size)]
-        ran_on = {r.attrs.get("backend") for r, _ in runs}
-        members = [r.isel(member=0) for r, _ in runs]
-        result = xr.concat([r for r, _ in runs], dim="member", join="outer")
-        done_at = np.concatenate([d for _, d in runs]) if route else None
+    in_loop = None if route or study.series else scored_in_loop(scenario, setup, sim, x0, seeds,
+                                                                 backend)
+    if in_loop is not None:  # no series: the members' figures are all the chunk keeps
+        (arrays, diverged), result, done_at = in_loop, None, None
+        ran_on = {"compiled"} | diverged_alone(scenario, setup, sim, x0, seeds, backend, arrays,
+                                               diverged)
     else:
-        ran_on = {result.attrs.get("backend")}
-        arrays = metric_arrays(scenario, result, setup)  # every member scored at once
-        members = [result.isel(member=i) for i in range(chunk.size)] if arrays is None else []
-    if route and arrays is None:  # each member scored on its own run, which ends at its completion
-        members = [m.isel(time=slice(0, round(d / sim.dt) + 1)) if np.isfinite(d) else m
-                   for m, d in zip(members, done_at, strict=True)]
-    if arrays is None:
-        rows = [numeric_metrics(compute_metrics(scenario, m, setup)) for m in members]
-        keys = list(dict.fromkeys(k for row in rows for k in row))
-        arrays = {k: np.array([row.get(k, math.nan) for row in rows]) for k in keys}
+        arrays, ran_on, result, done_at = scored_from_log(scenario, setup, sim, x0, seeds,
+                                                          backend, route)
     # copies: a metric that is a view of the log (a final value) would keep the chunk's whole
     # log alive until the study ends (≈ 190 MB per 1 000 boats of boat-autopilot)
     data = {k: ("member", np.array(v, dtype=float)) for k, v in arrays.items()}

@@ -1,0 +1,94 @@
+"""The composed loop's scoring step, as source: :mod:`shipgnc.sim.compose` writes it after the loop
+body (:mod:`shipgnc.sim.loop_template`, whose free names it shares: the log columns ``c_*``, the
+sizes ``nx``, ``nu``, ...). At every step, where the log would take its sample, each ship's
+accumulators are updated from the values that sample would hold, so that a study scores its
+members without logging every step (:mod:`shipgnc.sim.scored` runs it;
+:mod:`shipgnc.analysis.accumulated` says which accumulators a metric set needs and finishes its
+formulas from them).
+
+An accumulator ``m`` reads log column ``ops[m, 0]`` in the time window ``span[m, 0] <= t <
+span[m, 1]`` and keeps three numbers ``acc[3 m: 3 m + 3]`` of the ship; its kind ``ops[m, 1]``:
+
+* ``SCORE_MAX`` — the largest ``v · span[m, 2]`` (NaN once a sample is NaN, as ``numpy.max``);
+* ``SCORE_MAX_ABS`` — the largest ``|v|`` (NaN as above);
+* ``SCORE_SUM_SQUARES`` — ``Σ (v · span[m, 2])²`` in time order (``batchmath.time_sum`` of the
+  squares, to the bit) and the number of samples;
+* ``SCORE_LAST`` — the last value in the window, and 1 once there is one;
+* ``SCORE_FIRST`` — the first value in the window, and 1 once there is one;
+* ``SCORE_BAND_EXIT`` — settling bookkeeping for the band ``|v · span[m, 2]| <= span[m, 3]``:
+  whether any sample was outside it, the time of the first sample after the last one outside
+  (NaN while the latest is outside), whether the latest was outside.
+
+Every value is the log's own arithmetic (:func:`column_value` is ``log_sample``'s), so a finished
+figure equals the one computed from the logged series.
+"""
+# ruff: noqa: F821
+
+SCORE_MAX = 0
+SCORE_MAX_ABS = 1
+SCORE_SUM_SQUARES = 2
+SCORE_LAST = 3
+SCORE_FIRST = 4
+SCORE_BAND_EXIT = 5
+
+
+@inline
+def column_value(c, x, cmd, u, ref, gout, sig, nsg, err):
+    """The value log column ``c`` takes at this sample (the arithmetic of ``log_sample``)."""
+    if c < c_cmd:
+        return x[c]
+    if c < c_app:
+        return cmd[c - c_cmd]
+    if c < c_ref:
+        return u[c - c_app]
+    if c < c_err:
+        return ref[c - c_ref]
+    if c < c_out:
+        j = c - c_err
+        e = x[err[j, 0]] - ref[err[j, 1]]
+        return wrap(e) if err[j, 2] else e
+    if c < c_sig:
+        return gout[c - c_out]
+    if c < c_nav:
+        return sig[c - c_sig]
+    return nsg[c - c_nav]
+
+
+@inline
+def running_max(acc, a, v):
+    """``acc[a]`` ← max(acc[a], v), NaN sticking as in ``numpy.max``."""
+    if not math.isnan(acc[a]) and (v > acc[a] or math.isnan(v)):
+        acc[a] = v
+
+
+@inline
+def score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):
+    """Update the ship's accumulators ``acc`` with the sample at time ``t`` (see the module)."""
+    for m in range(ops.shape[0]):
+        if not (t >= span[m, 0] and t < span[m, 1]):
+            continue
+        v = column_value(ops[m, 0], x, cmd, u, ref, gout, sig, nsg, err)
+        kind, a = ops[m, 1], 3 * m
+        if kind == SCORE_MAX:
+            running_max(acc, a, v * span[m, 2])
+        elif kind == SCORE_MAX_ABS:
+            running_max(acc, a, abs(v))
+        elif kind == SCORE_SUM_SQUARES:
+            w = v * span[m, 2]
+            acc[a] = acc[a] + w * w
+            acc[a + 1] = acc[a + 1] + 1.0
+        elif kind == SCORE_LAST:
+            acc[a] = v
+            acc[a + 1] = 1.0
+        elif kind == SCORE_FIRST:
+            if acc[a + 1] == 0.0:
+                acc[a] = v
+                acc[a + 1] = 1.0
+        elif kind == SCORE_BAND_EXIT:
+            if abs(v * span[m, 2]) > span[m, 3]:
+                acc[a] = 1.0
+                acc[a + 1] = math.nan
+                acc[a + 2] = 1.0
+            elif acc[a + 2] != 0.0:
+                acc[a + 1] = t
+                acc[a + 2] = 0.0

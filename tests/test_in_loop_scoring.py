@@ -1,0 +1,147 @@
+"""Metrics scored inside the compiled loop (``shipgnc.analysis.accumulated``) against the same
+metric set scored from the full log of every step (the reference: ``metric_arrays`` on the logged
+series, the path studies took before and still take with ``--series``).
+
+Tolerance: every figure that is a maximum, a first or last value or a band exit is the log's own
+number, so it must agree to the bit. The RMSE's sum of squares is added in the same time order as
+``batchmath.time_sum``, but the loop is compiled with floating-point contraction (``fastmath
+{"contract"}``), so ``acc + w·w`` may be one fused multiply-add: each product then skips one
+rounding of at most ε/2 of that (positive) term, so the sum differs by at most N·ε/2 relative
+(N samples), the RMSE by half that; the test allows N·ε.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from shipgnc.analysis.accumulated import IN_LOOP_SETS
+from shipgnc.scenarios.runner import build, simulation_of
+from shipgnc.study.chunk import (
+    Chunk,
+    member_initial_states,
+    run_chunk,
+    scored_from_log,
+    scored_in_loop,
+)
+from shipgnc.study.spec import Perturbation, Study
+
+#: a built-in scenario of each metric set scored in the loop
+BUILT_IN = {"heading-steps": "boat-autopilot"}
+#: figures that are sums (round-off bound in the module docstring); every other figure exact
+SUMS = {"heading_rmse_deg"}
+#: (metric set, overrides, perturbation): settled steps, a step that never settles (NaN), a
+#: window whose ψ_d does not change (no overshoot direction). One combination of components
+#: (a scored loop compiles once per combination; per-member disturbance streams are the study's,
+#: tested in test_sweep.py, whose chunks are scored in the loop)
+CASES = [
+    ("heading-steps", (), "psi_deg=uniform:-30,30"),
+    ("heading-steps", ("simulation.t_end=41",), "psi_deg=uniform:-30,30"),
+    ("heading-steps", ("guidance.schedule=[{t: 0.0, psi_deg: 0.0, u: 1.5}, "
+                       "{t: 5.0, psi_deg: 0.0, u: 2.0}, {t: 20.0, psi_deg: 60.0, u: 2.0}]",
+                       "simulation.t_end=30"), "r_deg_s=normal:2"),
+]
+
+
+def test_every_in_loop_metric_set_has_a_case():
+    assert set(IN_LOOP_SETS) == set(BUILT_IN) == {case[0] for case in CASES}
+
+
+def _both(metric_set, overrides, perturb, members=6):
+    study = Study(BUILT_IN[metric_set], members=members, seed=7, overrides=overrides,
+                  perturb=(Perturbation.parse(perturb),))
+    scenario = study.scenario_at(study.points[0])
+    setup = build(scenario, seed=study.seed)
+    chunk = Chunk(0, 0, members)
+    x0 = member_initial_states(study, setup.x0, setup.model, chunk)
+    seeds = study.member_seeds(0, members, 1)
+    sim = simulation_of(scenario, setup)
+    in_loop = scored_in_loop(scenario, setup, sim, x0, seeds, "compiled-or-numpy")
+    if in_loop is not None:
+        in_loop, diverged = in_loop
+        assert not diverged.any()
+    logged, ran_on, _, _ = scored_from_log(scenario, setup, sim, x0, seeds, "compiled-or-numpy",
+                                           False)
+    return in_loop, logged, ran_on, round(sim.t_end / sim.dt) + 1
+
+
+@pytest.mark.parametrize(("metric_set", "overrides", "perturb"), CASES)
+def test_in_loop_figures_equal_those_of_the_full_log(metric_set, overrides, perturb):
+    in_loop, logged, ran_on, n_samples = _both(metric_set, overrides, perturb)
+    assert ran_on == {"compiled"}
+    assert in_loop is not None, "the metric set was not scored in the loop"
+    assert list(in_loop) == list(logged)  # same keys in the same order
+    for key, reference in logged.items():
+        ours = in_loop[key]
+        assert ours.shape == reference.shape, key
+        if key in SUMS:
+            np.testing.assert_allclose(ours, reference, rtol=n_samples * np.finfo(float).eps,
+                                       atol=0, err_msg=key)
+        else:
+            np.testing.assert_array_equal(ours, reference, err_msg=key)
+    assert np.ptp(logged["heading_rmse_deg"]) > 0  # the members differ
+
+
+def test_the_cases_reach_each_branch_of_the_settling_and_overshoot_figures():
+    """A step never settled (NaN), every step settled, and a window without a ψ_d change."""
+    unsettled, _, _, _ = _both(*CASES[1])
+    settled, _, _, _ = _both(*CASES[0])
+    flat, logged, _, _ = _both(*CASES[2])
+    assert np.isnan(unsettled["settling_time_s"]).all()
+    assert np.isfinite(settled["settling_time_s"]).all()
+    assert (logged["overshoot_deg"] >= 0).all() and np.isfinite(flat["overshoot_deg"]).all()
+
+
+def test_a_chunk_without_series_keeps_the_figures_of_one_with_series():
+    """The study's default (scored in the loop) and --series (scored from the log) agree."""
+    kw = {"members": 5, "seed": 3, "perturb": (Perturbation.parse("psi_deg=uniform:-20,20"),),
+          "overrides": ("simulation.t_end=20",)}
+    plain = run_chunk(Study("boat-autopilot", **kw), Chunk(0, 0, 5))
+    series = run_chunk(Study("boat-autopilot", series=True, **kw), Chunk(0, 0, 5))
+    assert not any(name.startswith("series_") for name in plain.data_vars)
+    assert any(name.startswith("series_") for name in series.data_vars)
+    for key in plain.data_vars:
+        np.testing.assert_allclose(plain[key].values, series[key].values, rtol=1e-12, err_msg=key)
+
+
+def test_a_diverged_member_is_scored_alone_from_its_log_and_the_others_in_the_loop(monkeypatch):
+    """A member that diverged in the chunk's scored loop is run again alone with its log (as a
+    chunk scored from its log does), the others keep their in-loop figures: neither depends on
+    the chunk the member shares."""
+    import shipgnc.sim.scored as scored
+    from shipgnc.study import chunk as chunk_module
+
+    real = scored.run_scored
+
+    def one_diverged(*args):
+        out = real(*args)
+        out.event[1] = 2 * 10 + 1  # as if member 1's state went bad after step 10
+        return out
+
+    study = Study("boat-autopilot", members=3, seed=1, overrides=("simulation.t_end=5",),
+                  perturb=(Perturbation.parse("psi_deg=uniform:-20,20"),))
+    reference = run_chunk(study, Chunk(0, 0, 3))
+    alone = []
+    real_alone = chunk_module._run_batch
+
+    def recorded(setup, sim, x0, *args):
+        alone.append(x0.copy())
+        return real_alone(setup, sim, x0, *args)
+
+    monkeypatch.setattr(scored, "run_scored", one_diverged)
+    monkeypatch.setattr(chunk_module, "_run_batch", recorded)
+    ds = run_chunk(study, Chunk(0, 0, 3))
+    assert len(alone) == 1 and alone[0].shape[0] == 1  # member 1, alone
+    for key in ds.data_vars:  # here it did not truly diverge: its own run gives its figures
+        np.testing.assert_allclose(ds[key].values, reference[key].values, rtol=1e-12, err_msg=key)
+    np.testing.assert_array_equal(ds["heading_rmse_deg"].values[[0, 2]],
+                                  reference["heading_rmse_deg"].values[[0, 2]])
+
+
+def test_the_numpy_backend_is_scored_from_its_log():
+    study = Study("boat-autopilot", members=2, seed=1, overrides=("simulation.t_end=5",))
+    scenario = study.scenario_at(study.points[0])
+    setup = build(scenario, seed=study.seed)
+    x0 = member_initial_states(study, setup.x0, setup.model, Chunk(0, 0, 2))
+    assert scored_in_loop(scenario, setup, simulation_of(scenario, setup), x0,
+                          study.member_seeds(0, 2, 1), "numpy") is None
