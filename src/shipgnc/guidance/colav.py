@@ -37,13 +37,16 @@ from shipgnc.colav.vo import vo_choose
 from shipgnc.derive import per_ship
 from shipgnc.errors import ConfigError, require
 from shipgnc.guidance.los import LOSGuidance, los_reference
+from shipgnc.guidance.vessel_targets import S_FIXED, SCRATCH, VesselTarget, vessel_targets
 from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal, state_index
 
 #: avoidance methods by name → the kernel's method code
 METHODS = {"none": 0, "sbmpc": 1, "vo": 2}
 #: header of a parameter row (see :meth:`ColavGuidance.params`)
-_HEADER = 13
+_HEADER = 16
+#: logged per vessel target slot (:mod:`shipgnc.guidance.vessel_targets`): north, east, heading
+_VESSEL_OUT = ("north", "east", "psi")
 #: the LOS part of the per-ship state, then [next decision time, course offset, speed factor,
 #: least range so far, its time, its target]
 _LOS_STATE = 6
@@ -90,12 +93,14 @@ class ColavGuidance:
             require(m in METHODS, "guidance.method", m, f"allowed: {', '.join(METHODS)}")
         require(math.isfinite(decision_interval) and decision_interval >= 0,
                 "guidance.decision_interval", decision_interval, "must be >= 0 s")
-        members = [list(encounters)] if not encounters or isinstance(encounters[0], TargetTrack) \
+        members = [list(encounters)] if not encounters or isinstance(
+            encounters[0], (TargetTrack, VesselTarget)) \
             else [list(m) for m in encounters]
         for m, tracks in enumerate(members):
             for track in tracks:
-                if not isinstance(track, TargetTrack):
-                    raise ConfigError(f"targets of member {m}: {track!r} is not a TargetTrack")
+                if not isinstance(track, (TargetTrack, VesselTarget)):
+                    raise ConfigError(f"targets of member {m}: {track!r} is not a TargetTrack "
+                                      "or a VesselTarget")
         self.los = los
         if len(methods) not in (1, len(members)) and len(members) != 1:
             raise ConfigError(f"methods: {len(methods)} for {len(members)} encounters (give one, "
@@ -107,9 +112,76 @@ class ColavGuidance:
         self.parts = {m: method_parts(m, configs.get(m)) for m in dict.fromkeys(methods)}
         self.memory = max(memory for _, memory in self.parts.values())
         self.n_max = max(1, max(len(t) for t in members))
-        self.n_samples = max([1] + [tr.t.size for tracks in members for tr in tracks])
+        self.n_samples = max([1] + [tr.t.size for tracks in members for tr in tracks
+                                    if isinstance(tr, TargetTrack)])
+        self._vessels_init(members, configs)
         self._z = None
         self._outputs: dict[str, np.ndarray] = {}
+
+    # ------------------------------------------------------------------ vessel targets
+    def _vessels_init(self, members, configs) -> None:
+        """The vessel targets (:class:`~shipgnc.guidance.vessel_targets.VesselTarget`) of every
+        member, their avoidance's parameters (the own ship's ``configs``, course offsets only: the
+        reduced model holds its speed), block widths and logged slots."""
+        from shipgnc.colav.sbmpc import SBMPCConfig
+        from shipgnc.colav.vo import VOConfig
+
+        configs = configs or {}
+        self._vessels = [[(j, tr) for j, tr in enumerate(tracks) if isinstance(tr, VesselTarget)]
+                         for tracks in members]
+        self.n_vessels = max([0] + [len(v) for v in self._vessels])
+        kinds = dict.fromkeys(tr.avoidance for v in self._vessels for _, tr in v
+                              if tr.avoidance != "none")
+        defaults = {"sbmpc": SBMPCConfig, "vo": VOConfig}
+        self._vessel_mp, memory = {}, 0
+        for kind in kinds:
+            config = (configs.get(kind) or defaults[kind]()).model_copy(
+                update={"speed_factors": [1.0]})
+            self._vessel_mp[kind], m = method_parts(kind, config)
+            memory = max(memory, m)
+        self._width_z = S_FIXED + memory + SCRATCH if self.n_vessels else 0
+        self._width_p = max([0] + [tr.params(j, self._vessel_mp.get(tr.avoidance, flat())).size
+                                   for v in self._vessels for j, tr in v])
+        if self.n_vessels:
+            self.outputs = (*ColavGuidance.outputs, *(
+                Signal(f"vessel_target{k}_{q}", "rad" if q == "psi" else "m",
+                       f"vessel target slot {k}: {q}", angle=q == "psi")
+                for k in range(self.n_vessels) for q in _VESSEL_OUT))
+
+    def _vessel_params(self, tracks) -> np.ndarray:
+        """The vessel targets' parameter blocks of one member, ``(n, width)`` zero-padded."""
+        blocks = [tr.params(j, self._vessel_mp.get(tr.avoidance, flat()))
+                  for j, tr in enumerate(tracks) if isinstance(tr, VesselTarget)]
+        out = np.zeros((len(blocks), self._width_p))
+        for k, block in enumerate(blocks):
+            out[k, :block.size] = block
+        return out
+
+    def _vessels_reset(self, n: int) -> None:
+        """Every row's vessel targets at their start."""
+        zo = _LOS_STATE + _HOLD + self.memory + 8 + 4 * self.n_max
+        w = self._width_z
+        for row in range(n if self.n_vessels else 0):
+            for k, (_, tr) in enumerate(self._vessels[row % len(self._vessels)]):
+                self._z[row, zo + k * w:zo + (k + 1) * w] = tr.state(w)
+
+    def _vessel_states(self, states, result):
+        """``states`` (time, member, target) per ship of ``result``, the vessel targets' from
+        their logged slots; returns (states per ship, the slots' variable names)."""
+        time = result["time"].values
+        n_ships = math.prod(result["north"].shape[1:])
+        rows = np.arange(n_ships) % len(self.members)
+        out = {key: value[:, rows, :].copy() for key, value in states.items()}
+        names = [f"vessel_target{k}_{q}" for k in range(self.n_vessels) for q in _VESSEL_OUT]
+        logged = {name: result[name].values.reshape(time.size, n_ships) for name in names}
+        for i, m in enumerate(rows):
+            for k, (j, tr) in enumerate(self._vessels[m]):
+                out["target_north"][:, i, j] = logged[f"vessel_target{k}_north"][:, i]
+                out["target_east"][:, i, j] = logged[f"vessel_target{k}_east"][:, i]
+                out["target_sog"][:, i, j] = tr.U
+                out["target_cog"][:, i, j] = np.mod(logged[f"vessel_target{k}_psi"][:, i],
+                                                    2 * np.pi)
+        return out, names
 
     # ------------------------------------------------------------------ set-up
     @property
@@ -124,9 +196,11 @@ class ColavGuidance:
         """One parameter row per member, shape ``(n_members, n_p)``, shorter rows padded with zeros.
 
         A row holds, in order, n_los, method, n_targets, n_samples, n_max, i_north, i_east, i_psi,
-        i_u, i_v (−1 for none), n_method_params, memory, the decision interval, the LOS parameters
+        i_u, i_v (−1 for none), n_method_params, memory, the decision interval, the number of
+        vessel targets and the widths of their parameter and state blocks, the LOS parameters
         (n_los numbers), the targets (n_max × n_samples × (t, north, east, v_north, v_east), unused
-        samples at t = +inf) and the method's parameters.
+        samples — and every sample of a vessel target — at t = +inf), the method's parameters and
+        the vessel targets' parameter blocks (:meth:`_vessel_params`).
         """
         los = self.los.kernel(self._batch_shape).params
         rows = []
@@ -138,10 +212,13 @@ class ColavGuidance:
             table = np.zeros((self.n_max, self.n_samples, 5))
             table[:, :, 0] = np.inf
             for j, track in enumerate(tracks):
-                table[j, :track.t.size] = track.table()
+                if isinstance(track, TargetTrack):
+                    table[j, :track.t.size] = track.table()
+            vessels = self._vessel_params(tracks)
             rows.append(flat(los.size, METHODS[method], len(tracks), self.n_samples,
                              self.n_max, *self._index, mp.size, self.memory,
-                             self.decision_interval, los, table, mp))
+                             self.decision_interval, vessels.shape[0], self._width_p,
+                             self._width_z, los, table, mp, vessels))
         width = max(r.size for r in rows)
         return np.vstack([np.pad(r, (0, width - r.size)) for r in rows])
 
@@ -162,12 +239,15 @@ class ColavGuidance:
         self._z[:, 4] = np.nan  # LOS: completion time
         self._z[:, _LOS_STATE + 2] = 1.0  # held speed factor: the nominal
         self._z[:, _LOS_STATE + 3:_LOS_STATE + 6] = (np.inf, np.nan, -1.0)  # no range yet
+        self._vessels_reset(n)
 
     @property
     def state_width(self) -> int:
         """LOS state, the held decision [next decision time, course offset, speed factor], the
-        method's memory, then scratch: own (4), nominal (2), command (2), targets (4 n_max)."""
-        return _LOS_STATE + _HOLD + self.memory + 8 + 4 * self.n_max
+        method's memory, then scratch: own (4), nominal (2), command (2), targets (4 n_max); then
+        the vessel targets' states (:mod:`shipgnc.guidance.vessel_targets`)."""
+        return _LOS_STATE + _HOLD + self.memory + 8 + 4 * self.n_max \
+            + self.n_vessels * self._width_z
 
     # ------------------------------------------------------------------ numpy loop
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
@@ -200,13 +280,15 @@ class ColavGuidance:
     def target_states(self, t: np.ndarray) -> dict[str, np.ndarray]:
         """Every member's targets at times ``t``: ``target_north``, ``target_east`` [m],
         ``target_sog`` [m/s], ``target_cog`` [rad], each ``(time, member, target)`` (NaN where a
-        member has fewer targets)."""
+        member has fewer targets, and for vessel targets: they are integrated in the run)."""
         t = np.asarray(t, dtype=float)
         shape = (t.size, len(self.members), self.n_max)
         out = {k: np.full(shape, np.nan) for k in ("target_north", "target_east", "target_sog",
                                                     "target_cog")}
         for m, tracks in enumerate(self.members):
             for j, track in enumerate(tracks):
+                if not isinstance(track, TargetTrack):
+                    continue  # a vessel target: its logged states (add_targets)
                 n, e, vn, ve = track.at(t)
                 out["target_north"][:, m, j], out["target_east"][:, m, j] = n, e
                 out["target_sog"][:, m, j] = np.hypot(vn, ve)
@@ -218,6 +300,11 @@ class ColavGuidance:
         a batch result; none for one ship)."""
         time = result["time"].values
         states = self.target_states(time)
+        per_ship = len(self.members) > 1
+        if self.n_vessels:  # integrated in the run: each ship's own, from the logged slots
+            states, slots = self._vessel_states(states, result)
+            result = result.drop_vars(slots)
+            per_ship = True
         ship_dims = [d for d in result["north"].dims if d != "time"]
         names = [tr.label for tr in self.members[0]] + [""] * (self.n_max - len(self.members[0]))
         units = {"target_north": "m", "target_east": "m", "target_sog": "m/s",
@@ -226,7 +313,7 @@ class ColavGuidance:
             if ship_dims:
                 dims = ("time", *ship_dims, "target")
                 value = value.reshape(time.size, *result["north"].shape[1:], self.n_max) \
-                    if len(self.members) > 1 else np.broadcast_to(
+                    if per_ship else np.broadcast_to(
                         value, (time.size, *result["north"].shape[1:], self.n_max))
             else:
                 dims, value = ("time", "target"), value[:, 0, :]
@@ -253,6 +340,7 @@ def colav_reference(t, x, z, p, ref, out):
     n_samples, n_max = int(p[3]), int(p[4])
     i_north, i_east, i_psi, i_u, i_v = int(p[5]), int(p[6]), int(p[7]), int(p[8]), int(p[9])
     n_mp, memory, interval = int(p[10]), int(p[11]), p[12]
+    n_vessels = int(p[13])
     h = _HEADER
     finished = los_reference(t, x, z[:_LOS_STATE], p[h:h + n_los], ref, out)
     table = p[h + n_los:h + n_los + n_max * n_samples * 5]
@@ -281,11 +369,13 @@ def colav_reference(t, x, z, p, ref, out):
         d = math.hypot(targets[m] - x[i_north], targets[m + 1] - x[i_east])
         if d < hold[3]:
             hold[3], hold[4], hold[5] = d, t, float(j)
+    if n_vessels > 0:
+        _own_motion(x, i_north, i_east, i_psi, i_u, i_v, own)
+        present = _vessels_sample(t, p, z, s + 8 + 4 * n_max,
+                                  h + n_los + n_max * n_samples * 5 + n_mp, own, targets, present,
+                                  hold, out)
     if method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t)):
-        v = x[i_v] if i_v >= 0 else 0.0
-        own[0], own[1] = x[i_north], x[i_east]
-        own[2] = course_over_ground(x[i_psi], x[i_u], v)
-        own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
+        _own_motion(x, i_north, i_east, i_psi, i_u, i_v, own)
         if method == 1:
             sbmpc_choose(t, own, targets, present, nominal, mp, zm, cmd)
         else:
@@ -300,9 +390,36 @@ def colav_reference(t, x, z, p, ref, out):
     return finished
 
 
-def check_clear(track: TargetTrack, own, safety_radius: float, where: str) -> None:
-    """A target inside the safety radius of the own ship at t = 0 is a ConfigError naming it."""
-    n, e, _, _ = track.at(0.0)
+@kernel_function
+def _own_motion(x, i_north, i_east, i_psi, i_u, i_v, own):
+    """``own`` = the own ship's [north, east, χ, U] over ground from its state ``x``."""
+    v = x[i_v] if i_v >= 0 else 0.0
+    own[0], own[1] = x[i_north], x[i_east]
+    own[2] = course_over_ground(x[i_psi], x[i_u], v)
+    own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
+
+
+@kernel_function
+def _vessels_sample(t, p, z, zo, po, own, targets, present, hold, out):
+    """The member's vessel targets at ``t`` (:func:`~shipgnc.guidance.vessel_targets.vessel_targets`;
+    their parameter blocks from ``p[po]``, states from ``z[zo]``), each slot's north, east, heading
+    logged after the nine outputs (NaN in a slot the member does not use); returns the count of
+    targets present."""
+    n_vessels, width_p, width_z, interval = int(p[13]), int(p[14]), int(p[15]), p[12]
+    zv = z[zo:zo + n_vessels * width_z]
+    present = vessel_targets(t, own, p[po:po + n_vessels * width_p], width_p, zv, width_z,
+                             n_vessels, width_z - S_FIXED - SCRATCH, interval, targets, present,
+                             hold)
+    for k in range((out.size - 9) // 3):
+        for q in range(3):
+            out[9 + 3 * k + q] = zv[k * width_z + q] if k < n_vessels else np.nan
+    return present
+
+
+def check_clear(track, own, safety_radius: float, where: str) -> None:
+    """A target (a track or a vessel) inside the safety radius of the own ship at t = 0 is a
+    ConfigError naming it."""
+    n, e = track.start() if isinstance(track, VesselTarget) else track.at(0.0)[:2]
     distance = math.hypot(float(n) - own[0], float(e) - own[1])
     if distance < safety_radius:
         raise ConfigError(f"{where}: {distance:.1f} m from the own ship at t = 0, inside the "

@@ -158,7 +158,7 @@ def colav_guidance(g, scenario):
     own = (init.north, init.east) if init is not None else (0.0, 0.0)
     tracks = []
     for j, target in enumerate(g.targets):
-        track = target.track(label=f"target {j + 1}")
+        track = _target(target, j)
         check_clear(track, own, g.safety_radius, f"guidance.targets[{j}]")
         tracks.append(track)
     if g.ais_log is not None:
@@ -172,6 +172,17 @@ def colav_guidance(g, scenario):
             tracks.append(track)
     return ColavGuidance(los, tracks, method=g.method, configs={"sbmpc": g.sbmpc, "vo": g.vo},
                          decision_interval=g.decision_interval)
+
+
+def _target(target, j: int):
+    """``guidance.targets[j]`` as a track (kinematic) or a vessel target (its speed checked against
+    its model's range, naming the field)."""
+    if target.vessel is None:
+        return target.track(label=f"target {j + 1}")
+    try:
+        return target.vessel_target(label=f"target {j + 1}")
+    except ConfigError as e:
+        raise ConfigError(f"guidance.targets[{j}]: {e}") from None
 
 
 def check_members(members: list[Member], safety_radius: float = SAFETY_RADIUS) -> None:
