@@ -25,7 +25,7 @@ along ``[start, *waypoints]`` (:func:`shipgnc.guidance.los.los_reference`, the o
 plus the held course offset of the target's own avoidance.
 
 **Integration:** from one guidance sample to the next, classic RK4 of (n, e, ψ, r, δ) with δ_c held,
-in sub-steps of at most :data:`MAX_STEP`.
+in sub-steps of at most :data:`MAX_STEP` and T_δ.
 
 **Avoidance** (optional, ``sbmpc`` or ``vo``): the target runs the method with the own ship as its one
 target, seen as ground truth (position and velocity over ground at the sample), course offsets only,
@@ -165,8 +165,9 @@ def _rates(psi, r, delta, delta_c, p):
 @kernel_function
 def integrate_vessel(s, p, h):
     """Advance the target's (n, e, ψ, r, δ) = ``s[:5]`` by ``h`` [s] with δ_c = ``s[5]`` held:
-    classic RK4 in ⌈h / MAX_STEP⌉ equal sub-steps."""
-    n_sub = max(1, math.ceil(h / MAX_STEP - 1e-9))
+    classic RK4 in equal sub-steps of at most MAX_STEP and at most T_δ (the servo's lag, which
+    would make a longer RK4 step unstable: its stability bound is 2.78 T_δ)."""
+    n_sub = max(1, math.ceil(h / min(MAX_STEP, p[9]) - 1e-9))
     dt = h / n_sub
     dc = s[5]
     for _ in range(n_sub):
