@@ -1008,7 +1008,7 @@ class TargetConfig(Strict):
     running its own ``avoidance`` against the own ship."""
 
     field_units: ClassVar[dict[str, str]] = {"north": "m", "east": "m", "speed": "m/s",
-                                             "length": "m", "beam": "m"}
+                                             "length": "m", "beam": "m", "waypoints": "m"}
 
     name: str = ""
     mmsi: Annotated[int, Field(ge=0, le=999_999_999)] = 0
