@@ -1020,7 +1020,7 @@ class TargetConfig(Strict):
                         AfterValidator(_in_time_order)] | None = None
     length: Positive = 100.0
     beam: Positive = 20.0
-    #: a vessel target: its steering model and autopilot (null: kinematic)
+    #: a vessel target's steering model and autopilot (null = a kinematic target)
     vessel: TargetVesselConfig | None = None
     #: a vessel target's waypoints ``[[north, east], ...]`` after its start
     waypoints: Annotated[list[tuple[Finite, Finite]], Field(min_length=1)] | None = None
