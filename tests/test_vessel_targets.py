@@ -250,12 +250,12 @@ def test_compiled_loop_runs_the_vessel_targets_as_the_numpy_loop():
 @pytest.mark.parametrize("target, message", [
     ({"vessel": {"model": "frigate"}, "schedule": [{"t": 0, "course_deg": 0, "speed": 5}]},
      "schedule with a vessel target"),
-    ({"waypoints": [[0.0, 1.0]], "speed": 5.0}, "waypoints need a vessel target"),
+    ({"waypoints": [[0.0, 1.0]], "speed": 5.0}, "waypoints needs a vessel target"),
     ({"vessel": {"model": "nomoto", "K": 0.1}, "speed": 5.0}, "model nomoto needs K"),
     ({"vessel": {"model": "frigate", "T": 10.0}, "speed": 9.0}, "T with model frigate"),
     ({"vessel": {"model": "frigate"}, "speed": 0.0}, "speed > 0"),
     ({"vessel": {"model": "frigate"}, "speed": 20.0},
-     r"guidance.targets\[0\]: vessel frigate: speed_mps = 20.0"),
+     r"guidance.targets\[0\].speed = 20 m/s is outside the frigate model's valid range 5–12"),
 ])
 def test_bad_vessel_targets_are_one_line_naming_the_field(target, message):
     from shipgnc.errors import ConfigError

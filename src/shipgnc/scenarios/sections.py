@@ -1036,7 +1036,8 @@ class TargetConfig(Strict):
         if self.vessel is None:
             extra = sorted({"waypoints", "avoidance"} & self.model_fields_set)
             if extra:
-                raise ValueError(f"{' and '.join(extra)} need a vessel target (give vessel: "
+                raise ValueError(f"{' and '.join(extra)} need{'s' if len(extra) == 1 else ''} a "
+                                 "vessel target (give vessel: "
                                  "{model: frigate}); a kinematic target follows its schedule")
         elif self.schedule is not None:
             raise ValueError("schedule with a vessel target: a vessel follows its waypoints")

@@ -179,10 +179,15 @@ def _target(target, j: int):
     its model's range, naming the field)."""
     if target.vessel is None:
         return target.track(label=f"target {j + 1}")
-    try:
-        return target.vessel_target(label=f"target {j + 1}")
-    except ConfigError as e:
-        raise ConfigError(f"guidance.targets[{j}]: {e}") from None
+    if target.vessel.model == "frigate":
+        from shipgnc.vessels.frigate import SPEED_RANGE
+
+        low, high = SPEED_RANGE
+        if not low <= target.speed <= high:
+            raise ConfigError(f"guidance.targets[{j}].speed = {target.speed:g} m/s is outside the "
+                              f"frigate model's valid range {low:g}–{high:g} m/s (van Amerongen "
+                              "1982); use vessel: {model: nomoto, K: ..., T: ...}")
+    return target.vessel_target(label=f"target {j + 1}")
 
 
 def check_members(members: list[Member], safety_radius: float = SAFETY_RADIUS) -> None:
