@@ -247,6 +247,43 @@ def test_compiled_loop_runs_the_vessel_targets_as_the_numpy_loop():
         np.testing.assert_allclose(b.result[key].values, a.result[key].values, atol=1e-6)
 
 
+def test_each_batch_member_moves_its_own_targets():
+    """One batch of two encounters — a steering SB-MPC target and, in the other member, a kinematic
+    crosser and a second steering target — gives each member the run it has alone (the targets'
+    blocks padded per member, slots a member does not use left empty)."""
+    from shipgnc.guidance.colav import ColavGuidance
+    from shipgnc.scenarios.runner import build
+    from shipgnc.sim.simulator import simulate
+    from shipgnc.study.encounter_scores import batch_arrays
+
+    head_on = {"name": "v", "north": 11112.0, "east": 50.0, "course_deg": 180.0, "speed": U,
+               "vessel": {"model": "frigate"}, "avoidance": "sbmpc"}
+    crosser = {"name": "k", "north": 6000.0, "east": -6000.0, "course_deg": 80.0, "speed": 6.0}
+    wide = {"name": "w", "north": 9000.0, "east": 3000.0, "course_deg": 250.0, "speed": 7.0,
+            "vessel": {"model": "frigate"}, "avoidance": "vo"}
+    members = [[head_on], [crosser, wide]]
+    alone = [_run(m, "sbmpc", t_end=600.0) for m in members]
+    scenarios = [load_scenario("colav-head-on", ["runs=null", "guidance.method=sbmpc",
+                                                 f"guidance.targets={json.dumps(m)}"])
+                 for m in members]
+    setups = [build(sc) for sc in scenarios]
+    setup, g = setups[0], scenarios[0].guidance
+    encounters = [s.guidance.members[0] for s in setups]  # the targets as each run builds them
+    guidance = ColavGuidance(setup.guidance.los, encounters, methods=["sbmpc", "sbmpc"],
+                             configs={"sbmpc": g.sbmpc, "vo": g.vo})
+    result = simulate(setup.model, np.tile(setup.x0, (2, 1)), t_end=600.0, dt=0.5,
+                      controller=setup.controller, actuator=setup.actuator, guidance=guidance,
+                      u0=setup.u0, backend="numpy")
+    result = guidance.add_targets(result)
+    scores = batch_arrays(result, guidance, 200.0)
+    for k, run in enumerate(alone):
+        assert scores["min_range_m"][k] == pytest.approx(run.metrics["min_range_m"], rel=1e-12)
+        n = len(members[k])
+        np.testing.assert_allclose(result["target_north"].values[:, k, :n],
+                                   run.result["target_north"].values, atol=1e-9)
+    assert np.all(np.isnan(result["target_north"].values[:, 0, 1]))  # member 0 has one target
+
+
 @pytest.mark.parametrize("target, message", [
     ({"vessel": {"model": "frigate"}, "schedule": [{"t": 0, "course_deg": 0, "speed": 5}]},
      "schedule with a vessel target"),
