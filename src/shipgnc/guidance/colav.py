@@ -8,7 +8,9 @@ Each sample the guidance
    the last sample at or before t, moved on at constant velocity) to its position and velocity
    over ground at t, and keeps the least range to any target so far (``range_min``, its time and
    target: the realised closest point of approach, at every guidance sample whatever the log's
-   thinning);
+   thinning); targets that are vessels (:mod:`shipgnc.guidance.vessel_targets`: their own
+   steering, autopilot, waypoints and avoidance) are integrated from the last sample to t instead,
+   seeing the own ship's state as the guidance sees it;
 3. hands the own ship ``[north, east, χ, U]`` (course and speed over ground,
    χ = ψ + atan2(v, u), U = √(u² + v²)), the targets and the nominal ``[χ_n, U_n]`` to the
    avoidance method, which returns the commanded course and speed; with ``method = none`` the
@@ -45,8 +47,10 @@ from shipgnc.models.base import Signal, state_index
 METHODS = {"none": 0, "sbmpc": 1, "vo": 2}
 #: header of a parameter row (see :meth:`ColavGuidance.params`)
 _HEADER = 16
-#: logged per vessel target slot (:mod:`shipgnc.guidance.vessel_targets`): north, east, heading
+#: logged per vessel target slot (:mod:`shipgnc.guidance.vessel_targets`): north, east, heading,
+#: after the guidance's nine outputs (:attr:`ColavGuidance.outputs`)
 _VESSEL_OUT = ("north", "east", "psi")
+_BASE_OUT = 9
 #: the LOS part of the per-ship state, then [next decision time, course offset, speed factor,
 #: least range so far, its time, its target]
 _LOS_STATE = 6
@@ -410,9 +414,9 @@ def _vessels_sample(t, p, z, zo, po, own, targets, present, hold, out):
     present = vessel_targets(t, own, p[po:po + n_vessels * width_p], width_p, zv, width_z,
                              n_vessels, width_z - S_FIXED - SCRATCH, interval, targets, present,
                              hold)
-    for k in range((out.size - 9) // 3):
+    for k in range((out.size - _BASE_OUT) // 3):
         for q in range(3):
-            out[9 + 3 * k + q] = zv[k * width_z + q] if k < n_vessels else np.nan
+            out[_BASE_OUT + 3 * k + q] = zv[k * width_z + q] if k < n_vessels else np.nan
     return present
 
 
