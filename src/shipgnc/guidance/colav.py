@@ -373,13 +373,17 @@ def colav_reference(t, x, z, p, ref, out):
         d = math.hypot(targets[m] - x[i_north], targets[m + 1] - x[i_east])
         if d < hold[3]:
             hold[3], hold[4], hold[5] = d, t, float(j)
+    decide = method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t))
+    if decide or n_vessels > 0:  # the own ship over ground, for the method and the vessel targets
+        v = x[i_v] if i_v >= 0 else 0.0
+        own[0], own[1] = x[i_north], x[i_east]
+        own[2] = course_over_ground(x[i_psi], x[i_u], v)
+        own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
     if n_vessels > 0:
-        _own_motion(x, i_north, i_east, i_psi, i_u, i_v, own)
         present = _vessels_sample(t, p, z, s + 8 + 4 * n_max,
                                   h + n_los + n_max * n_samples * 5 + n_mp, own, targets, present,
                                   hold, out)
-    if method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t)):
-        _own_motion(x, i_north, i_east, i_psi, i_u, i_v, own)
+    if decide:
         if method == 1:
             sbmpc_choose(t, own, targets, present, nominal, mp, zm, cmd)
         else:
@@ -392,15 +396,6 @@ def colav_reference(t, x, z, p, ref, out):
     out[3], out[4], out[5] = nominal[0], ref[0], ref[1]
     out[6], out[7], out[8] = hold[3], hold[4], hold[5]
     return finished
-
-
-@kernel_function
-def _own_motion(x, i_north, i_east, i_psi, i_u, i_v, own):
-    """``own`` = the own ship's [north, east, χ, U] over ground from its state ``x``."""
-    v = x[i_v] if i_v >= 0 else 0.0
-    own[0], own[1] = x[i_north], x[i_east]
-    own[2] = course_over_ground(x[i_psi], x[i_u], v)
-    own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
 
 
 @kernel_function
