@@ -459,11 +459,11 @@ def colav_reference(t, x, z, p, ref, out):
 
 def _tables(tracks, n_max: int, n_samples: int) -> np.ndarray:
     """The tracks as one ``(n_max, n_samples, 5)`` table (unused rows at t = +inf; a None track,
-    never heard, all unused)."""
+    never heard, and a vessel target, integrated in the run, all unused)."""
     table = np.zeros((n_max, n_samples, 5))
     table[:, :, 0] = np.inf
     for j, track in enumerate(tracks):
-        if track is not None:
+        if isinstance(track, TargetTrack):
             table[j, :track.t.size] = track.table()
     return table
 
