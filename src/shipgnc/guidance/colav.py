@@ -51,7 +51,6 @@ from shipgnc.navigation.layout import Layout
 
 #: avoidance methods by name → the kernel's method code
 METHODS = {"none": 0, "sbmpc": 1, "vo": 2}
-#: header of a parameter row (see :meth:`ColavGuidance.params`)
 #: the fixed head of a parameter row (:meth:`ColavGuidance.params`), every offset from its names
 HEAD = Layout("colav parameters", ("n_los", 1), ("method", 1), ("n_targets", 1), ("n_samples", 1),
               ("n_max", 1), ("i_north", 1), ("i_east", 1), ("i_psi", 1), ("i_u", 1), ("i_v", 1),
@@ -219,7 +218,6 @@ class ColavGuidance:
     def params(self) -> np.ndarray:
         """One parameter row per member, shape ``(n_members, n_p)``, shorter rows padded with zeros.
 
-        A row holds, in order, n_los, method, n_targets, n_samples, n_max, i_north, i_east, i_psi,
         A row holds the head :data:`HEAD` (n_los, method, n_targets, n_samples, n_max, i_north,
         i_east, i_psi, i_u, i_v (−1 for none), n_method_params, memory, the decision interval,
         n_seen (the seen tables' sample count, 0: the avoidance sees the true tables), the number
