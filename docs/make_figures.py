@@ -43,6 +43,7 @@ SETS = {
     "observer-loop": ("observer_loop:figure", ("observer-loop-rudder.png",)),
     "encounters": ("shipgnc.viz.encounter_figures:document_figures",
                    ("encounters-tracks.png", "encounters-cpa-polar.png")),
+    "vessel-targets": ("shipgnc.viz.vessel_target_figures:document_figures", ("vessel-targets.png",)),
     "trials": ("shipgnc.viz.trial_figures:document_figures",
                tuple(f"trials-{v}-{w}.png" for v in ("mariner", "kvlcc2")
                      for w in ("turning", "zigzag-20", "zigzag-10", "spiral"))),

@@ -171,3 +171,22 @@ def test_a_sweep_seen_through_ais_every_step_scores_as_the_truth_and_reruns_alik
     alone = E.run_members([members[k]], backend="numpy", compliance=False, ais=noisy,
                           numbers=[k])
     assert alone.scores["min_range_m"][0] == pytest.approx(sweep.scores["min_range_m"][k], abs=0.01)
+
+
+def test_awareness_ais_with_a_vessel_target_is_refused_naming_the_field():
+    """A vessel target's track exists only inside the run, so its AIS reports cannot be drawn
+    before it: ``awareness: ais`` with a ``vessel`` target is one line naming the target's field
+    and what is allowed; the API refuses seen tracks for a member with a vessel target alike."""
+    from shipgnc.guidance.colav import ColavGuidance
+
+    steering = {"name": "v", "north": 9000.0, "east": 3000.0, "course_deg": 250.0, "speed": U,
+                "vessel": {"model": "frigate"}}
+    with pytest.raises(ConfigError, match=r"awareness ais with a vessel target "
+                                          r"\(targets\[1\]\.vessel\).*awareness: truth") as info:
+        _scenario([*HEAD_ON, steering], extra=("guidance.awareness=ais",))
+    assert "\n" not in str(info.value).strip()
+    sc = _scenario([*HEAD_ON, steering])  # the same targets seen as they are: accepted
+    g = E.colav_guidance(sc.guidance, sc)
+    kinematic, vessel = g.members[0]
+    with pytest.raises(ConfigError, match="member 0 has vessel target 'v'"):
+        ColavGuidance(g.los, [kinematic, vessel], seen=[kinematic, None])

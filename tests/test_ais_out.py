@@ -122,3 +122,35 @@ def test_a_scenario_log_has_one_file_per_run(tmp_path):
 def test_ais_log_bad_input_is_one_line(args, message):
     res = CliRunner().invoke(app, args)
     assert res.exit_code == 2 and message in res.output
+
+
+def test_a_vessel_target_is_logged_from_its_integrated_states(tmp_path):
+    """A vessel target (integrated in the run, no track before it) is written from its states in
+    the result: the log reads back to ``target_north``/``target_east``/``target_sog`` at every
+    report within the message's resolution, at the Class A interval of its 17.5 kn straight run
+    (6 s, ITU-R M.1371-5 Table 1)."""
+    import json
+
+    import xarray as xr
+
+    log = tmp_path / "vessel.nmea"
+    out = tmp_path / "run"
+    target = {"name": "v", "north": 11112.0, "east": 50.0, "course_deg": 180.0, "speed": 9.0,
+              "vessel": {"model": "frigate"}}
+    res = CliRunner().invoke(app, ["run", "colav-head-on", "--set", "runs=null",
+                                   "--set", "simulation.backend=numpy",
+                                   "--set", "simulation.t_end=120", "--set",
+                                   f"guidance.targets={json.dumps([target])}", "--no-figures",
+                                   "--out", str(out), "--ais-log", str(log)])
+    assert res.exit_code == 0, res.output
+    ds = xr.open_dataset(out / "result.nc")
+    tracks, _ = read_log(log, origin=(0.0, 0.0))
+    own = next(tr for tr in tracks if tr.source == "ais-own")
+    seen = next(tr for tr in tracks if tr.source == "ais")
+    _check_own(own, ds)
+    k = np.searchsorted(ds["time"].values, seen.t)
+    _within(seen.north, seen.east, ds["target_north"].values[k, 0],
+            ds["target_east"].values[k, 0])
+    assert np.abs(np.hypot(seen.v_north, seen.v_east) - 9.0).max() < SOG_TOL
+    np.testing.assert_array_equal(np.diff(seen.t), 6.0)
+    assert _pyais_messages(log) > 0

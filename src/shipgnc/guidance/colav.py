@@ -8,10 +8,14 @@ Each sample the guidance
    the last sample at or before t, moved on at constant velocity) to its position and velocity
    over ground at t, and keeps the least range to any target so far (``range_min``, its time and
    target: the realised closest point of approach, at every guidance sample whatever the log's
-   thinning); with ``seen`` tracks (the targets as the own ship's AIS receiver hears them,
-   :func:`shipgnc.ais.reporting.seen_tracks`) the avoidance is handed the seen targets —
-   the last report received, dead-reckoned from its SOG and COG, absent until first heard —
-   while ``range_min`` (and so the scores) stays the true tracks';
+   thinning); targets that are vessels (:mod:`shipgnc.guidance.vessel_targets`: their own
+   steering, autopilot, waypoints and avoidance) are integrated from the last sample to t instead,
+   seeing the own ship's state as the guidance sees it; with ``seen`` tracks (the targets as the
+   own ship's AIS receiver hears them, :func:`shipgnc.ais.reporting.seen_tracks`) the avoidance is
+   handed the seen targets — the last report received, dead-reckoned from its SOG and COG, absent
+   until first heard — while ``range_min`` (and so the scores) stays the true tracks' (seen tracks
+   exist for track targets only: a run seeing through AIS refuses vessel targets,
+   :func:`_seen_members`);
 3. hands the own ship ``[north, east, χ, U]`` (course and speed over ground,
    χ = ψ + atan2(v, u), U = √(u² + v²)), the targets and the nominal ``[χ_n, U_n]`` to the
    avoidance method, which returns the commanded course and speed; with ``method = none`` the
@@ -40,13 +44,28 @@ from shipgnc.colav.vo import vo_choose
 from shipgnc.derive import per_ship
 from shipgnc.errors import ConfigError, require
 from shipgnc.guidance.los import LOSGuidance, los_reference
+from shipgnc.guidance.vessel_targets import S_FIXED, SCRATCH, VesselTarget, vessel_targets
 from shipgnc.kernels import Kernel, flat, kernel_function, wrap
 from shipgnc.models.base import Signal, state_index
+from shipgnc.navigation.layout import Layout
 
 #: avoidance methods by name → the kernel's method code
 METHODS = {"none": 0, "sbmpc": 1, "vo": 2}
-#: header of a parameter row (see :meth:`ColavGuidance.params`)
-_HEADER = 14
+#: the fixed head of a parameter row (:meth:`ColavGuidance.params`), every offset from its names
+HEAD = Layout("colav parameters", ("n_los", 1), ("method", 1), ("n_targets", 1), ("n_samples", 1),
+              ("n_max", 1), ("i_north", 1), ("i_east", 1), ("i_psi", 1), ("i_u", 1), ("i_v", 1),
+              ("n_mp", 1), ("memory", 1), ("interval", 1), ("n_seen", 1), ("n_vessels", 1),
+              ("width_p", 1), ("width_z", 1),
+              tail="the LOS parameters (n_los), the true tables (n_max × n_samples × 5), the "
+                   "method's parameters (n_mp), the seen tables (n_max × n_seen × 5), the vessel "
+                   "targets' blocks (n_vessels × width_p)")
+HEAD_SIZE = HEAD.size
+(_N_LOS, _METHOD, _N_TARGETS, _N_SAMPLES, _N_MAX, _I_NORTH, _I_EAST, _I_PSI, _I_U, _I_V, _N_MP,
+ _MEMORY, _INTERVAL, _N_SEEN, _N_VESSELS, _WIDTH_P, _WIDTH_Z) = HEAD.at(*(f for f, _ in HEAD.fields))
+#: logged per vessel target slot (:mod:`shipgnc.guidance.vessel_targets`): north, east, heading,
+#: after the guidance's nine outputs (:attr:`ColavGuidance.outputs`)
+_VESSEL_OUT = ("north", "east", "psi")
+_BASE_OUT = 9
 #: the LOS part of the per-ship state, then [next decision time, course offset, speed factor,
 #: least range so far, its time, its target]
 _LOS_STATE = 6
@@ -94,12 +113,14 @@ class ColavGuidance:
             require(m in METHODS, "guidance.method", m, f"allowed: {', '.join(METHODS)}")
         require(math.isfinite(decision_interval) and decision_interval >= 0,
                 "guidance.decision_interval", decision_interval, "must be >= 0 s")
-        members = [list(encounters)] if not encounters or isinstance(encounters[0], TargetTrack) \
+        members = [list(encounters)] if not encounters or isinstance(
+            encounters[0], (TargetTrack, VesselTarget)) \
             else [list(m) for m in encounters]
         for m, tracks in enumerate(members):
             for track in tracks:
-                if not isinstance(track, TargetTrack):
-                    raise ConfigError(f"targets of member {m}: {track!r} is not a TargetTrack")
+                if not isinstance(track, (TargetTrack, VesselTarget)):
+                    raise ConfigError(f"targets of member {m}: {track!r} is not a TargetTrack "
+                                      "or a VesselTarget")
         self.los = los
         if len(methods) not in (1, len(members)) and len(members) != 1:
             raise ConfigError(f"methods: {len(methods)} for {len(members)} encounters (give one, "
@@ -111,12 +132,79 @@ class ColavGuidance:
         self.parts = {m: method_parts(m, configs.get(m)) for m in dict.fromkeys(methods)}
         self.memory = max(memory for _, memory in self.parts.values())
         self.n_max = max(1, max(len(t) for t in members))
-        self.n_samples = max([1] + [tr.t.size for tracks in members for tr in tracks])
+        self.n_samples = max([1] + [tr.t.size for tracks in members for tr in tracks
+                                    if isinstance(tr, TargetTrack)])
+        self._vessels_init(members, configs)
         self.seen = None if seen is None else _seen_members(seen, members)
         self.n_seen = 0 if self.seen is None else max(
             [1] + [tr.t.size for tracks in self.seen for tr in tracks if tr is not None])
         self._z = None
         self._outputs: dict[str, np.ndarray] = {}
+
+    # ------------------------------------------------------------------ vessel targets
+    def _vessels_init(self, members, configs) -> None:
+        """The vessel targets (:class:`~shipgnc.guidance.vessel_targets.VesselTarget`) of every
+        member, their avoidance's parameters (the own ship's ``configs``, course offsets only: the
+        reduced model holds its speed), block widths and logged slots."""
+        from shipgnc.colav.sbmpc import SBMPCConfig
+        from shipgnc.colav.vo import VOConfig
+
+        configs = configs or {}
+        self._vessels = [[(j, tr) for j, tr in enumerate(tracks) if isinstance(tr, VesselTarget)]
+                         for tracks in members]
+        self.n_vessels = max([0] + [len(v) for v in self._vessels])
+        kinds = dict.fromkeys(tr.avoidance for v in self._vessels for _, tr in v
+                              if tr.avoidance != "none")
+        defaults = {"sbmpc": SBMPCConfig, "vo": VOConfig}
+        self._vessel_mp, memory = {}, 0
+        for kind in kinds:
+            config = (configs.get(kind) or defaults[kind]()).model_copy(
+                update={"speed_factors": [1.0]})
+            self._vessel_mp[kind], m = method_parts(kind, config)
+            memory = max(memory, m)
+        self._width_z = S_FIXED + memory + SCRATCH if self.n_vessels else 0
+        self._width_p = max([0] + [tr.params(j, self._vessel_mp.get(tr.avoidance, flat())).size
+                                   for v in self._vessels for j, tr in v])
+        if self.n_vessels:
+            self.outputs = (*ColavGuidance.outputs, *(
+                Signal(f"vessel_target{k}_{q}", "rad" if q == "psi" else "m",
+                       f"vessel target slot {k}: {q}", angle=q == "psi")
+                for k in range(self.n_vessels) for q in _VESSEL_OUT))
+
+    def _vessel_params(self, tracks) -> np.ndarray:
+        """The vessel targets' parameter blocks of one member, ``(n, width)`` zero-padded."""
+        blocks = [tr.params(j, self._vessel_mp.get(tr.avoidance, flat()))
+                  for j, tr in enumerate(tracks) if isinstance(tr, VesselTarget)]
+        out = np.zeros((len(blocks), self._width_p))
+        for k, block in enumerate(blocks):
+            out[k, :block.size] = block
+        return out
+
+    def _vessels_reset(self, n: int) -> None:
+        """Every row's vessel targets at their start."""
+        zo = _LOS_STATE + _HOLD + self.memory + 8 + 4 * self.n_max
+        w = self._width_z
+        for row in range(n if self.n_vessels else 0):
+            for k, (_, tr) in enumerate(self._vessels[row % len(self._vessels)]):
+                self._z[row, zo + k * w:zo + (k + 1) * w] = tr.state(w)
+
+    def _vessel_states(self, states, result):
+        """``states`` (time, member, target) per ship of ``result``, the vessel targets' from
+        their logged slots; returns (states per ship, the slots' variable names)."""
+        time = result["time"].values
+        n_ships = math.prod(result["north"].shape[1:])
+        rows = np.arange(n_ships) % len(self.members)
+        out = {key: value[:, rows, :].copy() for key, value in states.items()}
+        names = [f"vessel_target{k}_{q}" for k in range(self.n_vessels) for q in _VESSEL_OUT]
+        logged = {name: result[name].values.reshape(time.size, n_ships) for name in names}
+        for i, m in enumerate(rows):
+            for k, (j, tr) in enumerate(self._vessels[m]):
+                out["target_north"][:, i, j] = logged[f"vessel_target{k}_north"][:, i]
+                out["target_east"][:, i, j] = logged[f"vessel_target{k}_east"][:, i]
+                out["target_sog"][:, i, j] = tr.U
+                out["target_cog"][:, i, j] = np.mod(logged[f"vessel_target{k}_psi"][:, i],
+                                                    2 * np.pi)
+        return out, names
 
     # ------------------------------------------------------------------ set-up
     @property
@@ -130,11 +218,14 @@ class ColavGuidance:
     def params(self) -> np.ndarray:
         """One parameter row per member, shape ``(n_members, n_p)``, shorter rows padded with zeros.
 
-        A row holds, in order, n_los, method, n_targets, n_samples, n_max, i_north, i_east, i_psi,
-        i_u, i_v (−1 for none), n_method_params, memory, the decision interval, n_seen (the seen
-        tables' sample count, 0: the avoidance sees the true tables), the LOS parameters (n_los
-        numbers), the targets (n_max × n_samples × (t, north, east, v_north, v_east), unused
-        samples at t = +inf), the method's parameters and the seen targets (n_max × n_seen × 5).
+        A row holds the head :data:`HEAD` (n_los, method, n_targets, n_samples, n_max, i_north,
+        i_east, i_psi, i_u, i_v (−1 for none), n_method_params, memory, the decision interval,
+        n_seen (the seen tables' sample count, 0: the avoidance sees the true tables), the number
+        of vessel targets and the widths of their parameter and state blocks), then the LOS
+        parameters (n_los numbers), the targets (n_max × n_samples × (t, north, east, v_north,
+        v_east), unused samples — and every sample of a vessel target — at t = +inf), the method's
+        parameters, the seen targets (n_max × n_seen × 5) and the vessel targets' parameter blocks
+        (:meth:`_vessel_params`).
         """
         los = self.los.kernel(self._batch_shape).params
         rows = []
@@ -146,9 +237,15 @@ class ColavGuidance:
             table = _tables(tracks, self.n_max, self.n_samples)
             seen = _tables(self.seen[m % len(self.seen)], self.n_max, self.n_seen) \
                 if self.seen is not None else np.zeros(0)
-            rows.append(flat(los.size, METHODS[method], len(tracks), self.n_samples,
-                             self.n_max, *self._index, mp.size, self.memory,
-                             self.decision_interval, self.n_seen, los, table, mp, seen))
+            vessels = self._vessel_params(tracks)
+            i_north, i_east, i_psi, i_u, i_v = self._index
+            head = HEAD.pack(n_los=los.size, method=METHODS[method], n_targets=len(tracks),
+                             n_samples=self.n_samples, n_max=self.n_max, i_north=i_north,
+                             i_east=i_east, i_psi=i_psi, i_u=i_u, i_v=i_v, n_mp=mp.size,
+                             memory=self.memory, interval=self.decision_interval,
+                             n_seen=self.n_seen, n_vessels=vessels.shape[0],
+                             width_p=self._width_p, width_z=self._width_z)
+            rows.append(flat(head, los, table, mp, seen, vessels))
         width = max(r.size for r in rows)
         return np.vstack([np.pad(r, (0, width - r.size)) for r in rows])
 
@@ -169,12 +266,15 @@ class ColavGuidance:
         self._z[:, 4] = np.nan  # LOS: completion time
         self._z[:, _LOS_STATE + 2] = 1.0  # held speed factor: the nominal
         self._z[:, _LOS_STATE + 3:_LOS_STATE + 6] = (np.inf, np.nan, -1.0)  # no range yet
+        self._vessels_reset(n)
 
     @property
     def state_width(self) -> int:
         """LOS state, the held decision [next decision time, course offset, speed factor], the
-        method's memory, then scratch: own (4), nominal (2), command (2), targets (4 n_max)."""
-        return _LOS_STATE + _HOLD + self.memory + 8 + 4 * self.n_max
+        method's memory, then scratch: own (4), nominal (2), command (2), targets (4 n_max); then
+        the vessel targets' states (:mod:`shipgnc.guidance.vessel_targets`)."""
+        return _LOS_STATE + _HOLD + self.memory + 8 + 4 * self.n_max \
+            + self.n_vessels * self._width_z
 
     # ------------------------------------------------------------------ numpy loop
     def reference(self, t: float, x: np.ndarray) -> np.ndarray:
@@ -207,16 +307,17 @@ class ColavGuidance:
     def target_states(self, t: np.ndarray, *, seen: bool = False) -> dict[str, np.ndarray]:
         """Every member's targets at times ``t``: ``target_north``, ``target_east`` [m],
         ``target_sog`` [m/s], ``target_cog`` [rad], each ``(time, member, target)`` (NaN where a
-        member has fewer targets); ``seen``: as the avoidance saw them, keys ``target_seen_*``
-        (NaN before a target is first heard)."""
+        member has fewer targets, and for vessel targets: they are integrated in the run, their
+        states logged, :meth:`add_targets`); ``seen``: as the avoidance saw them, keys
+        ``target_seen_*`` (NaN before a target is first heard)."""
         t = np.asarray(t, dtype=float)
         shape = (t.size, len(self.members), self.n_max)
         prefix = "target_seen_" if seen else "target_"
         out = {prefix + k: np.full(shape, np.nan) for k in ("north", "east", "sog", "cog")}
         for m, tracks in enumerate(self.seen if seen else self.members):
             for j, track in enumerate(tracks):
-                if track is None:
-                    continue
+                if not isinstance(track, TargetTrack):
+                    continue  # never heard, or a vessel target: its logged states (add_targets)
                 n, e, vn, ve = track.at(t)
                 out[prefix + "north"][:, m, j], out[prefix + "east"][:, m, j] = n, e
                 out[prefix + "sog"][:, m, j] = np.hypot(vn, ve)
@@ -230,6 +331,11 @@ class ColavGuidance:
         states = self.target_states(time)
         if self.seen is not None:
             states.update(self.target_states(time, seen=True))
+        per_ship = len(self.members) > 1
+        if self.n_vessels:  # integrated in the run: each ship's own, from the logged slots
+            states, slots = self._vessel_states(states, result)
+            result = result.drop_vars(slots)
+            per_ship = True
         ship_dims = [d for d in result["north"].dims if d != "time"]
         names = [tr.label for tr in self.members[0]] + [""] * (self.n_max - len(self.members[0]))
         units = {f"target_{s}{k}": u for s in ("", "seen_") for k, u in
@@ -238,7 +344,7 @@ class ColavGuidance:
             if ship_dims:
                 dims = ("time", *ship_dims, "target")
                 value = value.reshape(time.size, *result["north"].shape[1:], self.n_max) \
-                    if len(self.members) > 1 else np.broadcast_to(
+                    if per_ship else np.broadcast_to(
                         value, (time.size, *result["north"].shape[1:], self.n_max))
             else:
                 dims, value = ("time", "target"), value[:, 0, :]
@@ -269,21 +375,34 @@ def last_sample(rows, n_samples, t):
 
 
 @kernel_function
+def tail_offsets(p):
+    """Where the variable blocks of a parameter row (:data:`HEAD`'s tail) start, from the head's
+    counts: (true tables, method parameters, seen tables, vessel blocks, end); the LOS parameters
+    start at the head's end, ``HEAD.size``."""
+    at_table = HEAD_SIZE + int(p[_N_LOS])
+    at_mp = at_table + int(p[_N_MAX]) * int(p[_N_SAMPLES]) * 5
+    at_seen = at_mp + int(p[_N_MP])
+    at_vessels = at_seen + int(p[_N_MAX]) * int(p[_N_SEEN]) * 5
+    return at_table, at_mp, at_seen, at_vessels, at_vessels + int(p[_N_VESSELS]) * int(p[_WIDTH_P])
+
+
+@kernel_function
 def colav_reference(t, x, z, p, ref, out):
     """One sample of :class:`ColavGuidance` for one ship (module docstring): LOS for the nominal
     course, the targets dead-reckoned from their tables, then the avoidance method — called every
     decision interval (the paper's re-planning period; 0: every sample), its choice held as an
     offset from the nominal course and a factor of the nominal speed in between."""
-    n_los, method, n_targets = int(p[0]), int(p[1]), int(p[2])
-    n_samples, n_max = int(p[3]), int(p[4])
-    i_north, i_east, i_psi, i_u, i_v = int(p[5]), int(p[6]), int(p[7]), int(p[8]), int(p[9])
-    n_mp, memory, interval, n_seen = int(p[10]), int(p[11]), p[12], int(p[13])
-    h = _HEADER
-    finished = los_reference(t, x, z[:_LOS_STATE], p[h:h + n_los], ref, out)
-    table = p[h + n_los:h + n_los + n_max * n_samples * 5]
-    mp = p[h + n_los + n_max * n_samples * 5:h + n_los + n_max * n_samples * 5 + n_mp]
-    s_seen = h + n_los + n_max * n_samples * 5 + n_mp
-    seen = p[s_seen:s_seen + n_max * n_seen * 5]
+    method, n_targets = int(p[_METHOD]), int(p[_N_TARGETS])
+    n_samples, n_max = int(p[_N_SAMPLES]), int(p[_N_MAX])
+    i_north, i_east, i_psi = int(p[_I_NORTH]), int(p[_I_EAST]), int(p[_I_PSI])
+    i_u, i_v = int(p[_I_U]), int(p[_I_V])
+    memory, interval = int(p[_MEMORY]), p[_INTERVAL]
+    n_seen, n_vessels = int(p[_N_SEEN]), int(p[_N_VESSELS])
+    at_table, at_mp, at_seen, at_vessels, _ = tail_offsets(p)
+    finished = los_reference(t, x, z[:_LOS_STATE], p[HEAD_SIZE:at_table], ref, out)
+    table = p[at_table:at_mp]
+    mp = p[at_mp:at_seen]
+    seen = p[at_seen:at_vessels]
     hold = z[_LOS_STATE:_LOS_STATE + _HOLD]
     zm = z[_LOS_STATE + _HOLD:_LOS_STATE + _HOLD + memory]
     s = _LOS_STATE + _HOLD + memory  # scratch
@@ -312,11 +431,16 @@ def colav_reference(t, x, z, p, ref, out):
         targets[m + 2] = rows[k * 5 + 3]
         targets[m + 3] = rows[k * 5 + 4]
         present += 1
-    if method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t)):
+    decide = method > 0 and t >= hold[0] - 1e-9 * max(1.0, abs(t))
+    if decide or n_vessels > 0:  # the own ship over ground, for the method and the vessel targets
         v = x[i_v] if i_v >= 0 else 0.0
         own[0], own[1] = x[i_north], x[i_east]
         own[2] = course_over_ground(x[i_psi], x[i_u], v)
         own[3] = math.sqrt(x[i_u] * x[i_u] + v * v)
+    if n_vessels > 0:
+        present = _vessels_sample(t, p, z, s + 8 + 4 * n_max, at_vessels, own, targets, present,
+                                  hold, out)
+    if decide:
         if method == 1:
             sbmpc_choose(t, own, targets, present, nominal, mp, zm, cmd)
         else:
@@ -333,17 +457,19 @@ def colav_reference(t, x, z, p, ref, out):
 
 def _tables(tracks, n_max: int, n_samples: int) -> np.ndarray:
     """The tracks as one ``(n_max, n_samples, 5)`` table (unused rows at t = +inf; a None track,
-    never heard, all unused)."""
+    never heard, and a vessel target, integrated in the run, all unused)."""
     table = np.zeros((n_max, n_samples, 5))
     table[:, :, 0] = np.inf
     for j, track in enumerate(tracks):
-        if track is not None:
+        if isinstance(track, TargetTrack):
             table[j, :track.t.size] = track.table()
     return table
 
 
 def _seen_members(seen, members) -> list[list]:
-    """``seen`` in the shape of ``members`` (one list per member), checked against it."""
+    """``seen`` in the shape of ``members`` (one list per member), checked against it; a member
+    with a vessel target is refused (its AIS reports would have to be drawn inside the kernel from
+    its integrated state: not implemented)."""
     seen = [list(seen)] if not seen or isinstance(seen[0], (TargetTrack, type(None))) \
         else [list(m) for m in seen]
     if len(seen) != len(members) or any(len(a) != len(b) for a, b in zip(seen, members, strict=True)):
@@ -353,12 +479,37 @@ def _seen_members(seen, members) -> list[list]:
         for track in tracks:
             if track is not None and not isinstance(track, TargetTrack):
                 raise ConfigError(f"seen targets of member {m}: {track!r} is not a TargetTrack")
+    for m, tracks in enumerate(members):
+        for track in tracks:
+            if isinstance(track, VesselTarget):
+                raise ConfigError(f"seen: member {m} has vessel target {track.label!r}; AIS "
+                                  "awareness sees kinematic and logged targets only (seen=None "
+                                  "for vessel targets)")
     return seen
 
 
-def check_clear(track: TargetTrack, own, safety_radius: float, where: str) -> None:
-    """A target inside the safety radius of the own ship at t = 0 is a ConfigError naming it."""
-    n, e, _, _ = track.at(0.0)
+@kernel_function
+def _vessels_sample(t, p, z, zo, po, own, targets, present, hold, out):
+    """The member's vessel targets at ``t`` (:func:`~shipgnc.guidance.vessel_targets.vessel_targets`;
+    their parameter blocks from ``p[po]``, states from ``z[zo]``), each slot's north, east, heading
+    logged after the nine outputs (NaN in a slot the member does not use); returns the count of
+    targets present."""
+    n_vessels, width_p, width_z = int(p[_N_VESSELS]), int(p[_WIDTH_P]), int(p[_WIDTH_Z])
+    interval = p[_INTERVAL]
+    zv = z[zo:zo + n_vessels * width_z]
+    present = vessel_targets(t, own, p[po:po + n_vessels * width_p], width_p, zv, width_z,
+                             n_vessels, width_z - S_FIXED - SCRATCH, interval, targets, present,
+                             hold)
+    for k in range((out.size - _BASE_OUT) // 3):
+        for q in range(3):
+            out[_BASE_OUT + 3 * k + q] = zv[k * width_z + q] if k < n_vessels else np.nan
+    return present
+
+
+def check_clear(track, own, safety_radius: float, where: str) -> None:
+    """A target (a track or a vessel) inside the safety radius of the own ship at t = 0 is a
+    ConfigError naming it."""
+    n, e = track.start() if isinstance(track, VesselTarget) else track.at(0.0)[:2]
     distance = math.hypot(float(n) - own[0], float(e) - own[1])
     if distance < safety_radius:
         raise ConfigError(f"{where}: {distance:.1f} m from the own ship at t = 0, inside the "

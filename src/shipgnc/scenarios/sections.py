@@ -966,13 +966,49 @@ class TargetLegEntry(Strict):
     speed: NonNegative
 
 
+class TargetVesselConfig(Strict):
+    """The steering of a vessel target (:mod:`shipgnc.guidance.vessel_targets`): ``model``
+    ``frigate`` (van Amerongen's 1982 K, T, n₃ at the target's ``speed``, the catalogue's frigate)
+    or ``nomoto`` (``K``, ``T`` and ``n3`` given, e.g. identified from trials); the PD heading
+    autopilot ``Kp``, ``Kd``; the steering machine; lookahead LOS along the target's waypoints."""
+
+    field_units: ClassVar[dict[str, str]] = {
+        "K": "1/s", "T": "s", "n3": "s²/rad²", "Kp": "1", "Kd": "s", "delta_max_deg": "deg",
+        "delta_rate_deg": "deg/s", "T_delta": "s", "lookahead": "m", "switch_radius": "m"}
+
+    model: Literal["frigate", "nomoto"] = "frigate"
+    K: Positive | None = None
+    T: Positive | None = None
+    n3: NonNegative | None = None
+    Kp: NonNegative = 1.0
+    Kd: NonNegative = 20.0
+    delta_max_deg: Annotated[float, Field(gt=0, le=90, allow_inf_nan=False)] = 30.0
+    delta_rate_deg: Positive = 10.0
+    T_delta: Positive = 1.0
+    lookahead: Positive = 500.0
+    switch_radius: NonNegative = 0.0
+
+    @model_validator(mode="after")
+    def _gains_for_nomoto(self):
+        given = [k for k in ("K", "T", "n3") if getattr(self, k) is not None]
+        if self.model == "frigate" and given:
+            raise ValueError(f"{', '.join(given)} with model frigate: its K, T, n3 follow from "
+                             "the speed (van Amerongen 1982); use model: nomoto to give them")
+        if self.model == "nomoto" and (self.K is None or self.T is None):
+            raise ValueError("model nomoto needs K [1/s] and T [s]")
+        return self
+
+
 class TargetConfig(Strict):
-    """A kinematic target ship: at (``north``, ``east``) at t = 0, holding ``course_deg`` and
+    """A target ship: at (``north``, ``east``) at t = 0. Kinematic: holding ``course_deg`` and
     ``speed`` over ground, or following ``schedule`` (course and speed from each entry's time on;
-    the first entry at t = 0 replaces ``course_deg`` and ``speed``)."""
+    the first entry at t = 0 replaces ``course_deg`` and ``speed``). A vessel (``vessel`` given):
+    steered by its own autopilot at ``speed`` along ``waypoints`` (from its start; none: straight
+    on ``course_deg``), its heading at t = 0 ``course_deg`` (default: toward its first waypoint),
+    running its own ``avoidance`` against the own ship."""
 
     field_units: ClassVar[dict[str, str]] = {"north": "m", "east": "m", "speed": "m/s",
-                                             "length": "m", "beam": "m"}
+                                             "length": "m", "beam": "m", "waypoints": "m"}
 
     name: str = ""
     mmsi: Annotated[int, Field(ge=0, le=999_999_999)] = 0
@@ -984,6 +1020,12 @@ class TargetConfig(Strict):
                         AfterValidator(_in_time_order)] | None = None
     length: Positive = 100.0
     beam: Positive = 20.0
+    #: a vessel target's steering model and autopilot (null = a kinematic target)
+    vessel: TargetVesselConfig | None = None
+    #: a vessel target's waypoints ``[[north, east], ...]`` after its start
+    waypoints: Annotated[list[tuple[Finite, Finite]], Field(min_length=1)] | None = None
+    #: a vessel target's own collision avoidance (seeing the own ship as it is)
+    avoidance: Literal["none", "sbmpc", "vo"] = "none"
 
     @model_validator(mode="after")
     def _schedule_or_course(self):
@@ -991,7 +1033,47 @@ class TargetConfig(Strict):
         if self.schedule is not None and given:
             raise ValueError(f"{' and '.join(given)} with a schedule: give one or the other "
                              "(the schedule's entries set course and speed)")
+        if self.vessel is None:
+            extra = sorted({"waypoints", "avoidance"} & self.model_fields_set)
+            if extra:
+                raise ValueError(f"{' and '.join(extra)} need{'s' if len(extra) == 1 else ''} a "
+                                 "vessel target (give vessel: "
+                                 "{model: frigate}); a kinematic target follows its schedule")
+        elif self.schedule is not None:
+            raise ValueError("schedule with a vessel target: a vessel follows its waypoints")
+        elif self.speed <= 0:
+            raise ValueError("a vessel target needs speed > 0 m/s")
         return self
+
+    def vessel_target(self, label: str = "target"):
+        """The vessel target as a :class:`~shipgnc.guidance.vessel_targets.VesselTarget`: K, T,
+        n₃ of its model at its speed, heading ``course_deg`` or toward the first waypoint."""
+        from shipgnc.guidance.vessel_targets import VesselTarget
+
+        v = self.vessel
+        if v.model == "frigate":
+            from shipgnc.vessels.frigate import frigate_gains
+
+            K, T, n3 = frigate_gains(self.speed)
+        else:
+            K, T, n3 = v.K, v.T, v.n3 or 0.0
+        if self.waypoints:
+            first = self.waypoints[0]
+            bearing = math.atan2(first[1] - self.east, first[0] - self.north)
+            psi = math.radians(self.course_deg) if "course_deg" in self.model_fields_set \
+                else bearing
+            waypoints = self.waypoints
+        else:
+            psi = math.radians(self.course_deg)
+            far = 1e3 * self.speed * 3600.0  # a thousand hours on: the straight run
+            waypoints = [(self.north + far * math.cos(psi), self.east + far * math.sin(psi))]
+        return VesselTarget(
+            north=self.north, east=self.east, psi=psi, U=self.speed, K=K, T=T, n3=n3,
+            waypoints=waypoints, Kp=v.Kp, Kd=v.Kd,
+            delta_max=math.radians(v.delta_max_deg), delta_rate=math.radians(v.delta_rate_deg),
+            T_delta=v.T_delta, lookahead=v.lookahead, switch_radius=v.switch_radius,
+            avoidance=self.avoidance, mmsi=self.mmsi, name=self.name or label,
+            length=self.length, beam=self.beam)
 
     def track(self, label: str = "target"):
         """The target as a :class:`~shipgnc.colav.tracks.TargetTrack`: one sample per leg, each
@@ -1087,10 +1169,20 @@ class ColavConfig(Strict):
     #: more targets, replayed from a logged AIS file
     ais_log: AISLogConfig | None = None
     #: what the avoidance sees of the targets, ``truth`` (their true tracks) or ``ais`` (their
-    #: AIS reports as ``ais`` sets them); the ``colav`` scores are against the truth either way
+    #: AIS reports as ``ais`` sets them; kinematic and logged targets only, not vessel targets);
+    #: the ``colav`` scores are against the truth either way
     awareness: Literal["truth", "ais"] = "truth"
     #: the AIS reception of ``awareness: ais``
     ais: AISAwarenessConfig = Field(default_factory=AISAwarenessConfig)
+
+    @model_validator(mode="after")
+    def _ais_sees_tracks(self):
+        vessels = [j for j, target in enumerate(self.targets) if target.vessel is not None]
+        if self.awareness == "ais" and vessels:
+            raise ValueError(f"awareness ais with a vessel target (targets[{vessels[0]}].vessel): "
+                             "AIS awareness sees kinematic and logged targets only; use awareness: "
+                             "truth, or a course and speed or schedule for that target")
+        return self
 
 
 # the navigation sections live with their components, beside their registry records

@@ -4,7 +4,8 @@ ITU-R M.1371-5 intervals of each ship's speed and rate of turn, static data ever
 
 The own ship's motion is the run's: position (north, east), course over ground
 χ = ψ + atan2(v, u) and speed √(u² + v²) (no current), heading ψ. The targets are their true tracks
-(what the ships did, whatever the own ship saw of them). Positions are placed on the earth with the
+(what the ships did, whatever the own ship saw of them; a vessel target, integrated in the run, its
+logged states). Positions are placed on the earth with the
 local plane about ``origin`` (lat, lon) [deg]; a situation turned to the sweep's frame (own course 0)
 is turned back by ``rotation``, so the log shows it as the file gave it.
 
@@ -57,8 +58,9 @@ def own_motion(ds, rotation: float = 0.0) -> dict[str, np.ndarray]:
 def write_run_log(path, ds, targets, origin, *, rotation: float = 0.0, names=None,
                   own_dims=None, tag_blocks: bool = True) -> Path:
     """Write one run (``ds``: one ship, dims ``time``) and its ``targets`` (true
-    :class:`~shipgnc.colav.tracks.TargetTrack`) as an AIS log at ``path`` (module docstring);
-    ``names``: the own ship's, then the targets' (default: OWN SHIP and the tracks' labels);
+    :class:`~shipgnc.colav.tracks.TargetTrack`, or vessel targets: their states in ``ds``) as
+    an AIS log at ``path`` (module docstring); ``names``: the own ship's, then the targets'
+    (default: OWN SHIP and the tracks' labels);
     ``own_dims``: the own ship's (length, beam) [m] for its static data (None: not given)."""
     from shipgnc.ais.write import write_log
     from shipgnc.study.encounters import rotated
@@ -69,12 +71,29 @@ def write_run_log(path, ds, targets, origin, *, rotation: float = 0.0, names=Non
         raise ConfigError(f"{path}: the run has no finite own-ship position to write")
     ds = ds.isel(time=np.flatnonzero(keep))
     t = t[keep]
-    tracks = [rotated(tr, rotation) if rotation else tr for tr in targets]
+    tracks = [_logged(tr, ds, j) for j, tr in enumerate(targets)]
+    tracks = [rotated(tr, rotation) if rotation else tr for tr in tracks]
     if names is None:
         names = ["OWN SHIP", *(tr.label for tr in tracks)]
     lengths = [own_dims, *((tr.length, tr.beam) for tr in tracks)]
     return write_log(path, t, own_motion(ds, rotation), tracks, origin, OWN_MMSI,
                      target_mmsis(tracks), names=names, lengths=lengths, tag_blocks=tag_blocks)
+
+
+def _logged(track, ds, j: int):
+    """Target j as a track: a vessel target (integrated in the run) from its states in ``ds``
+    (``target_north``, ``target_east``, ``target_sog``, ``target_cog`` at every logged time), a
+    track as it is."""
+    from shipgnc.colav.tracks import TargetTrack
+    from shipgnc.guidance.vessel_targets import VesselTarget
+
+    if not isinstance(track, VesselTarget):
+        return track
+    sog, cog = ds["target_sog"].values[:, j], ds["target_cog"].values[:, j]
+    return TargetTrack(ds["time"].values, ds["target_north"].values[:, j],
+                       ds["target_east"].values[:, j], sog * np.cos(cog), sog * np.sin(cog),
+                       mmsi=track.mmsi, name=track.name, length=track.length, beam=track.beam,
+                       source="vessel")
 
 
 def scenario_logs(run, path) -> list[Path]:

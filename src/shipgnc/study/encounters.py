@@ -160,7 +160,7 @@ def colav_guidance(g, scenario):
     own = (init.north, init.east) if init is not None else (0.0, 0.0)
     tracks = []
     for j, target in enumerate(g.targets):
-        track = target.track(label=f"target {j + 1}")
+        track = _target(target, j)
         check_clear(track, own, g.safety_radius, f"guidance.targets[{j}]")
         tracks.append(track)
     if g.ais_log is not None:
@@ -189,6 +189,22 @@ def seen_tracks(tracks, ais, *, t_end: float, member: int = 0, origin=(0.0, 0.0)
     return observed(tracks, seed=ais.seed, t_end=t_end, member=member, origin=origin,
                     position_noise_m=ais.position_noise_m, dropout=ais.dropout,
                     ais_class=ais.ais_class, anchored=ais.anchored, every=ais.interval)
+
+
+def _target(target, j: int):
+    """``guidance.targets[j]`` as a track (kinematic) or a vessel target (its speed checked against
+    its model's range, naming the field)."""
+    if target.vessel is None:
+        return target.track(label=f"target {j + 1}")
+    if target.vessel.model == "frigate":
+        from shipgnc.vessels.frigate import SPEED_RANGE
+
+        low, high = SPEED_RANGE
+        if not low <= target.speed <= high:
+            raise ConfigError(f"guidance.targets[{j}].speed = {target.speed:g} m/s is outside the "
+                              f"frigate model's valid range {low:g}–{high:g} m/s (van Amerongen "
+                              "1982); use vessel: {model: nomoto, K: ..., T: ...}")
+    return target.vessel_target(label=f"target {j + 1}")
 
 
 def check_members(members: list[Member], safety_radius: float = SAFETY_RADIUS) -> None:
