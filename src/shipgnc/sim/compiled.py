@@ -33,7 +33,7 @@ MIN_LOGGED_CALL_WORK = 500_000
 #: seconds a kernel call should last at most: Ctrl-C is answered between calls (a signal waits
 #: for compiled code to return), so each run is cut into calls about this long, measured as it goes
 #: (wall time: a loaded machine makes calls shorter, so the fixed cost per call must stay small
-#: beside this; at 0.05 s a run on a loaded machine paid ≈ 30 % of its CPU time in calls)
+#: beside this: 2 000 ships × 1 000 steps in 100 calls took 27–45 % more CPU than in one)
 CALL_S = 0.25
 #: ship-steps of the first call (before the rate is known), and the growth of a call over the last
 FIRST_CALL_WORK = 20_000
