@@ -246,3 +246,38 @@ def test_unsupported_reasons():
     assert reason and "observer" in reason
     reason = compose.unsupported_reason(setup_of(integrator="solve_ivp"))
     assert reason and "solve_ivp" in reason
+
+
+def test_a_few_ships_logging_every_step_are_not_cut_into_many_calls():
+    # a call costs a fixed amount (each ship's carried state unpacked, the input tables): the log's
+    # bound of LOG_SAMPLES_PER_CALL samples per call holds only where a call keeps
+    # MIN_LOGGED_CALL_WORK ship-steps of work
+    from types import SimpleNamespace
+
+    from shipgnc.sim import compiled
+    from shipgnc.sim.compiled import LOG_SAMPLES_PER_CALL, MIN_LOGGED_CALL_WORK
+
+    def rule(n, every=1):
+        return compiled.log_samples_per_call(SimpleNamespace(log_every=every), n)
+
+    assert rule(2000) == LOG_SAMPLES_PER_CALL
+    assert rule(4) == MIN_LOGGED_CALL_WORK // 4
+    assert rule(4, every=10) == MIN_LOGGED_CALL_WORK // 40
+    calls = []
+    plain = simulate(BOAT, fleet(4), controller=stern_kick(), t_end=1000.0, dt=0.05,
+                     backend="compiled")
+    s = _validate(BOAT, fleet(4), t_end=1000.0, dt=0.05, controller=stern_kick(), actuator=None,
+                  guidance=None, disturbance=None, u0=None, integrator="rk4", method="RK45",
+                  rtol=1e-3, atol=1e-6, seed=1, on_divergence="stop", observer=None,
+                  progress=None, log_every=1)
+    from shipgnc.sim.compose import Composition
+    from shipgnc.sim.simulator import reset_components
+
+    reset_components(s)
+    comp = Composition(s)
+    compiled.drive(s, lambda k0, k1, k_last: (calls.append((k0, k1)), comp.call(k0, k1, k_last)),
+                   comp.S, comp.event, prepare=comp.prepare)
+    # 20 001 samples of 4 ships: one bounded call per 125 000 samples, then cut by time only
+    assert len(calls) < 20_001 / LOG_SAMPLES_PER_CALL
+    assert calls[0][0] == 0 and calls[-1][1] == 20_001
+    np.testing.assert_array_equal(comp.out[0], plain[next(iter(comp.signals))].values)

@@ -58,7 +58,7 @@ def kernel_function(function):
     on disk when it is defined in a file; a kernel typed into a notebook or ``exec``-ed compiles
     once per process). Kernels are called, not inlined, by the composed loop: numba's IR-level
     inlining (``inline="always"``) ran the boat ≈ 25 % faster but tripled the loop's first compile
-    and defeated its disk cache.
+    and defeated its disk cache (a disturbance's kernels excepted: :mod:`shipgnc.sim.loop_template`).
 
     Developers: numba's cache of a kernel is keyed to its own file only, so after editing a helper
     that kernels in *other* files call (``wrap``, ``paths.track_leg``), delete the

@@ -37,7 +37,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import control
 import numpy as np
 
 from shipgnc.control.base import kernel_step
@@ -141,7 +140,8 @@ class SMCDesign:
 def design_smc(a22: float, b2: float, lam1: float, lam2: float) -> SMCDesign:
     """Gains of the sliding-mode autopilot for ṙ = a₂₂ r + b₂ δ (notes 003-3.2, 003-3.4).
 
-    K by python-control (``place``; ``acker`` for a repeated eigenvalue), h from numpy's
+    K by scipy's ``place_poles`` (YT, what python-control's ``place`` calls; python-control's
+    ``acker`` for a repeated eigenvalue), h from numpy's
     eigenvectors of A_cᵀ (eigenvalue nearest λ₁), N_x, N_u by solving (13). λ₁ and λ₂ must be real
     and negative, |λ₁| ≤ |λ₂| (λ₁ is the eigenvalue of smallest modulus, the one h belongs to).
     """
@@ -158,7 +158,14 @@ def design_smc(a22: float, b2: float, lam1: float, lam2: float) -> SMCDesign:
     C = np.array([[1.0, 0.0]])
     D = np.array([[0.0]])
     poles = [float(lam1), float(lam2)]
-    gain = control.acker(A, B, poles) if lam1 == lam2 else control.place(A, B, poles)
+    if lam1 == lam2:
+        import control  # python-control (≈ 1 s to import, with matplotlib.pyplot): this case only
+
+        gain = control.acker(A, B, poles)
+    else:  # python-control's place is this call (YT method)
+        from scipy.signal import place_poles
+
+        gain = place_poles(A, B, np.array(poles), method="YT").gain_matrix
     K = np.asarray(gain, dtype=float).reshape(2)
     A_c = A - B @ K.reshape(1, 2)
     values, vectors = np.linalg.eig(A_c.T)

@@ -27,12 +27,14 @@ source                  K [1/s]    T [s]       a₂₂ [1/s]   b₂ [1/s²]
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
-import control
 import numpy as np
 
 from shipgnc.errors import ConfigError, require
+
+if TYPE_CHECKING:
+    import control
 
 
 class SwayYawModel(NamedTuple):
@@ -120,6 +122,8 @@ def nomoto_second_order(M, N, b) -> NomotoII:
     require(abs(np.linalg.det(M)) > 0, "nomoto_second_order.M", M.tolist(), "must be invertible")
     A = -np.linalg.solve(M, N)
     B = np.linalg.solve(M, b)
+    import control  # python-control (≈ 1 s to import, with matplotlib.pyplot): when reducing only
+
     tf = control.ss2tf(control.ss(A, B.reshape(2, 1), [[0.0, 1.0]], [[0.0]], inputs=["delta"],
                                  outputs=["r"]), name="r/delta")
     num = np.atleast_1d(np.squeeze(tf.num[0][0]))

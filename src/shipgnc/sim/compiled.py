@@ -24,11 +24,17 @@ MIN_THREAD_WORK = 100_000
 MAX_CALL_WORK = 5_000_000
 #: most logged samples per ship of one kernel call in a batch: the log is (variable, sample, ship),
 #: so neighbouring ships share its cache lines, and short calls keep them cached from one ship to
-#: the next (a 1 000-ship log of every step is written ≈ 2× faster)
+#: the next (a 1 000-ship log of every step is written ≈ 2× faster) ...
 LOG_SAMPLES_PER_CALL = 256
+#: ... unless the call would then hold fewer ship-steps than this: a call costs ≈ 0.5 µs per ship
+#: (its carried state unpacked into local arrays) and ≈ 0.1–3 ms of Python (its input tables), so
+#: a few ships logging every step are not cut into hundreds of calls of a millisecond's work
+MIN_LOGGED_CALL_WORK = 500_000
 #: seconds a kernel call should last at most: Ctrl-C is answered between calls (a signal waits
 #: for compiled code to return), so each run is cut into calls about this long, measured as it goes
-CALL_S = 0.05
+#: (wall time: a loaded machine makes calls shorter, so the fixed cost per call must stay small
+#: beside this: 2 000 ships × 1 000 steps in 100 calls took 27–45 % more CPU than in one)
+CALL_S = 0.25
 #: ship-steps of the first call (before the rate is known), and the growth of a call over the last
 FIRST_CALL_WORK = 20_000
 CALL_GROWTH = 4
@@ -85,7 +91,7 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
     if setup.progress is not None:
         n_chunks = max(n_chunks, PROGRESS_CHUNKS)
     if n_ships > 1:
-        n_chunks = max(n_chunks, math.ceil(log_length(setup) / LOG_SAMPLES_PER_CALL))
+        n_chunks = max(n_chunks, math.ceil(log_length(setup) / log_samples_per_call(setup, n_ships)))
     if done_at is not None:
         n_chunks = max(n_chunks, FINISH_CHUNKS)
     n_chunks = max(n_chunks, math.ceil(n_ships * (n_steps + 1) / MAX_CALL_WORK))
@@ -133,6 +139,13 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
     except KeyboardInterrupt:  # Ctrl-C between (or within) kernel calls
         return Stop(None, done_through, interrupted=True)
     return Stop(None, n_steps)
+
+
+def log_samples_per_call(setup, n_ships: int) -> int:
+    """Most logged samples per ship of one kernel call of a batch: :data:`LOG_SAMPLES_PER_CALL`,
+    or as many as make a call of :data:`MIN_LOGGED_CALL_WORK` ship-steps."""
+    steps = math.ceil(MIN_LOGGED_CALL_WORK / max(n_ships, 1))
+    return max(LOG_SAMPLES_PER_CALL, math.ceil(steps / int(setup.log_every)))
 
 
 def _timed_calls(bounds: list[int], n_ships: int):
