@@ -7,7 +7,11 @@ number, so it must agree to the bit. The RMSE's sum of squares is added in the s
 ``batchmath.time_sum``, but the loop is compiled with floating-point contraction (``fastmath
 {"contract"}``), so ``acc + w·w`` may be one fused multiply-add: each product then skips one
 rounding of at most ε/2 of that (positive) term, so the sum differs by at most N·ε/2 relative
-(N samples), the RMSE by half that; the test allows N·ε.
+(N samples), the RMSE by half that; the test allows N·ε. The same holds for ``path-tracking``'s
+sums of squares (the RMS of y_r after leg 1 and of δ); its other sums add no products.
+``path-tracking``'s ``stable`` is decided in the loop only where bounds on the residual
+half-range clear the band (``shipgnc.analysis.accumulated``); a member whose bounds do not is
+scored from its own log, which the chunk test checks.
 """
 
 from __future__ import annotations
@@ -27,9 +31,11 @@ from shipgnc.study.chunk import (
 from shipgnc.study.spec import Perturbation, Study
 
 #: a built-in scenario of each metric set scored in the loop
-BUILT_IN = {"heading-steps": "boat-autopilot"}
+BUILT_IN = {"heading-steps": "boat-autopilot", "path-tracking": "mariner-fl-lookahead"}
 #: figures that are sums (round-off bound in the module docstring); every other figure exact
-SUMS = {"heading_rmse_deg"}
+SUMS = {"heading_rmse_deg", "crosstrack_rms_after_leg1_nm", "rudder_rms_deg"}
+#: a figure of each set that differs between the members
+VARIES = {"heading-steps": "heading_rmse_deg", "path-tracking": "rudder_rms_deg"}
 #: (metric set, overrides, perturbation): settled steps, a step that never settles (NaN), a
 #: window whose ψ_d does not change (no overshoot direction). One combination of components
 #: (a scored loop compiles once per combination; per-member disturbance streams are the study's,
@@ -40,6 +46,10 @@ CASES = [
     ("heading-steps", ("guidance.schedule=[{t: 0.0, psi_deg: 0.0, u: 1.5}, "
                        "{t: 5.0, psi_deg: 0.0, u: 2.0}, {t: 20.0, psi_deg: 60.0, u: 2.0}]",
                        "simulation.t_end=30"), "r_deg_s=normal:2"),
+    # 100 min: legs switched, one ship reversed (ψ_r near 180°, leg 1 never ends); 15 min: leg 1
+    # never ends, and the verdict of a ship still approaching is left to its log
+    ("path-tracking", (), "east=uniform:-900,900"),
+    ("path-tracking", ("simulation.t_end=900",), "east=uniform:-2700,2700"),
 ]
 
 
@@ -57,11 +67,13 @@ def _both(metric_set, overrides, perturb, members=6):
     seeds = study.member_seeds(0, members, 1)
     sim = simulation_of(scenario, setup)
     in_loop = scored_in_loop(scenario, setup, sim, x0, seeds, "compiled-or-numpy")
-    if in_loop is not None:
-        in_loop, diverged = in_loop
-        assert not diverged.any()
     logged, ran_on, _, _ = scored_from_log(scenario, setup, sim, x0, seeds, "compiled-or-numpy",
                                            False)
+    if in_loop is not None:  # the members left to their logs compared in the chunk test
+        in_loop, to_log = in_loop
+        assert not to_log.all()
+        logged = {key: value[~to_log] for key, value in logged.items()}
+        in_loop = {key: value[~to_log] for key, value in in_loop.items()}
     return in_loop, logged, ran_on, round(sim.t_end / sim.dt) + 1
 
 
@@ -79,7 +91,7 @@ def test_in_loop_figures_equal_those_of_the_full_log(metric_set, overrides, pert
                                        atol=0, err_msg=key)
         else:
             np.testing.assert_array_equal(ours, reference, err_msg=key)
-    assert np.ptp(logged["heading_rmse_deg"]) > 0  # the members differ
+    assert np.ptp(logged[VARIES[metric_set]]) > 0  # the members differ
 
 
 def test_the_cases_reach_each_branch_of_the_settling_and_overshoot_figures():
@@ -100,6 +112,29 @@ def test_a_chunk_without_series_keeps_the_figures_of_one_with_series():
     series = run_chunk(Study("boat-autopilot", series=True, **kw), Chunk(0, 0, 5))
     assert not any(name.startswith("series_") for name in plain.data_vars)
     assert any(name.startswith("series_") for name in series.data_vars)
+    for key in plain.data_vars:
+        np.testing.assert_allclose(plain[key].values, series[key].values, rtol=1e-12, err_msg=key)
+
+
+def test_path_tracking_branches_and_members_left_to_their_logs():
+    """Leg 1 never ends (NaN after it), a reversed ship, a stable one; and a chunk whose members
+    include some whose ``stable`` the loop leaves to their logs keeps the figures of the chunk
+    scored from its log."""
+    full, _, _, _ = _both(*CASES[3])
+    assert np.isnan(full["crosstrack_rms_after_leg1_nm"]).any()
+    assert full["reversed"].any() and full["stable"].any()
+    assert "zero_dynamics_pole_per_min" in full
+    kw = {"members": 6, "seed": 7, "perturb": (Perturbation.parse(CASES[4][2]),),
+          "overrides": CASES[4][1]}
+    study = Study("mariner-fl-lookahead", **kw)
+    scenario = study.scenario_at(study.points[0])
+    setup = build(scenario, seed=study.seed)
+    x0 = member_initial_states(study, setup.x0, setup.model, Chunk(0, 0, 6))
+    _, to_log = scored_in_loop(scenario, setup, simulation_of(scenario, setup), x0,
+                               study.member_seeds(0, 6, 1), "compiled-or-numpy")
+    assert to_log.any()  # the case reaches the members scored from their logs
+    plain = run_chunk(study, Chunk(0, 0, 6))
+    series = run_chunk(Study("mariner-fl-lookahead", series=True, **kw), Chunk(0, 0, 6))
     for key in plain.data_vars:
         np.testing.assert_allclose(plain[key].values, series[key].values, rtol=1e-12, err_msg=key)
 

@@ -15,6 +15,18 @@ the step ``sign(wrap(ψ_d(first sample) − ψ_d(last sample before)))``), ψ_d'
 window and its last before it; over the run: ``Σ e_ψ²`` [deg²] in time order (the RMSE), max
 ``|α|``, max T, max T_cmd, the last u. Each is the series formula's own arithmetic on the same
 values, so the figures are the same to the bit.
+
+``path-tracking`` (:func:`shipgnc.analysis.path_tracking.path_tracking_arrays`, note 000-0.8):
+leg 1 is each ship's samples before its first with ``leg > 0`` (a gate on the switch); on it the
+band ``|y_r| < 0.05 nm``'s last exit and the largest ±y_r, from the switch on max |y_r| and
+Σ y_r²; over the last 10 min Σ sin ψ_r, Σ cos ψ_r, Σ y_r, Σ δ; over the run Σ δ², the
+samples at ±δ_max, max |y_r| and y_r(0). ``stable``'s residual half-range A about the least-squares
+line over the final 20 % (:func:`shipgnc.analysis.metrics.stable_arrays`) needs the window's
+samples after the fit; it lies between ½ [(e_max − b·tc(e_max)) − (e_min − b·tc(e_min))] and
+½ [e_max − e_min + |b| (tc_last − tc_first)] (b the fitted slope, tc the centred time), so a ship
+whose bounds fall on one side of the band by more than :data:`MARGIN` has its verdict, and the
+others (and any ship with a non-finite sample) are marked :data:`NEEDS_LOG`: the caller scores
+them from their logged series.
 """
 
 from __future__ import annotations
@@ -31,19 +43,26 @@ from shipgnc.sim.result import time_coordinate
 from shipgnc.units import to_deg
 
 # the kinds of shipgnc.sim.score_template (its module constants; that module is source only)
-MAX, MAX_ABS, SUM_SQUARES, LAST, FIRST, BAND_EXIT = range(6)
+(MAX, MAX_ABS, SUM_SQUARES, LAST, FIRST, BAND_EXIT, SUM, COUNT, SWITCH, LAST_OUT, SUM_TC,
+ ARGMAX) = range(12)
 #: accumulator kinds that start from −∞ (the others from 0)
-_FROM_MINUS_INF = (MAX, MAX_ABS)
+_FROM_MINUS_INF = (MAX, MAX_ABS, ARGMAX)
 #: a window's edges as the series formulas draw them (a sample at t_k − 1e-9 or later)
 EDGE = 1e-9
 #: metric sets scored inside the loop
-IN_LOOP_SETS = ("heading-steps",)
+IN_LOOP_SETS = ("heading-steps", "path-tracking")
+#: the key of :attr:`Accumulators.finish`'s mask of the ships to score from their logged series
+NEEDS_LOG = "needs_log"
+#: how far [m] the bounds on ``stable``'s residual half-range must clear the band to decide it
+#: (the series formula's own round-off is below 1e-11 m at the 10⁴ m of a Mariner's y_r)
+MARGIN = 1e-6
 
 
 @dataclass(frozen=True)
 class Accumulators:
     """The accumulators of a metric set (see :class:`shipgnc.sim.compose.ScoreArrays`): ``ops``
-    (m, 2), ``span`` (m, 4), ``init`` (3 m,) and ``finish(acc)`` → the metric arrays (ships,)."""
+    (m, 3), ``span`` (m, 4), ``init`` (3 m,) and ``finish(acc)`` → the metric arrays (ships,),
+    and under :data:`NEEDS_LOG` (if present) the ships to score from their logged series."""
 
     ops: np.ndarray
     span: np.ndarray
@@ -56,20 +75,24 @@ class _Plan:
 
     def __init__(self, signals) -> None:
         self.columns = {name: i for i, name in enumerate(signals)}
-        self.rows: list[tuple[int, int, float, float, float, float]] = []
+        self.rows: list[tuple[int, int, int, float, float, float, float]] = []
+        self.start: dict[int, float] = {}
 
-    def add(self, name: str, kind: int, start=-math.inf, end=math.inf, arg=1.0, level=0.0) -> int:
-        """Index of a new accumulator of signal ``name``."""
-        self.rows.append((self.columns[name], kind, start, end, arg, level))
+    def add(self, name: str, kind: int, start=-math.inf, end=math.inf, arg=1.0, level=0.0,
+            gate=-1, init=None) -> int:
+        """Index of a new accumulator of signal ``name`` (``init``: its first number's start,
+        else −∞ or 0 by kind)."""
+        self.rows.append((self.columns[name], kind, gate, start, end, arg, level))
+        if init is not None:
+            self.start[len(self.rows) - 1] = init
         return len(self.rows) - 1
 
     def build(self, finish) -> Accumulators:
-        ops = np.array([r[:2] for r in self.rows], dtype=np.int64).reshape(-1, 2)
-        span = np.array([r[2:] for r in self.rows], dtype=np.float64).reshape(-1, 4)
+        ops = np.array([r[:3] for r in self.rows], dtype=np.int64).reshape(-1, 3)
+        span = np.array([r[3:] for r in self.rows], dtype=np.float64).reshape(-1, 4)
         init = np.zeros(3 * len(self.rows))
         for m, kind in enumerate(ops[:, 1]):
-            if kind in _FROM_MINUS_INF:
-                init[3 * m] = -math.inf
+            init[3 * m] = self.start.get(m, -math.inf if kind in _FROM_MINUS_INF else 0.0)
         return Accumulators(ops, span, init, finish)
 
 
@@ -80,6 +103,9 @@ def plan_for(scenario, setup, signals, n_steps: int, dt: float) -> Accumulators 
     if scenario.metrics not in IN_LOOP_SETS or setup.navigation is not None:
         return None
     t = time_coordinate(np.arange(n_steps + 1) * dt)  # the sample times of a log of every step
+    if scenario.metrics == "path-tracking":
+        delta_max = float(setup.model.params.delta_max)
+        return path_tracking(signals, t, delta_max) if delta_max > 0 else None
     return heading_steps(signals, t, setup.guidance.step_times)
 
 
@@ -123,3 +149,108 @@ def heading_steps(signals, t: np.ndarray, step_times, tolerance_deg: float = 2.0
         }
 
     return plan.build(finish)
+
+
+def path_tracking(signals, t: np.ndarray, delta_max: float) -> Accumulators:
+    """The accumulators of ``path-tracking`` (see the module) for a run sampled at ``t``, rudder
+    limit ``delta_max`` > 0 [rad]."""
+    from shipgnc.analysis import path_tracking as pt
+    from shipgnc.analysis.metrics import STABLE_FINAL_FRACTION, STABLE_PINNED_FRACTION
+    from shipgnc.units import MINUTE, NAUTICAL_MILE
+
+    plan = _Plan(signals)
+    y, psi, leg, rudder = "cross_track_error", "heading_error", "leg", "delta"
+    switch = plan.add(leg, SWITCH)  # first: a gated accumulator reads its switch of this sample
+    before, after = 2 * switch, 2 * switch + 1
+    out = plan.add(y, LAST_OUT, level=pt.SETTLE_BAND, gate=before)
+    up, down = plan.add(y, MAX, gate=before), plan.add(y, MAX, arg=-1.0, gate=before)
+    after_max, after_sq = plan.add(y, MAX_ABS, gate=after), plan.add(y, SUM_SQUARES, gate=after)
+    # the last 10 min; the series sums start from −0.0 and add +0.0 for each sample before
+    final_from = t[-1] - pt.FINAL_WINDOW - 1e-9
+    zero = -0.0 if final_from <= t[0] else 0.0
+    sin_psi, cos_psi = (plan.add(psi, SUM, final_from, level=f, init=zero) for f in (1.0, 2.0))
+    y_sum = plan.add(y, SUM, final_from, init=zero)
+    d_sum = plan.add(rudder, SUM, final_from, init=zero)
+    d_sq = plan.add(rudder, SUM_SQUARES)
+    saturated_at = delta_max * (1.0 - 1e-9)
+    sat = [plan.add(rudder, COUNT, arg=sign, level=saturated_at) for sign in (1.0, -1.0)]
+    peak, y0 = plan.add(y, MAX_ABS), plan.add(y, FIRST)
+    finite = [peak] + [plan.add(name, MAX_ABS) for name in (psi, leg, rudder)]  # NaN sticks
+    # stable_arrays' final window (one segment: the run)
+    window_from = t[-1] - STABLE_FINAL_FRACTION * (t[-1] - t[0]) - 1e-9
+    center = 0.5 * (t[0] + t[-1])
+    e_sum, te_sum = plan.add(y, SUM, window_from), plan.add(y, SUM_TC, window_from, level=center)
+    e_max, e_min = plan.add(y, ARGMAX, window_from), plan.add(y, ARGMAX, window_from, arg=-1.0)
+    limit = delta_max * (1.0 - 1e-6)
+    pinned_at = [plan.add(rudder, COUNT, window_from, arg=sign, level=limit) for sign in (1.0, -1.0)]
+    tc = t[t >= window_from] - center
+    n_w, s_t, s_tt = float(tc.size), float(tc.sum()), float((tc * tc).sum())
+
+    def finish(acc: np.ndarray) -> dict:
+        a = acc.reshape(acc.shape[0], -1, 3)
+        n_t = t.size
+        has_switch = a[:, switch, 0] != 0.0
+        settle_idx, n_leg1 = a[:, out, 0], a[:, out, 1]
+        settled = (settle_idx < n_leg1) & (n_leg1 > 0)
+        settle = np.where(settled, t[np.minimum(settle_idx, n_t - 1).astype(np.int64)] / MINUTE,
+                          np.nan)
+        first = a[:, y0, 0]
+        side = -np.sign(first)
+        opposite = np.where(side > 0, a[:, up, 0], np.where(side < 0, a[:, down, 0], 0.0))
+        overshoot = np.where(np.abs(first) < pt.ON_LINE, 0.0,
+                             np.maximum(opposite, 0.0) / NAUTICAL_MILE)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            max_after = np.where(has_switch, a[:, after_max, 0], np.nan)
+            rms_after = np.where(has_switch, np.sqrt(a[:, after_sq, 0] / a[:, after_sq, 1]), np.nan)
+            rudder_rms = np.sqrt(a[:, d_sq, 0] / a[:, d_sq, 1])
+            saturation = (a[:, sat[0], 0] + a[:, sat[1], 0]) / a[:, d_sq, 1]
+            n_final = a[:, sin_psi, 1]
+            final_sin, final_cos = a[:, sin_psi, 0] / n_final, a[:, cos_psi, 0] / n_final
+            final_y, final_d = a[:, y_sum, 0] / n_final, a[:, d_sum, 0] / n_final
+        final_heading = to_deg(np.arctan2(final_sin, final_cos))
+        reversed_ = np.abs(final_heading) > pt.REVERSED_DEG
+        bounded = a[:, peak, 0] < np.maximum(pt.STABLE_BOUND, 2.0 * np.abs(first))
+        calm, undecided = _calm(a, n_w, s_t, s_tt, tc, center, e_sum, te_sum, e_max, e_min,
+                                pt.SETTLE_BAND)
+        if n_w >= 3:
+            pinned = ((a[:, pinned_at[0], 0] / n_w >= STABLE_PINNED_FRACTION)
+                      & (a[:, pinned_at[1], 0] / n_w >= STABLE_PINNED_FRACTION))
+        else:
+            pinned = np.zeros(acc.shape[0], dtype=bool)
+        stable = bounded & calm & ~pinned & ~reversed_
+        needs_log = undecided | ~np.isfinite(a[:, finite, 0]).all(axis=1)
+        return {
+            "settle_time_min": settle,
+            "overshoot_nm": overshoot,
+            "crosstrack_max_after_leg1_nm": max_after / NAUTICAL_MILE,
+            "crosstrack_rms_after_leg1_nm": rms_after / NAUTICAL_MILE,
+            "final_crosstrack_nm": final_y / NAUTICAL_MILE,
+            "final_heading_error_deg": final_heading,
+            "final_rudder_deg": to_deg(final_d),
+            "rudder_rms_deg": to_deg(rudder_rms),
+            "saturation_fraction": saturation,
+            "stable": stable.astype(float),
+            "reversed": reversed_.astype(float),
+            NEEDS_LOG: needs_log,
+        }
+
+    return plan.build(finish)
+
+
+def _calm(a, n, s_t, s_tt, tc, center, e_sum, te_sum, e_max, e_min, tolerance):
+    """Whether each ship's residual half-range over the final window is within ``tolerance``
+    (see the module: decided where its bounds clear it by :data:`MARGIN`), and where undecided.
+    A window of fewer than 3 samples has none (A = 0), as in ``stable_arrays``."""
+    ships = a.shape[0]
+    if n < 3:
+        return np.ones(ships, dtype=bool), np.zeros(ships, dtype=bool)
+    det = n * s_tt - s_t * s_t
+    with np.errstate(invalid="ignore", divide="ignore"):
+        slope = (n * a[:, te_sum, 0] - s_t * a[:, e_sum, 0]) / det if det > 0 else np.zeros(ships)
+    high, t_high = a[:, e_max, 0], a[:, e_max, 1] - center
+    low, t_low = -a[:, e_min, 0], a[:, e_min, 1] - center
+    upper = 0.5 * (high - low + np.abs(slope) * (tc[-1] - tc[0]))
+    lower = 0.5 * ((high - slope * t_high) - (low - slope * t_low))
+    calm = upper <= tolerance - MARGIN
+    restless = lower > tolerance + MARGIN
+    return calm, ~(calm | restless)

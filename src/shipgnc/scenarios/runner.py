@@ -378,18 +378,7 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
             out = path_tracking.montecarlo_summary(result, delta_max=delta_max, diverged=diverged)
         else:
             out = path_tracking.path_tracking_metrics(result, delta_max=delta_max, diverged=diverged)
-        K_paper = getattr(setup.controller, "K_paper", None)
-        if K_paper is not None:
-            out["lqr_gain"] = [float(k) for k in K_paper]
-        lookahead = getattr(setup.controller, "lookahead", None)
-        if lookahead is not None:  # output feedback linearisation: its zero dynamics (note 000-0.5)
-            from shipgnc.control.feedback_linearization import zero_dynamics_pole
-
-            try:
-                out["zero_dynamics_pole_per_min"] = zero_dynamics_pole(setup.model.params,
-                                                                       lookahead=lookahead)[0]
-            except ConfigError:  # relative degree 3 (r1 + l = 0): no zero dynamics
-                out["zero_dynamics_pole_per_min"] = None
+        out.update(design_figures(setup))
     else:
         out = {}
     if setup.navigation is not None:
@@ -399,6 +388,26 @@ def compute_metrics(scenario: Scenario, result, setup: Setup) -> dict:
         if setup.navigation.estimator is not None:
             out["unmodelled_sensor_errors"] = unmodelled
     out["diverged"] = diverged
+    return out
+
+
+def design_figures(setup: Setup) -> dict:
+    """The path-tracking controller's design figures reported with its metrics (the same for every
+    ship): the LQR gain ``lqr_gain`` as printed, or the zero-dynamics pole of output feedback
+    linearisation ``zero_dynamics_pole_per_min`` (note 000-0.5; None at relative degree 3)."""
+    out = {}
+    K_paper = getattr(setup.controller, "K_paper", None)
+    if K_paper is not None:
+        out["lqr_gain"] = [float(k) for k in K_paper]
+    lookahead = getattr(setup.controller, "lookahead", None)
+    if lookahead is not None:  # output feedback linearisation: its zero dynamics (note 000-0.5)
+        from shipgnc.control.feedback_linearization import zero_dynamics_pole
+
+        try:
+            out["zero_dynamics_pole_per_min"] = zero_dynamics_pole(setup.model.params,
+                                                                   lookahead=lookahead)[0]
+        except ConfigError:  # relative degree 3 (r1 + l = 0): no zero dynamics
+            out["zero_dynamics_pole_per_min"] = None
     return out
 
 

@@ -100,7 +100,7 @@ class LoopParams(NamedTuple):
 
 class ScoreArrays(NamedTuple):
     """The in-loop scoring step's accumulators (:mod:`shipgnc.sim.score_template`): ``ops``
-    (m, 2) int64 log column and kind, ``span`` (m, 4) window start and end [s] and two arguments,
+    (m, 3) int64 log column, kind and gate, ``span`` (m, 4) window start and end [s] and two arguments,
     ``acc`` (ships, 3 m) each ship's numbers. No accumulator (m = 0): nothing is scored."""
 
     ops: np.ndarray
@@ -110,7 +110,7 @@ class ScoreArrays(NamedTuple):
 
 def no_scoring(n_ships: int) -> ScoreArrays:
     """The scoring step's arrays when nothing is scored in the loop."""
-    return ScoreArrays(np.zeros((0, 2), dtype=np.int64), np.zeros((0, 4)), np.zeros((n_ships, 0)))
+    return ScoreArrays(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4)), np.zeros((n_ships, 0)))
 
 
 class LoopTables(NamedTuple):
@@ -390,7 +390,7 @@ class Composition:
         if not self.scored:
             raise ValueError("score_in_loop: the Composition was built without scored=True")
         n = self.S.shape[0]
-        ops = np.ascontiguousarray(ops, dtype=np.int64).reshape(-1, 2)
+        ops = np.ascontiguousarray(ops, dtype=np.int64).reshape(-1, 3)
         span = np.ascontiguousarray(span, dtype=np.float64).reshape(-1, 4)
         if acc.shape != (n, 3 * ops.shape[0]) or acc.dtype != np.float64 or not acc.flags.c_contiguous:
             raise ValueError(f"score_in_loop: acc must be C-contiguous float64 of shape "

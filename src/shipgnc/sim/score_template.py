@@ -7,7 +7,10 @@ members without logging every step (:mod:`shipgnc.sim.scored` runs it;
 formulas from them).
 
 An accumulator ``m`` reads log column ``ops[m, 0]`` in the time window ``span[m, 0] <= t <
-span[m, 1]`` and keeps three numbers ``acc[3 m: 3 m + 3]`` of the ship; its kind ``ops[m, 1]``:
+span[m, 1]`` and keeps three numbers ``acc[3 m: 3 m + 3]`` of the ship. Its gate ``ops[m, 2]``
+(−1: none) restricts it further to the ship's samples before (``2 j``) or from (``2 j + 1``) the
+switch recorded by the ``SCORE_SWITCH`` accumulator ``j`` (listed before it). Its kind
+``ops[m, 1]``:
 
 * ``SCORE_MAX`` — the largest ``v · span[m, 2]`` (NaN once a sample is NaN, as ``numpy.max``);
 * ``SCORE_MAX_ABS`` — the largest ``|v|`` (NaN as above);
@@ -17,7 +20,16 @@ span[m, 1]`` and keeps three numbers ``acc[3 m: 3 m + 3]`` of the ship; its kind
 * ``SCORE_FIRST`` — the first value in the window, and 1 once there is one;
 * ``SCORE_BAND_EXIT`` — settling bookkeeping for the band ``|v · span[m, 2]| <= span[m, 3]``:
   whether any sample was outside it, the time of the first sample after the last one outside
-  (NaN while the latest is outside), whether the latest was outside.
+  (NaN while the latest is outside), whether the latest was outside;
+* ``SCORE_SUM`` — ``Σ f(v)`` in time order, f by ``span[m, 3]``: 0 v, 1 sin v, 2 cos v, 3 |v|;
+  and the number of samples;
+* ``SCORE_COUNT`` — the number of samples with ``v · span[m, 2] >= span[m, 3]``, and of all;
+* ``SCORE_SWITCH`` — 1 from the first sample with ``v > 0`` on (a switch), and the number of
+  samples before it;
+* ``SCORE_LAST_OUT`` — the number of samples up to and including the last one outside the band
+  ``|v · span[m, 2]| < span[m, 3]`` (0 if none), and the number of samples;
+* ``SCORE_SUM_TC`` — ``Σ (t − span[m, 3]) · v`` and the number of samples;
+* ``SCORE_ARGMAX`` — the largest ``v · span[m, 2]`` (its first sample) and its time ``t``.
 
 Every value is the log's own arithmetic (:func:`column_value` is ``log_sample``'s), so a finished
 figure equals the one computed from the logged series.
@@ -30,6 +42,12 @@ SCORE_SUM_SQUARES = 2
 SCORE_LAST = 3
 SCORE_FIRST = 4
 SCORE_BAND_EXIT = 5
+SCORE_SUM = 6
+SCORE_COUNT = 7
+SCORE_SWITCH = 8
+SCORE_LAST_OUT = 9
+SCORE_SUM_TC = 10
+SCORE_ARGMAX = 11
 
 
 @inline
@@ -67,6 +85,9 @@ def score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):
     for m in range(ops.shape[0]):
         if not (t >= span[m, 0] and t < span[m, 1]):
             continue
+        gate = ops[m, 2]
+        if gate >= 0 and (acc[3 * (gate // 2)] != 0.0) != (gate % 2 == 1):
+            continue
         v = column_value(ops[m, 0], x, cmd, u, ref, gout, sig, nsg, err)
         kind, a = ops[m, 1], 3 * m
         if kind == SCORE_MAX:
@@ -92,3 +113,29 @@ def score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):
             elif acc[a + 2] != 0.0:
                 acc[a + 1] = t
                 acc[a + 2] = 0.0
+        elif kind == SCORE_SUM:
+            f = span[m, 3]
+            acc[a] = acc[a] + (v if f == 0.0 else math.sin(v) if f == 1.0 else
+                               math.cos(v) if f == 2.0 else abs(v))
+            acc[a + 1] = acc[a + 1] + 1.0
+        elif kind == SCORE_COUNT:
+            if v * span[m, 2] >= span[m, 3]:
+                acc[a] = acc[a] + 1.0
+            acc[a + 1] = acc[a + 1] + 1.0
+        elif kind == SCORE_SWITCH:
+            if acc[a] == 0.0:
+                if v > 0:
+                    acc[a] = 1.0
+                else:
+                    acc[a + 1] = acc[a + 1] + 1.0
+        elif kind == SCORE_LAST_OUT:
+            acc[a + 1] = acc[a + 1] + 1.0
+            if not (abs(v * span[m, 2]) < span[m, 3]):
+                acc[a] = acc[a + 1]
+        elif kind == SCORE_SUM_TC:
+            acc[a] = acc[a] + (t - span[m, 3]) * v
+            acc[a + 1] = acc[a + 1] + 1.0
+        elif kind == SCORE_ARGMAX:
+            if v * span[m, 2] > acc[a]:
+                acc[a] = v * span[m, 2]
+                acc[a + 1] = t

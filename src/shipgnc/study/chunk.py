@@ -246,9 +246,10 @@ def _alone(setup, i: int):
 def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str):
     """Every member's metrics scored inside the compiled loop (:mod:`shipgnc.analysis.accumulated`),
     in :func:`~shipgnc.scenarios.runner.metric_arrays`' key order, and which members diverged
-    (their figures NaN here: :func:`run_chunk` runs each again alone with its log); None when the
-    metric set, the backend or the setup needs the logged series."""
-    from shipgnc.analysis.accumulated import plan_for
+    or need their series (their figures NaN here: :func:`run_chunk` runs each again alone with its
+    log); None when the metric set, the backend or the setup needs the logged series."""
+    from shipgnc.analysis.accumulated import NEEDS_LOG, plan_for
+    from shipgnc.scenarios.runner import design_figures
     from shipgnc.sim.scored import run_scored
     from shipgnc.sim.simulator import _validate, log_signals
 
@@ -266,8 +267,12 @@ def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str):
     scored = run_scored(run, plan.ops, plan.span, plan.init)
     if scored is None:
         return None
-    diverged = scored.event >= 0
-    arrays = {k: np.where(diverged, math.nan, v) for k, v in plan.finish(scored.acc).items()}
+    figures = plan.finish(scored.acc)
+    diverged = (scored.event >= 0) | figures.pop(NEEDS_LOG, False)
+    arrays = {k: np.where(diverged, math.nan, v) for k, v in figures.items()}
+    for key, value in design_figures(setup).items() if scenario.metrics == "path-tracking" else ():
+        if isinstance(value, (int, float)):  # as metric_arrays adds them (not the lists)
+            arrays[key] = np.full(x0.shape[0], float(value))
     arrays["diverged"] = np.zeros(x0.shape[0])
     return arrays, diverged
 
