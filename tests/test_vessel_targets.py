@@ -78,6 +78,37 @@ def test_constant_rudder_follows_the_nomoto_closed_form():
     assert math.hypot(s[0] - centre[0], s[1] - centre[1]) == pytest.approx(radius, rel=1e-6)
 
 
+def test_short_nomoto_time_constant_is_integrated_stably():
+    """T = 0.01 s (far below the guidance sample and T_δ): the sub-step is held below T/2 (RK4's
+    real-axis stability bound is 2.785 T), so r follows T ṙ + r = K δ with δ held: r = Kδ within
+    round-off after the first step, no blow-up."""
+    tg = _target(K=0.1, T=0.01)
+    p = tg.params(0, flat())
+    s = _state(tg)
+    delta = math.radians(10.0)
+    s[4] = s[5] = delta
+    for _ in range(120):
+        integrate_vessel(s, p, 0.5)
+    assert np.all(np.isfinite(s[:5]))
+    assert s[3] == pytest.approx(0.1 * delta, rel=1e-9)
+    assert s[2] == pytest.approx(0.1 * delta * (60.0 - 0.01), rel=1e-6)
+
+
+def test_short_nomoto_target_runs_and_a_non_finite_target_stops_the_run():
+    """The T = 0.01 s target runs to the end with a finite track; a target whose state does become
+    non-finite (n₃ r³ far too stiff for the sub-step) stops the run as a divergence at that sample
+    instead of being left out of the scores."""
+    from shipgnc.errors import DivergenceError
+
+    base = {"north": 11112.0, "east": 150.0, "course_deg": 180.0, "speed": U,
+            "waypoints": [[11112.0, 5000.0]]}
+    run = _run([{**base, "vessel": {"model": "nomoto", "K": 0.1, "T": 0.01}}], t_end=60.0)
+    assert np.all(np.isfinite(run.result["target_north"].values))
+    assert not run.metrics["diverged"]
+    with pytest.raises(DivergenceError, match=r"diverged at t = "):
+        _run([{**base, "vessel": {"model": "nomoto", "K": 0.1, "T": 1.0, "n3": 1e6}}], t_end=60.0)
+
+
 def test_frigate_steady_turn_is_the_norrbin_root():
     """Van Amerongen's frigate at 9 m/s (K, T, n₃ of its table) with 20° rudder: the steady yaw rate
     is the real root of n₃ r³ + r = Kδ (Norrbin), and the tactical-scale turning radius U/r."""

@@ -25,7 +25,10 @@ along ``[start, *waypoints]`` (:func:`shipgnc.guidance.los.los_reference`, the o
 plus the held course offset of the target's own avoidance.
 
 **Integration:** from one guidance sample to the next, classic RK4 of (n, e, ψ, r, δ) with δ_c held,
-in sub-steps of at most :data:`MAX_STEP` and T_δ.
+in sub-steps of at most :data:`MAX_STEP`, T_δ and T/2 (RK4's stability bound on the real axis is
+|h λ| ≤ 2.785, and the lags have λ = −1/T_δ and −1/T; half of T keeps a margin for the n₃ r³ term).
+A target whose state is no longer finite turns the own ship's references NaN, so that the run stops
+as a divergence at that sample (the controller's command not finite) instead of scoring without it.
 
 **Avoidance** (optional, ``sbmpc`` or ``vo``): the target runs the method with the own ship as its one
 target, seen as ground truth (position and velocity over ground at the sample), course offsets only,
@@ -165,9 +168,9 @@ def _rates(psi, r, delta, delta_c, p):
 @kernel_function
 def integrate_vessel(s, p, h):
     """Advance the target's (n, e, ψ, r, δ) = ``s[:5]`` by ``h`` [s] with δ_c = ``s[5]`` held:
-    classic RK4 in equal sub-steps of at most MAX_STEP and at most T_δ (the servo's lag, which
-    would make a longer RK4 step unstable: its stability bound is 2.78 T_δ)."""
-    n_sub = max(1, math.ceil(h / min(MAX_STEP, p[9]) - 1e-9))
+    classic RK4 in equal sub-steps of at most MAX_STEP, T_δ and T/2 (the servo's and the yaw
+    rate's lags, which would make a longer RK4 step unstable: its stability bound is 2.785 × the lag)."""
+    n_sub = max(1, math.ceil(h / min(MAX_STEP, p[9], 0.5 * p[2]) - 1e-9))
     dt = h / n_sub
     dc = s[5]
     for _ in range(n_sub):
@@ -219,7 +222,7 @@ def vessel_targets(t, own, pv, width_p, zv, width_z, n_vessels, memory, interval
                    present, hold):
     """Every vessel target of one ship at ``t`` (:func:`vessel_target_sample`): appended to the
     avoidance's ``targets`` after the ``present`` kinematic ones, the least range ``hold[3:6]``
-    kept; returns the new count of targets present."""
+    kept; returns the new count of targets present, or −1 when a target's state is not finite."""
     for k in range(n_vessels):
         p = pv[k * width_p:(k + 1) * width_p]
         s = zv[k * width_z:(k + 1) * width_z]
@@ -229,6 +232,8 @@ def vessel_targets(t, own, pv, width_p, zv, width_z, n_vessels, memory, interval
         targets[m + 2], targets[m + 3] = p[4] * math.cos(s[2]), p[4] * math.sin(s[2])
         present += 1
         d = math.hypot(s[0] - own[0], s[1] - own[1])
+        if not (math.isfinite(d) and math.isfinite(s[2])):
+            return -1
         if d < hold[3]:
             hold[3], hold[4], hold[5] = d, t, p[0]
     return present
