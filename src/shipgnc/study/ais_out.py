@@ -99,7 +99,8 @@ def _logged(track, ds, j: int):
 def scenario_logs(run, path) -> list[Path]:
     """``shipgnc run --ais-log PATH`` for a ``guidance: colav`` scenario: the run at ``path``; a
     scenario with several runs (``runs:``) writes one file per run, ``PATH`` with ``-<run>`` before
-    its suffix. The origin: the AIS log's (``guidance.ais_log.origin``), else (0°, 0°)."""
+    its suffix, with that run's own targets. The origin: the AIS log's
+    (``guidance.ais_log.origin``), else (0°, 0°)."""
     sc = run.scenario
     g = sc.guidance
     if g is None or g.type != "colav":
@@ -116,8 +117,9 @@ def scenario_logs(run, path) -> list[Path]:
     out = []
     for key in ds[dim].values:
         one = ds.sel({dim: key})
-        out.append(write_run_log(path.with_name(f"{path.stem}-{key}{path.suffix}"), one, tracks,
-                                 origin))
+        own = run.setups.get(str(key)) if run.setups else None  # each run's own targets
+        out.append(write_run_log(path.with_name(f"{path.stem}-{key}{path.suffix}"), one,
+                                 own.guidance.members[0] if own is not None else tracks, origin))
     return out
 
 
