@@ -168,9 +168,30 @@ def test_a_sweep_seen_through_ais_every_step_scores_as_the_truth_and_reruns_alik
     noisy = AISAwarenessConfig(seed=4, position_noise_m=30.0, dropout=0.5)
     sweep = E.run_members(members, backend="numpy", compliance=False, ais=noisy)
     k = 3
-    alone = E.run_members([members[k]], backend="numpy", compliance=False, ais=noisy,
-                          numbers=[k])
+    alone = E.run_members([members[k]], backend="numpy", compliance=False, ais=noisy)
     assert alone.scores["min_range_m"][0] == pytest.approx(sweep.scores["min_range_m"][k], abs=0.01)
+
+
+def test_every_method_meets_the_same_ais_reports_of_an_encounter():
+    """The AIS reports of an encounter are drawn by (seed, situation, variant, target), not by the
+    member's place in the sweep: the three methods of one situation see the same reports, and a
+    sweep with one method scores that method's members as the sweep with all three."""
+    from shipgnc.scenarios.sections import AISAwarenessConfig
+
+    noisy = AISAwarenessConfig(seed=4, position_noise_m=30.0, dropout=0.5)
+    methods = ["none", "sbmpc", "vo"]
+    members = [m for m in E.standard_members(methods, mc=2, seed=1) if m.index == 3]
+    assert len(members) == 6
+    sweep = E.run_members(members, backend="numpy", compliance=False, ais=noisy,
+                          keep_results=True)
+    (_, ds), = sweep.results
+    seen = ds["target_seen_north"].values  # (time, member, target)
+    for a, b in ((0, 1), (0, 2), (3, 4), (3, 5)):
+        assert members[a].mc == members[b].mc and members[a].method != members[b].method
+        np.testing.assert_array_equal(seen[:, a], seen[:, b])
+    assert not np.array_equal(seen[:, 0], seen[:, 3], equal_nan=True)  # variants differ
+    alone = E.run_members(members[1::3], backend="numpy", compliance=False, ais=noisy)
+    np.testing.assert_allclose(alone.scores["min_range_m"], sweep.scores["min_range_m"][1::3], atol=0.01)
 
 
 def test_awareness_ais_with_a_vessel_target_is_refused_naming_the_field():

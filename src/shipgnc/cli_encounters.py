@@ -103,8 +103,7 @@ def encounters(
         if ais_log is not None:
             from shipgnc.study.ais_out import member_log
 
-            log = member_log(ais_log, members[ais_member], backend=backend, ais=ais,
-                             number=ais_member)
+            log = member_log(ais_log, members[ais_member], backend=backend, ais=ais)
             print(f"wrote the AIS log {log} (member {ais_member}: {members[ais_member].situation.title}, "
                   f"{members[ais_member].method})")
         print(f"wrote {', '.join(p.name for p in written)} to {out}")

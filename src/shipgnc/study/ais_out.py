@@ -123,15 +123,15 @@ def scenario_logs(run, path) -> list[Path]:
     return out
 
 
-def member_log(path, member, *, backend: str = "auto", ais=None, number: int = 0) -> Path:
+def member_log(path, member, *, backend: str = "auto", ais=None) -> Path:
     """``shipgnc encounters --ais-log PATH``: one sweep member
-    (:class:`~shipgnc.study.encounters.Member`, the sweep's member ``number``) run again alone,
-    seeing its targets as in the sweep (``ais``), logged at every step (the sweep logs every 10th:
-    its 5 s would stretch the 2–6 s reporting intervals), written at ``path``."""
+    (:class:`~shipgnc.study.encounters.Member`) run again alone, seeing its targets as in the
+    sweep (``ais``, drawn by the member's situation and variant), logged at every step (the sweep
+    logs every 10th: its 5 s would stretch the 2–6 s reporting intervals), written at ``path``."""
     from shipgnc.study.encounters import run_members
 
     sweep = run_members([member], backend=backend, log_every=1, keep_results=True,
-                        compliance=False, ais=ais, numbers=[number])
+                        compliance=False, ais=ais)
     (_, ds), = sweep.results
     dim = next((d for d in ds["north"].dims if d != "time"), None)
     one = ds.isel({dim: 0}) if dim is not None else ds
