@@ -211,3 +211,18 @@ def test_awareness_ais_with_a_vessel_target_is_refused_naming_the_field():
     kinematic, vessel = g.members[0]
     with pytest.raises(ConfigError, match="member 0 has vessel target 'v'"):
         ColavGuidance(g.los, [kinematic, vessel], seen=[kinematic, None])
+
+
+def test_a_monte_carlo_sweep_through_ais_is_refused_in_one_line():
+    """``awareness: ais`` draws one set of reports from ``guidance.ais.seed``: a ``--mc`` sweep
+    would give every member the same noise (a spread of zero that is not one), so it is refused
+    before any work, naming the flag, the field and what to use instead (exit 2)."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+
+    res = CliRunner().invoke(app, ["sweep", "colav-head-on", "--mc", "4", "--set", "runs=null",
+                                   "--set", "guidance.method=sbmpc",
+                                   "--set", "guidance.awareness=ais", "--out", "/nonexistent/x"])
+    assert res.exit_code == 2
+    assert "--mc 4 with guidance.awareness = ais" in res.output and "--grid" in res.output
