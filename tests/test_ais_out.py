@@ -118,6 +118,12 @@ def test_a_scenario_log_has_one_file_per_run(tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["encounters", "--ais-log", "x.nmea", "--ais-member", "99"], "--ais-member 99"),
     (["run", "boat-los", "--ais-log", "x.nmea"], "--ais-log"),
+    (["run", "colav-head-on", "--no-figures", "--out", "/nonexistent/run", "--ais-log",
+      "/nonexistent/dir/x.nmea"], "--ais-log '/nonexistent/dir/x.nmea': its directory"),
+    (["encounters", "--no-figures", "--out", "/nonexistent/enc", "--ais-log",
+      "/nonexistent/dir/x.nmea"], "--ais-log '/nonexistent/dir/x.nmea': its directory"),
+    (["run", "colav-head-on", "--no-figures", "--out", "/nonexistent/run", "--ais-log", "."],
+     "not a directory"),
 ])
 def test_ais_log_bad_input_is_one_line(args, message):
     res = CliRunner().invoke(app, args)

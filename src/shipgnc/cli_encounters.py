@@ -74,6 +74,10 @@ def encounters(
         members = E.file_members(situations, methods) if situations else \
             E.standard_members(methods, mc=mc, seed=seed)
         ais = _awareness(awareness, ais_noise, ais_dropout, seed)
+        if ais_log is not None:
+            from shipgnc.outputs import check_out_file
+
+            check_out_file(ais_log, "--ais-log")  # before the sweep, not after it
         if ais_log is not None and ais_member >= len(members):
             raise ConfigError(f"--ais-member {ais_member}: the sweep has members 0 to "
                               f"{len(members) - 1}")
