@@ -1107,6 +1107,9 @@ class AISLogConfig(Strict):
     path: Annotated[str, Field(min_length=1)]
     origin: tuple[Annotated[float, Field(ge=-90, le=90)],
                   Annotated[float, Field(ge=-180, le=180)]] | None = None
+    #: a message without a time of its own is refused (``refuse``), or takes the time of the line
+    #: before it (``previous``)
+    untimed: Literal["refuse", "previous"] = "refuse"
 
 
 class AISAwarenessConfig(Strict):

@@ -173,7 +173,7 @@ def colav_guidance(g, scenario):
     if g.ais_log is not None:
         from shipgnc.ais.logs import read_log
 
-        logged, _ = read_log(g.ais_log.path, origin=g.ais_log.origin)
+        logged, _ = read_log(g.ais_log.path, origin=g.ais_log.origin, untimed=g.ais_log.untimed)
         for track in logged:
             if track.source == "ais-own":
                 continue
