@@ -324,6 +324,12 @@ def test_each_batch_member_moves_its_own_targets():
     ({"vessel": {"model": "frigate"}, "speed": 0.0}, "speed > 0"),
     ({"vessel": {"model": "frigate"}, "speed": 20.0},
      r"guidance.targets\[0\].speed = 20 m/s is outside the frigate model's valid range 5–12"),
+    ({"vessel": {"model": "frigate"}, "speed": 9.0, "waypoints": [[9000.0, 0.0], [9000.0, 3000.0]]},
+     r"^guidance\.targets\[0\]\.waypoints: repeat a point \(or the start\)$"),
+    ({"vessel": {"model": "frigate", "switch_radius": 5000.0}, "speed": 9.0,
+      "waypoints": [[12000.0, 0.0]]},
+     r"^guidance\.targets\[0\]\.vessel\.switch_radius = 5000 m must be shorter than the "
+     r"shortest leg \(3000 m\)$"),
 ])
 def test_bad_vessel_targets_are_one_line_naming_the_field(target, message):
     from shipgnc.errors import ConfigError

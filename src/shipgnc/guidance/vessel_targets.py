@@ -91,29 +91,38 @@ class VesselTarget:
     length: float = 100.0
     beam: float = 20.0
     source: str = "vessel"
+    #: the scenario field the target comes from (``guidance.targets[j]``), named by its errors
+    where: str = ""
 
     def __post_init__(self) -> None:
         wp = np.asarray(self.waypoints, dtype=float).reshape(-1, 2)
         object.__setattr__(self, "waypoints", wp)
-        checks = (("speed", self.U, self.U > 0), ("K", self.K, self.K > 0),
-                  ("T", self.T, self.T > 0), ("n3", self.n3, self.n3 >= 0),
-                  ("Kp", self.Kp, self.Kp >= 0), ("Kd", self.Kd, self.Kd >= 0),
-                  ("delta_max", self.delta_max, 0 < self.delta_max <= math.pi / 2),
-                  ("delta_rate", self.delta_rate, self.delta_rate > 0),
-                  ("T_delta", self.T_delta, self.T_delta > 0),
-                  ("lookahead", self.lookahead, self.lookahead > 0))
+        checks = (("speed", self.U, self.U > 0), ("vessel.K", self.K, self.K > 0),
+                  ("vessel.T", self.T, self.T > 0), ("vessel.n3", self.n3, self.n3 >= 0),
+                  ("vessel.Kp", self.Kp, self.Kp >= 0), ("vessel.Kd", self.Kd, self.Kd >= 0),
+                  ("vessel.delta_max_deg", math.degrees(self.delta_max),
+                   0 < self.delta_max <= math.pi / 2),
+                  ("vessel.delta_rate_deg", math.degrees(self.delta_rate), self.delta_rate > 0),
+                  ("vessel.T_delta", self.T_delta, self.T_delta > 0),
+                  ("vessel.lookahead", self.lookahead, self.lookahead > 0))
         for name, value, ok in checks:
             if not (math.isfinite(value) and ok):
-                raise ConfigError(f"target {self.label}: {name} = {value!r} is out of range")
+                raise ConfigError(f"{self.field(name)} = {value!r} is out of range")
         if wp.shape[0] == 0 or not np.all(np.isfinite(wp)):
-            raise ConfigError(f"target {self.label}: waypoints must be ≥ 1 finite [north, east]")
+            raise ConfigError(f"{self.field('waypoints')}: must be ≥ 1 finite [north, east]")
         if self.avoidance not in AVOIDANCE:
-            raise ConfigError(f"target {self.label}: avoidance = {self.avoidance!r}; allowed: "
+            raise ConfigError(f"{self.field('avoidance')} = {self.avoidance!r}; allowed: "
                               f"{', '.join(AVOIDANCE)}")
 
     @property
     def label(self) -> str:
         return self.name or (f"MMSI {self.mmsi}" if self.mmsi else "target")
+
+    def field(self, name: str) -> str:
+        """The config field ``name`` (``vessel.T``) of this target as an error names it:
+        ``guidance.targets[j].vessel.T``, or without :attr:`where` the target's label and the
+        field's last part."""
+        return f"{self.where}.{name}" if self.where else f"{self.label}: {name.split('.')[-1]}"
 
     def start(self) -> tuple[float, float]:
         """(north, east) at t = 0."""
@@ -125,15 +134,16 @@ class VesselTarget:
 
         points = np.vstack([[self.north, self.east], self.waypoints])
         if np.any(np.hypot(*np.diff(points, axis=0).T) <= 0):
-            raise ConfigError(f"target {self.label}: waypoints repeat a point (or the start)")
+            raise ConfigError(f"{self.field('waypoints')}: repeat a point (or the start)")
         return WaypointPath(points)
 
     def los_params(self) -> np.ndarray:
         """:func:`los_reference`'s parameters with the target's own state (north at 0, east at 1)."""
         path = self.path()
         if self.switch_radius >= path.leg_lengths.min():
-            raise ConfigError(f"target {self.label}: switch_radius = {self.switch_radius:g} m must be "
-                              f"shorter than the shortest leg ({path.leg_lengths.min():g} m)")
+            raise ConfigError(f"{self.field('vessel.switch_radius')} = {self.switch_radius:g} m "
+                              f"must be shorter than the shortest leg "
+                              f"({path.leg_lengths.min():g} m)")
         return flat(0, 1, path.n_legs, self.lookahead, 0.0, self.U, self.switch_radius, 0.0,
                     path.waypoints[:-1, 0], path.waypoints[:-1, 1], path.leg_lengths,
                     path.leg_angles)

@@ -211,7 +211,7 @@ def _target(target, j: int):
             raise ConfigError(f"guidance.targets[{j}].speed = {target.speed:g} m/s is outside the "
                               f"frigate model's valid range {low:g}–{high:g} m/s (van Amerongen "
                               "1982); use vessel: {model: nomoto, K: ..., T: ...}")
-    return target.vessel_target(label=f"target {j + 1}")
+    return target.vessel_target(label=f"target {j + 1}", where=f"guidance.targets[{j}]")
 
 
 def check_members(members: list[Member], safety_radius: float = SAFETY_RADIUS) -> None:
