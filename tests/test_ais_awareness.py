@@ -168,9 +168,30 @@ def test_a_sweep_seen_through_ais_every_step_scores_as_the_truth_and_reruns_alik
     noisy = AISAwarenessConfig(seed=4, position_noise_m=30.0, dropout=0.5)
     sweep = E.run_members(members, backend="numpy", compliance=False, ais=noisy)
     k = 3
-    alone = E.run_members([members[k]], backend="numpy", compliance=False, ais=noisy,
-                          numbers=[k])
+    alone = E.run_members([members[k]], backend="numpy", compliance=False, ais=noisy)
     assert alone.scores["min_range_m"][0] == pytest.approx(sweep.scores["min_range_m"][k], abs=0.01)
+
+
+def test_every_method_meets_the_same_ais_reports_of_an_encounter():
+    """The AIS reports of an encounter are drawn by (seed, situation, variant, target), not by the
+    member's place in the sweep: the three methods of one situation see the same reports, and a
+    sweep with one method scores that method's members as the sweep with all three."""
+    from shipgnc.scenarios.sections import AISAwarenessConfig
+
+    noisy = AISAwarenessConfig(seed=4, position_noise_m=30.0, dropout=0.5)
+    methods = ["none", "sbmpc", "vo"]
+    members = [m for m in E.standard_members(methods, mc=2, seed=1) if m.index == 3]
+    assert len(members) == 6
+    sweep = E.run_members(members, backend="numpy", compliance=False, ais=noisy,
+                          keep_results=True)
+    (_, ds), = sweep.results
+    seen = ds["target_seen_north"].values  # (time, member, target)
+    for a, b in ((0, 1), (0, 2), (3, 4), (3, 5)):
+        assert members[a].mc == members[b].mc and members[a].method != members[b].method
+        np.testing.assert_array_equal(seen[:, a], seen[:, b])
+    assert not np.array_equal(seen[:, 0], seen[:, 3], equal_nan=True)  # variants differ
+    alone = E.run_members(members[1::3], backend="numpy", compliance=False, ais=noisy)
+    np.testing.assert_allclose(alone.scores["min_range_m"], sweep.scores["min_range_m"][1::3], atol=0.01)
 
 
 def test_awareness_ais_with_a_vessel_target_is_refused_naming_the_field():
@@ -190,3 +211,18 @@ def test_awareness_ais_with_a_vessel_target_is_refused_naming_the_field():
     kinematic, vessel = g.members[0]
     with pytest.raises(ConfigError, match="member 0 has vessel target 'v'"):
         ColavGuidance(g.los, [kinematic, vessel], seen=[kinematic, None])
+
+
+def test_a_monte_carlo_sweep_through_ais_is_refused_in_one_line():
+    """``awareness: ais`` draws one set of reports from ``guidance.ais.seed``: a ``--mc`` sweep
+    would give every member the same noise (a spread of zero that is not one), so it is refused
+    before any work, naming the flag, the field and what to use instead (exit 2)."""
+    from typer.testing import CliRunner
+
+    from shipgnc.cli import app
+
+    res = CliRunner().invoke(app, ["sweep", "colav-head-on", "--mc", "4", "--set", "runs=null",
+                                   "--set", "guidance.method=sbmpc",
+                                   "--set", "guidance.awareness=ais", "--out", "/nonexistent/x"])
+    assert res.exit_code == 2
+    assert "--mc 4 with guidance.awareness = ais" in res.output and "--grid" in res.output

@@ -118,6 +118,12 @@ def test_a_scenario_log_has_one_file_per_run(tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["encounters", "--ais-log", "x.nmea", "--ais-member", "99"], "--ais-member 99"),
     (["run", "boat-los", "--ais-log", "x.nmea"], "--ais-log"),
+    (["run", "colav-head-on", "--no-figures", "--out", "/nonexistent/run", "--ais-log",
+      "/nonexistent/dir/x.nmea"], "--ais-log '/nonexistent/dir/x.nmea': its directory"),
+    (["encounters", "--no-figures", "--out", "/nonexistent/enc", "--ais-log",
+      "/nonexistent/dir/x.nmea"], "--ais-log '/nonexistent/dir/x.nmea': its directory"),
+    (["run", "colav-head-on", "--no-figures", "--out", "/nonexistent/run", "--ais-log", "."],
+     "not a directory"),
 ])
 def test_ais_log_bad_input_is_one_line(args, message):
     res = CliRunner().invoke(app, args)
@@ -154,3 +160,23 @@ def test_a_vessel_target_is_logged_from_its_integrated_states(tmp_path):
     assert np.abs(np.hypot(seen.v_north, seen.v_east) - 9.0).max() < SOG_TOL
     np.testing.assert_array_equal(np.diff(seen.t), 6.0)
     assert _pyais_messages(log) > 0
+
+
+def test_each_run_of_a_scenario_logs_its_own_targets(tmp_path):
+    """A scenario with ``runs:`` whose targets differ writes each run's own targets: the first
+    report of each log is that run's target at its configured start (within the message's
+    resolution), not the first run's."""
+    import json
+
+    starts = {"a": (11112.0, 150.0, 180.0), "b": (6000.0, 4000.0, 270.0)}
+    runs = {k: {"guidance": {"targets": [{"name": "t", "north": n, "east": e, "course_deg": c,
+                                          "speed": 9.0}]}} for k, (n, e, c) in starts.items()}
+    log = tmp_path / "x.nmea"
+    res = CliRunner().invoke(app, ["run", "colav-head-on", "--set", f"runs={json.dumps(runs)}",
+                                   "--set", "simulation.t_end=30", "--no-figures",
+                                   "--out", str(tmp_path / "run"), "--ais-log", str(log)])
+    assert res.exit_code == 0, res.output
+    for key, (n, e, _) in starts.items():
+        tracks, _ = read_log(tmp_path / f"x-{key}.nmea", origin=(0.0, 0.0))
+        seen = next(tr for tr in tracks if tr.source == "ais")
+        _within(seen.north[:1], seen.east[:1], np.array([n]), np.array([e]))

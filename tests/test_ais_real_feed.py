@@ -59,8 +59,29 @@ def test_a_real_feed_refuses_as_the_format_says_one_line_each():
         read_reports(FEED)
     with pytest.raises(ConfigError, match=r"line \d+: AIS message type 21 \(aid to navigation\)"):
         read_reports(FEED, untimed="previous")
+    reports = read_reports(FEED, skip_unknown=True, untimed="previous")
     with pytest.raises(ConfigError, match=r"MMSI \d+ \(first at line \d+\) has no position report"):
-        read_log(FEED, skip_unknown=True, untimed="previous")
+        read_log(FEED, reports=reports)
+
+
+def test_skip_unknown_leaves_out_the_ships_heard_only_by_static_data():
+    """With ``skip_unknown`` the ships of the Bergen area and the ships heard only by their static
+    data (pyais's stream reader: an MMSI of types 5 or 24 and none of 1, 2, 3, 18, 19) read as the
+    area's tracks, the static-only MMSIs listed as left out."""
+    decoded = _pyais()
+    positions = {d.mmsi for d in decoded if d.msg_type in (1, 2, 3, 18, 19)}
+    static_only = {d.mmsi for d in decoded if d.msg_type in (5, 24)} - positions
+    assert static_only
+    reports = read_reports(FEED, skip_unknown=True, untimed="previous")
+    plane = LocalPlane(BERGEN)
+    near = {r.msg.mmsi for r in reports if isinstance(r.msg, nmea.PositionReport)
+            and r.msg.lat is not None
+            and np.hypot(*plane.to_plane(np.array([r.msg.lat]), np.array([r.msg.lon])))[0] < 55e3}
+    kept = [r for r in reports if r.msg.mmsi in near | static_only]
+    left_out: list[int] = []
+    tracks, _ = read_log(FEED, reports=kept, origin=BERGEN, skip_unknown=True, left_out=left_out)
+    assert {tr.mmsi for tr in tracks} == near
+    assert set(left_out) == static_only and len(left_out) == len(static_only)
 
 
 def test_the_ships_of_one_area_of_a_real_feed_become_tracks():

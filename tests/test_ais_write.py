@@ -98,3 +98,40 @@ def test_write_bad_input(tmp_path):
         write_log(tmp_path / "x", t[::-1], own, [], ORIGIN, 257000001, [])
     with pytest.raises(ConfigError, match="beyond what AIS can report"):
         write_log(tmp_path / "x", t, dict(own, sog=np.full_like(t, 60.0)), [], ORIGIN, 257000001, [])
+
+
+@pytest.mark.parametrize("origin", [(0.0, 0.0), (0.3, 0.3), (0.2, 0.0), (0.3, 5.0), (-0.1, 179.9)])
+def test_near_the_equator_a_log_reads_back_about_its_own_centre(tmp_path, origin):
+    """A log written about an origin on or near the equator (where an oblique Mercator with its
+    central line along the parallel is refused by PROJ) reads back with ``origin=None`` (about the
+    data's centre): each report's geodesic position is the written one within the message's
+    resolution, and its speed over ground the written one to 0.1 kn."""
+    from pyproj import Geod
+
+    from shipgnc.ais.plane import LocalPlane
+
+    t, own, targets = _scene()
+    path = write_log(tmp_path / "eq.nmea", t, own, targets, origin, 257000001,
+                     [257000002, 257000003])
+    tracks, centre = read_log(path)
+    written, read = LocalPlane(origin), LocalPlane(centre)
+    by = {tr.mmsi: tr for tr in tracks}
+    for mmsi, truth in ((257000002, targets[0]), (257000003, targets[1])):
+        tr = by[mmsi]
+        k = np.searchsorted(t, tr.t)
+        if isinstance(truth, TargetTrack):
+            n, e = truth.at(tr.t)[:2]
+        else:
+            n, e = truth["north"][k], truth["east"][k]
+        lat0, lon0 = written.to_geo(n, e)
+        lat1, lon1 = read.to_geo(tr.north, tr.east)
+        _, _, d = Geod(ellps="WGS84").inv(lon0, lat0, lon1, lat1)
+        assert np.max(d) < POS_TOL
+        assert np.abs(np.hypot(tr.v_north, tr.v_east) - np.hypot(*_speeds(truth, k))).max() \
+            < 0.051 * KNOT + 1e-9
+
+
+def _speeds(truth, k):
+    if isinstance(truth, TargetTrack):
+        return truth.v_north[0], truth.v_east[0]
+    return truth["sog"][k] * np.cos(truth["cog"][k]), truth["sog"][k] * np.sin(truth["cog"][k])

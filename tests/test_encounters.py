@@ -353,3 +353,30 @@ def test_sweep_compliance_thresholds_fit_the_domain_and_horizon():
     assert safety_score(E.SAFETY_RADIUS - 1e-6, c) == 0.0 < safety_score(E.SAFETY_RADIUS + 1.0, c)
     sweep = E.run_members(E.standard_members(["sbmpc"], specs=(tg.STANDARD[1],)), backend="numpy")
     assert sweep.scores["collision"][0] == 0 and sweep.scores["rule_16"][0] > 0.0
+
+
+def test_an_ais_log_with_untimed_lines_replays_with_untimed_previous(tmp_path):
+    """``guidance.ais_log.untimed``: a log whose later sentences lost their tag block (no time of
+    their own) is refused by default naming the line, and with ``untimed: previous`` each such
+    report takes the time of the line before it (as ``shipgnc ais info --untimed previous``)."""
+    from shipgnc.ais.logs import read_log
+    from shipgnc.ais.write import write_log
+    from shipgnc.colav.tracks import TargetTrack
+    from shipgnc.errors import ConfigError
+
+    origin = (58.0, 10.0)
+    t = np.arange(0.0, 301.0, 10.0)
+    own = {"north": U * t, "east": 0.0 * t, "sog": np.full_like(t, U), "cog": 0.0 * t}
+    true = TargetTrack.constant(8000.0, 2500.0, math.radians(200.0), 8.0)
+    path = write_log(tmp_path / "log.nmea", t, own, [true], origin, 257000001, [257000002],
+                     interval=10.0)
+    lines = path.read_text().splitlines()
+    lines[-1] = lines[-1][lines[-1].rindex("\\") + 1:]  # the last sentence without its tag block
+    path.write_text("\n".join(lines) + "\n")
+    log = {"path": str(path), "origin": origin}
+    with pytest.raises(ConfigError, match=rf"line {len(lines)}: no time"):
+        _run([], extra=(f"guidance.ais_log={json.dumps(log)}",))
+    run = _run([], extra=(f"guidance.ais_log={json.dumps({**log, 'untimed': 'previous'})}",))
+    tracks, _ = read_log(path, origin=origin, untimed="previous")
+    seen = next(tr for tr in tracks if tr.source == "ais")
+    assert run.result.sizes["target"] == 1 and seen.t[-1] == pytest.approx(300.0)

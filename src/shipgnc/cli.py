@@ -176,6 +176,10 @@ def run_command(
         if ais_log is not None and (sc.guidance is None or sc.guidance.type != "colav"):
             raise ConfigError(f"--ais-log: scenario {sc.name!r} has no ships to meet (it needs "
                               "guidance type colav)")
+        if ais_log is not None:
+            from shipgnc.outputs import check_out_file
+
+            check_out_file(ais_log, "--ais-log")  # before the run, not after it
         if live and (sc.vessel.model != "vectored-thrust-boat" or sc.controllers is not None):
             raise ConfigError(f"--live: the live dashboard shows the vectored-thrust boat; scenario "
                               f"{sc.name!r} ({sc.vessel.model}) writes its figures after the run")

@@ -54,7 +54,9 @@ def info(
 
         reports = read_reports(file, skip_unknown=skip_unknown, untimed=untimed)
         t0 = min(r.time for r in reports) if reports else 0.0
-        tracks, org = read_log(file, origin=_origin(origin), t0=t0, reports=reports)
+        left_out: list[int] = []
+        tracks, org = read_log(file, origin=_origin(origin), t0=t0, reports=reports,
+                               skip_unknown=skip_unknown, left_out=left_out)
         t1 = max(r.time for r in reports)
         rows = []
         for tr in tracks:
@@ -64,7 +66,8 @@ def info(
                              span_min=round(float(tr.t[-1] - tr.t[0]) / 60.0, 2),
                              min_sog_kn=round(min(speed), 1), max_sog_kn=round(max(speed), 1)))
         summary = dict(file=str(file), messages=len(reports), targets=len(tracks), first_utc=utc_text(t0),
-                       last_utc=utc_text(t1), span_min=round((t1 - t0) / 60.0, 2), origin=list(org))
+                       last_utc=utc_text(t1), span_min=round((t1 - t0) / 60.0, 2), origin=list(org),
+                       no_position=left_out)
         if json_:
             stdout.print_json(json.dumps(dict(summary, tracks=rows)))
             return
@@ -74,3 +77,6 @@ def info(
         names = ["name", "source", "reports", "first_utc", "last_utc", "span_min", "min_sog_kn", "max_sog_kn"]
         print_columns(stdout, "targets", "MMSI", [str(r["mmsi"]) for r in rows],
                      {n: [str(r[n]) for r in rows] for n in names})
+        if left_out:
+            stdout.print(f"note: left out (static data only, no position report): MMSI "
+                         f"{', '.join(str(m) for m in left_out)}", soft_wrap=True)

@@ -74,6 +74,10 @@ def encounters(
         members = E.file_members(situations, methods) if situations else \
             E.standard_members(methods, mc=mc, seed=seed)
         ais = _awareness(awareness, ais_noise, ais_dropout, seed)
+        if ais_log is not None:
+            from shipgnc.outputs import check_out_file
+
+            check_out_file(ais_log, "--ais-log")  # before the sweep, not after it
         if ais_log is not None and ais_member >= len(members):
             raise ConfigError(f"--ais-member {ais_member}: the sweep has members 0 to "
                               f"{len(members) - 1}")
@@ -103,8 +107,7 @@ def encounters(
         if ais_log is not None:
             from shipgnc.study.ais_out import member_log
 
-            log = member_log(ais_log, members[ais_member], backend=backend, ais=ais,
-                             number=ais_member)
+            log = member_log(ais_log, members[ais_member], backend=backend, ais=ais)
             print(f"wrote the AIS log {log} (member {ais_member}: {members[ais_member].situation.title}, "
                   f"{members[ais_member].method})")
         print(f"wrote {', '.join(p.name for p in written)} to {out}")

@@ -147,6 +147,21 @@ def check_out(out: Path, *, overwrite: bool = False, option: str = "--out",
     return out
 
 
+def check_out_file(path: Path, option: str) -> Path:
+    """Check an output file's place before any work; return it. A ConfigError (exit 2) naming
+    ``option`` when it is a directory, or its directory does not exist or cannot be written."""
+    path = Path(path)
+    shown = str(path)
+    if shown == "" or path.is_dir():
+        raise ConfigError(f"{option} {shown!r}: name a file to write, not a directory")
+    parent = path.resolve().parent
+    if not parent.is_dir():
+        raise ConfigError(f"{option} {shown!r}: its directory {str(parent)!r} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ConfigError(f"{option} {shown!r}: cannot write in {str(parent)!r} (permission denied)")
+    return path
+
+
 def _existing_ancestor(path: Path) -> Path:
     while not path.exists() and path != path.parent:
         path = path.parent

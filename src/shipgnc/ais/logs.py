@@ -31,7 +31,7 @@ heard twice), an error if they differ.
 
 Bad input raises :class:`~shipgnc.errors.ConfigError` naming the line and field: an unreadable line, a
 message type not read (unless ``skip_unknown``), a sentence without a time, times of one MMSI going
-back, an MMSI with no position report.
+back, an MMSI with no position report (left out with ``skip_unknown``).
 """
 
 from __future__ import annotations
@@ -298,8 +298,8 @@ def _velocities(t, north, east, vn, ve, lines, mmsi) -> tuple[np.ndarray, np.nda
 
 
 def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None = None,
-             reports: list[Report] | None = None,
-             untimed: str = "refuse") -> tuple[list[TargetTrack], tuple[float, float]]:
+             reports: list[Report] | None = None, untimed: str = "refuse",
+             left_out: list[int] | None = None) -> tuple[list[TargetTrack], tuple[float, float]]:
     """The targets of a logged AIS file, one track per MMSI (sorted by MMSI), and the origin.
 
     Positions are in the local plane about ``origin`` (lat, lon) [deg] — given, or the centre of the
@@ -310,7 +310,9 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
     earliest message). Names and lengths come
     from static data (types 5, 24) where the file has them. ``!AIVDO`` tracks (the logging ship) have
     ``source = "ais-own"``, the others ``"ais"``. ``reports``: the file's reports if already read
-    (:func:`read_reports`); ``untimed``: as :func:`read_reports` takes it."""
+    (:func:`read_reports`); ``untimed``: as :func:`read_reports` takes it. An MMSI heard only by
+    its static data (no position report) is an error, or with ``skip_unknown`` left out and added
+    to ``left_out`` (when given)."""
     from shipgnc.ais.plane import LocalPlane, centre, check_origin, check_range
 
     if reports is None:
@@ -333,8 +335,11 @@ def read_log(path, *, origin=None, skip_unknown: bool = False, t0: float | None 
         if r.msg.has_position:
             by_mmsi.setdefault(r.msg.mmsi, []).append(r)
     for mmsi, line in sorted(first_line.items(), key=lambda kv: kv[1]):
-        if mmsi not in by_mmsi:
-            raise ConfigError(f"{where}: MMSI {mmsi} (first at line {line}) has no position report")
+        if mmsi not in by_mmsi and not skip_unknown:
+            raise ConfigError(f"{where}: MMSI {mmsi} (first at line {line}) has no position report "
+                              "(--skip-unknown leaves it out)")
+        if mmsi not in by_mmsi and left_out is not None:
+            left_out.append(mmsi)
     if not by_mmsi:
         raise ConfigError(f"{where}: no position report in the file")
     lat_all = np.array([r.msg.lat for rs in by_mmsi.values() for r in rs])

@@ -1,12 +1,14 @@
-"""The local plane a logged or written AIS track lives in: the geo router's projection
-(:class:`shipgnc.routing.geo.projection.RouteProjection`) centred on one point.
+"""The local plane a logged or written AIS track lives in: the transverse Mercator about one point.
 
-With both ends at ``origin`` the router's oblique Mercator has its centre there and grid north is true
-north at the origin; it is conformal with scale k ≈ 1 + y²/(2R²) off its central line (Snyder 1987,
-eq. 9-9 on the sphere), so positions and headings within a few tens of kilometres of the origin are in
-metres and radians to 10⁻⁴ (:data:`MAX_RANGE_M`, 60 km; a point farther from the origin is refused by
-:func:`check_range`). Velocities are turned between true and grid north by the meridian
-convergence at each point (:meth:`RouteProjection.rotate`); the scale k is left out of them.
+The transverse Mercator (PROJ ``tmerc``, WGS84, k₀ = 1) with its central meridian through ``origin``
+and its origin there: grid north is true north at the origin and along its meridian, defined for
+every origin off the poles (the geo router's oblique Mercator, with both ends at one point, has no
+central line that PROJ accepts near the equator). It is conformal with scale k ≈ 1 + x²/(2R²) at
+x east of the central meridian (Snyder 1987, eq. 8-11 on the sphere), so positions and headings
+within a few tens of kilometres of the origin are in metres and radians to 10⁻⁴ (:data:`MAX_RANGE_M`,
+60 km; a point farther from the origin is refused by :func:`check_range`). Velocities are turned
+between true and grid north by the meridian convergence at each point (:meth:`LocalPlane.rotate`);
+the scale k is left out of them.
 """
 
 from __future__ import annotations
@@ -16,10 +18,9 @@ import math
 import numpy as np
 
 from shipgnc.errors import ConfigError
-from shipgnc.routing.geo.projection import RouteProjection
 
 #: how far from its origin the local plane is used [m]: scale within 10⁻⁴ (k − 1 ≈ y²/(2R²) = 4.4·10⁻⁵
-#: at 60 km, Snyder 1987 eq. 9-9 with R = 6371 km)
+#: at 60 km, Snyder 1987 eq. 8-11 with R = 6371 km)
 MAX_RANGE_M = 60_000.0
 
 
@@ -64,24 +65,46 @@ class LocalPlane:
     (speed over ground, course clockwise from true north) and the plane's (v_north, v_east)."""
 
     def __init__(self, origin):
+        from pyproj import CRS, Transformer
+
         self.origin = check_origin(origin)
-        self._proj = RouteProjection(self.origin, self.origin)
+        lat, lon = self.origin
+        crs = CRS.from_proj4(f"+proj=tmerc +lat_0={lat:.10f} +lon_0={lon:.10f} +k_0=1 +x_0=0 "
+                             "+y_0=0 +ellps=WGS84 +units=m +no_defs")
+        self._fwd = Transformer.from_crs("EPSG:4326", crs, always_xy=True)
+        self._inv = Transformer.from_crs(crs, "EPSG:4326", always_xy=True)
 
     def to_plane(self, lat, lon) -> tuple[np.ndarray, np.ndarray]:
-        return self._proj.to_plane(lat, lon)
+        """(north, east) [m] of (lat, lon) [deg]."""
+        x, y = self._fwd.transform(np.asarray(lon, float), np.asarray(lat, float))
+        return np.asarray(y, float), np.asarray(x, float)
 
     def to_geo(self, north, east) -> tuple[np.ndarray, np.ndarray]:
-        return self._proj.to_geo(north, east)
+        """(lat, lon) [deg] of plane points (north, east) [m]."""
+        lon, lat = self._inv.transform(np.asarray(east, float), np.asarray(north, float))
+        return np.asarray(lat, float), np.asarray(lon, float)
+
+    def rotate(self, lat, lon, vn, ve) -> tuple[np.ndarray, np.ndarray]:
+        """A vector of true (north, east) components at (lat, lon) in the plane's (north, east)
+        axes: turned by the meridian convergence (true north's direction in the plane, from the
+        image of a short meridian step), its length kept (conformal)."""
+        lat, lon = np.asarray(lat, float), np.asarray(lon, float)
+        d = 1e-5  # deg
+        n1, e1 = self.to_plane(lat + d, lon)
+        n0, e0 = self.to_plane(lat - d, lon)
+        norm = np.hypot(n1 - n0, e1 - e0)
+        c, s = (n1 - n0) / norm, (e1 - e0) / norm
+        return vn * c - ve * s, vn * s + ve * c
 
     def _north(self, lat, lon) -> tuple[np.ndarray, np.ndarray]:
         """(cos, sin) of true north's direction in the plane at (lat, lon)."""
-        return self._proj.rotate(lat, lon, np.ones_like(np.asarray(lat, float)), 0.0)
+        return self.rotate(lat, lon, np.ones_like(np.asarray(lat, float)), 0.0)
 
     def velocity_to_plane(self, lat, lon, sog, cog) -> tuple[np.ndarray, np.ndarray]:
         """(v_north, v_east) [m/s] in the plane of speed ``sog`` [m/s] over ground on course ``cog``
         [rad, clockwise from true north] at (lat, lon)."""
         sog, cog = np.asarray(sog, float), np.asarray(cog, float)
-        return self._proj.rotate(lat, lon, sog * np.cos(cog), sog * np.sin(cog))
+        return self.rotate(lat, lon, sog * np.cos(cog), sog * np.sin(cog))
 
     def velocity_to_true(self, lat, lon, v_north, v_east) -> tuple[np.ndarray, np.ndarray]:
         """(sog [m/s], cog [rad, clockwise from true north, in [0, 2π)]) of a plane velocity."""

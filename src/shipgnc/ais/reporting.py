@@ -156,17 +156,19 @@ def observe(track: TargetTrack, *, seed: int, position_noise_m: float = 0.0, dro
                        name=track.name, length=track.length, beam=track.beam, source="ais")
 
 
-def seen_tracks(tracks, *, seed: int, t_end: float, member: int = 0, **options) -> list:
+def seen_tracks(tracks, *, seed: int, t_end: float, member: int | tuple = 0, **options) -> list:
     """What the own ship's AIS receiver makes of each of ``tracks`` (:func:`observe` with
     ``options``) up to ``t_end`` [s]: one :class:`TargetTrack` per target, or None for a target
     every one of whose reports was lost (never heard, so never avoided). Target ``j`` of batch
-    member ``member`` draws from ``SeedSequence([seed, member, j])``: the same seed gives the same
-    reports, and adding a target or a member leaves the others' reports as they were."""
+    member ``member`` (a number, or a tuple of numbers such as (situation, variant)) draws from
+    ``SeedSequence([seed, *member, j])``: the same seed gives the same reports, and adding a target
+    or a member leaves the others' reports as they were."""
+    key = [int(k) for k in (member if isinstance(member, tuple) else (member,))]
     out = []
     for j, track in enumerate(tracks):
         if track.t[0] > t_end:  # appears after the run: never heard
             out.append(None)
             continue
-        rng_seed = np.random.SeedSequence([int(seed), int(member), j])
+        rng_seed = np.random.SeedSequence([int(seed), *key, j])
         out.append(observe(track, seed=rng_seed, t_end=t_end, lost_ok=True, **options))
     return out

@@ -440,6 +440,10 @@ def colav_reference(t, x, z, p, ref, out):
     if n_vessels > 0:
         present = _vessels_sample(t, p, z, s + 8 + 4 * n_max, at_vessels, own, targets, present,
                                   hold, out)
+        if present < 0:  # a vessel target's state is not finite: the run stops as diverged
+            ref[0], ref[1] = np.nan, np.nan
+            out[3], out[4], out[5] = np.nan, np.nan, np.nan
+            return finished
     if decide:
         if method == 1:
             sbmpc_choose(t, own, targets, present, nominal, mp, zm, cmd)
@@ -493,7 +497,7 @@ def _vessels_sample(t, p, z, zo, po, own, targets, present, hold, out):
     """The member's vessel targets at ``t`` (:func:`~shipgnc.guidance.vessel_targets.vessel_targets`;
     their parameter blocks from ``p[po]``, states from ``z[zo]``), each slot's north, east, heading
     logged after the nine outputs (NaN in a slot the member does not use); returns the count of
-    targets present."""
+    targets present (−1: a target's state is not finite)."""
     n_vessels, width_p, width_z = int(p[_N_VESSELS]), int(p[_WIDTH_P]), int(p[_WIDTH_Z])
     interval = p[_INTERVAL]
     zv = z[zo:zo + n_vessels * width_z]

@@ -25,7 +25,10 @@ along ``[start, *waypoints]`` (:func:`shipgnc.guidance.los.los_reference`, the o
 plus the held course offset of the target's own avoidance.
 
 **Integration:** from one guidance sample to the next, classic RK4 of (n, e, ψ, r, δ) with δ_c held,
-in sub-steps of at most :data:`MAX_STEP` and T_δ.
+in sub-steps of at most :data:`MAX_STEP`, T_δ and T/2 (RK4's stability bound on the real axis is
+|h λ| ≤ 2.785, and the lags have λ = −1/T_δ and −1/T; half of T keeps a margin for the n₃ r³ term).
+A target whose state is no longer finite turns the own ship's references NaN, so that the run stops
+as a divergence at that sample (the controller's command not finite) instead of scoring without it.
 
 **Avoidance** (optional, ``sbmpc`` or ``vo``): the target runs the method with the own ship as its one
 target, seen as ground truth (position and velocity over ground at the sample), course offsets only,
@@ -88,29 +91,38 @@ class VesselTarget:
     length: float = 100.0
     beam: float = 20.0
     source: str = "vessel"
+    #: the scenario field the target comes from (``guidance.targets[j]``), named by its errors
+    where: str = ""
 
     def __post_init__(self) -> None:
         wp = np.asarray(self.waypoints, dtype=float).reshape(-1, 2)
         object.__setattr__(self, "waypoints", wp)
-        checks = (("speed", self.U, self.U > 0), ("K", self.K, self.K > 0),
-                  ("T", self.T, self.T > 0), ("n3", self.n3, self.n3 >= 0),
-                  ("Kp", self.Kp, self.Kp >= 0), ("Kd", self.Kd, self.Kd >= 0),
-                  ("delta_max", self.delta_max, 0 < self.delta_max <= math.pi / 2),
-                  ("delta_rate", self.delta_rate, self.delta_rate > 0),
-                  ("T_delta", self.T_delta, self.T_delta > 0),
-                  ("lookahead", self.lookahead, self.lookahead > 0))
+        checks = (("speed", self.U, self.U > 0), ("vessel.K", self.K, self.K > 0),
+                  ("vessel.T", self.T, self.T > 0), ("vessel.n3", self.n3, self.n3 >= 0),
+                  ("vessel.Kp", self.Kp, self.Kp >= 0), ("vessel.Kd", self.Kd, self.Kd >= 0),
+                  ("vessel.delta_max_deg", math.degrees(self.delta_max),
+                   0 < self.delta_max <= math.pi / 2),
+                  ("vessel.delta_rate_deg", math.degrees(self.delta_rate), self.delta_rate > 0),
+                  ("vessel.T_delta", self.T_delta, self.T_delta > 0),
+                  ("vessel.lookahead", self.lookahead, self.lookahead > 0))
         for name, value, ok in checks:
             if not (math.isfinite(value) and ok):
-                raise ConfigError(f"target {self.label}: {name} = {value!r} is out of range")
+                raise ConfigError(f"{self.field(name)} = {value!r} is out of range")
         if wp.shape[0] == 0 or not np.all(np.isfinite(wp)):
-            raise ConfigError(f"target {self.label}: waypoints must be ≥ 1 finite [north, east]")
+            raise ConfigError(f"{self.field('waypoints')}: must be ≥ 1 finite [north, east]")
         if self.avoidance not in AVOIDANCE:
-            raise ConfigError(f"target {self.label}: avoidance = {self.avoidance!r}; allowed: "
+            raise ConfigError(f"{self.field('avoidance')} = {self.avoidance!r}; allowed: "
                               f"{', '.join(AVOIDANCE)}")
 
     @property
     def label(self) -> str:
         return self.name or (f"MMSI {self.mmsi}" if self.mmsi else "target")
+
+    def field(self, name: str) -> str:
+        """The config field ``name`` (``vessel.T``) of this target as an error names it:
+        ``guidance.targets[j].vessel.T``, or without :attr:`where` the target's label and the
+        field's last part."""
+        return f"{self.where}.{name}" if self.where else f"{self.label}: {name.split('.')[-1]}"
 
     def start(self) -> tuple[float, float]:
         """(north, east) at t = 0."""
@@ -122,15 +134,16 @@ class VesselTarget:
 
         points = np.vstack([[self.north, self.east], self.waypoints])
         if np.any(np.hypot(*np.diff(points, axis=0).T) <= 0):
-            raise ConfigError(f"target {self.label}: waypoints repeat a point (or the start)")
+            raise ConfigError(f"{self.field('waypoints')}: repeat a point (or the start)")
         return WaypointPath(points)
 
     def los_params(self) -> np.ndarray:
         """:func:`los_reference`'s parameters with the target's own state (north at 0, east at 1)."""
         path = self.path()
         if self.switch_radius >= path.leg_lengths.min():
-            raise ConfigError(f"target {self.label}: switch_radius = {self.switch_radius:g} m must be "
-                              f"shorter than the shortest leg ({path.leg_lengths.min():g} m)")
+            raise ConfigError(f"{self.field('vessel.switch_radius')} = {self.switch_radius:g} m "
+                              f"must be shorter than the shortest leg "
+                              f"({path.leg_lengths.min():g} m)")
         return flat(0, 1, path.n_legs, self.lookahead, 0.0, self.U, self.switch_radius, 0.0,
                     path.waypoints[:-1, 0], path.waypoints[:-1, 1], path.leg_lengths,
                     path.leg_angles)
@@ -165,9 +178,9 @@ def _rates(psi, r, delta, delta_c, p):
 @kernel_function
 def integrate_vessel(s, p, h):
     """Advance the target's (n, e, ψ, r, δ) = ``s[:5]`` by ``h`` [s] with δ_c = ``s[5]`` held:
-    classic RK4 in equal sub-steps of at most MAX_STEP and at most T_δ (the servo's lag, which
-    would make a longer RK4 step unstable: its stability bound is 2.78 T_δ)."""
-    n_sub = max(1, math.ceil(h / min(MAX_STEP, p[9]) - 1e-9))
+    classic RK4 in equal sub-steps of at most MAX_STEP, T_δ and T/2 (the servo's and the yaw
+    rate's lags, which would make a longer RK4 step unstable: its stability bound is 2.785 × the lag)."""
+    n_sub = max(1, math.ceil(h / min(MAX_STEP, p[9], 0.5 * p[2]) - 1e-9))
     dt = h / n_sub
     dc = s[5]
     for _ in range(n_sub):
@@ -219,7 +232,7 @@ def vessel_targets(t, own, pv, width_p, zv, width_z, n_vessels, memory, interval
                    present, hold):
     """Every vessel target of one ship at ``t`` (:func:`vessel_target_sample`): appended to the
     avoidance's ``targets`` after the ``present`` kinematic ones, the least range ``hold[3:6]``
-    kept; returns the new count of targets present."""
+    kept; returns the new count of targets present, or −1 when a target's state is not finite."""
     for k in range(n_vessels):
         p = pv[k * width_p:(k + 1) * width_p]
         s = zv[k * width_z:(k + 1) * width_z]
@@ -229,6 +242,8 @@ def vessel_targets(t, own, pv, width_p, zv, width_z, n_vessels, memory, interval
         targets[m + 2], targets[m + 3] = p[4] * math.cos(s[2]), p[4] * math.sin(s[2])
         present += 1
         d = math.hypot(s[0] - own[0], s[1] - own[1])
+        if not (math.isfinite(d) and math.isfinite(s[2])):
+            return -1
         if d < hold[3]:
             hold[3], hold[4], hold[5] = d, t, p[0]
     return present

@@ -1045,9 +1045,10 @@ class TargetConfig(Strict):
             raise ValueError("a vessel target needs speed > 0 m/s")
         return self
 
-    def vessel_target(self, label: str = "target"):
+    def vessel_target(self, label: str = "target", where: str = ""):
         """The vessel target as a :class:`~shipgnc.guidance.vessel_targets.VesselTarget`: K, T,
-        n₃ of its model at its speed, heading ``course_deg`` or toward the first waypoint."""
+        n₃ of its model at its speed, heading ``course_deg`` or toward the first waypoint; its
+        errors name the field ``where`` (``guidance.targets[j]``)."""
         from shipgnc.guidance.vessel_targets import VesselTarget
 
         v = self.vessel
@@ -1073,7 +1074,7 @@ class TargetConfig(Strict):
             delta_max=math.radians(v.delta_max_deg), delta_rate=math.radians(v.delta_rate_deg),
             T_delta=v.T_delta, lookahead=v.lookahead, switch_radius=v.switch_radius,
             avoidance=self.avoidance, mmsi=self.mmsi, name=self.name or label,
-            length=self.length, beam=self.beam)
+            length=self.length, beam=self.beam, where=where)
 
     def track(self, label: str = "target"):
         """The target as a :class:`~shipgnc.colav.tracks.TargetTrack`: one sample per leg, each
@@ -1107,6 +1108,9 @@ class AISLogConfig(Strict):
     path: Annotated[str, Field(min_length=1)]
     origin: tuple[Annotated[float, Field(ge=-90, le=90)],
                   Annotated[float, Field(ge=-180, le=180)]] | None = None
+    #: a message without a time of its own is refused (``refuse``), or takes the time of the line
+    #: before it (``previous``)
+    untimed: Literal["refuse", "previous"] = "refuse"
 
 
 class AISAwarenessConfig(Strict):

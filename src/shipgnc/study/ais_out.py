@@ -99,7 +99,8 @@ def _logged(track, ds, j: int):
 def scenario_logs(run, path) -> list[Path]:
     """``shipgnc run --ais-log PATH`` for a ``guidance: colav`` scenario: the run at ``path``; a
     scenario with several runs (``runs:``) writes one file per run, ``PATH`` with ``-<run>`` before
-    its suffix. The origin: the AIS log's (``guidance.ais_log.origin``), else (0°, 0°)."""
+    its suffix, with that run's own targets. The origin: the AIS log's
+    (``guidance.ais_log.origin``), else (0°, 0°)."""
     sc = run.scenario
     g = sc.guidance
     if g is None or g.type != "colav":
@@ -116,20 +117,21 @@ def scenario_logs(run, path) -> list[Path]:
     out = []
     for key in ds[dim].values:
         one = ds.sel({dim: key})
-        out.append(write_run_log(path.with_name(f"{path.stem}-{key}{path.suffix}"), one, tracks,
-                                 origin))
+        own = run.setups.get(str(key)) if run.setups else None  # each run's own targets
+        out.append(write_run_log(path.with_name(f"{path.stem}-{key}{path.suffix}"), one,
+                                 own.guidance.members[0] if own is not None else tracks, origin))
     return out
 
 
-def member_log(path, member, *, backend: str = "auto", ais=None, number: int = 0) -> Path:
+def member_log(path, member, *, backend: str = "auto", ais=None) -> Path:
     """``shipgnc encounters --ais-log PATH``: one sweep member
-    (:class:`~shipgnc.study.encounters.Member`, the sweep's member ``number``) run again alone,
-    seeing its targets as in the sweep (``ais``), logged at every step (the sweep logs every 10th:
-    its 5 s would stretch the 2–6 s reporting intervals), written at ``path``."""
+    (:class:`~shipgnc.study.encounters.Member`) run again alone, seeing its targets as in the
+    sweep (``ais``, drawn by the member's situation and variant), logged at every step (the sweep
+    logs every 10th: its 5 s would stretch the 2–6 s reporting intervals), written at ``path``."""
     from shipgnc.study.encounters import run_members
 
     sweep = run_members([member], backend=backend, log_every=1, keep_results=True,
-                        compliance=False, ais=ais, numbers=[number])
+                        compliance=False, ais=ais)
     (_, ds), = sweep.results
     dim = next((d for d in ds["north"].dims if d != "time"), None)
     one = ds.isel({dim: 0}) if dim is not None else ds

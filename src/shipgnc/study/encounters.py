@@ -72,6 +72,13 @@ class Member:
     beta_deg: float = math.nan
     spec: tg.EncounterSpec | None = None  # the generated variant (None: read from a file)
     rotation: float = 0.0  # [rad] the situation as its file gave it is this turn of ``situation``
+    index: int = 0  # the situation's place in the sweep (its type, or its file): with ``mc`` the AIS draw
+
+    @property
+    def draw(self) -> tuple[int, int]:
+        """(situation, variant): the key of the member's AIS reports (:func:`seen_tracks`), so
+        that every method meets the same reports of the same encounter."""
+        return (self.index, self.mc)
 
 
 @dataclass
@@ -107,14 +114,14 @@ def standard_members(methods, *, mc: int = 0, seed: int = 0, own_speed: float = 
     (``SeedSequence(seed).spawn``), so the variants of ``mc`` = 5 are the first five of 10."""
     children = np.random.SeedSequence(seed).spawn(len(specs))
     members = []
-    for spec, child in zip(specs, children, strict=True):
+    for i, (spec, child) in enumerate(zip(specs, children, strict=True)):
         variants = [spec] if mc == 0 else tg.variants(spec, np.random.default_rng(child), mc,
                                                      own_speed)
         for k, variant in enumerate(variants):
             sit = tg.parse(tg.situation_dict(variant, own_speed), variant.title)
             sit = replace(sit, encounter_type=spec.encounter_type, title=spec.title)
             for method in methods:
-                members.append(Member(sit, method, k, variant.beta_deg, variant))
+                members.append(Member(sit, method, k, variant.beta_deg, variant, index=i))
     return members
 
 
@@ -125,7 +132,7 @@ def file_members(paths, methods) -> list[Member]:
 
     low, high = SPEED_RANGE  # the own ship's (OWN_SHIP) valid speeds
     members = []
-    for path in paths:
+    for i, path in enumerate(paths):
         given = tg.read(path)
         sit = own_frame(given)
         if not low <= sit.own_speed <= high:
@@ -133,7 +140,7 @@ def file_members(paths, methods) -> list[Member]:
                               f"sails {low / KNOT:.1f}–{high / KNOT:.1f} kn)")
         bearing = _bearing_deg(sit)
         for method in methods:
-            members.append(Member(sit, method, 0, bearing, rotation=given.own_course))
+            members.append(Member(sit, method, 0, bearing, rotation=given.own_course, index=i))
     return members
 
 
@@ -166,7 +173,7 @@ def colav_guidance(g, scenario):
     if g.ais_log is not None:
         from shipgnc.ais.logs import read_log
 
-        logged, _ = read_log(g.ais_log.path, origin=g.ais_log.origin)
+        logged, _ = read_log(g.ais_log.path, origin=g.ais_log.origin, untimed=g.ais_log.untimed)
         for track in logged:
             if track.source == "ais-own":
                 continue
@@ -180,10 +187,10 @@ def colav_guidance(g, scenario):
                          decision_interval=g.decision_interval, seen=seen)
 
 
-def seen_tracks(tracks, ais, *, t_end: float, member: int = 0, origin=(0.0, 0.0)) -> list:
+def seen_tracks(tracks, ais, *, t_end: float, member: int | tuple = 0, origin=(0.0, 0.0)) -> list:
     """The ``tracks`` as the own ship hears them through AIS set by ``ais`` (a
     :class:`~shipgnc.scenarios.sections.AISAwarenessConfig`) up to ``t_end`` [s]
-    (:func:`shipgnc.ais.reporting.seen_tracks`)."""
+    (:func:`shipgnc.ais.reporting.seen_tracks`; ``member`` the key of the draw)."""
     from shipgnc.ais.reporting import seen_tracks as observed
 
     return observed(tracks, seed=ais.seed, t_end=t_end, member=member, origin=origin,
@@ -204,7 +211,7 @@ def _target(target, j: int):
             raise ConfigError(f"guidance.targets[{j}].speed = {target.speed:g} m/s is outside the "
                               f"frigate model's valid range {low:g}–{high:g} m/s (van Amerongen "
                               "1982); use vessel: {model: nomoto, K: ..., T: ...}")
-    return target.vessel_target(label=f"target {j + 1}")
+    return target.vessel_target(label=f"target {j + 1}", where=f"guidance.targets[{j}]")
 
 
 def check_members(members: list[Member], safety_radius: float = SAFETY_RADIUS) -> None:
@@ -234,13 +241,13 @@ def own_scenario(own_speed: float, method: str):
 
 
 def run_members(members: list[Member], *, backend: str = "auto", log_every: int = 10,
-                keep_results: bool = False, compliance: bool = True, ais=None,
-                numbers=None) -> SweepResult:
+                keep_results: bool = False, compliance: bool = True, ais=None) -> SweepResult:
     """Run every member (one batch per own-ship speed) and score it (``compliance``: with the
     COLREG compliance scores, from the log at every ``log_every``-th step). ``ais``: an
     :class:`~shipgnc.scenarios.sections.AISAwarenessConfig` — the avoidance sees the targets
-    through AIS (:func:`seen_tracks`, member k drawing as member ``numbers[k]``, default k, so a
-    member run again alone sees what it saw in the sweep), scored against the truth."""
+    through AIS (:func:`seen_tracks`, each member drawing by its :attr:`Member.draw` — seed,
+    situation, variant, then target — so that every method meets the same reports of an encounter
+    and a member run again alone sees what it saw in the sweep), scored against the truth."""
     import time
 
     from shipgnc.colav.compliance import SCORES
@@ -265,7 +272,7 @@ def run_members(members: list[Member], *, backend: str = "auto", log_every: int 
         g = scenario.guidance
         seen = None if ais is None else [
             seen_tracks(members[i].situation.targets, ais, t_end=DURATION,
-                        member=i if numbers is None else numbers[i],
+                        member=members[i].draw,
                         origin=members[i].situation.origin) for i in index]
         guidance = ColavGuidance(g0.los, [list(members[i].situation.targets) for i in index],
                                  methods=methods, configs={"sbmpc": g.sbmpc, "vo": g.vo},

@@ -57,6 +57,12 @@ def variants_of(study: Study) -> list[str] | None:
     for point in study.points:
         scenario = study.scenario_at(point)
         check_sweepable(scenario)
+        g = scenario.guidance
+        if study.members > 1 and getattr(g, "awareness", None) == "ais":  # one draw for the batch
+            raise ConfigError(f"--mc {study.members} with guidance.awareness = ais: the AIS reports "
+                              "are drawn once from guidance.ais.seed, so every member would see the "
+                              "same ones; sweep guidance.ais.seed with --grid instead, or use "
+                              "shipgnc encounters --mc N --awareness ais")
         plant = [str(p) for p in study.perturb if p.param is not None]
         if scenario.route is not None and plant:
             raise ConfigError(f"--perturb {plant[0]}: a route scenario's ship is sail.vessel at its "

@@ -12,8 +12,8 @@ A traffic situation file (JSON, maritime units as trafficgen writes them)::
 ``sog`` in knots, ``cog`` and ``heading`` in degrees clockwise from north, positions in decimal
 degrees; ``static`` (``length``, ``width`` in metres) is optional here, as are trafficgen's other
 fields (``waypoints``, ``id``, ``height``, ...), which are read past. Positions are projected to the
-local plane (north, east) of the own ship's start with the geo router's projection
-(:class:`shipgnc.routing.geo.projection.RouteProjection` centred there: true north up, conformal);
+local plane (north, east) of the own ship's start (:class:`shipgnc.ais.plane.LocalPlane` about it:
+true north up, conformal);
 each target then holds its initial course and speed (a kinematic target).
 
 **The standard set** (:data:`STANDARD`): one situation of each encounter type trafficgen generates
@@ -218,11 +218,10 @@ def parse(data: dict, where: str = "situation") -> Situation:
         raise ConfigError(f"{where}: {field}: {err['msg']} (a trafficgen traffic situation: "
                           "ownShip and targetShips with initial position lat/lon, sog [kn], "
                           "cog [deg])") from None
-    from shipgnc.ais.plane import check_range
-    from shipgnc.routing.geo.projection import RouteProjection
+    from shipgnc.ais.plane import LocalPlane, check_range
 
     o = s.ownShip.initial.position
-    plane = RouteProjection((o.lat, o.lon), (o.lat, o.lon))
+    plane = LocalPlane((o.lat, o.lon))
     targets = []
     for j, ship in enumerate(s.targetShips):
         check_range((o.lat, o.lon), ship.initial.position.lat, ship.initial.position.lon,
@@ -258,9 +257,9 @@ def situation_dict(spec: EncounterSpec, own_speed: float, *, own_length: float =
                    own_width: float = 12.0, origin=ORIGIN) -> dict:
     """The trafficgen traffic situation of ``spec`` (own ship course 0 at ``own_speed`` m/s from
     ``origin``), in its maritime units."""
-    from shipgnc.routing.geo.projection import RouteProjection
+    from shipgnc.ais.plane import LocalPlane
 
-    plane = RouteProjection(origin, origin)
+    plane = LocalPlane(origin)
     n, e, course, speed = place_target(spec, own_speed)
     lat, lon = plane.to_geo(n, e)
 
