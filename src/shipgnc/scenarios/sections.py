@@ -1034,7 +1034,9 @@ class TargetConfig(Strict):
             raise ValueError(f"{' and '.join(given)} with a schedule: give one or the other "
                              "(the schedule's entries set course and speed)")
         if self.vessel is None:
-            extra = sorted({"waypoints", "avoidance"} & self.model_fields_set)
+            # as written back by ``shipgnc show``: the defaults (no waypoints, avoidance none) pass
+            extra = [name for name, unset in (("avoidance", "none"), ("waypoints", None))
+                     if name in self.model_fields_set and getattr(self, name) not in (unset, [])]
             if extra:
                 raise ValueError(f"{' and '.join(extra)} need{'s' if len(extra) == 1 else ''} a "
                                  "vessel target (give vessel: "
