@@ -173,7 +173,7 @@ def test_sweep_max_memory_option(tmp_path):
     from shipgnc.cli import app
 
     runner_ = CliRunner()
-    result = runner_.invoke(app, ["sweep", "boat-autopilot", "--mc", "10", "--max-memory", "1M",
+    result = runner_.invoke(app, ["sweep", "boat-autopilot", "--mc", "10", "--series", "--max-memory", "1M",
                                   "--out", str(tmp_path / "o")])
     assert result.exit_code == 2, result.stderr
     assert "more than --max-memory" in " ".join(result.stderr.split()), result.stderr

@@ -180,3 +180,42 @@ def test_the_numpy_backend_is_scored_from_its_log():
     x0 = member_initial_states(study, setup.x0, setup.model, Chunk(0, 0, 2))
     assert scored_in_loop(scenario, setup, simulation_of(scenario, setup), x0,
                           study.member_seeds(0, 2, 1), "numpy") is None
+
+
+@pytest.mark.parametrize(("scenario", "overrides", "series", "in_loop"), [
+    ("boat-autopilot", ("simulation.t_end=20",), False, True),
+    ("mariner-fl-lookahead", ("simulation.t_end=900",), False, True),
+    ("boat-autopilot", ("simulation.t_end=20",), True, False),  # --series: every step logged
+])
+def test_the_memory_estimate_takes_the_chunks_own_decision(monkeypatch, scenario, overrides,
+                                                           series, in_loop):
+    """The estimate's prediction (in_loop_plan on the first member) is what run_chunk does."""
+    import shipgnc.study.chunk as chunk_mod
+
+    study = Study(scenario, members=3, seed=2, overrides=overrides, series=series)
+    scenario_, setup, sim, x0, seeds, _ = chunk_mod.chunk_setup(study, Chunk(0, 0, 1))
+    predicted = chunk_mod.in_loop_plan(scenario_, setup, sim, x0, seeds, "compiled-or-numpy",
+                                       series) is not None
+    logged, from_log = [], chunk_mod.scored_from_log
+    monkeypatch.setattr(chunk_mod, "scored_from_log", lambda *a: logged.append(1) or from_log(*a))
+    run_chunk(study, Chunk(0, 0, 3))
+    assert predicted == in_loop == (not logged)
+
+
+def test_a_big_chunk_scored_in_the_loop_is_budgeted_its_accumulators_not_a_log():
+    """4 000 boats for 1 400 s: an every-step log of the chunk (logged_numbers, 8 bytes each)
+    would be ~30 GiB; scored in the loop the chunk holds its accumulators and one member's log.
+    With --series the log is kept, and the same chunk is refused."""
+    from shipgnc.errors import ConfigError
+    from shipgnc.sim.simulator import logged_numbers
+    from shipgnc.study.execute import check_memory, estimate_memory
+
+    study = Study("boat-autopilot", members=4000, overrides=("simulation.t_end=1400",))
+    model = build(study.scenario_at(study.points[0])).model
+    log = 8 * logged_numbers(model, (4000,), 28_000)
+    need = estimate_memory(study, None, 4000)
+    assert need["chunk"] < log / 100 and need["chunk"] >= 8 * 2 * logged_numbers(model, (1,), 28_000)
+    check_memory(study, None, 4000, max_memory=2.0**30)  # not refused under 1 GiB
+    with pytest.raises(ConfigError, match="smaller --chunk-size"):
+        check_memory(Study("boat-autopilot", members=4000, overrides=("simulation.t_end=1400",),
+                           series=True), None, 4000, max_memory=2.0**30)

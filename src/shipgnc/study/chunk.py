@@ -243,17 +243,19 @@ def _alone(setup, i: int):
     return replace(setup, model=model.subset(i, i + 1)) if isinstance(model, PerShipModel) else setup
 
 
-def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str):
-    """Every member's metrics scored inside the compiled loop (:mod:`shipgnc.analysis.accumulated`),
-    in :func:`~shipgnc.scenarios.runner.metric_arrays`' key order, and which members diverged
-    or need their series (their figures NaN here: :func:`run_chunk` runs each again alone with its
-    log); None when the metric set, the backend or the setup needs the logged series."""
-    from shipgnc.analysis.accumulated import NEEDS_LOG, plan_for
-    from shipgnc.scenarios.runner import design_figures
-    from shipgnc.sim.scored import run_scored
+def in_loop_plan(scenario, setup, sim, x0, seeds, backend: str, series: bool = False):
+    """The validated run of a chunk and its accumulators (:func:`~shipgnc.analysis.accumulated.plan_for`)
+    when the chunk is scored inside the compiled loop and keeps no log; None when it keeps its
+    every-step log: its ``series`` are kept, a route ends it (:func:`ends_early`), or the metric
+    set, the backend or the setup needs the logged series. The one decision of :func:`run_chunk`
+    and of the memory estimate (:func:`shipgnc.study.execute.estimate_memory`)."""
+    from shipgnc.analysis.accumulated import plan_for
+    from shipgnc.sim.compose import unsupported_reason
     from shipgnc.sim.simulator import _validate, log_signals
 
-    if backend not in ("compiled", "compiled-or-numpy") or sim.integrator != "rk4":
+    if series or backend not in ("compiled", "compiled-or-numpy") or sim.integrator != "rk4":
+        return None
+    if ends_early(setup):
         return None
     n_steps = round(sim.t_end / sim.dt)
     run = _validate(setup.model, x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
@@ -261,9 +263,25 @@ def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str):
                     u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
                     atol=sim.atol, seed=MemberStreams(seeds), on_divergence="mask", observer=None,
                     progress=None, log_every=max(1, n_steps), navigation=setup.navigation)
-    plan = plan_for(scenario, setup, list(log_signals(run)), run.n_steps, run.dt)
-    if plan is None:
+    if unsupported_reason(run):  # no compiled loop covers the setup
         return None
+    plan = plan_for(scenario, setup, list(log_signals(run)), run.n_steps, run.dt)
+    return None if plan is None else (run, plan)
+
+
+def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str, series: bool = False):
+    """Every member's metrics scored inside the compiled loop (:mod:`shipgnc.analysis.accumulated`),
+    in :func:`~shipgnc.scenarios.runner.metric_arrays`' key order, and which members diverged
+    or need their series (their figures NaN here: :func:`run_chunk` runs each again alone with its
+    log); None when the chunk keeps its log (:func:`in_loop_plan`)."""
+    from shipgnc.analysis.accumulated import NEEDS_LOG
+    from shipgnc.scenarios.runner import design_figures
+    from shipgnc.sim.scored import run_scored
+
+    planned = in_loop_plan(scenario, setup, sim, x0, seeds, backend, series)
+    if planned is None:
+        return None
+    run, plan = planned
     scored = run_scored(run, plan.ops, plan.span, plan.init)
     if scored is None:
         return None
@@ -326,6 +344,23 @@ def scored_from_log(scenario, setup, sim, x0, seeds, backend: str, route: bool):
     return arrays, ran_on, result, done_at
 
 
+def chunk_setup(study: Study, chunk: Chunk):
+    """(scenario, setup, SimulationConfig, x0, seeds, drawn plant parameters) of a chunk: the
+    scenario of its grid point built for its controller, with its members' initial states, random
+    streams and plants."""
+    from shipgnc.scenarios.runner import build, simulation_of
+
+    scenario = study.scenario_at(study.points[chunk.point])
+    check_sweepable(scenario)
+    setup = build(scenario, chunk.variant, seed=study.seed)
+    x0 = member_initial_states(study, setup.x0, setup.model, chunk)
+    drawn = member_params(study, setup.model, chunk.start, chunk.stop)  # the plant's parameters
+    if drawn:  # each member's own plant; the controller keeps its nominal design
+        setup = replace(setup, model=member_plant(study, setup.model, chunk.start, chunk.stop, drawn))
+    seeds = study.member_seeds(chunk.start, chunk.stop, 1)  # made when a disturbance draws
+    return scenario, setup, simulation_of(scenario, setup), x0, seeds, drawn
+
+
 def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """Run one chunk; an ``xarray.Dataset`` with a ``member`` dimension: every scalar metric, and
     with ``study.series`` every time series; ``attrs["backend"]`` says which code ran it.
@@ -347,20 +382,9 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
     """
     import xarray as xr
 
-    from shipgnc.scenarios.runner import build, simulation_of
-
-    scenario = study.scenario_at(study.points[chunk.point])
-    check_sweepable(scenario)
-    setup = build(scenario, chunk.variant, seed=study.seed)
-    x0 = member_initial_states(study, setup.x0, setup.model, chunk)
-    drawn = member_params(study, setup.model, chunk.start, chunk.stop)  # the plant's parameters
-    if drawn:  # each member's own plant; the controller keeps its nominal design
-        setup = replace(setup, model=member_plant(study, setup.model, chunk.start, chunk.stop, drawn))
-    seeds = study.member_seeds(chunk.start, chunk.stop, 1)  # made when a disturbance draws
+    scenario, setup, sim, x0, seeds, drawn = chunk_setup(study, chunk)
     route = ends_early(setup)
-    sim = simulation_of(scenario, setup)
-    in_loop = None if route or study.series else scored_in_loop(scenario, setup, sim, x0, seeds,
-                                                                 backend)
+    in_loop = scored_in_loop(scenario, setup, sim, x0, seeds, backend, study.series)
     if in_loop is not None:  # no series: the members' figures are all the chunk keeps
         (arrays, diverged), result, done_at = in_loop, None, None
         ran_on = {"compiled"} | diverged_alone(scenario, setup, sim, x0, seeds, backend, arrays,

@@ -23,7 +23,15 @@ import numpy as np
 from shipgnc.errors import ConfigError, Interrupted, ShipGNCWarning
 from shipgnc.interrupts import note
 from shipgnc.memory import available_memory
-from shipgnc.study.chunk import Chunk, check_perturbable, check_sweepable, plan_chunks, run_chunk
+from shipgnc.study.chunk import (
+    Chunk,
+    check_perturbable,
+    check_sweepable,
+    chunk_setup,
+    in_loop_plan,
+    plan_chunks,
+    run_chunk,
+)
 from shipgnc.study.spec import Study
 
 WORKERS = ("local", "dask")
@@ -251,9 +259,9 @@ NUMBERS_PER_MEMBER = 64
 
 def estimate_memory(study: Study, variants: list[str] | None, chunk_size: int) -> dict[str, int]:
     """Bytes a study holds at its peak, estimated before any work: ``result`` (every member's
-    metrics, with ``--series`` every member's thinned series) and ``chunk`` (one chunk's
-    every-step record that the metrics are computed from, about twice for the arrays derived
-    from it). The measure of a series is :func:`shipgnc.sim.simulator.logged_numbers`."""
+    metrics, with ``--series`` every member's thinned series) and ``chunk`` (what one chunk holds
+    while it runs, :func:`chunk_numbers`). The measure of a series is
+    :func:`shipgnc.sim.simulator.logged_numbers`."""
     from shipgnc.sim.simulator import logged_numbers
 
     model, _, sim = _vessel_of(study.scenario_at(study.points[0]), study.seed)
@@ -262,8 +270,29 @@ def estimate_memory(study: Study, variants: list[str] | None, chunk_size: int) -
     per_member = NUMBERS_PER_MEMBER
     if study.series:
         per_member += logged_numbers(model, (1,), n_steps, sim.log_every)
-    chunk = 2 * logged_numbers(model, (min(chunk_size, study.members),), n_steps)
+    size = min(chunk_size, study.members)
+    chunk = max(chunk_numbers(study, variant, size) for variant in variants or [None])
     return {"result": 8 * cells * study.members * per_member, "chunk": 8 * chunk}
+
+
+def chunk_numbers(study: Study, variant: str | None, size: int) -> int:
+    """Numbers a chunk of ``size`` members of the study's first grid point holds while it runs,
+    as :func:`~shipgnc.study.chunk.run_chunk` will run it (the decision is
+    :func:`~shipgnc.study.chunk.in_loop_plan`'s, taken on the chunk's first member). Scored in
+    the loop: each member's accumulators and its first and last sample, plus one member's
+    every-step record (a diverged member is run again alone with its log). Else the chunk's
+    every-step record, about twice (the arrays derived from it)."""
+    from shipgnc.sim.simulator import logged_numbers
+
+    scenario, setup, sim, x0, seeds, _ = chunk_setup(study, Chunk(0, 0, 1, variant))
+    n_steps = round(sim.t_end / sim.dt)
+    planned = in_loop_plan(scenario, setup, sim, x0, seeds, "compiled-or-numpy", study.series)
+    if planned is None:
+        return 2 * logged_numbers(setup.model, (size,), n_steps)
+    _, plan = planned
+    return (size * (len(plan.init) + NUMBERS_PER_MEMBER)
+            + logged_numbers(setup.model, (size,), n_steps, max(1, n_steps))
+            + 2 * logged_numbers(setup.model, (1,), n_steps))
 
 
 def check_memory(study: Study, variants: list[str] | None, chunk_size: int,
