@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import shutil
 import signal
@@ -184,7 +185,26 @@ def _one_line_130(code: int, err: str) -> str:
     return lines[0]
 
 
-#: a long run on the default (compiled) loop: about 3 s of CPU simulating after ~1 s starting
+def _ctrl_c_in_phase(args: list[str], cpu_s: float, cwd, phase, out: str = "o", tries: int = 6):
+    """:func:`_group_ctrl_c` at ``cpu_s`` s of CPU, then by bisection later or earlier until
+    ``phase(code, err)`` says the interrupt landed in the intended phase (0), not before it (-1)
+    or after it (+1): the phases' CPU seconds differ between machines (a faster one ends each
+    sooner, a slower one later), the order of the phases does not. Returns the last attempt."""
+    low, high = 0.0, math.inf
+    for _ in range(tries):
+        shutil.rmtree(Path(cwd) / out, ignore_errors=True)
+        code, err, took, children = _group_ctrl_c(args, cpu_s, cwd, keep_running=False)
+        side = phase(code, err)
+        if side == 0:
+            break
+        low, high = (cpu_s, high) if side < 0 else (low, cpu_s)
+        cpu_s = 2 * cpu_s if math.isinf(high) else (low + high) / 2
+    return code, err, took, children
+
+
+#: a long run on the default (compiled) loop, measured here (CPU s of the command; writing is
+#: system time mostly): starting 0–0.9, simulating 0.9–3.4, scoring and writing 3.4–7.7 without
+#: figures (to ~10 with them); its log is ~1.1 GB, so it is not made longer
 LONG_COMPILED = ["run", "boat-autopilot", "--set", "simulation.t_end=400000"]
 
 
@@ -196,7 +216,10 @@ def test_ctrl_c_with_the_figure_worker_is_one_line_and_leaves_no_process(tmp_pat
     figure worker printed 25–43 traceback lines and a stray "Process ForkProcess-1:"; the exit
     took up to 2.4 s. Now: one line, exit 130, no process left behind, and the exit within the
     0.5 s asked for (the command's own deadline is 0.2 s, the margin for a loaded machine)."""
-    code, err, took, children = _group_ctrl_c([*LONG_COMPILED, "--out", "o"], cpu_s, tmp_path)
+    # a machine three times as fast ends the command after ~3 s (main process): signalled later,
+    # the moment is moved earlier (bisected) until the command is still running when signalled
+    code, err, took, children = _ctrl_c_in_phase([*LONG_COMPILED, "--out", "o"], cpu_s, tmp_path,
+                                                 lambda code, err: 1 if code == 0 else 0)
     _one_line_130(code, err)
     assert took <= 0.5, f"{took:.2f} s from Ctrl-C to the exit"
     assert _eventually(lambda: not any(_running(c) for c in children), 30), "a worker outlived it"
@@ -215,17 +238,19 @@ def test_keep_partial_on_the_compiled_loop_keeps_what_was_computed(tmp_path):
                  "simulation.backend=compiled", "--no-figures", "--out", str(tmp_path / "warm"),
                  "--keep-partial"])  # the loop compiled and cached first (compiling is not the point)
     assert warm.returncode == 0, warm.stderr[-1500:]
-    # Where start-up ends (imports, the cached loop loaded, the log allocated) differs between
-    # machines in CPU seconds too (page faults are system time): interrupt later until the signal
-    # lands while simulating. Each earlier interrupt must still be a clean exit 130.
-    for cpu_s in (2.0, 3.0, 4.0, 5.0):
-        shutil.rmtree(tmp_path / "o", ignore_errors=True)
-        code, err, _, _ = _group_ctrl_c([*LONG_COMPILED, "--no-figures", "--out", "o",
-                                         "--keep-partial"], cpu_s, tmp_path)
+    # Where simulating begins and ends differs between machines in CPU seconds (0.9–3.4 s here;
+    # 0.3–1.1 s three times as fast, 1.8–6.8 s twice as slow): interrupt later while the signal
+    # lands in start-up (or at t = 0), earlier once it lands after the run. Each interrupt must
+    # be a clean exit 130.
+    def phase(code, err):
         assert code == 130 and "Traceback" not in err, err[-1500:]
-        if "interrupted at t = " in err:
-            break
-    assert "interrupted at t = " in err, f"never interrupted while simulating: {err[-500:]}"
+        if "interrupted after the run finished" in err:
+            return 1
+        return 0 if "interrupted at t = " in err and "interrupted at t = 0 s" not in err else -1
+
+    code, err, _, _ = _ctrl_c_in_phase([*LONG_COMPILED, "--no-figures", "--out", "o",
+                                        "--keep-partial"], 2.0, tmp_path, phase)
+    assert phase(code, err) == 0, f"never interrupted while simulating: {err[-500:]}"
     said = float(err.split("interrupted at t = ")[1].split()[0])
     metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
     assert metrics["interrupted"] is True
@@ -234,22 +259,25 @@ def test_keep_partial_on_the_compiled_loop_keeps_what_was_computed(tmp_path):
         assert 0 < float(ds.time[-1]) == pytest.approx(said, rel=1e-5) and said < 400000
 
 
-#: a sweep whose one chunk is scored inside the compiled loop for about 19 s of CPU (4 000 boats
-#: for 1 400 s, ~4 300 boat-runs of 70 s per CPU second) after ~0.6 s of start-up: its Ctrl-C
-#: message is "after 0 of 1 chunks" from ~0.6 s to ~20 s of CPU. The chunk holds its members'
-#: accumulators, not its log (which would be ~30 GiB)
+#: a sweep whose one chunk is scored inside the compiled loop for about 18 s of CPU (4 000 boats
+#: for 1 400 s, ~4 300 boat-runs of 70 s per CPU second); measured here, its Ctrl-C message is
+#: "after 0 of 1 chunks" from ~1.2 s (start-up: imports, the memory estimate) to ~19 s of CPU.
+#: The chunk holds its members' accumulators, not its log (which would be ~30 GiB)
 LONG_SWEEP = ["sweep", "boat-autopilot", "--mc", "4000", "--chunk-size", "4000", "--set",
               "simulation.t_end=1400", "--no-figures", "--out", "sw"]
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc, process groups: Linux")
-@pytest.mark.parametrize("cpu_s", [1.6, 2.4, 3.2])
+@pytest.mark.parametrize("cpu_s", [1.2, 1.6, 2.4])
 def test_ctrl_c_in_a_sweeps_first_chunk_is_one_line(tmp_path, cpu_s):
     """F9: Ctrl-C in a sweep's first chunk ended "internal error: ValueError: cannot reshape array
-    of size 0" (a batch interrupted before its first sample). The moments fall inside the chunk
-    on a machine twice as slow (start-up ends by ~1.2 s) or three times as fast (the chunk ends
-    after ~6.5 s) as the one they were measured on."""
-    code, err, took, _ = _group_ctrl_c(LONG_SWEEP, cpu_s, tmp_path)
+    of size 0" (a batch interrupted before its first sample). A moment that lands in start-up
+    (a machine twice as slow starts for ~2.4 s) is doubled until it lands in the chunk, which a
+    machine three times as fast ends after ~6 s; every attempt a clean one-line exit 130."""
+    def phase(code, err):
+        return 0 if _one_line_130(code, err).startswith("interrupted after 0 of 1 chunks") else -1
+
+    code, err, took, _ = _ctrl_c_in_phase(LONG_SWEEP, cpu_s, tmp_path, phase, out="sw", tries=3)
     assert _one_line_130(code, err).startswith("interrupted after 0 of 1 chunks")
     assert took <= 0.5, f"{took:.2f} s from Ctrl-C to the exit"
 
