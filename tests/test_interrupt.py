@@ -74,19 +74,40 @@ def ctrl_c(args, wait_s: float, tmp_path):
     return proc.returncode, err.decode()
 
 
+#: a run on the Python loop, measured here (CPU s of the command): starting 0–1, simulating 1–9
+#: (3000 s at ~390 simulated s per CPU second), writing to ~10
 LONG_RUN = ["run", "boat-stern-kick", "--set", "simulation.t_end=3000", "--set",
             "simulation.backend=numpy", "--no-figures"]
 
 
+def _while_simulating(code: int, err: str) -> int:
+    """Where a Ctrl-C landed: -1 before the simulation, 0 in it, 1 after the run ended."""
+    if code == 0:
+        return 1
+    assert code == 130 and "Traceback" not in err, err[-1500:]
+    return 0 if "interrupted at t = " in err and "interrupted at t = 0 s" not in err else -1
+
+
+def _ctrl_c_while_simulating(args, tmp_path):
+    """Ctrl-C at 3 s of the command's CPU (its moment whatever the machine's load), moved earlier
+    or later until it lands while simulating (a machine three times as fast ends the run after
+    ~3.3 s; one twice as slow starts simulating at ~2 s)."""
+    from test_faults import _ctrl_c_in_phase
+
+    code, err, _, _ = _ctrl_c_in_phase(args, 3.0, tmp_path, _while_simulating, out="out")
+    assert _while_simulating(code, err) == 0, err[-1500:]
+    return code, err
+
+
 def test_cli_run_interrupted_is_one_line_and_exit_130(tmp_path):
-    code, err = ctrl_c([*LONG_RUN, "--out", "out"], 4.0, tmp_path)
+    code, err = _ctrl_c_while_simulating([*LONG_RUN, "--out", "out"], tmp_path)
     assert code == 130
     assert err.strip().startswith("interrupted at t = ") and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "out" / "result.nc").exists()
 
 
 def test_cli_run_keep_partial_writes_what_was_computed(tmp_path):
-    code, err = ctrl_c([*LONG_RUN, "--out", "out", "--keep-partial"], 4.0, tmp_path)
+    code, err = _ctrl_c_while_simulating([*LONG_RUN, "--out", "out", "--keep-partial"], tmp_path)
     assert code == 130 and "interrupted at t = " in err and "Traceback" not in err
     metrics = json.loads((tmp_path / "out" / "metrics.json").read_text())
     assert metrics["interrupted"] is True
@@ -97,7 +118,10 @@ def test_cli_run_keep_partial_writes_what_was_computed(tmp_path):
 
 
 def test_cli_sweep_on_a_local_cluster_interrupted_without_worker_tracebacks(tmp_path):
+    # 40 000 boats for 700 s: ~90 s of the workers' CPU here (~15 s on two cores three times as
+    # fast), so the sweep still runs at 8 s; each chunk is scored in the loop (no log kept)
     code, err = ctrl_c(["sweep", "boat-autopilot", "--mc", "40000", "--chunk-size", "500",
-                        "--workers", "dask", "--no-figures", "--out", "sw"], 8.0, tmp_path)
+                        "--set", "simulation.t_end=700", "--workers", "dask", "--no-figures",
+                        "--out", "sw"], 8.0, tmp_path)
     assert code == 130
     assert err.strip().startswith("interrupted after ") and "Traceback" not in err
