@@ -28,6 +28,7 @@ import numpy as np
 
 from shipgnc.actuators import input_at_kernel, lag_rate_kernel, plan_kernel
 from shipgnc.kernels import JIT_OPTIONS, clip, wrap
+from shipgnc.sim.stack import stack_empty
 
 inline = numba.njit(inline="always", **{**JIT_OPTIONS, "cache": False})
 # the disturbance's kernels inlined into the loop (numba's IR level): called as functions they
@@ -76,7 +77,9 @@ def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err, op
     ref = row[o_ref:o_ref + nref].copy()
     gout = row[o_out:o_out + nout].copy()
     sig = row[o_sig:o_sig + nsig].copy()
-    d = row[o_d:o_d + nd].copy()
+    d = stack_empty(nd)  # on the stack: see below
+    for j in range(nd):
+        d[j] = row[o_d + j]
     zc = row[o_zc:o_zc + nzc].copy()
     zg = row[o_zg:o_zg + nzg].copy()
     zd = row[o_zd:o_zd + nzd].copy()
@@ -86,9 +89,16 @@ def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err, op
     seen = np.empty(nx if has_nav else 0)  # the state guidance and controller see
     nwk = np.empty(nav_work if has_nav else 0)  # the navigation step's scratch space
     # the actuator's plan of the step, the input, a continuous controller's stage command and
-    # signals; the RK4 stage state, derivative and sum of the plant and of the actuator lag
-    start, end, u, cs, sig_s = np.empty(nu), np.empty(nu), np.empty(nu), np.empty(nu), np.empty(nsig)
-    xs, kx, ax = np.empty(nx), np.empty(nx), np.empty(nx)
+    # signals; the RK4 stage state, derivative and sum of the plant and of the actuator lag. On the
+    # stack (shipgnc.sim.stack): LLVM then knows no other array's write changes them, so the
+    # input and the held disturbance are loaded (and a model's sin and cos of an input angle
+    # computed) once per step, not once per RK stage (boat-autopilot's loop 0.19 → 0.15 CPU s per
+    # 1 000 ships × 1 400 steps), results to the bit as on the heap. The stage state xs stays on
+    # the heap: with it in registers too, LLVM fuses other multiply-adds (fastmath "contract")
+    # and the last bit changes
+    start, end, u, cs = stack_empty(nu), stack_empty(nu), stack_empty(nu), stack_empty(nu)
+    sig_s = stack_empty(nsig)
+    xs, kx, ax = np.empty(nx), stack_empty(nx), stack_empty(nx)
     ls, kl, al = np.empty(nl), np.empty(nl), np.empty(nl)
     done = row[o_done]
     acc = scores.copy()  # the ship's accumulators of the scoring step (see score_step)
