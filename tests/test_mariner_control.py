@@ -154,6 +154,21 @@ def test_lqr_gain_matches_independent_care(R):
     assert np.all(K > 0)  # A8: δ = −Kx is negative feedback
 
 
+@pytest.mark.parametrize("R", [1.0, 0.5])
+def test_lqr_gain_is_python_controls(R):
+    """The design solves the Riccati equation with scipy as ``control.lqr`` does (python-control
+    without slycot): the same gain and poles to the bit, without importing python-control."""
+    import control  # python-control: a hard dependency (a missing one fails, never skips)
+
+    from shipgnc.models.mariner import tracking_model
+
+    A, B = tracking_model(A_PAPER, C_PAPER, U_PAPER)
+    K_ref, _, poles_ref = control.lqr(A, B, np.diag(PAPER_Q), np.array([[R]]))
+    K, poles = lqr_tracking_gain(A_PAPER, C_PAPER, U_PAPER, PAPER_Q, R)
+    np.testing.assert_array_equal(K, np.asarray(K_ref).reshape(4))
+    np.testing.assert_array_equal(poles, np.asarray(poles_ref).reshape(4))
+
+
 def test_printed_gain_is_reproduced_with_half_R_only():
     K_half, _ = independent_lqr(PAPER_Q, 0.5)
     rounding = np.array([0.05, 0.05, 0.5, 0.005])  # half a unit of each printed digit: 3.4, 3.2, 1, 0.45
