@@ -185,8 +185,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
             evaluator = getattr(disturbance, "evaluator", None)
             if evaluator is not None and evaluator() != "numpy":
                 ran_on = f"{ran_on}+{evaluator()}"
-    run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold,
-                 "t_end": t_end, "model": type(model).__name__, **(attrs or {})}
+    run_attrs = result_attrs(setup, ran_on, attrs)
     if log.status.get("interrupted"):  # the partial Dataset is built (xarray imported) only if
         last = float(log.time[-1]) if log.time.size else 0.0  # someone reads it
 
@@ -206,6 +205,13 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         result["diverged_at"] = (dims, log.diverged_at.reshape(setup.batch_shape),
                                  {"units": "s", "long_name": "time the ship diverged (NaN: never)"})
     return result
+
+
+def result_attrs(setup: SimSetup, ran_on: str, attrs: dict | None = None) -> dict:
+    """The attributes of a run's result: integrator, the loop that ran, steps, model, ``attrs``."""
+    return {"integrator": setup.integrator, "backend": ran_on, "dt": setup.dt,
+            "Ts": setup.dt * setup.hold, "t_end": setup.t_end, "model": type(setup.model).__name__,
+            **(attrs or {})}
 
 
 def _compiled_twin(setup: SimSetup):
