@@ -123,3 +123,26 @@ def test_a_diverged_batch_runs_as_before(monkeypatch):
     full = _full_log(scenario, "los_fl", seed)
     expected = runner.compute_metrics(scenario, full, build(scenario, "los_fl", seed=seed))
     assert run.metrics["los_fl"] == expected
+
+
+def test_the_controllers_sail_one_sea_drawn_once():
+    """The second controller reads the wave noise the first drew (``seas``): its batch is the
+    one it gives drawing the noise itself, to the bit."""
+    scenario = load_scenario("mariner-montecarlo", OVERRIDES)
+    seed = scenario.simulation.seed
+
+    def batch(name, seas):
+        return montecarlo.run(scenario, build(scenario, name, seed=seed),
+                              lambda: build(scenario, name, seed=seed), seed=seed, seas=seas)
+
+    seas = {}
+    batch("lqr", seas)
+    (tables,) = seas.values()
+    assert np.isfinite(tables["W"]).all()  # every step's noise of every ship
+    shared, own = batch("los_fl", seas), batch("los_fl", None)
+    assert len(seas) == 1
+    for var in own.result.data_vars:
+        np.testing.assert_array_equal(shared.result[var].values, own.result[var].values)
+    for key, values in own.figures.items():
+        np.testing.assert_array_equal(shared.figures[key], values, err_msg=key)
+    assert shared.metrics == own.metrics

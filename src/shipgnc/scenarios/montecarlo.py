@@ -45,10 +45,16 @@ def scored_in_loop(scenario, observer=None) -> bool:
 
 
 def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
-        attrs: dict | None = None) -> ScoredBatch | None:
+        attrs: dict | None = None, seas: dict | None = None) -> ScoredBatch | None:
     """The batch of ``setup`` (built from ``scenario``; ``rebuild()`` builds it again, fresh
     components for the ships run again) scored in the loop, or None (see the module). Ctrl-C
-    raises :class:`~shipgnc.errors.Interrupted` with the samples logged up to it."""
+    raises :class:`~shipgnc.errors.Interrupted` with the samples logged up to it.
+
+    ``seas``: the per-step input tables of the batches run so far (a dict this call reads and
+    fills), by :func:`sea_key`. The controllers of a comparison sail one sea: the same
+    disturbance section, vessel, simulation, seed and batch give the same tables (a table is
+    drawn from the run's generator before the steps it feeds, so it cannot depend on the
+    controller or the ships' states), drawn by the first controller and read by the others."""
     from shipgnc.analysis import accumulated
     from shipgnc.analysis.path_tracking import montecarlo_figures
     from shipgnc.scenarios.runner import design_figures
@@ -63,7 +69,9 @@ def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
     batch = _sim_setup(setup, sim, seed, sim.log_every, progress)
     t = time_coordinate(np.arange(batch.n_steps + 1) * batch.dt)  # every step's sample time
     plan = accumulated.path_tracking(list(log_signals(batch)), t, delta_max, final_abs=True)
-    scored = run_scored(batch, plan.ops, plan.span, plan.init, logged=True)
+    key = sea_key(scenario, seed, batch.x0.shape)
+    scored = run_scored(batch, plan.ops, plan.span, plan.init, logged=True,
+                        tables=None if seas is None else seas.get(key))
     if scored is None:
         return None
     run_attrs = result_attrs(batch, "compiled", attrs)
@@ -73,6 +81,8 @@ def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
         raise Interrupted(last, partial=(lambda: build_dataset(log, batch.batch_shape, None,
                                                                run_attrs))
                           if log.time.size else None)
+    if seas is not None:
+        seas[key] = scored.tables
     if (scored.event >= 0).any():
         return None
     figures = plan.finish(scored.acc)
@@ -86,6 +96,12 @@ def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
             values[block] = rows[key]
     metrics = {**montecarlo_figures(figures), **design_figures(setup), "diverged": False}
     return ScoredBatch(build_dataset(log, batch.batch_shape, None, run_attrs), metrics, figures)
+
+
+def sea_key(scenario, seed: int, shape) -> str:
+    """What a batch's per-step input tables (its wave noise) depend on: the scenario's
+    disturbance section, vessel and simulation, the seed and the batch's shape."""
+    return repr((scenario.disturbance, scenario.vessel, scenario.simulation, seed, tuple(shape)))
 
 
 #: ships of a batch run again together with their log of every step (a block's log stays small)

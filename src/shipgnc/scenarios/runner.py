@@ -503,6 +503,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         return routing.run(scenario, seed=seed)
     plan, compare = run_plan(scenario), compares(scenario)
     results, all_metrics, setups = {}, {}, {}
+    seas: dict = {}  # a Monte Carlo section's wave noise, drawn once for all its controllers
     run = _Interruptible()
     for name, (each, variant) in plan.items():
         if keep_interrupted and held():  # Ctrl-C after the last run finished: keep those done, no more
@@ -523,8 +524,9 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         hold(False)  # a Ctrl-C during the simulation cuts it short (kept as partial, or raised)
         try:
             with interruptible(keep_interrupted) as run:
-                batch = montecarlo.run(each, setup, lambda e=each, v=variant: build(
-                    e, v, seed=seed), seed=seed, progress=progress, attrs=attrs) if in_loop else None
+                batch = montecarlo.run(
+                    each, setup, lambda e=each, v=variant: build(e, v, seed=seed), seed=seed,
+                    progress=progress, attrs=attrs, seas=seas) if in_loop else None
                 if in_loop and batch is None:  # not covered, or a ship diverged: as any other run
                     setup = build(each, variant, seed=seed)
                     every = scoring_log_every(setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every)

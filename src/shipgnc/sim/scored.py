@@ -32,12 +32,14 @@ class Scored(NamedTuple):
 
 
 def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
-               logged: bool = False) -> Scored | None:
+               logged: bool = False, tables: dict | None = None) -> Scored | None:
     """Run ``setup`` (a validated :class:`~shipgnc.sim.simulator.SimSetup`; its ``log_every`` is
     best the run's length, unless ``logged``) in its composed loop with the accumulators ``ops``,
     ``span`` (see :class:`~shipgnc.sim.compose.ScoreArrays`) starting from ``init`` (3 m,) for
     every ship. None when no compiled loop covers ``setup``. Ctrl-C raises KeyboardInterrupt,
-    except with ``logged`` (the log then holds the samples up to it)."""
+    except with ``logged`` (the log then holds the samples up to it). ``tables``: the per-step
+    input tables (:attr:`Scored.tables` of a run whose components draw the same ones) used
+    instead of drawing them again (and returned as :attr:`Scored.tables`)."""
     from shipgnc.sim.compiled import drive, make_log
     from shipgnc.sim.compose import Composition, unsupported_reason
     from shipgnc.sim.simulator import reset_components
@@ -50,7 +52,10 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
     acc = np.empty((n, len(init)))
     acc[:] = np.asarray(init, dtype=np.float64)
     comp.score_in_loop(ops, span, acc)
-    prepare, tables = (_recording(comp, setup.n_steps + 1) if logged else (comp.prepare, None))
+    if tables is not None:
+        prepare = _replaying(comp, tables)
+    else:
+        prepare, tables = (_recording(comp, setup.n_steps + 1) if logged else (comp.prepare, None))
     stop = drive(setup, comp.call, comp.S, comp.event, prepare=prepare, done_at=comp.done_at)
     if stop.interrupted and not logged:
         raise KeyboardInterrupt
@@ -79,18 +84,24 @@ def run_with_tables(setup, tables: dict):
     comp = Composition(setup, scored=True)
     comp.score_in_loop(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4)),
                        np.zeros((comp.S.shape[0], 0)))
-
-    def prepare(k0: int, k1: int) -> None:
-        comp.prepare(k0, k1)
-        for name, table in tables.items():
-            comp._table[name] = np.ascontiguousarray(table[k0:k1])
-
-    stop = drive(setup, comp.call, comp.S, comp.event, prepare=prepare, done_at=comp.done_at)
+    stop = drive(setup, comp.call, comp.S, comp.event, prepare=_replaying(comp, tables),
+                 done_at=comp.done_at)
     if stop.interrupted:
         raise KeyboardInterrupt
     comp.restore()
     return make_log(setup, comp.signals, comp.out, comp.S, stop.event, state_slot=0,
                     cmd_slot=comp.layout["cmd"], k_end=stop.k_end, events=comp.event)
+
+
+def _replaying(comp, tables: dict):
+    """``comp.prepare`` with the per-step ``tables`` (by name, (steps + 1, ships, ·)) for those
+    they hold, the others empty, nothing drawn."""
+    def prepare(k0: int, k1: int) -> None:
+        for name, table in comp._table.items():
+            comp._table[name] = (np.ascontiguousarray(tables[name][k0:k1]) if name in tables
+                                 else np.zeros((k1 - k0, *table.shape[1:2], 0)))
+
+    return prepare
 
 
 def _recording(comp, n_rows: int):
