@@ -169,6 +169,21 @@ def test_lqr_gain_is_python_controls(R):
     np.testing.assert_array_equal(poles, np.asarray(poles_ref).reshape(4))
 
 
+@pytest.mark.parametrize("R", [1.0, 0.5])
+def test_lqr_gain_matches_the_hamiltonian_eigenvectors(R):
+    """A second method for the stabilising Riccati solution: the stable invariant subspace of the
+    Hamiltonian H = [[A, −BR⁻¹Bᵀ], [−Q, −Aᵀ]] spanned by [U₁; U₂] gives X = U₂U₁⁻¹ (Laub 1979)."""
+    A = np.zeros((4, 4))
+    A[0, 1], A[1, 2], A[2, 2], A[3, 0] = U_PAPER, 1.0, -A_PAPER, 1.0
+    B = np.array([[0.0], [0.0], [C_PAPER], [0.0]])
+    H = np.block([[A, -B @ B.T / R], [-np.diag(PAPER_Q), -A.T]])
+    values, vectors = np.linalg.eig(H)
+    stable = vectors[:, values.real < 0]
+    X = np.real(stable[4:] @ np.linalg.inv(stable[:4]))
+    K, _ = lqr_tracking_gain(A_PAPER, C_PAPER, U_PAPER, PAPER_Q, R)
+    np.testing.assert_allclose(K, (B.T @ X / R).ravel(), rtol=1e-9)
+
+
 def test_printed_gain_is_reproduced_with_half_R_only():
     K_half, _ = independent_lqr(PAPER_Q, 0.5)
     rounding = np.array([0.05, 0.05, 0.5, 0.005])  # half a unit of each printed digit: 3.4, 3.2, 1, 0.45
