@@ -12,7 +12,8 @@ leave undecided (:data:`~shipgnc.analysis.accumulated.NEEDS_LOG`) is run again w
 like it, on the wave noise the batch drew for it (:func:`shipgnc.sim.scored.run_with_tables`),
 logged at every step and scored from its log. A batch in which a ship diverged, or one the
 compiled loop does not cover, returns None: the caller runs it as before (logged at every step,
-scored from the log).
+scored from the log). A batch cut short by Ctrl-C keeps the samples it logged (every
+``log_every`` steps), and its metrics, flagged ``interrupted``, are scored from those.
 """
 
 from __future__ import annotations
