@@ -61,13 +61,15 @@ def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
     from shipgnc.scenarios.runner import design_figures
     from shipgnc.sim.result import build_dataset, time_coordinate
     from shipgnc.sim.scored import run_scored
-    from shipgnc.sim.simulator import log_signals, result_attrs
+    from shipgnc.sim.simulator import log_signals, result_attrs, wants_compiled
 
     delta_max = float(setup.model.params.delta_max)
     if delta_max <= 0 or setup.navigation is not None:
         return None
     sim = scenario.simulation
     batch = _sim_setup(setup, sim, seed, sim.log_every, progress)
+    if not wants_compiled(sim.backend, batch.x0.shape[0], batch.n_steps):
+        return None  # a run simulate leaves to the numpy loop
     t = time_coordinate(np.arange(batch.n_steps + 1) * batch.dt)  # every step's sample time
     plan = accumulated.path_tracking(list(log_signals(batch)), t, delta_max, final_abs=True)
     key = sea_key(scenario, seed, batch.x0.shape)
@@ -93,8 +95,8 @@ def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
                                 {k: v[:, block] for k, v in scored.tables.items()}, delta_max)
         if rows is None:
             return None
-        for key, values in figures.items():
-            values[block] = rows[key]
+        for name, values in figures.items():
+            values[block] = rows[name]
     metrics = {**montecarlo_figures(figures), **design_figures(setup), "diverged": False}
     return ScoredBatch(build_dataset(log, batch.batch_shape, None, run_attrs), metrics, figures)
 

@@ -166,10 +166,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
     _require_batch_dims(batch_dims, setup.batch_shape)
     log, ran_on = None, "numpy"
-    n_ships = math.prod(setup.batch_shape)
-    wants_compiled = backend in ("compiled", "compiled-or-numpy") or (backend == "auto" and (
-        n_ships >= COMPILED_MIN_BATCH or n_ships * setup.n_steps >= COMPILED_MIN_WORK))
-    if wants_compiled:
+    if wants_compiled(backend, math.prod(setup.batch_shape), setup.n_steps):
         twin, reasons = _compiled_twin(setup)
         if twin is not None:
             log, ran_on = twin.run(setup), COMPILED_TWINS[twin.__name__.rsplit(".", 1)[-1]]
@@ -205,6 +202,13 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         result["diverged_at"] = (dims, log.diverged_at.reshape(setup.batch_shape),
                                  {"units": "s", "long_name": "time the ship diverged (NaN: never)"})
     return result
+
+
+def wants_compiled(backend: str, n_ships: int, n_steps: int) -> bool:
+    """Whether ``backend`` asks for a compiled loop for a run of ``n_ships`` × ``n_steps``
+    (``"auto"``: from :data:`COMPILED_MIN_BATCH` ships or :data:`COMPILED_MIN_WORK` ship-steps)."""
+    return backend in ("compiled", "compiled-or-numpy") or (backend == "auto" and (
+        n_ships >= COMPILED_MIN_BATCH or n_ships * n_steps >= COMPILED_MIN_WORK))
 
 
 def result_attrs(setup: SimSetup, ran_on: str, attrs: dict | None = None) -> dict:
