@@ -154,6 +154,36 @@ def test_lqr_gain_matches_independent_care(R):
     assert np.all(K > 0)  # A8: δ = −Kx is negative feedback
 
 
+@pytest.mark.parametrize("R", [1.0, 0.5])
+def test_lqr_gain_is_python_controls(R):
+    """The design solves the Riccati equation with scipy as ``control.lqr`` does (python-control
+    without slycot): the same gain and poles to the bit, without importing python-control."""
+    import control  # python-control: a hard dependency (a missing one fails, never skips)
+
+    from shipgnc.models.mariner import tracking_model
+
+    A, B = tracking_model(A_PAPER, C_PAPER, U_PAPER)
+    K_ref, _, poles_ref = control.lqr(A, B, np.diag(PAPER_Q), np.array([[R]]))
+    K, poles = lqr_tracking_gain(A_PAPER, C_PAPER, U_PAPER, PAPER_Q, R)
+    np.testing.assert_array_equal(K, np.asarray(K_ref).reshape(4))
+    np.testing.assert_array_equal(poles, np.asarray(poles_ref).reshape(4))
+
+
+@pytest.mark.parametrize("R", [1.0, 0.5])
+def test_lqr_gain_matches_the_hamiltonian_eigenvectors(R):
+    """A second method for the stabilising Riccati solution: the stable invariant subspace of the
+    Hamiltonian H = [[A, −BR⁻¹Bᵀ], [−Q, −Aᵀ]] spanned by [U₁; U₂] gives X = U₂U₁⁻¹ (Laub 1979)."""
+    A = np.zeros((4, 4))
+    A[0, 1], A[1, 2], A[2, 2], A[3, 0] = U_PAPER, 1.0, -A_PAPER, 1.0
+    B = np.array([[0.0], [0.0], [C_PAPER], [0.0]])
+    H = np.block([[A, -B @ B.T / R], [-np.diag(PAPER_Q), -A.T]])
+    values, vectors = np.linalg.eig(H)
+    stable = vectors[:, values.real < 0]
+    X = np.real(stable[4:] @ np.linalg.inv(stable[:4]))
+    K, _ = lqr_tracking_gain(A_PAPER, C_PAPER, U_PAPER, PAPER_Q, R)
+    np.testing.assert_allclose(K, (B.T @ X / R).ravel(), rtol=1e-9)
+
+
 def test_printed_gain_is_reproduced_with_half_R_only():
     K_half, _ = independent_lqr(PAPER_Q, 0.5)
     rounding = np.array([0.05, 0.05, 0.5, 0.005])  # half a unit of each printed digit: 3.4, 3.2, 1, 0.45

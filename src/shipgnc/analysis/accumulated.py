@@ -151,9 +151,10 @@ def heading_steps(signals, t: np.ndarray, step_times, tolerance_deg: float = 2.0
     return plan.build(finish)
 
 
-def path_tracking(signals, t: np.ndarray, delta_max: float) -> Accumulators:
+def path_tracking(signals, t: np.ndarray, delta_max: float, *, final_abs: bool = False) -> Accumulators:
     """The accumulators of ``path-tracking`` (see the module) for a run sampled at ``t``, rudder
-    limit ``delta_max`` > 0 [rad]."""
+    limit ``delta_max`` > 0 [rad]; ``final_abs``: also Σ |y_r| over the last 10 min, for
+    ``final_abs_crosstrack_nm`` (a Monte Carlo summary's ``on_path_at_end_fraction``)."""
     from shipgnc.analysis import path_tracking as pt
     from shipgnc.analysis.metrics import STABLE_FINAL_FRACTION, STABLE_PINNED_FRACTION
     from shipgnc.units import MINUTE, NAUTICAL_MILE
@@ -171,6 +172,7 @@ def path_tracking(signals, t: np.ndarray, delta_max: float) -> Accumulators:
     sin_psi, cos_psi = (plan.add(psi, SUM, final_from, level=f, init=zero) for f in (1.0, 2.0))
     y_sum = plan.add(y, SUM, final_from, init=zero)
     d_sum = plan.add(rudder, SUM, final_from, init=zero)
+    abs_sum = plan.add(y, SUM, final_from, level=3.0, init=zero) if final_abs else None
     d_sq = plan.add(rudder, SUM_SQUARES)
     saturated_at = delta_max * (1.0 - 1e-9)
     sat = [plan.add(rudder, COUNT, arg=sign, level=saturated_at) for sign in (1.0, -1.0)]
@@ -219,20 +221,13 @@ def path_tracking(signals, t: np.ndarray, delta_max: float) -> Accumulators:
             pinned = np.zeros(acc.shape[0], dtype=bool)
         stable = bounded & calm & ~pinned & ~reversed_
         needs_log = undecided | ~np.isfinite(a[:, finite, 0]).all(axis=1)
-        return {
-            "settle_time_min": settle,
-            "overshoot_nm": overshoot,
-            "crosstrack_max_after_leg1_nm": max_after / NAUTICAL_MILE,
-            "crosstrack_rms_after_leg1_nm": rms_after / NAUTICAL_MILE,
-            "final_crosstrack_nm": final_y / NAUTICAL_MILE,
-            "final_heading_error_deg": final_heading,
-            "final_rudder_deg": to_deg(final_d),
-            "rudder_rms_deg": to_deg(rudder_rms),
-            "saturation_fraction": saturation,
-            "stable": stable.astype(float),
-            "reversed": reversed_.astype(float),
-            NEEDS_LOG: needs_log,
-        }
+        figures = pt.path_tracking_figures(
+            settle_time_min=settle, overshoot_nm=overshoot, max_after=max_after,
+            rms_after=rms_after, final_y=final_y, final_heading_deg=final_heading,
+            final_delta=final_d, rudder_rms=rudder_rms, saturation=saturation,
+            stable=stable.astype(float), reversed_=reversed_.astype(float),
+            final_abs=None if abs_sum is None else a[:, abs_sum, 0] / n_final)
+        return {**figures, NEEDS_LOG: needs_log}
 
     return plan.build(finish)
 

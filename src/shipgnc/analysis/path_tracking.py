@@ -117,21 +117,39 @@ def _path_tracking_block(t, y, psi, lg, d, delta_max: float, reached_end) -> dic
     verdict = stable_arrays(t, np.where(valid, y, np.nan), bound=bound,
                             oscillation_tol=SETTLE_BAND, reached=reached_end,
                             actuator=np.where(valid, d, np.nan), actuator_max=delta_max)
-    stable = verdict["stable"] & ~reversed_
-    return {
-        "settle_time_min": settle,
-        "overshoot_nm": overshoot,
+    return path_tracking_figures(
+        settle_time_min=settle, overshoot_nm=overshoot, max_after=max_after, rms_after=rms_after,
+        final_y=final_y, final_heading_deg=final_heading, final_delta=final_d,
+        rudder_rms=rudder_rms, saturation=saturation, stable=verdict["stable"] & ~reversed_,
+        reversed_=reversed_, final_abs=final_abs)
+
+
+def path_tracking_figures(*, settle_time_min, overshoot_nm, max_after, rms_after, final_y,
+                          final_heading_deg, final_delta, rudder_rms, saturation, stable,
+                          reversed_, final_abs=None) -> dict:
+    """The metric dict of :data:`PATH_TRACKING_KEYS` (and ``final_abs_crosstrack_nm`` when
+    ``final_abs`` is given) from each ship's finished values, the one place the keys and their
+    units are written: lengths in m (``max_after``, ``rms_after``: max |y_r| and RMS y_r after
+    leg 1; ``final_y``, ``final_abs``: mean y_r and |y_r| over the last 10 min) → nm, angles in
+    rad (``final_delta``, ``rudder_rms``) → deg; the settle time [min], overshoot [nm] and final
+    heading error [deg] as given. Whether scored from the log (:func:`path_tracking_arrays`) or
+    from the loop's accumulators (:func:`shipgnc.analysis.accumulated.path_tracking`)."""
+    out = {
+        "settle_time_min": settle_time_min,
+        "overshoot_nm": overshoot_nm,
         "crosstrack_max_after_leg1_nm": max_after / NAUTICAL_MILE,
         "crosstrack_rms_after_leg1_nm": rms_after / NAUTICAL_MILE,
         "final_crosstrack_nm": final_y / NAUTICAL_MILE,
-        "final_abs_crosstrack_nm": final_abs / NAUTICAL_MILE,
-        "final_heading_error_deg": final_heading,
-        "final_rudder_deg": to_deg(final_d),
+        "final_heading_error_deg": final_heading_deg,
+        "final_rudder_deg": to_deg(final_delta),
         "rudder_rms_deg": to_deg(rudder_rms),
         "saturation_fraction": saturation,
         "stable": stable,
         "reversed": reversed_,
     }
+    if final_abs is not None:
+        out["final_abs_crosstrack_nm"] = final_abs / NAUTICAL_MILE
+    return out
 
 
 def _first_row_at(t, thresholds) -> int:
@@ -257,6 +275,12 @@ def montecarlo_summary(ds, *, delta_max: float, diverged: bool = False) -> dict:
                                   _series(ds, "heading_error"), _series(ds, "leg"),
                                   _series(ds, "delta"), delta_max=delta_max,
                                   reached_end=not diverged)
+    return montecarlo_figures(arrays)
+
+
+def montecarlo_figures(arrays: dict) -> dict:
+    """:func:`montecarlo_summary` of the ships' figures ``arrays`` (:func:`path_tracking_arrays`'
+    dict, or the same figures scored inside the loop)."""
     settle = np.where(np.isnan(arrays["settle_time_min"]), np.inf, arrays["settle_time_min"])
     rms = np.where(np.isnan(arrays["crosstrack_rms_after_leg1_nm"]), np.inf,
                    arrays["crosstrack_rms_after_leg1_nm"])

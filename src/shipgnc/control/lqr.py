@@ -86,7 +86,10 @@ def lqr_tracking_gain(a: float, c: float, U: float, Q=PAPER_Q, R: float = PAPER_
                       ) -> tuple[np.ndarray, np.ndarray]:
     """LQR gain K (4,) and closed-loop poles eig(A − BK) (4,) of the design model (8)/(9).
 
-    ``control.lqr`` (python-control) on A, B of :func:`tracking_model`; ``Q`` is the diagonal
+    The stabilising solution X of the continuous algebraic Riccati equation
+    AᵀX + XA − XBR⁻¹BᵀX + Q = 0 (:func:`scipy.linalg.solve_continuous_are`), K = R⁻¹BᵀX and
+    eig(A − BK): the arithmetic of ``control.lqr`` (python-control without slycot; tested to the
+    bit) without its 1.4 s import, on A, B of :func:`tracking_model`; ``Q`` is the diagonal
     (4 numbers) or a 4 × 4 matrix, ``R`` > 0 a number. Units are those of a, c, U (and Q, R):
     with the paper's a = 1.084 /min, c = 3.553 /min², U = 0.25 nm/min, Q = diag[0.1, 4, 0, 0.1]:
     R = 1 → K = [2.4455, 2.3244, 0.8788, 0.3162], poles −1.961±1.805j, −0.142±0.139j /min;
@@ -103,13 +106,15 @@ def lqr_tracking_gain(a: float, c: float, U: float, Q=PAPER_Q, R: float = PAPER_
             "controller.Q", Q.tolist(), "must be symmetric positive semi-definite")
     require(isinstance(R, (int, float, np.floating)) and np.isfinite(R) and R > 0, "controller.R", R,
             "must be a finite number > 0")
-    import control  # python-control: ≈ 0.7 s to import, paid by the LQR design alone (the
-    # feedback-linearising laws share this module's path frame but design nothing)
+    from scipy.linalg import solve_continuous_are
 
+    Rm = np.array([[float(R)]])
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            K, _, poles = control.lqr(A, B, Q, np.array([[float(R)]]))
+            X = solve_continuous_are(A, B, Q, Rm)
+            K = np.linalg.solve(Rm, B.T @ X)
+            poles = np.linalg.eig(A - B @ K)[0]
     except (ValueError, np.linalg.LinAlgError, ArithmeticError) as exc:
         raise ConfigError(f"controller.Q = {np.diag(Q).tolist()}, R = {R}: the Riccati equation has no "
                           f"stabilising solution for a = {a:g}, c = {c:g}, U = {U:g} ({exc})") from None

@@ -26,6 +26,7 @@ from shipgnc.interrupts import held, hold
 from shipgnc.models.fossen3dof import VectoredThrustBoat
 from shipgnc.paths import WaypointPath
 from shipgnc.scenarios import components as C
+from shipgnc.scenarios import montecarlo
 from shipgnc.scenarios.registry import load_scenario
 from shipgnc.scenarios.schema import Scenario
 from shipgnc.units import deg
@@ -502,6 +503,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         return routing.run(scenario, seed=seed)
     plan, compare = run_plan(scenario), compares(scenario)
     results, all_metrics, setups = {}, {}, {}
+    seas: dict = {}  # a Monte Carlo section's wave noise, drawn once for all its controllers
     run = _Interruptible()
     for name, (each, variant) in plan.items():
         if keep_interrupted and held():  # Ctrl-C after the last run finished: keep those done, no more
@@ -510,24 +512,33 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                            "(each complete)")
             break
         setup, sim = build(each, variant, seed=seed), each.simulation
-        # the metrics see every step: an unthinned record, thinned to log_every once scored
-        every = scoring_log_every(setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every,
-                                  scored=scenario.metrics is not None)
+        attrs = {"scenario": scenario.name, "controller": name, "seed": seed,
+                 **_vessel_attrs(setup.model, each)}
+        # the metrics see every step: an unthinned record, thinned to log_every once scored (a
+        # Monte Carlo section scores every step inside the loop and logs at log_every)
+        batch, in_loop = None, montecarlo.scored_in_loop(each, observer)
+        every = sim.log_every if in_loop else scoring_log_every(
+            setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every, scored=scenario.metrics is not None)
         check_run_memory(setup.model, setup.x0, sim.t_end, sim.dt, every,
                          scored=scenario.metrics is not None)  # before the run, not a MemoryError
         hold(False)  # a Ctrl-C during the simulation cuts it short (kept as partial, or raised)
         try:
             with interruptible(keep_interrupted) as run:
-                run.result = simulate(
+                batch = montecarlo.run(
+                    each, setup, lambda e=each, v=variant: build(e, v, seed=seed), seed=seed,
+                    progress=progress, attrs=attrs, seas=seas) if in_loop else None
+                if in_loop and batch is None:  # not covered, or a ship diverged: as any other run
+                    setup = build(each, variant, seed=seed)
+                    every = scoring_log_every(setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every)
+                    check_run_memory(setup.model, setup.x0, sim.t_end, sim.dt, every, scored=True)
+                run.result = batch.result if batch is not None else simulate(
                     setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
                     actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
                     navigation=setup.navigation,
                     u0=setup.u0, integrator=sim.integrator, method=sim.method, rtol=sim.rtol,
                     atol=sim.atol, seed=seed, observer=observer, progress=progress,
                     log_every=every, backend="numpy" if observer is not None else sim.backend,
-                    on_divergence="stop" if compare else on_divergence,
-                    attrs={"scenario": scenario.name, "controller": name, "seed": seed,
-                           **_vessel_attrs(setup.model, each)})
+                    on_divergence="stop" if compare else on_divergence, attrs=attrs)
                 if keep_interrupted:  # finished: a Ctrl-C from now on keeps the complete result
                     hold()
         except DivergenceError as exc:  # a controller's note (e.g. poor margins) may say why
@@ -543,8 +554,11 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
             run.result.attrs["controller_notes"] = "; ".join(setup.controller.notes)
         if getattr(setup.controller, "events", None) is not None and run.result is not None:
             run.result.attrs["events"] = json.dumps(list(setup.controller.events))  # kept in the file
-        all_metrics[name] = run.metrics(lambda r, s=setup, e=each: compute_metrics(e, r, s))
-        results[name], setups[name] = thin(run.result, sim.log_every // every), setup
+        all_metrics[name] = run.metrics(
+            lambda r, s=setup, e=each, b=batch: b.metrics if b is not None and r is b.result
+            else compute_metrics(e, r, s))
+        results[name], setups[name] = (run.result if batch is not None else
+                                       thin(run.result, sim.log_every // every)), setup
         if run.interrupted:
             break
     first = next(iter(results))

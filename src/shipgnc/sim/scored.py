@@ -5,7 +5,11 @@ sample, so that a study member keeps only the numbers it is scored on.
 :func:`run_scored` is :func:`shipgnc.sim.compose.run` with
 :meth:`~shipgnc.sim.compose.Composition.score_in_loop` and a log period of the whole run; it
 returns None when the compiled loop does not cover the setup (the caller then logs every step and
-scores the series).
+scores the series). With ``logged=True`` it keeps the run's log at the setup's own ``log_every``
+too (a Monte Carlo section's written result) and the per-step input tables the batch drew (the
+wave noise of every ship), so that :func:`run_with_tables` can run some of its ships again alone
+on exactly the inputs they had in the batch (one generator draws for the whole batch, so a ship's
+noise depends on the batch it was drawn in).
 """
 
 from __future__ import annotations
@@ -17,18 +21,26 @@ import numpy as np
 
 class Scored(NamedTuple):
     """Each ship's accumulators ``acc`` (ships, 3 m) and divergence ``event`` (−1: none; see
-    :class:`shipgnc.sim.compose.Composition`)."""
+    :class:`shipgnc.sim.compose.Composition`); with ``logged``: the run's ``log``
+    (:class:`~shipgnc.sim.simulator.Log` at the setup's ``log_every``; ``status["interrupted"]``
+    after Ctrl-C) and its per-step input ``tables`` by name (steps + 1, ships, ·)."""
 
     acc: np.ndarray
     event: np.ndarray
+    log: object | None = None
+    tables: dict | None = None
 
 
-def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray) -> Scored | None:
+def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
+               logged: bool = False, tables: dict | None = None) -> Scored | None:
     """Run ``setup`` (a validated :class:`~shipgnc.sim.simulator.SimSetup`; its ``log_every`` is
-    best the run's length) in its composed loop with the accumulators ``ops``, ``span`` (see
-    :class:`~shipgnc.sim.compose.ScoreArrays`) starting from ``init`` (3 m,) for every ship.
-    None when no compiled loop covers ``setup``. Ctrl-C raises KeyboardInterrupt."""
-    from shipgnc.sim.compiled import drive
+    best the run's length, unless ``logged``) in its composed loop with the accumulators ``ops``,
+    ``span`` (see :class:`~shipgnc.sim.compose.ScoreArrays`) starting from ``init`` (3 m,) for
+    every ship. None when no compiled loop covers ``setup``. Ctrl-C raises KeyboardInterrupt,
+    except with ``logged`` (the log then holds the samples up to it). ``tables``: the per-step
+    input tables (:attr:`Scored.tables` of a run whose components draw the same ones) used
+    instead of drawing them again (and returned as :attr:`Scored.tables`)."""
+    from shipgnc.sim.compiled import drive, make_log
     from shipgnc.sim.compose import Composition, unsupported_reason
     from shipgnc.sim.simulator import reset_components
 
@@ -40,8 +52,70 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray) -> Sc
     acc = np.empty((n, len(init)))
     acc[:] = np.asarray(init, dtype=np.float64)
     comp.score_in_loop(ops, span, acc)
-    stop = drive(setup, comp.call, comp.S, comp.event, prepare=comp.prepare, done_at=comp.done_at)
+    if tables is not None:
+        prepare = _replaying(comp, tables)
+    else:
+        prepare, tables = (_recording(comp, setup.n_steps + 1) if logged else (comp.prepare, None))
+    stop = drive(setup, comp.call, comp.S, comp.event, prepare=prepare, done_at=comp.done_at)
+    if stop.interrupted and not logged:
+        raise KeyboardInterrupt
+    comp.restore()
+    if not logged:
+        return Scored(acc, comp.event.copy())
+    log = make_log(setup, comp.signals, comp.out, comp.S, stop.event, state_slot=0,
+                   cmd_slot=comp.layout["cmd"], k_end=stop.k_end, interrupted=stop.interrupted,
+                   events=comp.event)
+    return Scored(acc, comp.event.copy(), log, tables)
+
+
+def run_with_tables(setup, tables: dict):
+    """The :class:`~shipgnc.sim.simulator.Log` of ``setup`` in its composed loop with the per-step
+    input ``tables`` (by name, (steps + 1, ships, ·): :attr:`Scored.tables` of the ships ``setup``
+    holds) instead of those its components draw: ships of a batch run again on the inputs they had
+    there. None when no compiled loop covers ``setup``. The loop is the scored one with no
+    accumulator (the loop :func:`run_scored` compiled for the batch: no second compile)."""
+    from shipgnc.sim.compiled import drive, make_log
+    from shipgnc.sim.compose import Composition, unsupported_reason
+    from shipgnc.sim.simulator import reset_components
+
+    if unsupported_reason(setup):
+        return None
+    reset_components(setup)
+    comp = Composition(setup, scored=True)
+    comp.score_in_loop(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4)),
+                       np.zeros((comp.S.shape[0], 0)))
+    stop = drive(setup, comp.call, comp.S, comp.event, prepare=_replaying(comp, tables),
+                 done_at=comp.done_at)
     if stop.interrupted:
         raise KeyboardInterrupt
     comp.restore()
-    return Scored(acc, comp.event.copy())
+    return make_log(setup, comp.signals, comp.out, comp.S, stop.event, state_slot=0,
+                    cmd_slot=comp.layout["cmd"], k_end=stop.k_end, events=comp.event)
+
+
+def _replaying(comp, tables: dict):
+    """``comp.prepare`` with the per-step ``tables`` (by name, (steps + 1, ships, ·)) for those
+    they hold, the others empty, nothing drawn."""
+    def prepare(k0: int, k1: int) -> None:
+        for name, table in comp._table.items():
+            comp._table[name] = (np.ascontiguousarray(tables[name][k0:k1]) if name in tables
+                                 else np.zeros((k1 - k0, *table.shape[1:2], 0)))
+
+    return prepare
+
+
+def _recording(comp, n_rows: int):
+    """``comp.prepare`` that also keeps each drawn per-step table (a table of no columns is not
+    kept): the prepare function and the dict it fills, by name, (``n_rows``, ships, ·)."""
+    tables: dict[str, np.ndarray] = {}
+
+    def prepare(k0: int, k1: int) -> None:
+        comp.prepare(k0, k1)
+        for name, table in comp._table.items():
+            if table.shape[-1] == 0:
+                continue
+            if name not in tables:
+                tables[name] = np.full((n_rows, *table.shape[1:]), np.nan)
+            tables[name][k0:k1] = table
+
+    return prepare, tables

@@ -166,10 +166,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
     require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
     _require_batch_dims(batch_dims, setup.batch_shape)
     log, ran_on = None, "numpy"
-    n_ships = math.prod(setup.batch_shape)
-    wants_compiled = backend in ("compiled", "compiled-or-numpy") or (backend == "auto" and (
-        n_ships >= COMPILED_MIN_BATCH or n_ships * setup.n_steps >= COMPILED_MIN_WORK))
-    if wants_compiled:
+    if wants_compiled(backend, math.prod(setup.batch_shape), setup.n_steps):
         twin, reasons = _compiled_twin(setup)
         if twin is not None:
             log, ran_on = twin.run(setup), COMPILED_TWINS[twin.__name__.rsplit(".", 1)[-1]]
@@ -185,8 +182,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
             evaluator = getattr(disturbance, "evaluator", None)
             if evaluator is not None and evaluator() != "numpy":
                 ran_on = f"{ran_on}+{evaluator()}"
-    run_attrs = {"integrator": integrator, "backend": ran_on, "dt": dt, "Ts": dt * setup.hold,
-                 "t_end": t_end, "model": type(model).__name__, **(attrs or {})}
+    run_attrs = result_attrs(setup, ran_on, attrs)
     if log.status.get("interrupted"):  # the partial Dataset is built (xarray imported) only if
         last = float(log.time[-1]) if log.time.size else 0.0  # someone reads it
 
@@ -206,6 +202,20 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         result["diverged_at"] = (dims, log.diverged_at.reshape(setup.batch_shape),
                                  {"units": "s", "long_name": "time the ship diverged (NaN: never)"})
     return result
+
+
+def wants_compiled(backend: str, n_ships: int, n_steps: int) -> bool:
+    """Whether ``backend`` asks for a compiled loop for a run of ``n_ships`` × ``n_steps``
+    (``"auto"``: from :data:`COMPILED_MIN_BATCH` ships or :data:`COMPILED_MIN_WORK` ship-steps)."""
+    return backend in ("compiled", "compiled-or-numpy") or (backend == "auto" and (
+        n_ships >= COMPILED_MIN_BATCH or n_ships * n_steps >= COMPILED_MIN_WORK))
+
+
+def result_attrs(setup: SimSetup, ran_on: str, attrs: dict | None = None) -> dict:
+    """The attributes of a run's result: integrator, the loop that ran, steps, model, ``attrs``."""
+    return {"integrator": setup.integrator, "backend": ran_on, "dt": setup.dt,
+            "Ts": setup.dt * setup.hold, "t_end": setup.t_end, "model": type(setup.model).__name__,
+            **(attrs or {})}
 
 
 def _compiled_twin(setup: SimSetup):

@@ -15,13 +15,16 @@ their own. Titles say what is drawn (how many runs, which are unbounded).
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from shipgnc.errors import ConfigError
 from shipgnc.units import MINUTE, NAUTICAL_MILE
 from shipgnc.viz import style
+
+if TYPE_CHECKING:  # matplotlib is imported where a figure is drawn: the series helpers need none
+    from matplotlib.figure import Figure
 
 PATH_KEYS = ("time", "north", "east", "psi", "heading_error", "cross_track_error", "delta", "leg")
 #: one colour per controller of document 000 (others cycle through the tab10 palette)
@@ -119,6 +122,8 @@ def tracks_figure(series: Mapping[str, Mapping[str, np.ndarray]], waypoints, *,
     bounded runs; with an unbounded run a second panel shows every track whole."""
     _check(series)
     bounded, unbounded = split_bounded(series)
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(12.5 if unbounded else 7.5, 8.0))
     if unbounded:
         ax, ax_all = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.6, 1]})
@@ -148,6 +153,8 @@ def heading_figure(series: Mapping[str, Mapping[str, np.ndarray]], *, title: str
     """Fig. 4: heading ψ, heading error ψ_r and cross-track error y_r against time."""
     _check(series)
     bounded, unbounded = split_bounded(series)
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(10.0, 8.0))
     axes = fig.subplots(3, 1, sharex=True)
     panels = {0: [], 1: [], 2: []}
@@ -182,6 +189,8 @@ def rudder_figure(series: Mapping[str, Mapping[str, np.ndarray]], *, title: str 
     _check(series)
     bounded, unbounded = split_bounded(series)
     groups = [bounded] + ([unbounded] if unbounded else [])
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(10.0, 4.5 + 2.8 * (len(groups) - 1)))
     axes = fig.subplots(len(groups), 1, sharex=True, squeeze=False)[:, 0]
     notes = []
@@ -226,6 +235,8 @@ def montecarlo_figure(series: Mapping[str, Mapping[str, np.ndarray]], waypoints,
     band against time (right), one row per controller."""
     _check(series)
     names = list(series)
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(13.0, 5.2 * len(names)))
     axes = fig.subplots(len(names), 2, squeeze=False, gridspec_kw={"width_ratios": [1, 1.6]})
     for i, name in enumerate(names):

@@ -1,0 +1,148 @@
+"""A scenario's Monte Carlo section (``shipgnc run mariner-montecarlo``) scored inside the compiled
+loop (``shipgnc.scenarios.montecarlo``) against the reference: the same batch run with a log of
+every step (the path such a run took before) and scored from that log by
+``path_tracking_arrays``.
+
+Tolerance as in test_in_loop_scoring.py: every figure is the log's own number (to the bit) except
+the RMS figures, whose sums of squares may be formed with fused multiply-adds in the loop (one
+rounding of ≤ ε/2 per term skipped): N·ε relative for N samples. The written result must be the
+full log thinned to ``simulation.log_every``, to the bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from shipgnc.analysis import accumulated
+from shipgnc.analysis.path_tracking import montecarlo_figures, path_tracking_arrays
+from shipgnc.scenarios import montecarlo
+from shipgnc.scenarios.registry import load_scenario
+from shipgnc.scenarios.runner import build
+from shipgnc.sim.simulator import simulate, thin
+
+#: 50 min: leg 1 ends for most ships (figures after leg 1 exist), some have not settled; offsets
+#: up to 1.5 nm and 30° as the built-in, its wave noise
+OVERRIDES = ["simulation.t_end=3000", "montecarlo.runs=12"]
+#: the sums-of-squares figures (N·ε, see the module); every other figure exact
+SUMS = {"crosstrack_rms_after_leg1_nm", "rudder_rms_deg"}
+
+
+def _full_log(scenario, name, seed):
+    """The reference: the batch logged at every step, as ``run_scenario`` ran it before."""
+    setup, sim = build(scenario, name, seed=seed), scenario.simulation
+    return simulate(setup.model, setup.x0, t_end=sim.t_end, dt=sim.dt, controller=setup.controller,
+                    actuator=setup.actuator, guidance=setup.guidance, disturbance=setup.disturbance,
+                    u0=setup.u0, integrator=sim.integrator, seed=seed, log_every=1,
+                    backend=sim.backend, on_divergence="stop")
+
+
+def _compare(scenario, name, seed):
+    setup = build(scenario, name, seed=seed)
+    batch = montecarlo.run(scenario, setup, lambda: build(scenario, name, seed=seed), seed=seed)
+    assert batch is not None, "the compiled loop covers mariner-montecarlo"
+    full = _full_log(scenario, name, seed)
+    assert not full.attrs["diverged"]
+    ref = path_tracking_arrays(full.time.values, full["cross_track_error"].values,
+                               full["heading_error"].values, full["leg"].values,
+                               full["delta"].values, delta_max=float(setup.model.params.delta_max),
+                               reached_end=True)
+    assert set(batch.figures) == set(ref)
+    n = full.sizes["time"]
+    for key, expected in ref.items():
+        got = np.asarray(batch.figures[key], dtype=float)
+        expected = np.asarray(expected, dtype=float)
+        assert np.array_equal(np.isnan(got), np.isnan(expected)), key
+        rtol = n * np.finfo(float).eps if key in SUMS else 0.0
+        np.testing.assert_allclose(got, expected, rtol=rtol, atol=0.0, equal_nan=True, err_msg=key)
+    summary = montecarlo_figures(ref)
+    assert set(summary) <= set(batch.metrics)
+    for key, value in summary.items():
+        if value is None or key.startswith("crosstrack_rms"):
+            assert (batch.metrics[key] is None) == (value is None), key
+            if value is not None:
+                assert batch.metrics[key] == pytest.approx(value, rel=n * np.finfo(float).eps)
+        else:
+            assert batch.metrics[key] == value, key
+    # the written result: the full log on the grid of log_every, to the bit
+    thinned = thin(full, scenario.simulation.log_every)
+    assert set(batch.result.data_vars) == set(thinned.data_vars)
+    for var in thinned.data_vars:
+        np.testing.assert_array_equal(batch.result[var].values, thinned[var].values, err_msg=var)
+    np.testing.assert_array_equal(batch.result.time.values, thinned.time.values)
+    return batch, ref
+
+
+@pytest.mark.parametrize("name", ["lqr", "los_fl"])
+def test_montecarlo_figures_in_loop_equal_the_full_log(name):
+    scenario = load_scenario("mariner-montecarlo", OVERRIDES)
+    _, ref = _compare(scenario, name, scenario.simulation.seed)
+    # the case is not trivial: ships past leg 1, and ships that differ
+    assert np.isfinite(ref["crosstrack_rms_after_leg1_nm"]).any()
+    assert np.ptp(ref["rudder_rms_deg"]) > 0
+
+
+def test_ships_left_undecided_are_scored_from_their_own_log(monkeypatch):
+    """Every ship's ``stable`` verdict left to its log (the margin made huge): each is run again
+    on the wave noise the batch drew for it, in blocks, and scored from its log of every step."""
+    monkeypatch.setattr(accumulated, "MARGIN", 1e12)
+    monkeypatch.setattr(montecarlo, "SHIPS_PER_RERUN", 5)  # blocks of 5, 5 and 2 ships
+    calls = []
+    real = montecarlo._scored_from_log
+
+    def counted(*args):
+        calls.append(args[3].shape[0])
+        return real(*args)
+
+    monkeypatch.setattr(montecarlo, "_scored_from_log", counted)
+    scenario = load_scenario("mariner-montecarlo", OVERRIDES)
+    _compare(scenario, "los_fl", scenario.simulation.seed)
+    assert sorted(calls) == [4, 4, 4]  # 12 ships in blocks of at most 5 (array_split: even)
+
+
+def test_a_diverged_batch_runs_as_before(monkeypatch):
+    """A ship that diverges: the in-loop run gives the batch back (None) and ``run_scenario``
+    runs it logged at every step, scored from its log as before."""
+    from shipgnc.scenarios import runner
+    from shipgnc.sim import scored
+
+    real = scored.run_scored
+
+    def one_diverged(*args, **kwargs):
+        out = real(*args, **kwargs)
+        out.event[0] = 10
+        return out
+
+    monkeypatch.setattr(scored, "run_scored", one_diverged)
+    scenario = load_scenario("mariner-montecarlo", OVERRIDES)
+    seed = scenario.simulation.seed
+    setup = build(scenario, "los_fl", seed=seed)
+    assert montecarlo.run(scenario, setup, lambda: build(scenario, "los_fl", seed=seed),
+                          seed=seed) is None
+    run = runner.run_scenario(scenario)
+    full = _full_log(scenario, "los_fl", seed)
+    expected = runner.compute_metrics(scenario, full, build(scenario, "los_fl", seed=seed))
+    assert run.metrics["los_fl"] == expected
+
+
+def test_the_controllers_sail_one_sea_drawn_once():
+    """The second controller reads the wave noise the first drew (``seas``): its batch is the
+    one it gives drawing the noise itself, to the bit."""
+    scenario = load_scenario("mariner-montecarlo", OVERRIDES)
+    seed = scenario.simulation.seed
+
+    def batch(name, seas):
+        return montecarlo.run(scenario, build(scenario, name, seed=seed),
+                              lambda: build(scenario, name, seed=seed), seed=seed, seas=seas)
+
+    seas = {}
+    batch("lqr", seas)
+    (tables,) = seas.values()
+    assert np.isfinite(tables["W"]).all()  # every step's noise of every ship
+    shared, own = batch("los_fl", seas), batch("los_fl", None)
+    assert len(seas) == 1
+    for var in own.result.data_vars:
+        np.testing.assert_array_equal(shared.result[var].values, own.result[var].values)
+    for key, values in own.figures.items():
+        np.testing.assert_array_equal(shared.figures[key], values, err_msg=key)
+    assert shared.metrics == own.metrics
