@@ -74,7 +74,8 @@ COURSE_CASES = [
 
 def test_every_in_loop_metric_set_has_a_case():
     cases = {case[0] for case in CASES} | ({"course-quality"} if COURSE_CASES else set())
-    assert set(IN_LOOP_SETS) == set(BUILT_IN) == cases
+    assert set(IN_LOOP_SETS) == set(BUILT_IN) | {"none"}  # none: see its test below
+    assert set(BUILT_IN) == cases
 
 
 def _both(metric_set, overrides, perturb, variant=None, members=6):
@@ -255,3 +256,37 @@ def test_course_steps_foreseen_wrongly_leave_every_member_to_its_log(monkeypatch
     for key in plain.data_vars:
         np.testing.assert_allclose(plain[key].values, reference[key].values, rtol=1e-12,
                                    err_msg=key)
+
+
+def test_a_diverged_course_quality_member_is_scored_alone_from_its_log(monkeypatch):
+    """A member that diverged in the scored loop (here: flagged so after step 10) is run alone
+    with its log and scored there; the others keep their in-loop figures, to the bit."""
+    import shipgnc.sim.scored as scored
+
+    reference = _course_chunk(False, members=3)
+    real = scored.run_scored
+
+    def one_diverged(*args):
+        out = real(*args)
+        out.event[1] = 2 * 10 + 1
+        return out
+
+    monkeypatch.setattr(scored, "run_scored", one_diverged)
+    ds = _course_chunk(False, members=3)
+    series = _course_chunk(True, members=3)
+    for key in ds.data_vars:  # it did not truly diverge: its own run gives its figures
+        np.testing.assert_allclose(ds[key].values, series[key].values, rtol=1e-12, err_msg=key)
+        np.testing.assert_array_equal(ds[key].values[[0, 2]], reference[key].values[[0, 2]])
+
+
+def test_a_study_of_no_metric_set_keeps_nothing_but_its_status():
+    """``metrics: none``: nothing scored and nothing logged in the loop; the same Dataset as the
+    chunk that logs every step."""
+    kw = {"members": 3, "seed": 3, "perturb": (Perturbation.parse("psi_deg=uniform:-20,20"),),
+          "overrides": ("simulation.t_end=20", "metrics=none")}
+    plain = run_chunk(Study("boat-autopilot", **kw), Chunk(0, 0, 3))
+    series = run_chunk(Study("boat-autopilot", series=True, **kw), Chunk(0, 0, 3))
+    assert plain.attrs["backend"] == "compiled"
+    assert list(plain.data_vars) == ["diverged", "initial_state_psi_deg"]
+    for key in plain.data_vars:
+        np.testing.assert_array_equal(plain[key].values, series[key].values, err_msg=key)

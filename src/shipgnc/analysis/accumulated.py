@@ -56,7 +56,7 @@ _FROM_MINUS_INF = (MAX, MAX_ABS, ARGMAX)
 #: a window's edges as the series formulas draw them (a sample at t_k − 1e-9 or later)
 EDGE = 1e-9
 #: metric sets scored inside the loop
-IN_LOOP_SETS = ("heading-steps", "path-tracking", "course-quality")
+IN_LOOP_SETS = ("heading-steps", "path-tracking", "course-quality", "none")
 #: the key of :attr:`Accumulators.finish`'s mask of the ships to score from their logged series
 NEEDS_LOG = "needs_log"
 #: how far [m] the bounds on ``stable``'s residual half-range must clear the band to decide it
@@ -112,6 +112,8 @@ def plan_for(scenario, setup, signals, n_steps: int, dt: float) -> Accumulators 
     run with navigation, whose estimate errors are scored from the series)."""
     if scenario.metrics not in IN_LOOP_SETS or setup.navigation is not None:
         return None
+    if scenario.metrics == "none":  # nothing to score: no accumulator, and no log
+        return _Plan(signals).build(lambda acc: {})
     t = time_coordinate(np.arange(n_steps + 1) * dt)  # the sample times of a log of every step
     if scenario.metrics == "path-tracking":
         delta_max = float(setup.model.params.delta_max)
