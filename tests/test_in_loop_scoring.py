@@ -31,11 +31,14 @@ from shipgnc.study.chunk import (
 from shipgnc.study.spec import Perturbation, Study
 
 #: a built-in scenario of each metric set scored in the loop
-BUILT_IN = {"heading-steps": "boat-autopilot", "path-tracking": "mariner-fl-lookahead"}
+BUILT_IN = {"heading-steps": "boat-autopilot", "path-tracking": "mariner-fl-lookahead",
+            "course-quality": "cybership-calm"}
 #: figures that are sums (round-off bound in the module docstring); every other figure exact
-SUMS = {"heading_rmse_deg", "crosstrack_rms_after_leg1_nm", "rudder_rms_deg"}
+SUMS = {"heading_rmse_deg", "crosstrack_rms_after_leg1_nm", "rudder_rms_deg",
+        "psi_E", "delta_E", "J", "rudder_rate_rms_deg_s", "psi_E_ref"}
 #: a figure of each set that differs between the members
-VARIES = {"heading-steps": "heading_rmse_deg", "path-tracking": "rudder_rms_deg"}
+VARIES = {"heading-steps": "heading_rmse_deg", "path-tracking": "rudder_rms_deg",
+          "course-quality": "J"}
 #: (metric set, overrides, perturbation): settled steps, a step that never settles (NaN), a
 #: window whose ψ_d does not change (no overshoot direction). One combination of components
 #: (a scored loop compiles once per combination; per-member disturbance streams are the study's,
@@ -53,15 +56,33 @@ CASES = [
 ]
 
 
+#: (controller, overrides, perturbation) of ``course-quality`` (document 003's controllers, one
+#: compiled loop: the sliding-mode laws share it): the retuned SMC settles (stable, settled, ψ_z's
+#: index); the consistent SMC with the printed gains limit-cycles with the rudder pinned (not
+#: stable, not settled); the printed SMC chatters at the rate limit off course (stable: its
+#: oscillation is decided on blocks of the final windows; not settled); a course step off the
+#: sample grid (10.05 s: ψ_d changes at the next control sample) and a last step of two samples
+#: (a final window too short for a trend)
+COURSE_CASES = [
+    ("smc_tuned", (), "psi_deg=uniform:-30,30"),
+    ("smc_consistent", (), "psi_deg=uniform:-30,30"),
+    ("smc_printed", (), "r_deg_s=normal:1"),
+    ("smc_tuned", ("guidance.schedule=[{t: 0.0, psi_deg: 0.0}, {t: 10.05, psi_deg: 30.0}, "
+                   "{t: 60.0, psi_deg: -20.0}]", "simulation.t_end=60.1"), "psi_deg=uniform:-10,10"),
+]
+
+
 def test_every_in_loop_metric_set_has_a_case():
-    assert set(IN_LOOP_SETS) == set(BUILT_IN) == {case[0] for case in CASES}
+    cases = {case[0] for case in CASES} | ({"course-quality"} if COURSE_CASES else set())
+    assert set(IN_LOOP_SETS) == set(BUILT_IN) | {"none"}  # none: see its test below
+    assert set(BUILT_IN) == cases
 
 
-def _both(metric_set, overrides, perturb, members=6):
+def _both(metric_set, overrides, perturb, variant=None, members=6):
     study = Study(BUILT_IN[metric_set], members=members, seed=7, overrides=overrides,
                   perturb=(Perturbation.parse(perturb),))
     scenario = study.scenario_at(study.points[0])
-    setup = build(scenario, seed=study.seed)
+    setup = build(scenario, variant, seed=study.seed)
     chunk = Chunk(0, 0, members)
     x0 = member_initial_states(study, setup.x0, setup.model, chunk)
     seeds = study.member_seeds(0, members, 1)
@@ -77,9 +98,11 @@ def _both(metric_set, overrides, perturb, members=6):
     return in_loop, logged, ran_on, round(sim.t_end / sim.dt) + 1
 
 
-@pytest.mark.parametrize(("metric_set", "overrides", "perturb"), CASES)
-def test_in_loop_figures_equal_those_of_the_full_log(metric_set, overrides, perturb):
-    in_loop, logged, ran_on, n_samples = _both(metric_set, overrides, perturb)
+@pytest.mark.parametrize(("metric_set", "overrides", "perturb", "variant"),
+                         [(*case, None) for case in CASES]
+                         + [("course-quality", o, p, v) for v, o, p in COURSE_CASES])
+def test_in_loop_figures_equal_those_of_the_full_log(metric_set, overrides, perturb, variant):
+    in_loop, logged, ran_on, n_samples = _both(metric_set, overrides, perturb, variant)
     assert ran_on == {"compiled"}
     assert in_loop is not None, "the metric set was not scored in the loop"
     assert list(in_loop) == list(logged)  # same keys in the same order
@@ -219,3 +242,90 @@ def test_a_big_chunk_scored_in_the_loop_is_budgeted_its_accumulators_not_a_log()
     with pytest.raises(ConfigError, match="smaller --chunk-size"):
         check_memory(Study("boat-autopilot", members=4000, overrides=("simulation.t_end=1400",),
                            series=True), None, 4000, max_memory=2.0**30)
+
+
+def test_course_quality_cases_reach_each_verdict():
+    """Settled and stable; a limit cycle (neither); chattering off course (stable, not settled);
+    every member of them decided in the loop, none left to its log."""
+    tuned, _, _, _ = _both("course-quality", COURSE_CASES[0][1], COURSE_CASES[0][2], "smc_tuned")
+    cycle, _, _, _ = _both("course-quality", COURSE_CASES[1][1], COURSE_CASES[1][2],
+                           "smc_consistent")
+    chatter, _, _, _ = _both("course-quality", COURSE_CASES[2][1], COURSE_CASES[2][2],
+                             "smc_printed")
+    assert all(len(figures["J"]) == 6 for figures in (tuned, cycle, chatter))  # none to the log
+    assert tuned["stable"].all() and tuned["settled"].all() and np.isfinite(tuned["psi_E_ref"]).all()
+    assert not cycle["stable"].any() and not cycle["settled"].any()
+    assert chatter["stable"].all() and not chatter["settled"].any()
+    assert (chatter["rudder_rate_limit_fraction"] > 0.9).all()
+
+
+def _course_chunk(series, members=4, variant="smc_printed"):
+    kw = {"members": members, "seed": 5, "perturb": (Perturbation.parse("psi_deg=uniform:-20,20"),),
+          "overrides": ("simulation.t_end=120",)}
+    return run_chunk(Study("cybership-calm", series=series, **kw), Chunk(0, 0, members, variant))
+
+
+def test_a_course_quality_chunk_keeps_the_figures_of_one_with_series():
+    plain, series = _course_chunk(False), _course_chunk(True)
+    assert not any(name.startswith("series_") for name in plain.data_vars)
+    assert list(plain.data_vars) == [k for k in series.data_vars if not k.startswith("series_")]
+    for key in plain.data_vars:
+        np.testing.assert_allclose(plain[key].values, series[key].values, rtol=1e-12, err_msg=key)
+
+
+def test_course_steps_foreseen_wrongly_leave_every_member_to_its_log(monkeypatch):
+    """The course steps are foreseen from the schedule and checked in the loop: foreseen a sample
+    late, ψ_d's extremes in them do not match, and every member is scored from its own log —
+    with the figures of the chunk scored from its log."""
+    import shipgnc.analysis.accumulated as accumulated
+
+    reference = _course_chunk(True, members=2)
+    real = accumulated.foreseen_course
+    monkeypatch.setattr(accumulated, "foreseen_course",
+                        lambda *args: np.r_[0.0, real(*args)[:-1]])
+    study = Study("cybership-calm", members=2, seed=5, overrides=("simulation.t_end=120",),
+                  perturb=(Perturbation.parse("psi_deg=uniform:-20,20"),))
+    scenario = study.scenario_at(study.points[0])
+    setup = build(scenario, "smc_printed", seed=study.seed)
+    x0 = member_initial_states(study, setup.x0, setup.model, Chunk(0, 0, 2))
+    _, to_log = scored_in_loop(scenario, setup, simulation_of(scenario, setup), x0,
+                               study.member_seeds(0, 2, 1), "compiled-or-numpy")
+    assert to_log.all()
+    plain = _course_chunk(False, members=2)
+    for key in plain.data_vars:
+        np.testing.assert_allclose(plain[key].values, reference[key].values, rtol=1e-12,
+                                   err_msg=key)
+
+
+def test_a_diverged_course_quality_member_is_scored_alone_from_its_log(monkeypatch):
+    """A member that diverged in the scored loop (here: flagged so after step 10) is run alone
+    with its log and scored there; the others keep their in-loop figures, to the bit."""
+    import shipgnc.sim.scored as scored
+
+    reference = _course_chunk(False, members=3)
+    real = scored.run_scored
+
+    def one_diverged(*args):
+        out = real(*args)
+        out.event[1] = 2 * 10 + 1
+        return out
+
+    monkeypatch.setattr(scored, "run_scored", one_diverged)
+    ds = _course_chunk(False, members=3)
+    series = _course_chunk(True, members=3)
+    for key in ds.data_vars:  # it did not truly diverge: its own run gives its figures
+        np.testing.assert_allclose(ds[key].values, series[key].values, rtol=1e-12, err_msg=key)
+        np.testing.assert_array_equal(ds[key].values[[0, 2]], reference[key].values[[0, 2]])
+
+
+def test_a_study_of_no_metric_set_keeps_nothing_but_its_status():
+    """``metrics: none``: nothing scored and nothing logged in the loop; the same Dataset as the
+    chunk that logs every step."""
+    kw = {"members": 3, "seed": 3, "perturb": (Perturbation.parse("psi_deg=uniform:-20,20"),),
+          "overrides": ("simulation.t_end=20", "metrics=none")}
+    plain = run_chunk(Study("boat-autopilot", **kw), Chunk(0, 0, 3))
+    series = run_chunk(Study("boat-autopilot", series=True, **kw), Chunk(0, 0, 3))
+    assert plain.attrs["backend"] == "compiled"
+    assert list(plain.data_vars) == ["diverged", "initial_state_psi_deg"]
+    for key in plain.data_vars:
+        np.testing.assert_array_equal(plain[key].values, series[key].values, err_msg=key)

@@ -109,6 +109,23 @@ def test_short_nomoto_target_runs_and_a_non_finite_target_stops_the_run():
         _run([{**base, "vessel": {"model": "nomoto", "K": 0.1, "T": 1.0, "n3": 1e6}}], t_end=60.0)
 
 
+@pytest.mark.parametrize("backend", ["numpy", "compiled"])
+def test_a_diverging_vessel_target_is_named_by_its_field_and_state(backend):
+    """The divergence a vessel target causes names the target (``guidance.targets[j]``, its label)
+    and its non-finite state, then the command it made non-finite — in either loop."""
+    from shipgnc.errors import DivergenceError
+
+    kinematic = {"north": 11112.0, "east": -3000.0, "course_deg": 180.0, "speed": U}
+    stiff = {"north": 11112.0, "east": 150.0, "course_deg": 180.0, "speed": U, "name": "Stiff",
+             "waypoints": [[11112.0, 5000.0]],
+             "vessel": {"model": "nomoto", "K": 0.1, "T": 1.0, "n3": 1e6}}
+    pattern = (r"simulation diverged at t = 2 s: vessel target guidance\.targets\[1\] \(Stiff\): "
+               r"its state '(north|east|psi|r|delta)' = (nan|-?inf) (m|rad|rad/s) \(not finite\); "
+               r"the references from it made the controller command 'delta_c' = nan rad")
+    with pytest.raises(DivergenceError, match=pattern):
+        _run([kinematic, stiff], t_end=60.0, extra=(f"simulation.backend={backend}",))
+
+
 def test_frigate_steady_turn_is_the_norrbin_root():
     """Van Amerongen's frigate at 9 m/s (K, T, n₃ of its table) with 20° rudder: the steady yaw rate
     is the real root of n₃ r³ + r = Kδ (Norrbin), and the tactical-scale turning radius U/r."""

@@ -221,6 +221,11 @@ STABLE_FINAL_FRACTION = 0.2
 STABLE_PINNED_FRACTION = 0.05
 #: the heading error's oscillation amplitude above which a course-keeping run is not stable [deg]
 COURSE_OSCILLATION_DEG = 5.0
+#: the heading error a course-keeping run must stay below to be bounded [deg]
+COURSE_BOUND_DEG = 90.0
+#: ``settled``: |Δψ| within this band [deg] over the last window [s] of the run
+COURSE_SETTLE_BAND_DEG = 2.0
+COURSE_SETTLE_WINDOW_S = 30.0
 
 
 def stable_arrays(t, error, *, bound, oscillation_tol, reached=True, diverged=False,
@@ -388,6 +393,14 @@ def actuator_motion_arrays(t, actuator) -> tuple[np.ndarray, np.ndarray]:
     return np.where(time_sum(ok) > 0, rate_rms, np.nan), time_sum(np.abs(step0))
 
 
+def rudder_rate_limit(actuator) -> float | None:
+    """The steering machine's rudder rate limit [rad/s] (channel ``delta`` of ``actuator``), None
+    without an actuator or that channel."""
+    if actuator is None or "delta" not in actuator.names:
+        return None
+    return float(actuator.rate[actuator.names.index("delta")])
+
+
 def rate_limit_fraction(t, actuator, rate: float | None, rel_tol: float = 1e-6) -> np.ndarray:
     """Fraction of the sample intervals in which the actuator series ``(time, ship)`` moves at its
     rate limit ``rate`` [unit/s]: |Δa/Δt| ≥ rate (1 − ``rel_tol``) (a rate-limited steering
@@ -405,8 +418,10 @@ def rate_limit_fraction(t, actuator, rate: float | None, rel_tol: float = 1e-6) 
 
 
 def course_quality_arrays(t, psi_error, delta, u, *, lam: float = 1.0, t_end: float | None = None,
-                          diverged=False, psi=None, psi_z=None, bound_deg: float = 90.0,
-                          settle_window_s: float = 30.0, settle_band_deg: float = 2.0,
+                          diverged=False, psi=None, psi_z=None,
+                          bound_deg: float = COURSE_BOUND_DEG,
+                          settle_window_s: float = COURSE_SETTLE_WINDOW_S,
+                          settle_band_deg: float = COURSE_SETTLE_BAND_DEG,
                           psi_d=None, delta_max: float | None = None,
                           oscillation_deg: float = COURSE_OSCILLATION_DEG,
                           delta_rate: float | None = None) -> dict:
@@ -452,8 +467,9 @@ def course_quality_arrays(t, psi_error, delta, u, *, lam: float = 1.0, t_end: fl
 
 
 def course_quality_metrics(ds, *, lam: float = 1.0, t_end: float | None = None,
-                           diverged: bool = False, bound_deg: float = 90.0,
-                           settle_window_s: float = 30.0, settle_band_deg: float = 2.0,
+                           diverged: bool = False, bound_deg: float = COURSE_BOUND_DEG,
+                           settle_window_s: float = COURSE_SETTLE_WINDOW_S,
+                           settle_band_deg: float = COURSE_SETTLE_BAND_DEG,
                            delta_max: float | None = None,
                            oscillation_deg: float = COURSE_OSCILLATION_DEG,
                            delta_rate: float | None = None) -> dict:

@@ -65,6 +65,8 @@ HEAD_SIZE = HEAD.size
 #: logged per vessel target slot (:mod:`shipgnc.guidance.vessel_targets`): north, east, heading,
 #: after the guidance's nine outputs (:attr:`ColavGuidance.outputs`)
 _VESSEL_OUT = ("north", "east", "psi")
+#: a vessel target's integrated state (its block's first numbers) and units
+_VESSEL_STATE = (("north", "m"), ("east", "m"), ("psi", "rad"), ("r", "rad/s"), ("delta", "rad"))
 _BASE_OUT = 9
 #: the LOS part of the per-ship state, then [next decision time, course offset, speed factor,
 #: least range so far, its time, its target]
@@ -187,6 +189,26 @@ class ColavGuidance:
         for row in range(n if self.n_vessels else 0):
             for k, (_, tr) in enumerate(self._vessels[row % len(self._vessels)]):
                 self._z[row, zo + k * w:zo + (k + 1) * w] = tr.state(w)
+
+    def divergence_cause(self, index: tuple = ()) -> str | None:
+        """Why ship ``index`` of the batch got non-finite references: its first vessel target
+        whose state (n, e, ψ, r, δ) is no longer finite, named by its scenario field
+        (``guidance.targets[j]``) and state, as ``vessel target FIELD (LABEL): its state 'NAME' =
+        VALUE UNIT (not finite)`` — or None (no vessel target went bad). The state is the one at
+        the sample the run stopped on (the components' carried states)."""
+        if not self.n_vessels or self._z is None:
+            return None
+        row = int(np.ravel_multi_index(index, self._batch_shape)) if index else 0
+        zo = _LOS_STATE + _HOLD + self.memory + 8 + 4 * self.n_max
+        w = self._width_z
+        for k, (j, tr) in enumerate(self._vessels[row % len(self._vessels)]):
+            block = self._z[row, zo + k * w:zo + k * w + len(_VESSEL_STATE)]
+            for (name, unit), value in zip(_VESSEL_STATE, block, strict=True):
+                if not math.isfinite(value):
+                    where = tr.where or f"target {j + 1}"
+                    return (f"vessel target {where} ({tr.label}): its state '{name}' = "
+                            f"{value:g} {unit} (not finite)")
+        return None
 
     def _vessel_states(self, states, result):
         """``states`` (time, member, target) per ship of ``result``, the vessel targets' from

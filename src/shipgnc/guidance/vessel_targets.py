@@ -28,7 +28,9 @@ plus the held course offset of the target's own avoidance.
 in sub-steps of at most :data:`MAX_STEP`, T_δ and T/2 (RK4's stability bound on the real axis is
 |h λ| ≤ 2.785, and the lags have λ = −1/T_δ and −1/T; half of T keeps a margin for the n₃ r³ term).
 A target whose state is no longer finite turns the own ship's references NaN, so that the run stops
-as a divergence at that sample (the controller's command not finite) instead of scoring without it.
+as a divergence at that sample (the controller's command not finite) instead of scoring without it;
+the message names the target (``guidance.targets[j]``) and its state
+(:meth:`shipgnc.guidance.colav.ColavGuidance.divergence_cause`).
 
 **Avoidance** (optional, ``sbmpc`` or ``vo``): the target runs the method with the own ship as its one
 target, seen as ground truth (position and velocity over ground at the sample), course offsets only,

@@ -414,10 +414,9 @@ def design_figures(setup: Setup) -> dict:
 
 def rudder_rate(setup: Setup) -> float | None:
     """The steering machine's rudder rate limit [rad/s] (channel ``delta``), None if absent."""
-    act = setup.actuator
-    if act is None or "delta" not in act.names:
-        return None
-    return float(act.rate[act.names.index("delta")])
+    from shipgnc.analysis.metrics import rudder_rate_limit
+
+    return rudder_rate_limit(setup.actuator)
 
 
 def metric_arrays(scenario: Scenario, result, setup: Setup) -> dict[str, np.ndarray] | None:

@@ -29,7 +29,14 @@ switch recorded by the ``SCORE_SWITCH`` accumulator ``j`` (listed before it). It
 * ``SCORE_LAST_OUT`` — the number of samples up to and including the last one outside the band
   ``|v · span[m, 2]| < span[m, 3]`` (0 if none), and the number of samples;
 * ``SCORE_SUM_TC`` — ``Σ (t − span[m, 3]) · v`` and the number of samples;
-* ``SCORE_ARGMAX`` — the largest ``v · span[m, 2]`` (its first sample) and its time ``t``.
+* ``SCORE_ARGMAX`` — the largest ``v · span[m, 2]`` (its first sample) and its time ``t``;
+* ``SCORE_DIFF`` — over the steps between successive samples, Δv and Δt (the times as the log's
+  ``time`` coordinate holds them, rounded to 10⁻⁹ s with numpy's ``round`` arithmetic), f by
+  ``span[m, 3]``: 0 ``Σ (Δv/Δt)²``, 1 ``Σ |Δv|``, 2 the number of steps with
+  ``|Δv|/Δt >= span[m, 2]``; the previous value and time in the other two numbers (the time NaN
+  before the first sample: the builder starts it so);
+* ``SCORE_WRAP_DIFF_SQUARES`` — ``Σ wrap(v − x_j)²`` over the samples where it is finite, x_j
+  the state ``j = int(span[m, 3])`` (log column j), and the number of them.
 
 Every value is the log's own arithmetic (:func:`column_value` is ``log_sample``'s), so a finished
 figure equals the one computed from the logged series.
@@ -48,6 +55,8 @@ SCORE_SWITCH = 8
 SCORE_LAST_OUT = 9
 SCORE_SUM_TC = 10
 SCORE_ARGMAX = 11
+SCORE_DIFF = 12
+SCORE_WRAP_DIFF_SQUARES = 13
 
 
 @inline
@@ -139,3 +148,22 @@ def score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):
             if v * span[m, 2] > acc[a]:
                 acc[a] = v * span[m, 2]
                 acc[a + 1] = t
+        elif kind == SCORE_DIFF:
+            tr = np.rint(t * 1e9) / 1e9  # time_coordinate(t): np.round(t, 9)
+            if not math.isnan(acc[a + 2]):
+                step = v - acc[a + 1]
+                f = span[m, 3]
+                if f == 0.0:
+                    q = step / (tr - acc[a + 2])
+                    acc[a] = acc[a] + q * q
+                elif f == 1.0:
+                    acc[a] = acc[a] + abs(step)
+                elif abs(step) / (tr - acc[a + 2]) >= span[m, 2]:
+                    acc[a] = acc[a] + 1.0
+            acc[a + 1] = v
+            acc[a + 2] = tr
+        elif kind == SCORE_WRAP_DIFF_SQUARES:
+            w = wrap(v - x[int(span[m, 3])])
+            if not math.isnan(w):
+                acc[a] = acc[a] + w * w
+                acc[a + 1] = acc[a + 1] + 1.0

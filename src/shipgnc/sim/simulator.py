@@ -503,7 +503,9 @@ def check_divergence(setup: SimSetup, t: float, x: np.ndarray | None = None,
     """None if the state (or the command) is sane, else the error naming time, signal, value, ship.
 
     A state is bad when it is not finite or beyond the model's ``state_limits``; a command when it
-    is not finite (checked at the sample where the controller produced it).
+    is not finite (checked at the sample where the controller produced it). A guidance whose own
+    states can go bad and make the command non-finite (a vessel target's) says which through its
+    ``divergence_cause(index)``, and the message names that first.
     """
     if x is not None:
         limits = np.asarray(setup.model.state_limits, dtype=float)
@@ -523,6 +525,11 @@ def check_divergence(setup: SimSetup, t: float, x: np.ndarray | None = None,
             f"beyond the runaway limit |{signal.name}| <= {limits[idx[-1]]:g} {signal.unit}")
     message = (f"simulation diverged at t = {t:.4g} s: {kind} '{signal.name}'{ship} = "
                f"{value:.6g} {signal.unit} ({rule})")
+    cause = getattr(setup.guidance, "divergence_cause", None) if x is None else None
+    why = cause(idx[:-1]) if callable(cause) else None
+    if why:  # a guidance-internal state (a vessel target) went bad first: name it
+        message = (f"simulation diverged at t = {t:.4g} s: {why}{ship}; the references from "
+                   f"it made the {kind} '{signal.name}' = {value:.6g} {signal.unit} ({rule})")
     return DivergenceError(message, time=t, state=signal.name, value=value, index=idx[:-1])
 
 
