@@ -55,9 +55,9 @@ def friendly_errors():
         stderr.print(f"[bold red]error:[/] {_one_line(exc)}{hint}", soft_wrap=True)
         raise typer.Exit(exc.exit_code) from None
     except KeyboardInterrupt as exc:  # Ctrl-C: one line, no traceback (Interrupted names the time)
-        from shipgnc.interrupts import say_once
+        from shipgnc.interrupts import noted, say_once
 
-        say_once(" ".join(str(exc).split()) if str(exc) else "interrupted")
+        say_once(" ".join(str(exc).split()) if str(exc) else noted())
         raise typer.Exit(130) from None
     except BrokenPipeError:  # `shipgnc … | head`: the reader left; say nothing, exit as SIGPIPE would
         devnull = os.open(os.devnull, os.O_WRONLY)
@@ -376,7 +376,7 @@ def main() -> None:
     """Console-script entry point. A usage error (an unknown option or command, a value that does
     not parse, a missing argument) is one line and exit 2 like every other bad input, not the
     parser's boxed usage text."""
-    from shipgnc.interrupts import arm_exit_deadline, exit_now, install, say_once
+    from shipgnc.interrupts import arm_exit_deadline, exit_now, install, noted, say_once
 
     install()
     arm_exit_deadline()  # Ctrl-C ends the command within half a second, whatever it is doing
@@ -386,7 +386,7 @@ def main() -> None:
     try:
         code = app(standalone_mode=False)
     except typer.Abort:
-        say_once("interrupted")
+        say_once(noted())
         exit_now(130)
     except Exception as exc:  # the parser's own errors (click's, as vendored by typer)
         code = getattr(exc, "exit_code", None)

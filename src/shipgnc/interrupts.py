@@ -167,6 +167,11 @@ def note(line: str) -> None:
     _noted = " ".join(str(line).split()) or "interrupted"
 
 
+def noted() -> str:
+    """The line :func:`note` last set: what a Ctrl-C now cuts short."""
+    return _noted
+
+
 def on_hard_exit(key: int, cleanup: Callable[[], None] | None) -> None:
     """Register (or, with None, drop) a clean-up the watchdog runs before it ends the process."""
     if cleanup is None:

@@ -22,7 +22,7 @@ from shipgnc.environment.disturbance import ConstantDisturbance, GaussianForceNo
 from shipgnc.errors import ConfigError, DivergenceError, Interrupted
 from shipgnc.guidance.los import LOSGuidance
 from shipgnc.guidance.schedule import ReferenceSchedule
-from shipgnc.interrupts import held, hold
+from shipgnc.interrupts import held, hold, note
 from shipgnc.models.fossen3dof import VectoredThrustBoat
 from shipgnc.paths import WaypointPath
 from shipgnc.scenarios import components as C
@@ -520,6 +520,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
             setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every, scored=scenario.metrics is not None)
         check_run_memory(setup.model, setup.x0, sim.t_end, sim.dt, every,
                          scored=scenario.metrics is not None)  # before the run, not a MemoryError
+        note("interrupted")  # the watchdog's line while simulating (a run's own names its time)
         hold(False)  # a Ctrl-C during the simulation cuts it short (kept as partial, or raised)
         try:
             with interruptible(keep_interrupted) as run:
@@ -545,6 +546,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                 raise
             raise DivergenceError(f"{exc}; note: {'; '.join(setup.controller.notes)}", time=exc.time,
                                   state=exc.state, value=exc.value, index=exc.index) from None
+        note("interrupted while scoring the run")  # the line a Ctrl-C from now on ends with
         if hasattr(setup.guidance, "add_targets") and run.result is not None:  # other ships
             run.result = setup.guidance.add_targets(run.result)
         if setup.navigation is not None and run.result is not None:

@@ -26,8 +26,10 @@ def write_outputs(run: ScenarioRun, out_dir: str | Path, *, figures: bool = True
     ``figure_process`` (a :class:`shipgnc.viz.background.FigureProcess`) draws the figures in a
     worker process while this one writes the data files.
     """
+    from shipgnc.interrupts import note
     from shipgnc.outputs import atomic_dir, moved
 
+    note("interrupted while writing the results")  # the line a Ctrl-C from now on ends with
     out = Path(out_dir)
     failed = []
     with atomic_dir(out, overwrite=overwrite, command="run", status=run_status(run)) as tmp:
