@@ -146,3 +146,50 @@ def test_the_controllers_sail_one_sea_drawn_once():
     for key, values in own.figures.items():
         np.testing.assert_array_equal(shared.figures[key], values, err_msg=key)
     assert shared.metrics == own.metrics
+
+
+def test_runs_that_differ_in_their_current_each_sail_their_own(tmp_path, monkeypatch):
+    """``runs`` that differ only in a Gauss–Markov current (which draws a per-step table of its
+    own) do not share one sea: a run with no current, then two different currents, each give
+    the batch ``simulate`` gives for that run alone (its result thinned to ``log_every``, to the
+    bit), whatever ran before it."""
+    import yaml
+
+    from shipgnc.scenarios.registry import raw_scenario
+    from shipgnc.scenarios.runner import run_plan
+
+    data, _ = raw_scenario("mariner-montecarlo")
+    data = {k: v for k, v in data.items() if k not in ("controllers", "document_figures")}
+    data.update(name="mc-currents", controller=raw_scenario("mariner-montecarlo")[0]
+                ["controllers"]["los_fl"])
+    data["simulation"] = {**data["simulation"], "t_end": 1500.0}
+    data["montecarlo"] = {**data["montecarlo"], "runs": 4}
+    data["disturbance"] = {**data["disturbance"], "d_y_nm_min": 0.0}  # the current given apart
+    gm = "gauss-markov:speed=0.5,direction={},speed_std=0.3,speed_tau=60,direction_std=40,direction_tau=60"
+    data["runs"] = {"still": {}, "east": {"current": gm.format(90)},
+                    "north": {"current": gm.format(0)}}
+    path = tmp_path / "mc-currents.yaml"
+    path.write_text(yaml.safe_dump(data))
+    scenario = load_scenario(str(path))
+    seed = scenario.simulation.seed
+    plan = run_plan(scenario)
+    expected = {name: thin(_full_log(each, None, seed), each.simulation.log_every)
+                for name, (each, _) in plan.items()}
+
+    def sail(names, seas):
+        for name in names:
+            each = plan[name][0]
+            got = montecarlo.run(each, build(each, seed=seed), lambda e=each: build(e, seed=seed),
+                                 seed=seed, seas=seas)
+            assert got is not None
+            for var in ("east", "north", "psi", "delta"):
+                np.testing.assert_array_equal(got.result[var].values, expected[name][var].values,
+                                              err_msg=f"{name}: {var}")
+
+    seas = {}
+    sail(["still", "east", "north"], seas)
+    assert len(seas) == 3
+    # tables that are not the ones the loop's kernels draw (no current's table) are never
+    # replayed, whatever the key says: the run draws its own
+    monkeypatch.setattr(montecarlo, "sea_key", lambda *args: "one key")
+    sail(["still", "east"], {})

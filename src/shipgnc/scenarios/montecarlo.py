@@ -102,9 +102,13 @@ def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
 
 
 def sea_key(scenario, seed: int, shape) -> str:
-    """What a batch's per-step input tables (its wave noise) depend on: the scenario's
-    disturbance section, vessel and simulation, the seed and the batch's shape."""
-    return repr((scenario.disturbance, scenario.vessel, scenario.simulation, seed, tuple(shape)))
+    """What a batch's per-step input tables (its wave noise, a Gauss–Markov current's draws)
+    depend on: the scenario's sections that build the drawing components (disturbance, current,
+    vessel, sensors, estimator) and simulation, the seed and the batch's shape. (A table whose
+    name or width is not what the loop's kernels draw is not replayed either:
+    :func:`shipgnc.sim.scored.run_scored` draws afresh.)"""
+    return repr((scenario.disturbance, scenario.current, scenario.vessel, scenario.sensors,
+                 scenario.estimator, scenario.simulation, seed, tuple(shape)))
 
 
 #: ships of a batch run again together with their log of every step (a block's log stays small)

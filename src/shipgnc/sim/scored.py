@@ -52,9 +52,10 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
     acc = np.empty((n, len(init)))
     acc[:] = np.asarray(init, dtype=np.float64)
     comp.score_in_loop(ops, span, acc)
-    if tables is not None:
+    if tables is not None and table_widths(comp) == _widths(tables, n):
         prepare = _replaying(comp, tables)
-    else:
+    else:  # no tables, or not the ones this loop's kernels draw: draw them
+
         prepare, tables = (_recording(comp, setup.n_steps + 1) if logged else (comp.prepare, None))
     stop = drive(setup, comp.call, comp.S, comp.event, prepare=prepare, done_at=comp.done_at)
     if stop.interrupted and not logged:
@@ -84,6 +85,9 @@ def run_with_tables(setup, tables: dict):
     comp = Composition(setup, scored=True)
     comp.score_in_loop(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4)),
                        np.zeros((comp.S.shape[0], 0)))
+    if table_widths(comp) != _widths(tables, comp.S.shape[0]):
+        raise ValueError(f"run_with_tables: the tables {_widths(tables, None)} are not the ones "
+                         f"the loop's kernels draw {table_widths(comp)}")
     stop = drive(setup, comp.call, comp.S, comp.event, prepare=_replaying(comp, tables),
                  done_at=comp.done_at)
     if stop.interrupted:
@@ -93,12 +97,29 @@ def run_with_tables(setup, tables: dict):
                     cmd_slot=comp.layout["cmd"], k_end=stop.k_end, events=comp.event)
 
 
+def table_widths(comp) -> dict[str, int]:
+    """The per-step tables ``comp``'s kernels draw: their columns by name (a kernel that draws
+    none is left out)."""
+    return {name: int(k.n_table) for name, k in comp._tabled
+            if k is not None and k.table is not None and k.n_table > 0}
+
+
+def _widths(tables: dict, ships: int | None) -> dict[str, int] | None:
+    """The columns of each of ``tables`` by name, or None if one is not of ``ships`` ships."""
+    if ships is not None and any(t.shape[1] != ships for t in tables.values()):
+        return None
+    return {name: int(t.shape[-1]) for name, t in tables.items()}
+
+
 def _replaying(comp, tables: dict):
-    """``comp.prepare`` with the per-step ``tables`` (by name, (steps + 1, ships, ·)) for those
-    they hold, the others empty, nothing drawn."""
+    """``comp.prepare`` with the per-step ``tables`` (by name, (steps + 1, ships, ·): those
+    ``comp``'s kernels draw, :func:`table_widths`, checked by the caller), the other tables
+    empty, nothing drawn."""
+    widths = table_widths(comp)
+
     def prepare(k0: int, k1: int) -> None:
         for name, table in comp._table.items():
-            comp._table[name] = (np.ascontiguousarray(tables[name][k0:k1]) if name in tables
+            comp._table[name] = (np.ascontiguousarray(tables[name][k0:k1]) if name in widths
                                  else np.zeros((k1 - k0, *table.shape[1:2], 0)))
 
     return prepare
