@@ -193,3 +193,34 @@ def test_runs_that_differ_in_their_current_each_sail_their_own(tmp_path, monkeyp
     # replayed, whatever the key says: the run draws its own
     monkeypatch.setattr(montecarlo, "sea_key", lambda *args: "one key")
     sail(["still", "east"], {})
+
+
+def test_a_batch_whose_wave_noise_does_not_fit_is_refused_before_it_runs(monkeypatch):
+    """The in-loop batch keeps every step's wave noise of every ship ((steps + 1) × ships × 1
+    float64: the Mariner's one wave value per step) besides its log at ``log_every``: with
+    memory for the log but only half that table, ``run_scenario`` refuses the run with the
+    one-line ConfigError before simulating anything."""
+    from shipgnc import memory
+    from shipgnc.errors import ConfigError
+    from shipgnc.scenarios import runner
+    from shipgnc.sim.simulator import RUN_MEMORY_FACTOR, check_run_memory, logged_numbers
+
+    ships = 30000
+    scenario = load_scenario("mariner-montecarlo", [f"montecarlo.runs={ships}"])
+    sim = scenario.simulation
+    setup = build(scenario, "lqr", seed=sim.seed)
+    steps = round(sim.t_end / sim.dt)
+    log = 8 * RUN_MEMORY_FACTOR * logged_numbers(setup.model, (ships,), steps, sim.log_every)
+    noise = 8 * (steps + 1) * ships
+    have = log + noise // 2
+    check_run_memory(setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every, limit=have,
+                     scored=True)  # the log alone fits
+    monkeypatch.setattr(memory, "available_memory", lambda: have)
+
+    def never(*args, **kwargs):
+        raise AssertionError("the batch ran")
+
+    monkeypatch.setattr(montecarlo, "run", never)
+    with pytest.raises(ConfigError, match=r"^simulation\.t_end = .*fewer ships$") as err:
+        runner.run_scenario(scenario)
+    assert "\n" not in str(err.value)

@@ -18,6 +18,7 @@ scored from the log). A batch cut short by Ctrl-C keeps the samples it logged (e
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -109,6 +110,35 @@ def sea_key(scenario, seed: int, shape) -> str:
     :func:`shipgnc.sim.scored.run_scored` draws afresh.)"""
     return repr((scenario.disturbance, scenario.current, scenario.vessel, scenario.sensors,
                  scenario.estimator, scenario.simulation, seed, tuple(shape)))
+
+
+def table_numbers(scenario, setup, seed: int, seas: dict) -> int:
+    """The float64 numbers of per-step input tables alive while the batch of ``setup`` runs
+    (:func:`run` records them, ``seas`` keeps them for the comparison): those already in
+    ``seas`` and, unless its sea is among them, the batch's own, (steps + 1) × ships × the
+    columns its drawing kernels declare (``Kernel.n_table``). For
+    :func:`~shipgnc.sim.simulator.check_run_memory` before the run; ``setup`` is a fresh build
+    (its disturbance is reset here, on a generator of its own, to ask for its kernels)."""
+    from shipgnc.kernels import NotCompiled
+    from shipgnc.sim.simulator import reset_disturbance
+
+    held = sum(t.size for tables in seas.values() for t in tables.values())
+    sim, batch, dist = scenario.simulation, setup.x0.shape[:-1], setup.disturbance
+    steps = sim.t_end / sim.dt
+    if dist is None or sea_key(scenario, seed, setup.x0.shape) in seas or not math.isfinite(steps):
+        return held  # nothing drawn, drawn already, or a run simulate's own check refuses
+    reset_disturbance(dist, setup.model, batch, np.random.default_rng(0))
+    columns = 0
+    for make in (getattr(dist, "kernel", None), getattr(dist, "kernel_current", None)):
+        if not callable(make):
+            continue
+        try:
+            kernel = make(batch, dt=sim.dt)
+        except NotCompiled:  # no compiled loop: the run is not scored in it (no tables)
+            continue
+        if kernel is not None and kernel.table is not None:
+            columns += int(kernel.n_table)
+    return held + (round(steps) + 1) * math.prod(batch) * columns
 
 
 #: ships of a batch run again together with their log of every step (a block's log stays small)

@@ -519,7 +519,9 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
         every = sim.log_every if in_loop else scoring_log_every(
             setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every, scored=scenario.metrics is not None)
         check_run_memory(setup.model, setup.x0, sim.t_end, sim.dt, every,
-                         scored=scenario.metrics is not None)  # before the run, not a MemoryError
+                         scored=scenario.metrics is not None,  # before the run, not a MemoryError
+                         tables=montecarlo.table_numbers(each, build(each, variant, seed=seed), seed,
+                                                         seas) if in_loop else 0)
         note("interrupted")  # the watchdog's line while simulating (a run's own names its time)
         hold(False)  # a Ctrl-C during the simulation cuts it short (kept as partial, or raised)
         try:

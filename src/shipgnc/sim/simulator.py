@@ -418,13 +418,15 @@ RUN_MEMORY_FACTOR = 2
 
 
 def check_run_memory(model, x0, t_end: float, dt: float, log_every: int, *,
-                     limit: float | None = None, scored: bool = False) -> None:
+                     limit: float | None = None, scored: bool = False,
+                     tables: int = 0) -> None:
     """A ConfigError (exit 2) naming the estimate and what fits when a run's record (logged
     every ``log_every`` steps, :func:`logged_numbers`), about :data:`RUN_MEMORY_FACTOR` times
     over, needs more than ``limit`` bytes (default: the memory available now, ``ulimit -v``
     counted: :func:`shipgnc.memory.available_memory`). ``scored``: the metrics are computed
     from every step (see :func:`scoring_log_every`), so ``simulation.log_every`` would not help
-    and is not named."""
+    and is not named. ``tables``: float64 numbers held besides the record (a Monte Carlo
+    batch's per-step input tables, :func:`shipgnc.scenarios.montecarlo.table_numbers`)."""
     from shipgnc.memory import available_memory
 
     steps = t_end / dt
@@ -434,7 +436,7 @@ def check_run_memory(model, x0, t_end: float, dt: float, log_every: int, *,
     numbers = logged_numbers(model, batch, round(steps), log_every)
     if numbers > MAX_LOGGED:
         return  # simulate's own log-size guard names it
-    need = 8 * RUN_MEMORY_FACTOR * numbers
+    need = 8 * (RUN_MEMORY_FACTOR * numbers + tables)
     have = available_memory() if limit is None else limit
     if need <= have:
         return
