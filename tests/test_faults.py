@@ -474,3 +474,39 @@ def test_keep_partial_keeps_a_run_whose_ctrl_c_came_after_it_finished(tmp_path, 
     assert json.loads((out / ".shipgnc-run").read_text())["status"] == "complete"
     assert float(load(out / "result.nc")["time"].values[-1]) == 20.0
     assert "interrupted" not in json.loads((out / "metrics.json").read_text())
+
+
+def test_keep_partial_keeps_a_montecarlo_batch_whose_ctrl_c_came_while_ships_are_run_again(
+        tmp_path, monkeypatch):
+    """--keep-partial and a Ctrl-C while the ships the in-loop scoring left undecided are run
+    again (the batch itself had run to t_end): that is the batch's scoring, so the complete
+    result is written (the log to t_end, status complete), one line says so, exit 130."""
+    from typer.testing import CliRunner
+
+    from shipgnc.analysis import accumulated
+    from shipgnc.cli import app
+    from shipgnc.scenarios import montecarlo
+    from shipgnc.sim.result import load
+
+    monkeypatch.setattr(accumulated, "MARGIN", 1e12)  # every ship's verdict left to its log
+    events, again = [], montecarlo._scored_from_log
+
+    def ctrl_c_while_run_again(*args):
+        if not events:
+            os.kill(os.getpid(), signal.SIGINT)  # the handler runs here, before the next line
+        events.append("run again")
+        return again(*args)
+
+    monkeypatch.setattr(montecarlo, "_scored_from_log", ctrl_c_while_run_again)
+    out = tmp_path / "r"
+    r = CliRunner().invoke(app, ["run", "mariner-montecarlo", "--set", "simulation.t_end=600",
+                                 "--set", "montecarlo.runs=4", "--no-figures", "--keep-partial",
+                                 "--out", str(out)])
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert r.exit_code == 130, r.output
+    assert events == ["run again"]  # the undecided ships were all run again (one block)
+    # the first controller's batch complete, the second not started
+    assert lines[-1] == "interrupted after 1 of 2 runs (each complete)", lines
+    assert float(load(out / "result.nc")["time"].values[-1]) == 600.0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["lqr"]["runs"] == 4 and "los_fl" not in metrics, metrics

@@ -47,7 +47,8 @@ def scored_in_loop(scenario, observer=None) -> bool:
 
 
 def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
-        attrs: dict | None = None, seas: dict | None = None) -> ScoredBatch | None:
+        attrs: dict | None = None, seas: dict | None = None,
+        scoring: Callable[[], None] | None = None) -> ScoredBatch | None:
     """The batch of ``setup`` (built from ``scenario``; ``rebuild()`` builds it again, fresh
     components for the ships run again) scored in the loop, or None (see the module). Ctrl-C
     raises :class:`~shipgnc.errors.Interrupted` with the samples logged up to it.
@@ -56,7 +57,11 @@ def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
     fills), by :func:`sea_key`. The controllers of a comparison sail one sea: the same
     disturbance section, vessel, simulation, seed and batch give the same tables (a table is
     drawn from the run's generator before the steps it feeds, so it cannot depend on the
-    controller or the ships' states), drawn by the first controller and read by the others."""
+    controller or the ships' states), drawn by the first controller and read by the others.
+
+    ``scoring()`` is called once the batch has run to its end, before the ships left undecided
+    are run again (those runs are its scoring: the runner holds a Ctrl-C from then on with
+    --keep-partial, and the complete batch is kept as for any run scored after it finished)."""
     from shipgnc.analysis import accumulated
     from shipgnc.analysis.path_tracking import montecarlo_figures
     from shipgnc.scenarios.runner import design_figures
@@ -89,6 +94,8 @@ def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
         seas[key] = scored.tables
     if (scored.event >= 0).any():
         return None
+    if scoring is not None:
+        scoring()
     figures = plan.finish(scored.acc)
     again = np.flatnonzero(figures.pop(accumulated.NEEDS_LOG))
     for block in np.array_split(again, -(-again.size // SHIPS_PER_RERUN)) if again.size else ():

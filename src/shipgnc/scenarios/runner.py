@@ -524,12 +524,21 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                                                          seas) if in_loop else 0)
         note("interrupted")  # the watchdog's line while simulating (a run's own names its time)
         hold(False)  # a Ctrl-C during the simulation cuts it short (kept as partial, or raised)
+
+        def scoring() -> None:  # the run is complete: what follows is its scoring
+            note("interrupted while scoring the run")  # the line a Ctrl-C from now on ends with
+            if keep_interrupted:  # a Ctrl-C from now on keeps the complete result
+                hold()
+
         try:
             with interruptible(keep_interrupted) as run:
                 batch = montecarlo.run(
                     each, setup, lambda e=each, v=variant: build(e, v, seed=seed), seed=seed,
-                    progress=progress, attrs=attrs, seas=seas) if in_loop else None
+                    progress=progress, attrs=attrs, seas=seas,
+                    scoring=scoring) if in_loop else None
                 if in_loop and batch is None:  # not covered, or a ship diverged: as any other run
+                    note("interrupted")  # simulating again (a Ctrl-C cuts it short)
+                    hold(False)
                     setup = build(each, variant, seed=seed)
                     every = scoring_log_every(setup.model, setup.x0, sim.t_end, sim.dt, sim.log_every)
                     check_run_memory(setup.model, setup.x0, sim.t_end, sim.dt, every, scored=True)
@@ -541,14 +550,13 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                     atol=sim.atol, seed=seed, observer=observer, progress=progress,
                     log_every=every, backend="numpy" if observer is not None else sim.backend,
                     on_divergence="stop" if compare else on_divergence, attrs=attrs)
-                if keep_interrupted:  # finished: a Ctrl-C from now on keeps the complete result
-                    hold()
+                scoring()
         except DivergenceError as exc:  # a controller's note (e.g. poor margins) may say why
             if not getattr(setup.controller, "notes", None):
                 raise
             raise DivergenceError(f"{exc}; note: {'; '.join(setup.controller.notes)}", time=exc.time,
                                   state=exc.state, value=exc.value, index=exc.index) from None
-        note("interrupted while scoring the run")  # the line a Ctrl-C from now on ends with
+        note("interrupted while scoring the run")  # (also after a partial kept)
         if hasattr(setup.guidance, "add_targets") and run.result is not None:  # other ships
             run.result = setup.guidance.add_targets(run.result)
         if setup.navigation is not None and run.result is not None:
