@@ -329,3 +329,22 @@ def test_a_study_of_no_metric_set_keeps_nothing_but_its_status():
     assert list(plain.data_vars) == ["diverged", "initial_state_psi_deg"]
     for key in plain.data_vars:
         np.testing.assert_array_equal(plain[key].values, series[key].values, err_msg=key)
+
+
+@pytest.mark.parametrize("series", [False, True])
+def test_the_memory_estimate_takes_the_largest_grid_point_in_any_order(series):
+    """A grid over ``simulation.t_end``: the chunk (and, with --series, every member's series)
+    is budgeted for the longest run, 1400 s, whichever order the grid lists it in: the
+    estimate of the study of that point alone."""
+    from shipgnc.study.execute import estimate_memory
+
+    def need(*t_ends):
+        grid = (("simulation.t_end", t_ends),)
+        return estimate_memory(Study("boat-autopilot", grid=grid, members=4000, series=series),
+                               None, 4000)
+
+    alone = need(1400.0)
+    short_first, long_first = need(20.0, 1400.0), need(1400.0, 20.0)
+    assert short_first == long_first
+    assert short_first["chunk"] == alone["chunk"] > need(20.0)["chunk"]
+    assert short_first["result"] == 2 * alone["result"]  # two cells, each as large as the longest

@@ -262,21 +262,27 @@ def estimate_memory(study: Study, variants: list[str] | None, chunk_size: int) -
     metrics, with ``--series`` every member's thinned series) and ``chunk`` (what one chunk holds
     while it runs, :func:`chunk_numbers`). The measure of a series is
     :func:`shipgnc.sim.simulator.logged_numbers`."""
-    from shipgnc.sim.simulator import logged_numbers
-
-    model, _, sim = _vessel_of(study.scenario_at(study.points[0]), study.seed)
-    n_steps = round(sim.t_end / sim.dt)
     cells = len(study.points) * len(variants or [None])
     per_member = NUMBERS_PER_MEMBER
-    if study.series:
-        per_member += logged_numbers(model, (1,), n_steps, sim.log_every)
+    if study.series:  # the longest series of any grid point (a grid may set t_end, dt, log_every)
+        per_member += max(_series_numbers(study, point) for point in range(len(study.points)))
     size = min(chunk_size, study.members)
-    chunk = max(chunk_numbers(study, variant, size) for variant in variants or [None])
+    # the largest chunk of any grid point and controller (each point may decide otherwise)
+    chunk = max(chunk_numbers(study, variant, size, point) for variant in variants or [None]
+                for point in range(len(study.points)))
     return {"result": 8 * cells * study.members * per_member, "chunk": 8 * chunk}
 
 
-def chunk_numbers(study: Study, variant: str | None, size: int) -> int:
-    """Numbers a chunk of ``size`` members of the study's first grid point holds while it runs,
+def _series_numbers(study: Study, point: int) -> int:
+    """Numbers of one member's series at grid point ``point`` (logged at its ``log_every``)."""
+    from shipgnc.sim.simulator import logged_numbers
+
+    model, _, sim = _vessel_of(study.scenario_at(study.points[point]), study.seed)
+    return logged_numbers(model, (1,), round(sim.t_end / sim.dt), sim.log_every)
+
+
+def chunk_numbers(study: Study, variant: str | None, size: int, point: int = 0) -> int:
+    """Numbers a chunk of ``size`` members of grid point ``point`` holds while it runs,
     as :func:`~shipgnc.study.chunk.run_chunk` will run it (the decision is
     :func:`~shipgnc.study.chunk.in_loop_plan`'s, taken on the chunk's first member). Scored in
     the loop: each member's accumulators and its first and last sample, plus one member's
@@ -284,7 +290,7 @@ def chunk_numbers(study: Study, variant: str | None, size: int) -> int:
     every-step record, about twice (the arrays derived from it)."""
     from shipgnc.sim.simulator import logged_numbers
 
-    scenario, setup, sim, x0, seeds, _ = chunk_setup(study, Chunk(0, 0, 1, variant))
+    scenario, setup, sim, x0, seeds, _ = chunk_setup(study, Chunk(point, 0, 1, variant))
     n_steps = round(sim.t_end / sim.dt)
     planned = in_loop_plan(scenario, setup, sim, x0, seeds, "compiled-or-numpy", study.series)
     if planned is None:
