@@ -510,3 +510,21 @@ def test_keep_partial_keeps_a_montecarlo_batch_whose_ctrl_c_came_while_ships_are
     assert float(load(out / "result.nc")["time"].values[-1]) == 600.0
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["lqr"]["runs"] == 4 and "los_fl" not in metrics, metrics
+
+
+def test_a_ctrl_c_while_the_next_run_is_built_is_not_said_to_cut_the_scoring(monkeypatch):
+    """The watchdog's line while a comparison's second controller is built (and simulated) is
+    the plain "interrupted", not the first run's "interrupted while scoring the run"."""
+    from shipgnc import interrupts
+    from shipgnc.scenarios import runner as runner_mod
+
+    lines, real = [], runner_mod.build
+
+    def noting(*args, **kwargs):
+        lines.append(interrupts.noted())
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(runner_mod, "build", noting)
+    run = runner_mod.run_scenario("mariner-compare", overrides=["simulation.t_end=30"])
+    assert len(run.metrics) >= 2 and len(lines) >= 2
+    assert set(lines) == {"interrupted"}, lines

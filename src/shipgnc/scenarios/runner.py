@@ -510,6 +510,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
             run.message = (f"interrupted after {len(results)} of {len(plan)} runs "
                            "(each complete)")
             break
+        note("interrupted")  # the watchdog's line while building and simulating the run
         setup, sim = build(each, variant, seed=seed), each.simulation
         attrs = {"scenario": scenario.name, "controller": name, "seed": seed,
                  **_vessel_attrs(setup.model, each)}
@@ -522,7 +523,6 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                          scored=scenario.metrics is not None,  # before the run, not a MemoryError
                          tables=montecarlo.table_numbers(each, build(each, variant, seed=seed), seed,
                                                          seas) if in_loop else 0)
-        note("interrupted")  # the watchdog's line while simulating (a run's own names its time)
         hold(False)  # a Ctrl-C during the simulation cuts it short (kept as partial, or raised)
 
         def scoring() -> None:  # the run is complete: what follows is its scoring
