@@ -565,8 +565,11 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
             run.result.attrs["controller_notes"] = "; ".join(setup.controller.notes)
         if getattr(setup.controller, "events", None) is not None and run.result is not None:
             run.result.attrs["events"] = json.dumps(list(setup.controller.events))  # kept in the file
+        # a batch scored in the loop is complete (a Ctrl-C in it raised before ``batch`` was
+        # set): its metrics are the ones scored at every step (its result may since carry the
+        # targets, add_targets, a new Dataset of the same run)
         all_metrics[name] = run.metrics(
-            lambda r, s=setup, e=each, b=batch: b.metrics if b is not None and r is b.result
+            lambda r, s=setup, e=each, b=batch: b.metrics if b is not None
             else compute_metrics(e, r, s))
         results[name], setups[name] = (run.result if batch is not None else
                                        thin(run.result, sim.log_every // every)), setup
