@@ -156,14 +156,15 @@ def test_lqr_gain_matches_independent_care(R):
 
 @pytest.mark.parametrize("R", [1.0, 0.5])
 def test_lqr_gain_is_python_controls(R):
-    """The design solves the Riccati equation with scipy as ``control.lqr`` does (python-control
-    without slycot): the same gain and poles to the bit, without importing python-control."""
+    """The design solves the Riccati equation with scipy as ``control.lqr(method="scipy")`` does
+    (python-control's scipy path, whether slycot is installed or not): the same gain and poles to
+    the bit, without importing python-control."""
     import control  # python-control: a hard dependency (a missing one fails, never skips)
 
     from shipgnc.models.mariner import tracking_model
 
     A, B = tracking_model(A_PAPER, C_PAPER, U_PAPER)
-    K_ref, _, poles_ref = control.lqr(A, B, np.diag(PAPER_Q), np.array([[R]]))
+    K_ref, _, poles_ref = control.lqr(A, B, np.diag(PAPER_Q), np.array([[R]]), method="scipy")
     K, poles = lqr_tracking_gain(A_PAPER, C_PAPER, U_PAPER, PAPER_Q, R)
     np.testing.assert_array_equal(K, np.asarray(K_ref).reshape(4))
     np.testing.assert_array_equal(poles, np.asarray(poles_ref).reshape(4))
