@@ -55,7 +55,6 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
     if tables is not None and table_widths(comp) == _widths(tables, n):
         prepare = _replaying(comp, tables)
     else:  # no tables, or not the ones this loop's kernels draw: draw them
-
         prepare, tables = (_recording(comp, setup.n_steps + 1) if logged else (comp.prepare, None))
     stop = drive(setup, comp.call, comp.S, comp.event, prepare=prepare, done_at=comp.done_at)
     if stop.interrupted and not logged:
