@@ -2,18 +2,22 @@
 
 One column per controller; rows: surge speed u, heading ψ with the set-point ψ_d (and the
 reference model ψ_z dashed where the controller has one), applied rudder δ with its limits.
-Drawn from plain arrays (see :func:`course_series`), so a worker process needs no xarray.
+Drawn from plain arrays (see :func:`course_series`), so a worker process needs no xarray; the
+series are taken in the run's process, which imports matplotlib only to draw.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from shipgnc.errors import ConfigError
 from shipgnc.viz import style
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 COURSE_KEYS = ("time", "u", "psi", "psi_d", "psi_z", "delta")
 
@@ -30,6 +34,8 @@ def course_series(result, controller: str) -> dict[str, np.ndarray]:
 def course_comparison(series: Mapping[str, Mapping[str, np.ndarray]], *, title: str = "",
                       rudder_limit_deg: float | None = None) -> Figure:
     """Figure with one column per controller (document 003 Fig. 1–2 layout)."""
+    from matplotlib.figure import Figure
+
     if not series:
         raise ConfigError("course_comparison: no controller series to draw")
     names = list(series)
