@@ -10,7 +10,7 @@ last::
     gnc        guidance, control, navigation
     physics    models, actuators, environment
     paths      paths (waypoint paths, the leg tracker: its batch derived from its kernel)
-    derive     derive (the batch over ships derived from a scalar kernel)
+    derive     derive (the batch over ships derived from a scalar kernel), derived_cache
     core       errors, units, frames, timeseries, streams, batchmath, params, kernels, jit_cache,
                outputs, interrupts, lifeline, memory, user_files, config_types
 

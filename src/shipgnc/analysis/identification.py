@@ -33,7 +33,6 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
-from scipy import optimize, signal
 
 from shipgnc.errors import require
 
@@ -60,6 +59,8 @@ def zigzag_trial(model, actuator, x0, *, delta_deg: float = 20.0, psi_deg: float
 
 def _foh_first_order(K: float, T: float, h: float, delta: np.ndarray, r0: float) -> np.ndarray:
     """Exact response of ṙ = (Kδ − r)/T to δ linear between samples h apart (module docstring)."""
+    from scipy import signal
+
     a = -1.0 / T
     ah = a * h
     alpha = math.exp(ah)
@@ -186,6 +187,8 @@ def fit_nomoto(t, delta, r, *, guess: tuple[float, float] | None = None, label: 
             inv_T = 1e-12
         return _simulate_segments(K, 1.0 / inv_T, h, delta, r, segments) - r
 
+    from scipy import optimize
+
     sol = optimize.least_squares(residuals, [K0, 1.0 / T0], x_scale="jac", method="lm",
                                  xtol=1e-14, ftol=1e-14, gtol=1e-14, max_nfev=2000)
     K, inv_T = sol.x
@@ -242,6 +245,8 @@ def _lsim2(K, T1, T2, T3, t, delta, r0):
     A, B, C = _second_order_system(K, T1, T2, T3)
     # start on the output r0 with the state's derivative part at zero
     x0 = np.array([r0 / C[0, 0] if C[0, 0] != 0 else 0.0, 0.0])
+    from scipy import signal
+
     sys = signal.StateSpace(A, B, C, np.zeros((1, 1)))
     _, y, _ = signal.lsim(sys, delta, t - t[0], X0=x0, interp=True)
     return np.asarray(y, dtype=float).reshape(-1)
@@ -264,6 +269,8 @@ def fit_nomoto2(t, delta, r, *, guess: tuple[float, float, float, float] | None 
         if abs(T1 * T2) < 1e-9:
             return np.full(r.size, 1e3)
         return _lsim2(K, T1, T2, T3, t, delta, r[0]) - r
+
+    from scipy import optimize
 
     sol = optimize.least_squares(residuals, np.asarray(guess, dtype=float), x_scale="jac",
                                  max_nfev=400)
@@ -300,14 +307,24 @@ def _record(ds):
 
 @lru_cache(maxsize=16)
 def _identify_cached(params, delta_deg, psi_deg, propeller_rps, t_end, dt):
+    from shipgnc.derived_cache import stored
+
+    inputs = {"params": params.as_dict(), "delta_deg": delta_deg, "psi_deg": psi_deg,
+              "propeller_rps": propeller_rps, "t_end": t_end, "dt": dt}
+    kept = stored("cybership2-nomoto", inputs, (__name__, "shipgnc.models.cybership2"),
+                  lambda: _identify(params, delta_deg, psi_deg, propeller_rps, t_end, dt))
+    label = f"CyberShip II zig-zag {delta_deg:g}/{psi_deg:g}, {t_end:g} s"
+    return NomotoFit(**kept["fit"], label=label, extra=kept["extra"])
+
+
+def _identify(params, delta_deg, psi_deg, propeller_rps, t_end, dt) -> dict:
+    """:func:`identify_cybership2` computed: the zig-zag simulated and the model fitted to it."""
     ds = cybership2_zigzag(params, delta_deg=delta_deg, psi_deg=psi_deg,
                            propeller_rps=propeller_rps, t_end=t_end, dt=dt)
-    label = f"CyberShip II zig-zag {delta_deg:g}/{psi_deg:g}, {t_end:g} s"
-    fit = fit_nomoto(*_record(ds), label=label)
-    return NomotoFit(K=fit.K, T=fit.T, residual_rms=fit.residual_rms, r_rms=fit.r_rms, fit=fit.fit,
-                     cost=fit.cost, label=label,
-                     extra={"min_surge_mps": float(ds["u"].min()),
-                            "mean_surge_mps": float(ds["u"].mean())})
+    fit = fit_nomoto(*_record(ds))
+    return {"fit": {"K": fit.K, "T": fit.T, "residual_rms": fit.residual_rms, "r_rms": fit.r_rms,
+                    "fit": fit.fit, "cost": fit.cost},
+            "extra": {"min_surge_mps": float(ds["u"].min()), "mean_surge_mps": float(ds["u"].mean())}}
 
 
 def identify_cybership2(params=None, *, delta_deg: float = 20.0, psi_deg: float = 20.0,
@@ -316,7 +333,9 @@ def identify_cybership2(params=None, *, delta_deg: float = 20.0, psi_deg: float 
     """First-order Nomoto model of CyberShip II identified from its zig-zag (module docstring).
 
     ``params``: the plant (:class:`~shipgnc.models.cybership2.CyberShip2Params`, default the
-    published one with the ``table1`` rudder, 35° and 19.4105°/s). Cached per argument set.
+    published one with the ``table1`` rudder, 35° and 19.4105°/s). Kept per argument set, in the
+    process and on disk (:func:`shipgnc.derived_cache.stored`, keyed by the arguments and by the
+    code that simulates and fits: a later process reads back the same numbers).
     """
     from shipgnc.models.cybership2 import CRUISE_RPS, CyberShip2Params
 

@@ -141,7 +141,8 @@ def design_smc(a22: float, b2: float, lam1: float, lam2: float) -> SMCDesign:
     """Gains of the sliding-mode autopilot for ṙ = a₂₂ r + b₂ δ (notes 003-3.2, 003-3.4).
 
     K by scipy's ``place_poles`` (YT, what python-control's ``place`` calls; python-control's
-    ``acker`` for a repeated eigenvalue), h from numpy's
+    ``acker`` for a repeated eigenvalue; the gain kept on disk by A, B and the poles,
+    :func:`shipgnc.derived_cache.stored`), h from numpy's
     eigenvectors of A_cᵀ (eigenvalue nearest λ₁), N_x, N_u by solving (13). λ₁ and λ₂ must be real
     and negative, |λ₁| ≤ |λ₂| (λ₁ is the eigenvalue of smallest modulus, the one h belongs to).
     """
@@ -162,10 +163,11 @@ def design_smc(a22: float, b2: float, lam1: float, lam2: float) -> SMCDesign:
         import control  # python-control (≈ 1 s to import, with matplotlib.pyplot): this case only
 
         gain = control.acker(A, B, poles)
-    else:  # python-control's place is this call (YT method)
-        from scipy.signal import place_poles
+    else:  # python-control's place is this call (YT method), kept on disk by its inputs
+        from shipgnc.derived_cache import stored
 
-        gain = place_poles(A, B, np.array(poles), method="YT").gain_matrix
+        gain = stored("place-poles-yt", {"A": A, "B": B, "poles": poles}, (__name__,),
+                      lambda: {"K": _place_poles(A, B, poles)})["K"]
     K = np.asarray(gain, dtype=float).reshape(2)
     A_c = A - B @ K.reshape(1, 2)
     values, vectors = np.linalg.eig(A_c.T)
@@ -178,6 +180,14 @@ def design_smc(a22: float, b2: float, lam1: float, lam2: float) -> SMCDesign:
     Nx, Nu = sol[:2], float(sol[2])
     return SMCDesign(a22=float(a22), b2=float(b2), lam1=float(lam1), lam2=float(lam2), A=A, B=B, C=C,
                      D=D, K=K, Nx=Nx, Nu=Nu, N=float(Nu + K @ Nx), h=h, hB=float(h @ B[:, 0]))
+
+
+def _place_poles(A: np.ndarray, B: np.ndarray, poles: list[float]) -> list[float]:
+    """The state-feedback gain of ``scipy.signal.place_poles`` (method YT) as a list."""
+    from scipy.signal import place_poles
+
+    gain = place_poles(A, B, np.array(poles), method="YT").gain_matrix
+    return np.asarray(gain, dtype=float).ravel().tolist()
 
 
 class SlidingModeCourse(_CourseController):

@@ -40,7 +40,6 @@ from itertools import pairwise
 from typing import NamedTuple
 
 import numpy as np
-from scipy import integrate
 
 from shipgnc.errors import ConfigError, require
 from shipgnc.kernels import Kernel, flat
@@ -233,6 +232,8 @@ def _jonswap_norm(gamma: float, sigma_a: float, sigma_b: float) -> float:
     def excess(x: float) -> float:
         xa = np.array([x])
         return float((_unit_pm(xa) * (_peak_factor(xa, gamma, sigma_a, sigma_b) - 1.0))[0])
+
+    from scipy import integrate  # (imported when first needed: a run in waves does not integrate)
 
     extra = sum(integrate.quad(excess, a, b, epsabs=0.0, epsrel=1e-12, limit=200)[0]
                 for a, b in ((lo, 1.0), (1.0, hi)))
@@ -484,6 +485,8 @@ def _quad_moment(fn, k: float, points) -> float:
     def integrand(w: float) -> float:
         return float(np.asarray(fn(np.array([w])), dtype=float).reshape(-1)[0]) * w**k if w > 0 else 0.0
 
+    from scipy import integrate
+
     edges = [0.0, *sorted(p for p in points if p > 0)]
     total = 0.0
     for a, b in pairwise(edges):
@@ -532,6 +535,8 @@ def spectral_moment(spectrum, omega=None, k=0):
     require(math.isfinite(k), "waves.k", _num(k), "moment order must be a finite number")
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         weighted = np.where(s == 0, 0.0, np.power(w, k) * s)  # S(0) = 0 removes ω^k's pole at 0
+    from scipy import integrate
+
     return float(integrate.simpson(weighted, x=w))
 
 

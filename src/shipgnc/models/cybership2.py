@@ -244,11 +244,23 @@ def surge_equilibrium(params: CyberShip2Params, n: float) -> float:
     d₁₁(u) = −X_u − X_|u|u|u| − X_uuu u² (u̇ = 0 of :func:`cybership2_rhs`).
 
     At 8.13 rps this is 0.295838 m/s (note 003-3.5 rounds it to 0.2958; the document's 0.3 m/s).
+    Found by scipy's ``brentq`` on u̇(u) and kept on disk by its inputs and code
+    (:func:`shipgnc.derived_cache.stored`: a later process reads the same double back instead of
+    importing ``scipy.optimize``). With T > 0 the balance is the cubic
+    −X_uuu u³ − X_|u|u u² + (2T_nu n − X_u) u − 2T_nn n² = 0, whose one positive root the tests
+    check it against (Cardano's formula).
     """
-    from scipy.optimize import brentq
-
     require(math.isfinite(n) and n >= 0, "n", n, "propeller speed must be a finite number >= 0 rps")
-    p = params
+    from shipgnc.derived_cache import stored
+
+    root = stored("surge-equilibrium", {"params": params.as_dict(), "n": float(n)},
+                  (__name__,), lambda: {"u": _surge_root(params, float(n))})
+    return float(root["u"])
+
+
+def _surge_root(p: CyberShip2Params, n: float) -> float:
+    """:func:`surge_equilibrium` computed: ``brentq`` on u̇(u) at δ = 0 from a bracket [0, 2^k]."""
+    from scipy.optimize import brentq
 
     model = CyberShip2(p)
 

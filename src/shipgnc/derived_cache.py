@@ -1,0 +1,100 @@
+"""Deterministic derived results kept on disk, keyed by everything they are computed from.
+
+Some numbers a run needs are computed from fixed inputs by code that costs far more than the
+numbers (a root found with scipy's ``brentq`` costs the import of ``scipy.optimize``; a Nomoto
+model identified from a simulated zig-zag, a simulation and a least-squares fit). :func:`stored`
+computes such a result once and keeps it as JSON beside the generated loops
+(``<cache>/derived``, :func:`shipgnc.jit_cache.cache_dir`'s parent); a later process reads it back.
+
+* **Bit-identical.** Values are finite or non-finite floats, ints, strings, bools and lists or
+  dicts of them; a float is written as Python's shortest repr, which reads back to the same
+  double, so a stored result is exactly the computed one.
+* **Keyed by its inputs and its code.** The file's name is a SHA-256 of the result's kind, its
+  inputs (floats by repr), the package's source files the computing modules import, transitively
+  (:func:`shipgnc.jit_cache.source_files`, as a generated loop is keyed), and the versions of
+  Python, numpy and scipy: a changed input, an edited module on the path or an upgraded library
+  computes it again.
+* **Never in the way.** A cache that cannot be written, or a file that does not read back as a
+  result of the kind, is ignored: the result is computed. ``SHIPGNC_DERIVED_CACHE=0`` turns it off.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+#: bump when the stored form changes
+FORMAT = 1
+
+
+def stored(kind: str, inputs: dict, modules: tuple[str, ...], compute: Callable[[], dict]) -> dict:
+    """``compute()`` (a dict of JSON values), or the same dict kept from an earlier call with the
+    same ``kind``, ``inputs`` and code (``modules``: the package's modules the computation runs;
+    the files they import within the package count too)."""
+    if os.environ.get("SHIPGNC_DERIVED_CACHE", "1") == "0":
+        return compute()
+    path = cache_path(kind, inputs, modules)
+    try:
+        with open(path, encoding="utf-8") as f:
+            kept = json.load(f)
+        if isinstance(kept, dict) and kept.get("kind") == kind and isinstance(kept.get("result"), dict):
+            return kept["result"]
+    except (OSError, ValueError):
+        pass
+    text = json.dumps({"kind": kind, "inputs": _plain(inputs), "result": compute()}, sort_keys=True)
+    _write(path, text)
+    return json.loads(text)["result"]  # as a later process reads it: the same values and types
+
+
+def cache_path(kind: str, inputs: dict, modules: tuple[str, ...]) -> Path:
+    """The file of a result: ``<cache>/derived/<kind>-<16 hex digits of its key>.json``."""
+    from shipgnc.jit_cache import PACKAGE, cache_dir, source_files
+
+    digest = hashlib.sha256(f"{FORMAT} {kind}\n".encode())
+    digest.update(json.dumps(_plain(inputs), sort_keys=True).encode())
+    for path in sorted(source_files("", modules)):
+        digest.update(str(path.relative_to(PACKAGE) if path.is_relative_to(PACKAGE) else path).encode())
+        digest.update(path.read_bytes())
+    digest.update(_versions().encode())
+    return cache_dir().parent / "derived" / f"{kind}-{digest.hexdigest()[:16]}.json"
+
+
+def _versions() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    found = []
+    for name in ("numpy", "scipy"):
+        try:
+            found.append(f"{name} {version(name)}")
+        except PackageNotFoundError:
+            found.append(f"{name} -")
+    return f"python {sys.version}; " + "; ".join(found)
+
+
+def _plain(value):
+    """``value`` as JSON-ready data: floats (numpy's too) by repr, so -0.0, inf and nan keep."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, (bool, str, int)) or value is None:
+        return value
+    if hasattr(value, "tolist"):  # numpy scalars and arrays
+        return _plain(value.tolist())
+    number = float(value)
+    return number if math.isfinite(number) else repr(number)
+
+
+def _write(path: Path, text: str) -> None:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(text + "\n", encoding="utf-8")
+        os.replace(tmp, path)
+    except OSError:  # a read-only cache: computed each time
+        pass
