@@ -18,6 +18,7 @@ from shipgnc.derived_cache import cache_path, stored
 def _own_cache(tmp_path, monkeypatch):
     monkeypatch.setenv("SHIPGNC_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.delenv("SHIPGNC_DERIVED_CACHE", raising=False)
+    monkeypatch.setattr(derived_cache, "_CODE", {})  # each test a fresh process's code digests
 
 
 def _bits(values):
@@ -68,6 +69,7 @@ def test_edited_code_computes_again(tmp_path, monkeypatch):
     stored("probe", {}, ("whatever",), compute)
     assert compute.calls == 1
     code.write_text("def f(): return 2\n")
+    derived_cache._CODE.clear()  # the files are read once per process: the next process
     stored("probe", {}, ("whatever",), compute)
     assert compute.calls == 2
 
@@ -104,6 +106,21 @@ def test_an_unwritable_cache_and_the_switch_compute_each_time(tmp_path, monkeypa
     stored("probe", {}, ("shipgnc.errors",), compute)
     stored("probe", {}, ("shipgnc.errors",), compute)
     assert compute.calls == 4 and not (tmp_path / "ok").exists()
+
+
+def test_the_folder_is_bounded_and_keeps_what_was_used_last(monkeypatch):
+    import os
+
+    monkeypatch.setattr(derived_cache, "MAX_FILES", 8)
+    for i in range(8):
+        stored("probe", {"i": i}, ("shipgnc.errors",), lambda i=i: {"x": i})
+        os.utime(cache_path("probe", {"i": i}, ("shipgnc.errors",)), (1e9 + i, 1e9 + i))
+    stored("probe", {"i": 0}, ("shipgnc.errors",), lambda: {"x": -1.0})  # read: used now
+    stored("probe", {"i": 8}, ("shipgnc.errors",), lambda: {"x": 8})  # the ninth file
+    left = {p.name for p in cache_path("probe", {}, ()).parent.glob("*.json")}
+    assert len(left) == 6
+    kept = {i for i in range(9) if cache_path("probe", {"i": i}, ("shipgnc.errors",)).name in left}
+    assert kept == {0, 4, 5, 6, 7, 8}  # the three least recently used went
 
 
 # --- the results kept ---------------------------------------------------------------------------

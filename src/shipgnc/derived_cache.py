@@ -16,10 +16,13 @@ computes such a result once and keeps it as JSON beside the generated loops
   computes it again.
 * **Never in the way.** A cache that cannot be written, or a file that does not read back as a
   result of the kind, is ignored: the result is computed. ``SHIPGNC_DERIVED_CACHE=0`` turns it off.
+* **Bounded.** A study that varies an input (a sweep over gains) writes one small file per value:
+  beyond :data:`MAX_FILES` files the least recently used quarter is deleted.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
@@ -30,6 +33,10 @@ from pathlib import Path
 
 #: bump when the stored form changes
 FORMAT = 1
+#: files kept in the folder; when a write passes it, the least recently used quarter goes
+MAX_FILES = 2048
+#: the digest of the package files a tuple of modules imports, read once per process
+_CODE: dict[tuple[str, ...], bytes] = {}
 
 
 def stored(kind: str, inputs: dict, modules: tuple[str, ...], compute: Callable[[], dict]) -> dict:
@@ -43,6 +50,8 @@ def stored(kind: str, inputs: dict, modules: tuple[str, ...], compute: Callable[
         with open(path, encoding="utf-8") as f:
             kept = json.load(f)
         if isinstance(kept, dict) and kept.get("kind") == kind and isinstance(kept.get("result"), dict):
+            with contextlib.suppress(OSError):
+                os.utime(path)  # used: the last to be pruned
             return kept["result"]
     except (OSError, ValueError):
         pass
@@ -53,15 +62,26 @@ def stored(kind: str, inputs: dict, modules: tuple[str, ...], compute: Callable[
 
 def cache_path(kind: str, inputs: dict, modules: tuple[str, ...]) -> Path:
     """The file of a result: ``<cache>/derived/<kind>-<16 hex digits of its key>.json``."""
-    from shipgnc.jit_cache import PACKAGE, cache_dir, source_files
+    from shipgnc.jit_cache import cache_dir
 
     digest = hashlib.sha256(f"{FORMAT} {kind}\n".encode())
     digest.update(json.dumps(_plain(inputs), sort_keys=True).encode())
-    for path in sorted(source_files("", modules)):
-        digest.update(str(path.relative_to(PACKAGE) if path.is_relative_to(PACKAGE) else path).encode())
-        digest.update(path.read_bytes())
-    digest.update(_versions().encode())
+    digest.update(_code(tuple(modules)))
     return cache_dir().parent / "derived" / f"{kind}-{digest.hexdigest()[:16]}.json"
+
+
+def _code(modules: tuple[str, ...]) -> bytes:
+    """SHA-256 of the package files ``modules`` import (transitively) and of the library versions."""
+    if modules not in _CODE:
+        from shipgnc.jit_cache import PACKAGE, source_files
+
+        digest = hashlib.sha256()
+        for path in sorted(source_files("", modules)):
+            digest.update(str(path.relative_to(PACKAGE) if path.is_relative_to(PACKAGE) else path).encode())
+            digest.update(path.read_bytes())
+        digest.update(_versions().encode())
+        _CODE[modules] = digest.digest()
+    return _CODE[modules]
 
 
 def _versions() -> str:
@@ -96,5 +116,20 @@ def _write(path: Path, text: str) -> None:
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
         tmp.write_text(text + "\n", encoding="utf-8")
         os.replace(tmp, path)
+        _prune(path.parent)
     except OSError:  # a read-only cache: computed each time
         pass
+
+
+def _prune(folder: Path) -> None:
+    """Beyond :data:`MAX_FILES` results, delete the least recently used quarter."""
+    files = list(folder.glob("*.json"))
+    if len(files) <= MAX_FILES:
+        return
+    used = []
+    for f in files:
+        with contextlib.suppress(OSError):  # another process pruned it first
+            used.append((f.stat().st_mtime, f))
+    for _, f in sorted(used)[: len(used) - 3 * MAX_FILES // 4]:
+        with contextlib.suppress(OSError):
+            f.unlink()
