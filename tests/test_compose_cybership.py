@@ -76,8 +76,8 @@ def test_sincos_within_an_ulp_of_libm():
 
 def test_sincos_quadrants_of_negative_and_positive_arguments():
     """The quadrant (read from the bits of the rounded x·2/π) and the signs, against libm: every
-    quadrant of either sign, on both sides of each multiple of π/4, and at ±0 (where the sign of
-    a zero sine is +, not libm's −0 for −0: the branch-free kernel, as before this form)."""
+    quadrant of either sign, on both sides of each multiple of π/4, and at ±0 (the branch-free
+    kernel's sine of −0 is +0 where libm's is −0: equal as numbers)."""
     for k in range(-400, 401):
         for value in (k * math.pi / 4, math.nextafter(k * math.pi / 4, math.inf),
                       math.nextafter(k * math.pi / 4, -math.inf), (k + 0.5) * math.pi / 4):
