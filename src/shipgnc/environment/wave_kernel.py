@@ -174,7 +174,7 @@ def sincos(x):
     bits: no float → int conversion), and the signs are set by flipping the sign bit (what
     negation does): the same results to the bit in fewer vector instructions than a conversion,
     mask tests and blends (the loop over components 201 → 187 instructions per 8 long-crested
-    components, 246 → 222 short-crested; cybership-waves' composed loop ≈ 4 % and the
+    components, 246 → 222 short-crested; cybership-waves' composed loop ≈ 3 % and the
     short-crested kernel ≈ 7 % less CPU time per ship-step)."""
     qb = x * _INV_PIO2 + _ROUND
     q = qb - _ROUND
