@@ -8,12 +8,14 @@ evaluations per step at the RK4 stage times (as the composed loop calls them), i
 second (ships × steps / wall time, best of a few repeats after a warm-up):
 
 (a) the kernel :func:`~shipgnc.environment.wave_kernel.froude_krylov_sample` in a ``prange`` over
-    ships (the composed loop's way), long-crested and short-crested (``spreading=1``);
+    ships (the composed loop's way), long-crested and short-crested (``spreading=1``), and
+    long-crested for one ship over as many ship-steps (its whole state in the L1 cache: the same
+    CPU time per ship-step as the batch's says the kernel is not memory bound);
 (b) the batch over ships the numpy loop calls (:func:`shipgnc.derive.per_ship`), one call per
     stage, for 200 ships (below the batch's parallel threshold: one thread).
 
-Prints the table with the CPU time per ship-step (on a shared machine the rate per CPU-second
-says more than the wall rate) and writes it with the machine's details to
+Prints the table with the CPU time per ship-step and per component and RK stage (on a shared
+machine the CPU time says more than the wall rate) and writes it with the machine's details to
 ``benchmarks/results/bench_waves.json``.
 """
 
@@ -83,9 +85,14 @@ def kernel_rate(n_ships: int, n_steps: int, spreading, repeats: int) -> dict:
     _drive(kernel.function, z[:2], kernel.params, 2, DT, x0[:2], out[:2])  # compile / load
     wall, cpu = _best(lambda: _drive(kernel.function, z, kernel.params, n_steps, DT, x0, out),
                       repeats)
-    return {"ship_steps_per_s": n_ships * n_steps / wall, "cpu_us_per_ship_step":
-            1e6 * cpu / (n_ships * n_steps), "ships": n_ships, "steps": n_steps,
-            "components": loads.n_components}
+    return _row(n_ships, n_steps, wall, cpu, loads.n_components)
+
+
+def _row(n_ships: int, n_steps: int, wall: float, cpu: float, components: int) -> dict:
+    us = 1e6 * cpu / (n_ships * n_steps)
+    return {"ship_steps_per_s": n_ships * n_steps / wall, "cpu_us_per_ship_step": us,
+            "cpu_ns_per_component_stage": 1e3 * us / (len(STAGES) * components),
+            "ships": n_ships, "steps": n_steps, "components": components}
 
 
 def batch_rate(n_ships: int, n_steps: int, repeats: int) -> dict:
@@ -102,9 +109,7 @@ def batch_rate(n_ships: int, n_steps: int, repeats: int) -> dict:
                 loads(t, x)
 
     wall, cpu = _best(run, repeats)
-    return {"ship_steps_per_s": n_ships * n_steps / wall, "cpu_us_per_ship_step":
-            1e6 * cpu / (n_ships * n_steps), "ships": n_ships, "steps": n_steps,
-            "components": loads.n_components}
+    return _row(n_ships, n_steps, wall, cpu, loads.n_components)
 
 
 def main(argv=None) -> dict:
@@ -115,13 +120,15 @@ def main(argv=None) -> dict:
     rows = {
         "(a) kernel, long-crested": kernel_rate(n, steps, None, repeats),
         "(a) kernel, short-crested": kernel_rate(n, steps, 1.0, repeats),
+        "(a) kernel, long-crested, 1 ship": kernel_rate(1, n * steps, None, repeats),
         "(b) batch over ships (numpy loop)": batch_rate(200, steps // 2, repeats),
     }
     print(f"wave loads, {rows['(a) kernel, long-crested']['components']} components, "
           f"{numba.get_num_threads()} threads")
-    print(f"{'':36s} {'ship-steps/s':>14s} {'CPU µs/ship-step':>17s}")
+    print(f"{'':36s} {'ship-steps/s':>14s} {'CPU µs/ship-step':>17s} {'CPU ns/comp·stage':>18s}")
     for name, r in rows.items():
-        print(f"{name:36s} {r['ship_steps_per_s']:14.3g} {r['cpu_us_per_ship_step']:17.3f}")
+        print(f"{name:36s} {r['ship_steps_per_s']:14.3g} {r['cpu_us_per_ship_step']:17.3f} "
+              f"{r['cpu_ns_per_component_stage']:18.2f}")
     report = {"rows": rows, "target_ship_steps_per_s": 1e6, "machine": machine_info()}
     write_report("bench_waves", report, args.quick)
     return report

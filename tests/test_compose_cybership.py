@@ -74,6 +74,20 @@ def test_sincos_within_an_ulp_of_libm():
     assert all(math.isnan(v) for v in wave_kernel.sincos(math.nan))
 
 
+def test_sincos_quadrants_of_negative_and_positive_arguments():
+    """The quadrant (read from the bits of the rounded x·2/π) and the signs, against libm: every
+    quadrant of either sign, on both sides of each multiple of π/4, and at ±0 (the branch-free
+    kernel's sine of −0 is +0 where libm's is −0: equal as numbers)."""
+    for k in range(-400, 401):
+        for value in (k * math.pi / 4, math.nextafter(k * math.pi / 4, math.inf),
+                      math.nextafter(k * math.pi / 4, -math.inf), (k + 0.5) * math.pi / 4):
+            s, c = wave_kernel.sincos(value)
+            assert abs(s - math.sin(value)) <= 2.3e-16 and abs(c - math.cos(value)) <= 2.3e-16
+    for zero in (0.0, -0.0):
+        s, c = wave_kernel.sincos(zero)
+        assert s == 0.0 and c == 1.0
+
+
 @pytest.mark.parametrize("n", [1, 7, 8, 9, 15, 16, 127, 128, 129, 200, 257, 1000, 4099])
 def test_the_three_sums_are_numpys_to_the_bit(n):
     """The wave loads' sums (:func:`wave_kernel.pairwise_sum3`, three rows added eight lanes per
