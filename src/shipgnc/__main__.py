@@ -7,6 +7,7 @@ on a cold start) is answered like Ctrl-C later — one line, exit 130 — instea
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
 import sys
 import threading
@@ -53,12 +54,31 @@ def exit_finished(code: object) -> None:
     if any(t is not first and not t.daemon and t.is_alive() for t in threading.enumerate()):
         return
     atexit._run_exitfuncs()
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (OSError, ValueError):
-            pass
+    code = flush_output(code)
     os._exit(code)
+
+
+def flush_output(code: int) -> int:
+    """Flush standard output and error, and the exit code as Python's own exit would make it when
+    standard output cannot be written (a full disk, ``> /dev/full``, a reader that left): only a
+    command that succeeded (``code`` 0) changes its code. A reader that left (``shipgnc … | head``)
+    is 141, as SIGPIPE would end the command (the command line's convention); any other error is
+    one line on standard error and exit 1."""
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        code = code or 141
+    except OSError as exc:
+        if code == 0:
+            with contextlib.suppress(OSError, ValueError):
+                sys.stderr.write(f"error: could not write standard output: {exc.strerror or exc}\n")
+            code = 1
+    except (ValueError, AttributeError):  # closed, or replaced by None
+        pass
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        sys.stderr.flush()
+    return code
+
 
 
 if __name__ == "__main__":
