@@ -104,3 +104,29 @@ def test_a_reader_that_left_is_exit_141_without_a_message():
         os.close(write)
     assert done.returncode == 141 and done.stderr == ""
 
+
+def test_a_script_that_runs_the_package_goes_on_after_it(tmp_path):
+    script = tmp_path / "wrapper.py"
+    script.write_text(textwrap.dedent("""
+        import runpy, sys
+        sys.argv = ["shipgnc", "vessels"]
+        try:
+            runpy.run_module("shipgnc", run_name="__main__")
+        except SystemExit as done:
+            print("after", done.code)
+    """))
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          env=_plain_env(), timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1] == "after 0"
+
+
+def test_a_profiled_command_writes_its_profile(tmp_path):
+    profile = tmp_path / "p.out"
+    done = subprocess.run([sys.executable, "-m", "cProfile", "-o", str(profile), "-m", "shipgnc",
+                           "vessels"], capture_output=True, text=True, env=_plain_env(),
+                          cwd=tmp_path, timeout=120)
+    assert done.returncode == 0, done.stderr
+    import pstats
+
+    assert pstats.Stats(str(profile)).total_calls > 0

@@ -28,7 +28,8 @@ def main() -> None:
     try:
         cli_main()
     except SystemExit as done:  # finished: end without tearing the interpreter down
-        exit_finished(done.code)
+        if is_program(sys._getframe(1)):
+            exit_finished(done.code)
         raise
 
 
@@ -79,6 +80,34 @@ def flush_output(code: int) -> int:
         sys.stderr.flush()
     return code
 
+
+#: the frames of ``python -m`` running the package: runpy's functions between the interpreter and
+#: the module
+_RUNPY = {"_run_module_as_main", "_run_code"}
+
+
+def is_program(caller) -> bool:
+    """True when :func:`main`, called from the frame ``caller``, is the program itself: called
+    from the top level of the ``__main__`` module (the installed ``shipgnc`` script, or
+    ``python -m shipgnc`` through runpy's ``_run_module_as_main``), with no profiler or tracer
+    (``cProfile``, ``coverage``, a debugger) watching. Otherwise something runs after it (a script
+    that runs the package with :func:`runpy.run_module` and catches ``SystemExit``, a profiler that
+    writes its file at exit), and the ordinary exit is kept."""
+    if sys.getprofile() is not None or sys.gettrace() is not None:
+        return False
+    monitoring = getattr(sys, "monitoring", None)  # Python 3.12+: profilers and coverage use it
+    if monitoring is not None and any(monitoring.get_tool(i) is not None for i in range(6)):
+        return False
+    top = sys.modules.get("__main__")
+    if caller is None or caller.f_code.co_name != "<module>" or top is None \
+            or caller.f_globals is not vars(top):
+        return False
+    frame = caller.f_back
+    while frame is not None:  # only runpy's own frames of ``python -m`` above it
+        if frame.f_code.co_name not in _RUNPY or frame.f_globals.get("__name__") != "runpy":
+            return False
+        frame = frame.f_back
+    return True
 
 
 if __name__ == "__main__":
