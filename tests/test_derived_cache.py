@@ -184,3 +184,21 @@ def test_the_pole_placement_kept_is_scipys_and_the_closed_form(a22, b2, lam1, la
     # k₂ = (a₂₂ − λ₁ − λ₂)/b₂
     assert kept.K == pytest.approx([lam1 * lam2 / b2, (a22 - lam1 - lam2) / b2], rel=1e-12)
     assert len(list(derived_cache.cache_path("x", {}, ()).parent.glob("place-poles-yt-*.json"))) >= 1
+
+
+def test_plain_python_computes_and_the_compiler_is_in_the_key(monkeypatch):
+    # compiled and plain-Python kernels differ in the last bit: neither is to stand for the other
+    import numba
+
+    from shipgnc.derive import plain_python
+
+    stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 1.0})
+    with plain_python():
+        assert stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 2.0}) == {"x": 2.0}
+    assert stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 3.0}) == {"x": 1.0}
+    compiled = cache_path("probe", {}, ("shipgnc.errors",))
+    monkeypatch.setattr(numba.config, "DISABLE_JIT", not numba.config.DISABLE_JIT)
+    assert cache_path("probe", {}, ("shipgnc.errors",)) != compiled
+    monkeypatch.setattr(numba.config, "DISABLE_JIT", not numba.config.DISABLE_JIT)  # back
+    monkeypatch.setattr(numba.config, "CPU_NAME", "generic")
+    assert cache_path("probe", {}, ("shipgnc.errors",)) != compiled

@@ -11,9 +11,11 @@ computes such a result once and keeps it as JSON beside the generated loops
   double, so a stored result is exactly the computed one.
 * **Keyed by its inputs and its code.** The file's name is a SHA-256 of the result's kind, its
   inputs (floats by repr), the package's source files the computing modules import, transitively
-  (:func:`shipgnc.jit_cache.source_files`, as a generated loop is keyed), and the versions of
-  Python, numpy and scipy: a changed input, an edited module on the path or an upgraded library
-  computes it again.
+  (:func:`shipgnc.jit_cache.source_files`, as a generated loop is keyed), the versions of
+  Python, numpy, scipy and numba, whether numba compiles (``NUMBA_DISABLE_JIT``) and the CPU it
+  compiles for: a changed input, an edited module on the path, an upgraded library or another
+  compiler computes it again (compiled and plain-Python kernels round differently in the last
+  bit). Inside :func:`shipgnc.derive.plain_python` nothing is read or kept.
 * **Never in the way.** A cache that cannot be written, or a file that does not read back as a
   result of the kind, is ignored: the result is computed. ``SHIPGNC_DERIVED_CACHE=0`` turns it off.
 * **Bounded.** A study that varies an input (a sweep over gains) writes one small file per value:
@@ -43,7 +45,7 @@ def stored(kind: str, inputs: dict, modules: tuple[str, ...], compute: Callable[
     """``compute()`` (a dict of JSON values), or the same dict kept from an earlier call with the
     same ``kind``, ``inputs`` and code (``modules``: the package's modules the computation runs;
     the files they import within the package count too)."""
-    if os.environ.get("SHIPGNC_DERIVED_CACHE", "1") == "0":
+    if os.environ.get("SHIPGNC_DERIVED_CACHE", "1") == "0" or _plain_python():
         return compute()
     path = cache_path(kind, inputs, modules)
     try:
@@ -67,6 +69,7 @@ def cache_path(kind: str, inputs: dict, modules: tuple[str, ...]) -> Path:
     digest = hashlib.sha256(f"{FORMAT} {kind}\n".encode())
     digest.update(json.dumps(_plain(inputs), sort_keys=True).encode())
     digest.update(_code(tuple(modules)))
+    digest.update(_compiler().encode())
     return cache_dir().parent / "derived" / f"{kind}-{digest.hexdigest()[:16]}.json"
 
 
@@ -82,6 +85,27 @@ def _code(modules: tuple[str, ...]) -> bytes:
         digest.update(_versions().encode())
         _CODE[modules] = digest.digest()
     return _CODE[modules]
+
+
+def _plain_python() -> bool:
+    """Inside :func:`shipgnc.derive.plain_python` the kernels' plain-Python forms run, whose
+    rounding may differ from the compiled ones: a result is computed there, not read."""
+    from shipgnc.derive import in_plain_python
+
+    return in_plain_python()
+
+
+def _compiler() -> str:
+    """What the compiled kernels' rounding depends on: numba's version, whether it compiles at all
+    (``NUMBA_DISABLE_JIT``) and the CPU name and features it compiles for (fused multiply-adds,
+    vector widths). A surge root or a zig-zag run through a compiled batch differs from the
+    plain-Python one in the last bit."""
+    import llvmlite.binding as ll
+    import numba
+
+    name = numba.config.CPU_NAME or ll.get_host_cpu_name()
+    features = numba.config.CPU_FEATURES or ll.get_host_cpu_features().flatten()
+    return f"numba {numba.__version__}; jit {not numba.config.DISABLE_JIT}; cpu {name} {features}"
 
 
 def _versions() -> str:
