@@ -41,25 +41,43 @@ MAX_FILES = 2048
 _CODE: dict[tuple[str, ...], bytes] = {}
 
 
-def stored(kind: str, inputs: dict, modules: tuple[str, ...], compute: Callable[[], dict]) -> dict:
+def stored(kind: str, inputs: dict, modules: tuple[str, ...], compute: Callable[[], dict], *,
+           shape: dict) -> dict:
     """``compute()`` (a dict of JSON values), or the same dict kept from an earlier call with the
     same ``kind``, ``inputs`` and code (``modules``: the package's modules the computation runs;
-    the files they import within the package count too)."""
+    the files they import within the package count too). ``shape``: the result's form, a dict of
+    its keys to ``float``, ``int``, ``str``, ``bool``, a list of those (``[float] * 2``: that
+    length) or a dict of the same kind; a kept file whose inputs or result differ from it (a
+    damaged or foreign file) is computed again and replaced."""
     if os.environ.get("SHIPGNC_DERIVED_CACHE", "1") == "0" or _plain_python():
         return compute()
     path = cache_path(kind, inputs, modules)
+    expected = json.loads(json.dumps(_plain(inputs), sort_keys=True))
     try:
         with open(path, encoding="utf-8") as f:
             kept = json.load(f)
-        if isinstance(kept, dict) and kept.get("kind") == kind and isinstance(kept.get("result"), dict):
+        if isinstance(kept, dict) and kept.get("kind") == kind and kept.get("inputs") == expected \
+                and _fits(kept.get("result"), shape):
             with contextlib.suppress(OSError):
                 os.utime(path)  # used: the last to be pruned
             return kept["result"]
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         pass
     text = json.dumps({"kind": kind, "inputs": _plain(inputs), "result": compute()}, sort_keys=True)
     _write(path, text)
     return json.loads(text)["result"]  # as a later process reads it: the same values and types
+
+
+def _fits(value, shape) -> bool:
+    """True when ``value`` (read from JSON) has the form ``shape`` (:func:`stored`): the same keys,
+    list lengths and types (a float is a float, not an int or a string; a bool is not an int)."""
+    if isinstance(shape, dict):
+        return isinstance(value, dict) and value.keys() == shape.keys() and all(
+            _fits(value[k], s) for k, s in shape.items())
+    if isinstance(shape, list):
+        return isinstance(value, list) and len(value) == len(shape) and all(
+            _fits(v, s) for v, s in zip(value, shape, strict=True))
+    return type(value) is shape
 
 
 def cache_path(kind: str, inputs: dict, modules: tuple[str, ...]) -> Path:
