@@ -229,3 +229,23 @@ def test_a_file_whose_inputs_differ_is_not_taken():
     path.parent.mkdir(parents=True)
     path.write_text(json.dumps({"kind": "probe", "inputs": {"a": 2.0}, "result": {"x": 7.0}}))
     assert stored("probe", {"a": 1.0}, ("shipgnc.errors",), lambda: {"x": 1.0}, shape=X) == {"x": 1.0}
+
+
+def test_a_key_that_cannot_be_computed_computes_the_result(monkeypatch):
+    from pathlib import Path
+
+    def no_home():
+        raise RuntimeError("Could not determine home directory.")
+
+    monkeypatch.delenv("SHIPGNC_CACHE_DIR")
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+    monkeypatch.setattr(Path, "home", staticmethod(no_home))
+    assert stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 1.0}, shape=X) == {"x": 1.0}
+
+
+def test_an_unreadable_source_computes_the_result(monkeypatch):
+    def unreadable(source, modules=()):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(jit_cache, "source_files", unreadable)
+    assert stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 2.0}, shape=X) == {"x": 2.0}

@@ -16,7 +16,8 @@ computes such a result once and keeps it as JSON beside the generated loops
   compiles for: a changed input, an edited module on the path, an upgraded library or another
   compiler computes it again (compiled and plain-Python kernels round differently in the last
   bit). Inside :func:`shipgnc.derive.plain_python` nothing is read or kept.
-* **Never in the way.** A cache that cannot be written, or a file that does not read back as a
+* **Never in the way.** A cache that cannot be found or written, a key that cannot be computed
+  (no home folder, an unreadable source file), or a file that does not read back as a
   result of the kind, is ignored: the result is computed. ``SHIPGNC_DERIVED_CACHE=0`` turns it off.
 * **Bounded.** A study that varies an input (a sweep over gains) writes one small file per value:
   beyond :data:`MAX_FILES` files the least recently used quarter is deleted.
@@ -51,8 +52,11 @@ def stored(kind: str, inputs: dict, modules: tuple[str, ...], compute: Callable[
     damaged or foreign file) is computed again and replaced."""
     if os.environ.get("SHIPGNC_DERIVED_CACHE", "1") == "0" or _plain_python():
         return compute()
-    path = cache_path(kind, inputs, modules)
-    expected = json.loads(json.dumps(_plain(inputs), sort_keys=True))
+    try:
+        path = cache_path(kind, inputs, modules)
+        expected = json.loads(json.dumps(_plain(inputs), sort_keys=True))
+    except Exception:  # no home folder, a source file unreadable: computed, not kept
+        return compute()
     try:
         with open(path, encoding="utf-8") as f:
             kept = json.load(f)
