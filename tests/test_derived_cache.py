@@ -5,7 +5,9 @@ A kept result is the computed one to the bit, and a changed input or code comput
 from __future__ import annotations
 
 import math
+import os
 import struct
+import threading
 
 import numpy as np
 import pytest
@@ -18,6 +20,7 @@ from shipgnc.derived_cache import cache_path, stored
 def _own_cache(tmp_path, monkeypatch):
     monkeypatch.setenv("SHIPGNC_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.delenv("SHIPGNC_DERIVED_CACHE", raising=False)
+    monkeypatch.setattr(jit_cache, "_SWEPT", set())  # each test a fresh process's first write
     monkeypatch.setattr(derived_cache, "_CODE", {})  # each test a fresh process's code digests
 
 
@@ -111,8 +114,6 @@ def test_an_unwritable_cache_and_the_switch_compute_each_time(tmp_path, monkeypa
 
 
 def test_the_folder_is_bounded_and_keeps_what_was_used_last(monkeypatch):
-    import os
-
     monkeypatch.setattr(derived_cache, "MAX_FILES", 8)
     for i in range(8):
         stored("probe", {"i": i}, ("shipgnc.errors",), lambda i=i: {"x": float(i)}, shape=X)
@@ -249,3 +250,25 @@ def test_an_unreadable_source_computes_the_result(monkeypatch):
 
     monkeypatch.setattr(jit_cache, "source_files", unreadable)
     assert stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 2.0}, shape=X) == {"x": 2.0}
+
+
+def test_writers_do_not_clash_and_a_killed_writers_file_is_deleted():
+    folder = cache_path("probe", {}, ()).parent
+    folder.mkdir(parents=True)
+    old, fresh = folder / "probe-0.json.1.tmp", folder / "probe-1.json.2.tmp"
+    for f in (old, fresh):
+        f.write_text("{")
+    os.utime(old, (0.0, 0.0))  # a writer killed long ago; the fresh one may still be writing
+
+    def write(i):
+        stored("probe", {"i": i % 2}, ("shipgnc.errors",), lambda: {"x": float(i % 2)}, shape=X)
+
+    threads = [threading.Thread(target=write, args=(i,)) for i in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert sorted(p.name for p in folder.glob("*.tmp")) == [fresh.name]
+    for i in (0, 1):
+        assert stored("probe", {"i": i}, ("shipgnc.errors",), lambda: {"x": -1.0}, shape=X) == {
+            "x": float(i)}

@@ -4,7 +4,7 @@ Some numbers a run needs are computed from fixed inputs by code that costs far m
 numbers (a root found with scipy's ``brentq`` costs the import of ``scipy.optimize``; a Nomoto
 model identified from a simulated zig-zag, a simulation and a least-squares fit). :func:`stored`
 computes such a result once and keeps it as JSON beside the generated loops
-(``<cache>/derived``, :func:`shipgnc.jit_cache.cache_dir`'s parent); a later process reads it back.
+(``<cache>/derived``, in :func:`shipgnc.jit_cache.cache_root`); a later process reads it back.
 
 * **Bit-identical.** Values are finite or non-finite floats, ints, strings, bools and lists or
   dicts of them; a float is written as Python's shortest repr, which reads back to the same
@@ -86,24 +86,22 @@ def _fits(value, shape) -> bool:
 
 def cache_path(kind: str, inputs: dict, modules: tuple[str, ...]) -> Path:
     """The file of a result: ``<cache>/derived/<kind>-<16 hex digits of its key>.json``."""
-    from shipgnc.jit_cache import cache_dir
+    from shipgnc.jit_cache import cache_root
 
     digest = hashlib.sha256(f"{FORMAT} {kind}\n".encode())
     digest.update(json.dumps(_plain(inputs), sort_keys=True).encode())
     digest.update(_code(tuple(modules)))
     digest.update(_compiler().encode())
-    return cache_dir().parent / "derived" / f"{kind}-{digest.hexdigest()[:16]}.json"
+    return cache_root() / "derived" / f"{kind}-{digest.hexdigest()[:16]}.json"
 
 
 def _code(modules: tuple[str, ...]) -> bytes:
     """SHA-256 of the package files ``modules`` import (transitively) and of the library versions."""
     if modules not in _CODE:
-        from shipgnc.jit_cache import PACKAGE, source_files
+        from shipgnc.jit_cache import hash_files, source_files
 
         digest = hashlib.sha256()
-        for path in sorted(source_files("", modules)):
-            digest.update(str(path.relative_to(PACKAGE) if path.is_relative_to(PACKAGE) else path).encode())
-            digest.update(path.read_bytes())
+        hash_files(digest, sorted(source_files("", modules)))
         digest.update(_versions().encode())
         _CODE[modules] = digest.digest()
     return _CODE[modules]
@@ -157,11 +155,11 @@ def _plain(value):
 
 
 def _write(path: Path, text: str) -> None:
+    from shipgnc.jit_cache import write_atomic
+
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(text + "\n", encoding="utf-8")
-        os.replace(tmp, path)
+        write_atomic(path, text + "\n")
         _prune(path.parent)
     except OSError:  # a read-only cache: computed each time
         pass
