@@ -38,8 +38,6 @@ from pathlib import Path
 FORMAT = 1
 #: files kept in the folder; when a write passes it, the least recently used quarter goes
 MAX_FILES = 2048
-#: the digest of the package files a tuple of modules imports, read once per process
-_CODE: dict[tuple[str, ...], bytes] = {}
 
 
 def stored(kind: str, inputs: dict, modules: tuple[str, ...], compute: Callable[[], dict], *,
@@ -96,15 +94,14 @@ def cache_path(kind: str, inputs: dict, modules: tuple[str, ...]) -> Path:
 
 
 def _code(modules: tuple[str, ...]) -> bytes:
-    """SHA-256 of the package files ``modules`` import (transitively) and of the library versions."""
-    if modules not in _CODE:
-        from shipgnc.jit_cache import hash_files, source_files
+    """SHA-256 of the package files ``modules`` import (transitively; each read again when it
+    changes: a module edited and reloaded) and of the library versions."""
+    from shipgnc.jit_cache import hash_files, source_files
 
-        digest = hashlib.sha256()
-        hash_files(digest, sorted(source_files("", modules)))
-        digest.update(_versions().encode())
-        _CODE[modules] = digest.digest()
-    return _CODE[modules]
+    digest = hashlib.sha256()
+    hash_files(digest, sorted(source_files("", modules)))
+    digest.update(_versions().encode())
+    return digest.digest()
 
 
 def _plain_python() -> bool:

@@ -30,8 +30,10 @@ PACKAGE = Path(__file__).resolve().parent
 #: is deleted with its compiled files when a new module is written [s]
 STALE_AFTER = 7 * 24 * 3600.0
 _PRUNED: list[bool] = []
-#: each package file's imports, read once per process
-_FILE_IMPORTS: dict[Path, list[str]] = {}
+#: each package file's imports and its bytes, by its (modification time, size): read again when
+#: the file changes (a module edited and reloaded in a running session)
+_FILE_IMPORTS: dict[Path, tuple[tuple[int, int], list[str]]] = {}
+_SOURCES: dict[Path, tuple[tuple[int, int], bytes]] = {}
 #: a writer killed between creating its temporary file and renaming it leaves it: one older than
 #: this is deleted (once per process and folder, when a file is written there) [s]
 TEMPORARY_STALE_AFTER = 3600.0
@@ -95,7 +97,22 @@ def hash_files(digest, paths) -> None:
     package for the package's files) and its bytes."""
     for path in paths:
         digest.update(str(path.relative_to(PACKAGE) if _in_package(path) else path).encode())
-        digest.update(path.read_bytes())
+        digest.update(read_source(path))
+
+
+def read_source(path: Path) -> bytes:
+    """The bytes of the file ``path``, read again only when its modification time or size
+    changed."""
+    stamp = _stamp(path)
+    kept = _SOURCES.get(path)
+    if kept is None or kept[0] != stamp:
+        kept = _SOURCES[path] = (stamp, path.read_bytes())
+    return kept[1]
+
+
+def _stamp(path: Path) -> tuple[int, int]:
+    info = path.stat()
+    return info.st_mtime_ns, info.st_size
 
 
 def write_atomic(path: Path, text: str) -> None:
@@ -160,9 +177,10 @@ def source_files(source: str, modules=()) -> set[Path]:
         package = ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts)
         if path.name != "__init__.py":
             package = package.rpartition(".")[0]
-        if path not in _FILE_IMPORTS:
-            _FILE_IMPORTS[path] = _imports(path.read_text(), package)
-        for name in _FILE_IMPORTS[path]:
+        stamp = _stamp(path)
+        if _FILE_IMPORTS.get(path, (None,))[0] != stamp:
+            _FILE_IMPORTS[path] = (stamp, _imports(read_source(path).decode(), package))
+        for name in _FILE_IMPORTS[path][1]:
             found = _module_path(name)
             if found is not None and found not in seen:
                 todo.append(found)
