@@ -1,7 +1,11 @@
-"""The ``shipgnc`` command (also ``python -m shipgnc``).
+"""The ``shipgnc`` command (also ``python -m shipgnc``): ``[project.scripts]`` points here.
 
 A light entry point: Ctrl-C while the command-line modules are still importing (about a second
-on a cold start) is answered like Ctrl-C later — one line, exit 130 — instead of a traceback.
+on a cold start) is answered like Ctrl-C later — one line, exit 130 — instead of a traceback. A
+finished command ends without the interpreter's teardown (:func:`exit_finished`; the exit
+handlers run, standard output is flushed and its errors reported) when the command is the program
+itself (:func:`is_program`: not under a profiler, a tracer or a script running the package through
+:mod:`runpy`); ``SHIPGNC_QUICK_EXIT=0`` keeps Python's ordinary exit.
 """
 
 from __future__ import annotations
