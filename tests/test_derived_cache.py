@@ -5,7 +5,9 @@ A kept result is the computed one to the bit, and a changed input or code comput
 from __future__ import annotations
 
 import math
+import os
 import struct
+import threading
 
 import numpy as np
 import pytest
@@ -18,7 +20,7 @@ from shipgnc.derived_cache import cache_path, stored
 def _own_cache(tmp_path, monkeypatch):
     monkeypatch.setenv("SHIPGNC_CACHE_DIR", str(tmp_path / "cache"))
     monkeypatch.delenv("SHIPGNC_DERIVED_CACHE", raising=False)
-    monkeypatch.setattr(derived_cache, "_CODE", {})  # each test a fresh process's code digests
+    monkeypatch.setattr(jit_cache, "_SWEPT", set())  # each test a fresh process's first write
 
 
 def _bits(values):
@@ -34,13 +36,15 @@ class Counted:
         return self.result
 
 
+X = {"x": float}  # the form of most results below
 HARD = [0.1 + 0.2, -0.0, 1e-310, 2.0**-1074, 1.7976931348623157e308, math.pi, -1.0 / 3.0]
 
 
 def test_a_kept_result_is_the_computed_one_to_the_bit():
     compute = Counted({"x": HARD, "nan": float("nan"), "inf": -math.inf, "label": "a", "n": 3})
-    first = stored("probe", {"a": 1.5}, ("shipgnc.errors",), compute)
-    again = stored("probe", {"a": 1.5}, ("shipgnc.errors",), compute)
+    shape = {"x": [float] * len(HARD), "nan": float, "inf": float, "label": str, "n": int}
+    first = stored("probe", {"a": 1.5}, ("shipgnc.errors",), compute, shape=shape)
+    again = stored("probe", {"a": 1.5}, ("shipgnc.errors",), compute, shape=shape)
     assert compute.calls == 1
     for got in (first, again):
         assert _bits(got["x"]) == _bits(HARD)
@@ -50,27 +54,28 @@ def test_a_kept_result_is_the_computed_one_to_the_bit():
 
 def test_a_changed_input_computes_again():
     compute = Counted({"x": 1.0})
-    stored("probe", {"a": 0.1, "v": np.array([1.0, 2.0])}, ("shipgnc.errors",), compute)
-    stored("probe", {"a": 0.1, "v": np.array([1.0, 2.0])}, ("shipgnc.errors",), compute)
+    stored("probe", {"a": 0.1, "v": np.array([1.0, 2.0])}, ("shipgnc.errors",), compute, shape=X)
+    stored("probe", {"a": 0.1, "v": np.array([1.0, 2.0])}, ("shipgnc.errors",), compute, shape=X)
     assert compute.calls == 1
     stored("probe", {"a": np.nextafter(0.1, 1.0), "v": np.array([1.0, 2.0])}, ("shipgnc.errors",),
-           compute)  # one ulp
-    stored("probe", {"a": 0.1, "v": np.array([1.0, -2.0])}, ("shipgnc.errors",), compute)
-    stored("other", {"a": 0.1, "v": np.array([1.0, 2.0])}, ("shipgnc.errors",), compute)
+           compute, shape=X)  # one ulp
+    stored("probe", {"a": 0.1, "v": np.array([1.0, -2.0])}, ("shipgnc.errors",), compute, shape=X)
+    stored("other", {"a": 0.1, "v": np.array([1.0, 2.0])}, ("shipgnc.errors",), compute, shape=X)
     assert compute.calls == 4
 
 
-def test_edited_code_computes_again(tmp_path, monkeypatch):
+def test_edited_code_computes_again_in_the_same_process(tmp_path, monkeypatch):
+    # a module edited and reloaded in a running session (a notebook) is its new code
     code = tmp_path / "kernel.py"
     code.write_text("def f(): return 1\n")
     monkeypatch.setattr(jit_cache, "source_files", lambda source, modules=(): {code})
     compute = Counted({"x": 1.0})
-    stored("probe", {}, ("whatever",), compute)
-    stored("probe", {}, ("whatever",), compute)
+    stored("probe", {}, ("whatever",), compute, shape=X)
+    stored("probe", {}, ("whatever",), compute, shape=X)
     assert compute.calls == 1
     code.write_text("def f(): return 2\n")
-    derived_cache._CODE.clear()  # the files are read once per process: the next process
-    stored("probe", {}, ("whatever",), compute)
+    os.utime(code, ns=(1, 1))  # the same size: known changed by its modification time
+    stored("probe", {}, ("whatever",), compute, shape=X)
     assert compute.calls == 2
 
 
@@ -88,8 +93,8 @@ def test_a_damaged_file_is_computed_again_and_replaced():
     path = cache_path("probe", {"a": 1}, ("shipgnc.errors",))
     path.parent.mkdir(parents=True)
     path.write_text("{not json")
-    assert stored("probe", {"a": 1}, ("shipgnc.errors",), compute) == {"x": 2.5}
-    assert stored("probe", {"a": 1}, ("shipgnc.errors",), compute) == {"x": 2.5}
+    assert stored("probe", {"a": 1}, ("shipgnc.errors",), compute, shape=X) == {"x": 2.5}
+    assert stored("probe", {"a": 1}, ("shipgnc.errors",), compute, shape=X) == {"x": 2.5}
     assert compute.calls == 1
 
 
@@ -98,25 +103,23 @@ def test_an_unwritable_cache_and_the_switch_compute_each_time(tmp_path, monkeypa
     blocker.write_text("")
     monkeypatch.setenv("SHIPGNC_CACHE_DIR", str(blocker))  # a file: no folder can be made in it
     compute = Counted({"x": 1.0})
-    assert stored("probe", {}, ("shipgnc.errors",), compute) == {"x": 1.0}
-    assert stored("probe", {}, ("shipgnc.errors",), compute) == {"x": 1.0}
+    assert stored("probe", {}, ("shipgnc.errors",), compute, shape=X) == {"x": 1.0}
+    assert stored("probe", {}, ("shipgnc.errors",), compute, shape=X) == {"x": 1.0}
     assert compute.calls == 2
     monkeypatch.setenv("SHIPGNC_CACHE_DIR", str(tmp_path / "ok"))
     monkeypatch.setenv("SHIPGNC_DERIVED_CACHE", "0")
-    stored("probe", {}, ("shipgnc.errors",), compute)
-    stored("probe", {}, ("shipgnc.errors",), compute)
+    stored("probe", {}, ("shipgnc.errors",), compute, shape=X)
+    stored("probe", {}, ("shipgnc.errors",), compute, shape=X)
     assert compute.calls == 4 and not (tmp_path / "ok").exists()
 
 
 def test_the_folder_is_bounded_and_keeps_what_was_used_last(monkeypatch):
-    import os
-
     monkeypatch.setattr(derived_cache, "MAX_FILES", 8)
     for i in range(8):
-        stored("probe", {"i": i}, ("shipgnc.errors",), lambda i=i: {"x": i})
+        stored("probe", {"i": i}, ("shipgnc.errors",), lambda i=i: {"x": float(i)}, shape=X)
         os.utime(cache_path("probe", {"i": i}, ("shipgnc.errors",)), (1e9 + i, 1e9 + i))
-    stored("probe", {"i": 0}, ("shipgnc.errors",), lambda: {"x": -1.0})  # read: used now
-    stored("probe", {"i": 8}, ("shipgnc.errors",), lambda: {"x": 8})  # the ninth file
+    stored("probe", {"i": 0}, ("shipgnc.errors",), lambda: {"x": -1.0}, shape=X)  # read: used now
+    stored("probe", {"i": 8}, ("shipgnc.errors",), lambda: {"x": 8}, shape=X)  # the ninth file
     left = {p.name for p in cache_path("probe", {}, ()).parent.glob("*.json")}
     assert len(left) == 6
     kept = {i for i in range(9) if cache_path("probe", {"i": i}, ("shipgnc.errors",)).name in left}
@@ -184,3 +187,88 @@ def test_the_pole_placement_kept_is_scipys_and_the_closed_form(a22, b2, lam1, la
     # k₂ = (a₂₂ − λ₁ − λ₂)/b₂
     assert kept.K == pytest.approx([lam1 * lam2 / b2, (a22 - lam1 - lam2) / b2], rel=1e-12)
     assert len(list(derived_cache.cache_path("x", {}, ()).parent.glob("place-poles-yt-*.json"))) >= 1
+
+
+def test_plain_python_computes_and_the_compiler_is_in_the_key(monkeypatch):
+    # compiled and plain-Python kernels differ in the last bit: neither is to stand for the other
+    import numba
+
+    from shipgnc.derive import plain_python
+
+    stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 1.0}, shape=X)
+    with plain_python():
+        assert stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 2.0}, shape=X) == {"x": 2.0}
+    assert stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 3.0}, shape=X) == {"x": 1.0}
+    compiled = cache_path("probe", {}, ("shipgnc.errors",))
+    monkeypatch.setattr(numba.config, "DISABLE_JIT", not numba.config.DISABLE_JIT)
+    assert cache_path("probe", {}, ("shipgnc.errors",)) != compiled
+    monkeypatch.setattr(numba.config, "DISABLE_JIT", not numba.config.DISABLE_JIT)  # back
+    monkeypatch.setattr(numba.config, "CPU_NAME", "generic")
+    assert cache_path("probe", {}, ("shipgnc.errors",)) != compiled
+
+
+@pytest.mark.parametrize("result", [{}, {"u": None}, {"u": "0.3"}, {"u": 1}, {"u": [0.3]},
+                                    {"u": 0.3, "v": 0.1}, None, []])
+def test_a_valid_json_file_of_another_form_is_computed_again_and_replaced(result):
+    import json
+
+    from shipgnc.models.cybership2 import CyberShip2Params, _surge_root, surge_equilibrium
+
+    p = CyberShip2Params()
+    surge_equilibrium(p, 8.13)  # written
+    [path] = cache_path("x", {}, ()).parent.glob("surge-equilibrium-*.json")
+    kept = json.loads(path.read_text())
+    path.write_text(json.dumps({**kept, "result": result}))
+    assert surge_equilibrium(p, 8.13) == _surge_root(p, 8.13)
+    assert json.loads(path.read_text()) == kept  # replaced by the computed one
+
+
+def test_a_file_whose_inputs_differ_is_not_taken():
+    import json
+
+    path = cache_path("probe", {"a": 1.0}, ("shipgnc.errors",))
+    path.parent.mkdir(parents=True)
+    path.write_text(json.dumps({"kind": "probe", "inputs": {"a": 2.0}, "result": {"x": 7.0}}))
+    assert stored("probe", {"a": 1.0}, ("shipgnc.errors",), lambda: {"x": 1.0}, shape=X) == {"x": 1.0}
+
+
+def test_a_key_that_cannot_be_computed_computes_the_result(monkeypatch):
+    from pathlib import Path
+
+    def no_home():
+        raise RuntimeError("Could not determine home directory.")
+
+    monkeypatch.delenv("SHIPGNC_CACHE_DIR")
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+    monkeypatch.setattr(Path, "home", staticmethod(no_home))
+    assert stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 1.0}, shape=X) == {"x": 1.0}
+
+
+def test_an_unreadable_source_computes_the_result(monkeypatch):
+    def unreadable(source, modules=()):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(jit_cache, "source_files", unreadable)
+    assert stored("probe", {}, ("shipgnc.errors",), lambda: {"x": 2.0}, shape=X) == {"x": 2.0}
+
+
+def test_writers_do_not_clash_and_a_killed_writers_file_is_deleted():
+    folder = cache_path("probe", {}, ()).parent
+    folder.mkdir(parents=True)
+    old, fresh = folder / "probe-0.json.1.tmp", folder / "probe-1.json.2.tmp"
+    for f in (old, fresh):
+        f.write_text("{")
+    os.utime(old, (0.0, 0.0))  # a writer killed long ago; the fresh one may still be writing
+
+    def write(i):
+        stored("probe", {"i": i % 2}, ("shipgnc.errors",), lambda: {"x": float(i % 2)}, shape=X)
+
+    threads = [threading.Thread(target=write, args=(i,)) for i in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert sorted(p.name for p in folder.glob("*.tmp")) == [fresh.name]
+    for i in (0, 1):
+        assert stored("probe", {"i": i}, ("shipgnc.errors",), lambda: {"x": -1.0}, shape=X) == {
+            "x": float(i)}

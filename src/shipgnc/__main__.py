@@ -1,12 +1,17 @@
-"""The ``shipgnc`` command (also ``python -m shipgnc``).
+"""The ``shipgnc`` command (also ``python -m shipgnc``): ``[project.scripts]`` points here.
 
 A light entry point: Ctrl-C while the command-line modules are still importing (about a second
-on a cold start) is answered like Ctrl-C later — one line, exit 130 — instead of a traceback.
+on a cold start) is answered like Ctrl-C later — one line, exit 130 — instead of a traceback. A
+finished command ends without the interpreter's teardown (:func:`exit_finished`; the exit
+handlers run, standard output is flushed and its errors reported) when the command is the program
+itself (:func:`is_program`: not under a profiler, a tracer or a script running the package through
+:mod:`runpy`); ``SHIPGNC_QUICK_EXIT=0`` keeps Python's ordinary exit.
 """
 
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
 import sys
 import threading
@@ -27,7 +32,8 @@ def main() -> None:
     try:
         cli_main()
     except SystemExit as done:  # finished: end without tearing the interpreter down
-        exit_finished(done.code)
+        if is_program(sys._getframe(1)):
+            exit_finished(done.code)
         raise
 
 
@@ -53,12 +59,59 @@ def exit_finished(code: object) -> None:
     if any(t is not first and not t.daemon and t.is_alive() for t in threading.enumerate()):
         return
     atexit._run_exitfuncs()
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (OSError, ValueError):
-            pass
+    code = flush_output(code)
     os._exit(code)
+
+
+def flush_output(code: int) -> int:
+    """Flush standard output and error, and the exit code as Python's own exit would make it when
+    standard output cannot be written (a full disk, ``> /dev/full``, a reader that left): only a
+    command that succeeded (``code`` 0) changes its code. A reader that left (``shipgnc … | head``)
+    is 141, as SIGPIPE would end the command (the command line's convention); any other error is
+    one line on standard error and exit 1."""
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        code = code or 141
+    except OSError as exc:
+        if code == 0:
+            with contextlib.suppress(OSError, ValueError):
+                sys.stderr.write(f"error: could not write standard output: {exc.strerror or exc}\n")
+            code = 1
+    except (ValueError, AttributeError):  # closed, or replaced by None
+        pass
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        sys.stderr.flush()
+    return code
+
+
+#: the frames of ``python -m`` running the package: runpy's functions between the interpreter and
+#: the module
+_RUNPY = {"_run_module_as_main", "_run_code"}
+
+
+def is_program(caller) -> bool:
+    """True when :func:`main`, called from the frame ``caller``, is the program itself: called
+    from the top level of the ``__main__`` module (the installed ``shipgnc`` script, or
+    ``python -m shipgnc`` through runpy's ``_run_module_as_main``), with no profiler or tracer
+    (``cProfile``, ``coverage``, a debugger) watching. Otherwise something runs after it (a script
+    that runs the package with :func:`runpy.run_module` and catches ``SystemExit``, a profiler that
+    writes its file at exit), and the ordinary exit is kept."""
+    if sys.getprofile() is not None or sys.gettrace() is not None:
+        return False
+    monitoring = getattr(sys, "monitoring", None)  # Python 3.12+: profilers and coverage use it
+    if monitoring is not None and any(monitoring.get_tool(i) is not None for i in range(6)):
+        return False
+    top = sys.modules.get("__main__")
+    if caller is None or caller.f_code.co_name != "<module>" or top is None \
+            or caller.f_globals is not vars(top):
+        return False
+    frame = caller.f_back
+    while frame is not None:  # only runpy's own frames of ``python -m`` above it
+        if frame.f_code.co_name not in _RUNPY or frame.f_globals.get("__name__") != "runpy":
+            return False
+        frame = frame.f_back
+    return True
 
 
 if __name__ == "__main__":

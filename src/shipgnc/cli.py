@@ -373,7 +373,9 @@ app.add_typer(_ais, name="ais")
 
 
 def main() -> None:
-    """Console-script entry point. A usage error (an unknown option or command, a value that does
+    """Run the command line (called by :func:`shipgnc.__main__.main`, the console script's and
+    ``python -m shipgnc``'s entry point, which arms Ctrl-C first and ends a finished command
+    quickly). A usage error (an unknown option or command, a value that does
     not parse, a missing argument) is one line and exit 2 like every other bad input, not the
     parser's boxed usage text."""
     from shipgnc.interrupts import arm_exit_deadline, exit_now, install, noted, say_once

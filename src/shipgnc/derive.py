@@ -59,6 +59,11 @@ def plain_python():
         _PLAIN.pop()
 
 
+def in_plain_python() -> bool:
+    """True inside :func:`plain_python`."""
+    return bool(_PLAIN)
+
+
 def per_ship(function: Callable, spec: str) -> ShipBatch:
     """The batch over ships of the scalar kernel ``function`` (module docstring), memoised."""
     key = (function, spec)

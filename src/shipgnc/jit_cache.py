@@ -13,6 +13,7 @@ in memory (kernels defined in a notebook) is written there too, as ``shipgnc_mem
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib
 import inspect
@@ -29,16 +30,26 @@ PACKAGE = Path(__file__).resolve().parent
 #: is deleted with its compiled files when a new module is written [s]
 STALE_AFTER = 7 * 24 * 3600.0
 _PRUNED: list[bool] = []
-#: each package file's imports, read once per process
-_FILE_IMPORTS: dict[Path, list[str]] = {}
+#: each package file's imports and its bytes, by its (modification time, size): read again when
+#: the file changes (a module edited and reloaded in a running session)
+_FILE_IMPORTS: dict[Path, tuple[tuple[int, int], list[str]]] = {}
+_SOURCES: dict[Path, tuple[tuple[int, int], bytes]] = {}
+#: a writer killed between creating its temporary file and renaming it leaves it: one older than
+#: this is deleted (once per process and folder, when a file is written there) [s]
+TEMPORARY_STALE_AFTER = 3600.0
+_SWEPT: set[Path] = set()
+
+
+def cache_root() -> Path:
+    """The folder of shipgnc's caches (generated loops, derived results, the coastline):
+    ``$SHIPGNC_CACHE_DIR``, else ``$XDG_CACHE_HOME/shipgnc`` or ``~/.cache/shipgnc``."""
+    return Path(os.environ.get("SHIPGNC_CACHE_DIR") or Path(
+        os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "shipgnc")
 
 
 def cache_dir() -> Path:
-    """Where generated modules are written: ``$SHIPGNC_CACHE_DIR``, else
-    ``$XDG_CACHE_HOME/shipgnc`` or ``~/.cache/shipgnc`` (subfolder ``loops``)."""
-    root = os.environ.get("SHIPGNC_CACHE_DIR") or Path(
-        os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "shipgnc"
-    return Path(root) / "loops"
+    """Where generated modules are written: :func:`cache_root`'s subfolder ``loops``."""
+    return cache_root() / "loops"
 
 
 def importable(fn) -> bool:
@@ -62,9 +73,7 @@ def module_file(source: str, functions, *, prefix: str) -> Path | None:
         if not path.exists():
             path.parent.mkdir(parents=True, exist_ok=True)
             prune_stale_loops(path.parent, release)
-            tmp = path.with_suffix(f".{os.getpid()}.tmp")
-            tmp.write_text(source)
-            os.replace(tmp, path)
+            write_atomic(path, source)
     except OSError:
         return None
     return path
@@ -78,11 +87,78 @@ def module_key(source: str, functions) -> str:
     files = {inspect.getsourcefile(getattr(fn, "py_func", fn)) for fn in functions}
     own = sorted(Path(f).resolve() for f in files if f and not _in_package(Path(f).resolve()))
     modules = {getattr(getattr(fn, "py_func", fn), "__module__", "") for fn in functions}
-    for path in sorted(source_files(source, modules)) + own:
-        digest.update(str(path.relative_to(PACKAGE) if _in_package(path) else path).encode())
-        digest.update(path.read_bytes())
+    hash_files(digest, sorted(source_files(source, modules)) + own)
     digest.update(numba.__version__.encode())
     return digest.hexdigest()[:16]
+
+
+def hash_files(digest, paths) -> None:
+    """Feed each file of ``paths`` (in order) into the hash ``digest``: its name (relative to the
+    package for the package's files) and its bytes."""
+    for path in paths:
+        digest.update(str(path.relative_to(PACKAGE) if _in_package(path) else path).encode())
+        digest.update(read_source(path))
+
+
+def read_source(path: Path) -> bytes:
+    """The bytes of the file ``path``, read again only when its modification time or size
+    changed."""
+    stamp = _stamp(path)
+    kept = _SOURCES.get(path)
+    if kept is None or kept[0] != stamp:
+        kept = _SOURCES[path] = (stamp, path.read_bytes())
+    return kept[1]
+
+
+def _stamp(path: Path) -> tuple[int, int]:
+    info = path.stat()
+    return info.st_mtime_ns, info.st_size
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` atomically: into a uniquely named temporary file of the same
+    folder (:func:`tempfile.mkstemp`: no clash between threads, processes or hosts sharing the
+    folder), then renamed over ``path``. Temporary files of killed writers older than
+    :data:`TEMPORARY_STALE_AFTER` are deleted. Raises OSError (a read-only folder)."""
+    import tempfile
+
+    _sweep_temporary(path.parent)
+    handle, name = tempfile.mkstemp(prefix=f"{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.chmod(name, 0o666 & ~_umask())  # as an ordinary file (mkstemp's is private)
+        os.replace(name, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(name)
+        raise
+
+
+def _umask() -> int:
+    if not _UMASK:
+        mask = os.umask(0o022)
+        os.umask(mask)
+        _UMASK.append(mask)
+    return _UMASK[0]
+
+
+_UMASK: list[int] = []
+
+
+def _sweep_temporary(folder: Path, *, now: float | None = None) -> None:
+    """Delete the ``*.tmp`` files in ``folder`` older than :data:`TEMPORARY_STALE_AFTER`, once per
+    process and folder."""
+    if folder in _SWEPT:
+        return
+    _SWEPT.add(folder)
+    import time
+
+    now = time.time() if now is None else now
+    for tmp in folder.glob("*.tmp"):
+        with contextlib.suppress(OSError):  # another process deleted or renamed it first
+            if now - tmp.stat().st_mtime > TEMPORARY_STALE_AFTER:
+                tmp.unlink()
 
 
 def source_files(source: str, modules=()) -> set[Path]:
@@ -101,9 +177,10 @@ def source_files(source: str, modules=()) -> set[Path]:
         package = ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts)
         if path.name != "__init__.py":
             package = package.rpartition(".")[0]
-        if path not in _FILE_IMPORTS:
-            _FILE_IMPORTS[path] = _imports(path.read_text(), package)
-        for name in _FILE_IMPORTS[path]:
+        stamp = _stamp(path)
+        if _FILE_IMPORTS.get(path, (None,))[0] != stamp:
+            _FILE_IMPORTS[path] = (stamp, _imports(read_source(path).decode(), package))
+        for name in _FILE_IMPORTS[path][1]:
             found = _module_path(name)
             if found is not None and found not in seen:
                 todo.append(found)

@@ -305,6 +305,11 @@ def _record(ds):
     return ds["time"].values, ds["delta"].values, ds["r"].values
 
 
+#: the form of a kept identification (:func:`shipgnc.derived_cache.stored`)
+_KEPT = {"fit": dict.fromkeys(("K", "T", "residual_rms", "r_rms", "fit", "cost"), float),
+         "extra": {"min_surge_mps": float, "mean_surge_mps": float}}
+
+
 @lru_cache(maxsize=16)
 def _identify_cached(params, delta_deg, psi_deg, propeller_rps, t_end, dt):
     from shipgnc.derived_cache import stored
@@ -312,7 +317,8 @@ def _identify_cached(params, delta_deg, psi_deg, propeller_rps, t_end, dt):
     inputs = {"params": params.as_dict(), "delta_deg": delta_deg, "psi_deg": psi_deg,
               "propeller_rps": propeller_rps, "t_end": t_end, "dt": dt}
     kept = stored("cybership2-nomoto", inputs, (__name__, "shipgnc.models.cybership2"),
-                  lambda: _identify(params, delta_deg, psi_deg, propeller_rps, t_end, dt))
+                  lambda: _identify(params, delta_deg, psi_deg, propeller_rps, t_end, dt),
+                  shape=_KEPT)
     label = f"CyberShip II zig-zag {delta_deg:g}/{psi_deg:g}, {t_end:g} s"
     return NomotoFit(**kept["fit"], label=label, extra=kept["extra"])
 

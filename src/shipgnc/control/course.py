@@ -167,7 +167,7 @@ def design_smc(a22: float, b2: float, lam1: float, lam2: float) -> SMCDesign:
         from shipgnc.derived_cache import stored
 
         gain = stored("place-poles-yt", {"A": A, "B": B, "poles": poles}, (__name__,),
-                      lambda: {"K": _place_poles(A, B, poles)})["K"]
+                      lambda: {"K": _place_poles(A, B, poles)}, shape={"K": [float] * 2})["K"]
     K = np.asarray(gain, dtype=float).reshape(2)
     A_c = A - B @ K.reshape(1, 2)
     values, vectors = np.linalg.eig(A_c.T)

@@ -254,7 +254,7 @@ def surge_equilibrium(params: CyberShip2Params, n: float) -> float:
     from shipgnc.derived_cache import stored
 
     root = stored("surge-equilibrium", {"params": params.as_dict(), "n": float(n)},
-                  (__name__,), lambda: {"u": _surge_root(params, float(n))})
+                  (__name__,), lambda: {"u": _surge_root(params, float(n))}, shape={"u": float})
     return float(root["u"])
 
 

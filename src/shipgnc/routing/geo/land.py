@@ -64,9 +64,9 @@ def _gshhg_wkb(rl) -> bytes:
     package's version; later routes read the file. Where the cache cannot be written, in process."""
     from importlib.metadata import version
 
-    from shipgnc.jit_cache import cache_dir
+    from shipgnc.jit_cache import cache_root
 
-    path = cache_dir().parent / "coastline" / f"gshhg-{version('roaring-landmask')}.wkb"
+    path = cache_root() / "coastline" / f"gshhg-{version('roaring-landmask')}.wkb"
     if path.is_file():
         return path.read_bytes()
     tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
