@@ -145,6 +145,7 @@ def main(argv=None) -> dict:
     import xarray as xr
     from dask.distributed import Client, LocalCluster
 
+    from shipgnc.study.chunk import Chunk, run_chunk
     from shipgnc.study.execute import run_study
     from shipgnc.study.spec import Perturbation, Study
 
@@ -152,6 +153,7 @@ def main(argv=None) -> dict:
     study = Study("boat-autopilot", members=members, seed=1,
                   perturb=(Perturbation.parse("psi_deg=uniform:-30,30"), Perturbation.parse("u=normal:0.2")))
     run_study(Study("boat-autopilot", members=2), chunk_size=2)  # warm-up: imports, kernel cache
+    run_chunk(study, Chunk(0, 0, 2))  # and the loop of the study's own plan (chunk.UNROLLED_SHIP_STEPS)
     if args.rate:
         rate = sweep_rate(study, args.repeats)
         print(f"{members} members of boat-autopilot (70 s, dt 0.05 s), scored in the loop")

@@ -99,18 +99,23 @@ class LoopParams(NamedTuple):
 
 
 class ScoreArrays(NamedTuple):
-    """The in-loop scoring step's accumulators (:mod:`shipgnc.sim.score_template`): ``ops``
-    (m, 3) int64 log column, kind and gate, ``span`` (m, 4) window start and end [s] and two arguments,
-    ``acc`` (ships, 3 m) each ship's numbers. No accumulator (m = 0): nothing is scored."""
+    """The in-loop scoring step's accumulators (:mod:`shipgnc.sim.score_template`) as the loop
+    reads them: ``order`` (m,) int64 the accumulators group by group and ``bounds`` (groups + 1,)
+    int64 where each group starts in it (:func:`shipgnc.sim.scored.score_groups`; the groups'
+    column, kind, gate and function are the constants of the loop's generated step), ``span``
+    (m, 4) each one's window start and end [s] and two arguments, ``acc`` (ships, 3 m) each ship's
+    numbers. No accumulator (m = 0): nothing is scored."""
 
-    ops: np.ndarray
+    order: np.ndarray
+    bounds: np.ndarray
     span: np.ndarray
     acc: np.ndarray
 
 
 def no_scoring(n_ships: int) -> ScoreArrays:
     """The scoring step's arrays when nothing is scored in the loop."""
-    return ScoreArrays(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4)), np.zeros((n_ships, 0)))
+    return ScoreArrays(np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros((0, 4)),
+                       np.zeros((n_ships, 0)))
 
 
 class LoopTables(NamedTuple):
@@ -142,7 +147,7 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
              has_ctrl: bool, continuous: bool, has_guid: bool, has_dist: bool, per_stage: bool,
              has_lag: bool, rate_limited: bool, hold_mode: bool, has_cur: bool = False,
              est_slot: str | None = None, nzn: int = 0, nnsig: int = 0, ne: int = 0,
-             has_score: bool = False):
+             score: tuple | None = None):
     """The composed loop of one combination (compiled on first use, memoised per process).
     ``cur_fn``: a disturbance's current part (``kernel_current``), called right after ``dist_fn``
     with the same arguments and its own parameters, table and (empty) state. ``est_slot``: None
@@ -151,12 +156,14 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
     ``kf_slot``; or an estimator's own kernel function ``"module:function"`` with the slots'
     signature; :meth:`Navigation.kernel`) that runs after the sensors at each control sample
     with ``nzn`` numbers of state per ship and ``nnsig`` logged signals; ``ne`` the EKF's state
-    dimension (the model's ``nx`` plus its augmented states; 0: ``nx``). ``has_score``: the loop
-    with the in-loop scoring step (:mod:`shipgnc.sim.score_template`), a loop of its own so that
-    the others compile without it."""
+    dimension (the model's ``nx`` plus its augmented states; 0: ``nx``). ``score``: None, or the
+    loop with the in-loop scoring step (:mod:`shipgnc.sim.score_template`) of the accumulator
+    groups ``score`` (:func:`shipgnc.sim.scored.score_groups`' signature: each group's column,
+    kind, gate and function; unrolled, each accumulator's window and index too), a loop of its
+    own per signature, so that the others compile without it."""
     key = (model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
            nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx, has_score)
+           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx, score)
     if key not in _LOOPS:
         _LOOPS[key] = _generate(*key)
     return _LOOPS[key]
@@ -201,9 +208,11 @@ def _resolve(target: str):
 
 def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
             nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-            hold_mode, has_cur, est_slot, nzn, nnsig, ne, has_score=False, *, imports: bool):
+            hold_mode, has_cur, est_slot, nzn, nnsig, ne, score=None, *, imports: bool):
     """Source of the combination's module: constants, the components' kernels, the navigation
-    step, the loop body."""
+    step, the loop body, the scoring step of the accumulator groups ``score``."""
+    from shipgnc.sim.scored import score_step_source
+
     nl = nu if has_lag else 0
     lay = row_layout(nx, nl, nu, nref, nout, nsig, nd, nzc, nzg, nzd, nzn, nnsig)
     constants = {
@@ -213,7 +222,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
         "has_dist": has_dist, "per_stage": per_stage, "has_lag": has_lag,
         "rate_limited": rate_limited, "hold_mode": hold_mode, "has_cur": has_cur,
         "has_nav": est_slot is not None, "nzn": nzn, "nnsig": nnsig, "ne": ne,
-        "has_score": has_score,
+        "has_score": score is not None,
         **{f"o_{name}": lay[key] for name, key in (
             ("x", "x"), ("lag", "lag"), ("app", "applied"), ("cmd", "cmd"), ("ref", "ref"),
             ("out", "out"), ("sig", "sig"), ("d", "d"), ("done", "done"), ("zc", "zc"),
@@ -238,7 +247,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
     elif est_slot is not None and not est_slot.isidentifier():
         raise ValueError(f"est_slot = {est_slot!r}: not a slot of the navigation template")
     return ("\n".join(lines) + "\n" + NAV_TEMPLATE.read_text() + slot + "\n" + TEMPLATE.read_text()
-            + "\n" + SCORE_TEMPLATE.read_text()
+            + "\n" + SCORE_TEMPLATE.read_text() + "\n\n" + score_step_source(score or ())
             + '\nloop = numba.njit(parallel=True, **{**JIT_OPTIONS, "cache": CACHE})(loop)\n')
 
 
@@ -286,7 +295,8 @@ class Composition:
     (:class:`~shipgnc.sim.transition.Transition`, an agent's episode) a control period at a time
     (:meth:`advance`, :meth:`carried`, :meth:`put_state`), with a log of
     ``log_samples`` samples from sample :attr:`s_base` (set before each call) instead of the whole
-    run's. ``scored``: the loop with the in-loop scoring step (:meth:`score_in_loop`)."""
+    run's. ``scored``: the loop with the in-loop scoring step, chosen by :meth:`score_in_loop`
+    (one loop per signature of accumulator groups), which comes before the first :meth:`call`."""
 
     def __init__(self, setup, log_samples: int | None = None, scored: bool = False):
         from shipgnc.sim.compiled import log_length
@@ -325,7 +335,7 @@ class Composition:
         zn0 = kn.state_for(n) if kn else np.zeros((n, 0))
         nnsig = kn.n_signals if kn else 0
         continuous = bool(getattr(ctrl, "continuous", False))
-        self.loop = loop = loop_for(
+        self._loop_for = lambda score: loop_for(
             km.function, kc.function if kc else _no_controller,
             kg.function if kg else _no_guidance, kd.function if kd else _no_disturbance,
             nx=nx, nu=nu, nd=nd, nref=len(refs), nout=nout, nsig=nsig, nerr=err.shape[0],
@@ -335,9 +345,12 @@ class Composition:
             rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold",
             cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None,
             est_slot=kn.estimator if kn else None, nzn=zn0.shape[1], nnsig=nnsig,
-            ne=kn.n_filter if kn else 0, has_score=scored)
+            ne=kn.n_filter if kn else 0, score=score)
+        #: the loop (a scored one: None until :meth:`score_in_loop`)
+        self.loop = None if scored else self._loop_for(None)
         #: the file holding the loop's generated source, exactly what runs (:func:`source_path`)
-        self.source_path = source_path(loop)
+        self.source_path = None if scored else source_path(self.loop)
+        self._nx = nx
         lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd,
                          zc0.shape[1], zg0.shape[1], zd0.shape[1], zn0.shape[1], nnsig)
         self.layout = lay
@@ -384,9 +397,17 @@ class Composition:
         #: the in-loop scoring step's accumulators (none unless :meth:`score_in_loop`)
         self.score = no_scoring(n)
 
-    def score_in_loop(self, ops: np.ndarray, span: np.ndarray, acc: np.ndarray) -> None:
-        """Score every step in the loop into ``acc`` (ships, 3 m), updated in place
-        (:class:`ScoreArrays`; :mod:`shipgnc.sim.scored`)."""
+    def score_in_loop(self, ops: np.ndarray, span: np.ndarray, acc: np.ndarray,
+                      unrolled: bool = False, declared=()) -> None:
+        """Score every step in the loop into ``acc`` (ships, 3 m), updated in place, with the
+        accumulators ``ops`` (m, 3) int64 log column, kind and gate and ``span`` (m, 4)
+        (:mod:`shipgnc.sim.score_template`): the loop of their groups' signature
+        (:func:`shipgnc.sim.scored.score_groups` with the groups ``declared``; ``unrolled``: a
+        loop of this plan's own) is compiled now unless it is in the disk cache; with no
+        accumulator and no group, the loop without scoring (:class:`ScoreArrays`;
+        :mod:`shipgnc.sim.scored`)."""
+        from shipgnc.sim.scored import score_groups
+
         if not self.scored:
             raise ValueError("score_in_loop: the Composition was built without scored=True")
         n = self.S.shape[0]
@@ -398,7 +419,10 @@ class Composition:
         if ops.shape[0] and not (0 <= ops[:, 0].min() and ops[:, 0].max() < len(self.signals)):
             raise ValueError(f"score_in_loop: log columns {ops[:, 0].tolist()} outside "
                              f"0 … {len(self.signals) - 1}")
-        self.score = ScoreArrays(ops, span, acc)
+        signature, order, bounds = score_groups(ops, span, self._nx, unrolled, declared)
+        self.score = ScoreArrays(order, bounds, span, acc)
+        self.loop = self._loop_for(signature or None)
+        self.source_path = source_path(self.loop)
 
     def prepare(self, k0: int, k1: int) -> None:
         """The input tables of steps ``k0 … k1 − 1`` (a noise's draws, the sensors' draws)."""
@@ -416,6 +440,8 @@ class Composition:
         """Steps ``k0 <= k < k1`` of every ship without an event (``k_last``: the step logged
         whatever ``log_every`` that ends the run); :meth:`prepare` first."""
         setup, table, params = self.setup, self._table, self._params
+        if self.loop is None:
+            raise ValueError("call: a scored Composition runs after score_in_loop")
         steps = LoopSteps(int(k0), int(k1), int(k_last), int(setup.hold), int(setup.log_every),
                           float(setup.dt), int(self.s_base))
         self.loop(steps, self.S, self.out, self.event,
