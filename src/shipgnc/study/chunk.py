@@ -128,11 +128,12 @@ def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> 
     pushed beyond the model's state range is a ConfigError naming the member and the field."""
     state_names = names(model.states)
     batch = np.tile(np.asarray(x0, dtype=float), (chunk.size, 1))
-    for row, member in enumerate(range(chunk.start, chunk.stop) if study.offsets else ()):
+    fields = [(state_names.index(PERTURBABLE[p.field][0]), PERTURBABLE[p.field][1], p)
+              for p in study.offsets]  # each member's draws in this order
+    for row, member in enumerate(range(chunk.start, chunk.stop) if fields else ()):
         rng = np.random.default_rng(study.member_stream(member, 0))
-        for p in study.offsets:
-            state, scale = PERTURBABLE[p.field]
-            batch[row, state_names.index(state)] += scale * p.draw(rng)
+        for i, scale, p in fields:
+            batch[row, i] += scale * p.draw(rng)
     limits = np.asarray(model.state_limits, dtype=float)
     for p in study.offsets:
         state, scale = PERTURBABLE[p.field]
