@@ -20,7 +20,9 @@ with the compiled loop on 1 and on 2 threads (alternately, best of ``--repeats``
 second of wall time and per CPU-second, the CPU time split into the loop's kernel calls and the
 rest (the chunks' set-up in Python, the figures' finishing, the Dataset), and the rate two idle
 cores would give, ``members / (rest + loop on 1 thread / 2)`` — a projection (the rest runs on one
-core; the loop's ships split evenly over both), not a measurement. ``--rate`` runs (e) alone.
+core; the loop's ships split evenly over both), not a measurement. ``--rate`` runs (e) alone. The
+warm-up (imports, the kernels' cache) also loads the loop of the study's own plan, which a study
+of this size is scored in (``shipgnc.study.chunk.UNROLLED_SHIP_STEPS``), so no compile is timed.
 Writes ``benchmarks/results/bench_sweep.json`` (``..._quick.json`` with ``--quick``: 2 000
 members).
 """

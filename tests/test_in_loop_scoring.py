@@ -350,10 +350,10 @@ def test_the_memory_estimate_takes_the_largest_grid_point_in_any_order(series):
     assert short_first["result"] == 2 * alone["result"]  # two cells, each as large as the longest
 
 
-def test_a_plan_s_own_loop_scores_to_the_bit_as_its_groups_loop(monkeypatch):
+def test_a_plan_s_own_loop_scores_to_the_bit_as_the_generic_one(monkeypatch):
     """A study of at least ``UNROLLED_SHIP_STEPS`` members × steps runs its chunks in a loop of
-    the plan's own (each accumulator's index a constant of its code): the same accumulators, to
-    the bit, as the loop of the metric set's groups, so the same chunk."""
+    the plan's own (each accumulator's kind, column and index constants of its code): the same
+    accumulators, to the bit, as the combination's scored loop, so the same chunk."""
     import xarray as xr
 
     import shipgnc.sim.scored as scored
@@ -361,7 +361,7 @@ def test_a_plan_s_own_loop_scores_to_the_bit_as_its_groups_loop(monkeypatch):
 
     study = Study("boat-autopilot", members=4, seed=7, overrides=("simulation.t_end=12",),
                   perturb=(Perturbation.parse("psi_deg=uniform:-30,30"),))  # one heading step
-    reference = run_chunk(study, Chunk(0, 0, 4))  # 4 members: the groups' loop
+    reference = run_chunk(study, Chunk(0, 0, 4))  # 4 members: the generic step
     real, unrolled = scored.run_scored, []
 
     def spied(*args, **kwargs):
@@ -374,40 +374,30 @@ def test_a_plan_s_own_loop_scores_to_the_bit_as_its_groups_loop(monkeypatch):
     assert unrolled == [True]
 
 
-def test_the_scoring_step_is_written_with_each_group_s_constants():
-    """The generated step: the switches' group first, a group per column, kind, gate, function
-    and windowing (the windows' count is not in its code); unrolled, an update per accumulator
-    with its index; a kind, a function or a gate the step cannot take is refused."""
+def test_a_plan_s_own_step_is_written_with_each_accumulator_s_constants():
+    """The step written for one plan: each accumulator's update with its column, gate, function
+    and index constants, its window checked only where it has one; a kind, a function or a gate
+    the step cannot take is refused."""
     from shipgnc.analysis.accumulated import MAX, SUM, SWITCH, WRAP_DIFF_SQUARES
-    from shipgnc.sim.scored import score_groups, score_step_source
+    from shipgnc.sim.scored import score_plan, score_step_source
 
     inf = np.inf
-    ops = np.array([[5, MAX, -1], [3, SWITCH, -1], [5, MAX, 3], [5, MAX, -1], [4, SUM, -1]])
-    span = np.array([[0.0, 10.0, 1.0, 0.0], [-inf, inf, 1.0, 0.0], [-inf, inf, -1.0, 0.0],
-                     [10.0, 20.0, 1.0, 0.0], [-inf, inf, 1.0, 2.0]])
-    signature, order, bounds = score_groups(ops, span, 3)
-    assert signature == ((3, SWITCH, -1, 0, None, None), (5, MAX, -1, 0, None, None),
-                         (5, MAX, 3, 0, None, None), (4, SUM, -1, 2, None, None))
-    assert order.tolist() == [1, 0, 3, 2, 4] and bounds.tolist() == [0, 1, 3, 4, 5]
-    more = score_groups(np.r_[ops, [[5, MAX, -1]]], np.r_[span, [[20.0, 30.0, 1.0, 0.0]]], 3)
-    assert more[0] == signature  # a third window: the same code
-    declared = [(5, MAX, -1, 0, None, None)]  # a plan without the windows, the group declared
-    fewer = score_groups(ops[[1, 4]], span[[1, 4]], 3, declared=declared)
-    assert fewer[0] == ((3, SWITCH, -1, 0, None, None), *declared, signature[3])
-    assert fewer[2].tolist() == [0, 1, 1, 2]  # the declared group empty
-    grouped = score_step_source(signature)
-    assert "    for q in range(bounds[1], bounds[2]):" in grouped
-    assert "span[m, 1]) and (acc[3] != 0.0):" in grouped  # from the switch of accumulator 1 on
-    unrolled = score_groups(ops, span, 3, unrolled=True)[0]
-    source = score_step_source(unrolled)
-    assert "bounds" not in source.split('"""')[-1]
-    assert "    if (t >= span[3, 0] and t < span[3, 1]):\n        score_max(acc, 3 * 3, v5," in source
-    assert "    if (acc[3] != 0.0):\n        score_max(acc, 3 * 2, v5, t, span[2, 2]" in source
-    assert "    score_sum(acc, 3 * 4, v4, t, span[4, 2], span[4, 3], 2, x)" in source
+    ops = np.array([[3, SWITCH, -1], [5, MAX, -1], [5, MAX, 1], [4, SUM, -1]])
+    span = np.array([[-inf, inf, 1.0, 0.0], [0.0, 10.0, 1.0, 0.0], [-inf, inf, -1.0, 0.0],
+                     [-inf, inf, 1.0, 2.0]])
+    plan = score_plan(ops, span, 3)
+    assert plan == ((3, SWITCH, -1, 0, False), (5, MAX, -1, 0, True), (5, MAX, 1, 0, False),
+                    (4, SUM, -1, 2, False))
+    source = score_step_source(plan)
+    assert "    score_switch(acc, 0, v3, t, span[0, 2], span[0, 3], 0, x)" in source
+    assert "    if (t >= span[1, 0] and t < span[1, 1]):\n        score_max(acc, 3, v5," in source
+    assert "    if (acc[0] != 0.0):\n        score_max(acc, 6, v5, t, span[2, 2]" in source  # from it
+    assert "    score_sum(acc, 9, v4, t, span[3, 2], span[3, 3], 2, x)" in source
+    assert score_step_source(None) == "score_step = score_step_generic\n"
     for bad_ops, bad_span, what in (
             ([[5, 14, -1]], [[-inf, inf, 1.0, 0.0]], "kind 14"),
             ([[4, SUM, -1]], [[-inf, inf, 1.0, 4.0]], "span\\[m, 3\\] = 4,"),
             ([[4, WRAP_DIFF_SQUARES, -1]], [[-inf, inf, 1.0, 3.0]], "0 … 2"),
             ([[4, MAX, 1]], [[-inf, inf, 1.0, 0.0]], "switch 0 must come before")):
         with pytest.raises(ValueError, match=what):
-            score_groups(np.array(bad_ops), np.array(bad_span), 3)
+            score_plan(np.array(bad_ops), np.array(bad_span), 3)

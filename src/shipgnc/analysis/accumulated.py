@@ -70,16 +70,12 @@ BLOCKS = 8
 class Accumulators:
     """The accumulators of a metric set (see :class:`shipgnc.sim.compose.ScoreArrays`): ``ops``
     (m, 3), ``span`` (m, 4), ``init`` (3 m,) and ``finish(acc)`` → the metric arrays (ships,),
-    and under :data:`NEEDS_LOG` (if present) the ships to score from their logged series;
-    ``groups``: the accumulator groups the metric set's plans may hold even where this one has
-    none (:func:`shipgnc.sim.scored.score_groups`: a run with no heading step in its window shares
-    the loop of one with some)."""
+    and under :data:`NEEDS_LOG` (if present) the ships to score from their logged series."""
 
     ops: np.ndarray
     span: np.ndarray
     init: np.ndarray
     finish: Callable[[np.ndarray], dict]
-    groups: tuple = ()
 
 
 class _Plan:
@@ -89,7 +85,6 @@ class _Plan:
         self.columns = {name: i for i, name in enumerate(signals)}
         self.rows: list[tuple[int, int, int, float, float, float, float]] = []
         self.start: dict[int, float] = {}
-        self.declared: list[tuple] = []
 
     def add(self, name: str, kind: int, start=-math.inf, end=math.inf, arg=1.0, level=0.0,
             gate=-1, init=None) -> int:
@@ -100,11 +95,6 @@ class _Plan:
             self.start[len(self.rows) - 1] = init
         return len(self.rows) - 1
 
-    def declare(self, name: str, kind: int, gate=-1) -> None:
-        """A group of accumulators of signal ``name`` and ``kind`` (of no function) that other
-        plans of the metric set hold (:attr:`Accumulators.groups`)."""
-        self.declared.append((self.columns[name], kind, gate, 0, None, None))
-
     def build(self, finish) -> Accumulators:
         ops = np.array([r[:3] for r in self.rows], dtype=np.int64).reshape(-1, 3)
         span = np.array([r[3:] for r in self.rows], dtype=np.float64).reshape(-1, 4)
@@ -113,7 +103,7 @@ class _Plan:
             init[3 * m] = self.start.get(m, -math.inf if kind in _FROM_MINUS_INF else 0.0)
             if kind == DIFF:  # no previous sample yet
                 init[3 * m + 2] = math.nan
-        return Accumulators(ops, span, init, finish, tuple(self.declared))
+        return Accumulators(ops, span, init, finish)
 
 
 def plan_for(scenario, setup, signals, n_steps: int, dt: float) -> Accumulators | None:
@@ -139,8 +129,6 @@ def heading_steps(signals, t: np.ndarray, step_times, tolerance_deg: float = 2.0
     deg = 180.0 / math.pi  # units.to_deg's factor
     windows = []
     first_psi_d = plan.add("psi_d", FIRST)
-    for name, kind in (("psi_error", BAND_EXIT), ("psi_error", MAX), ("psi_d", LAST)):
-        plan.declare(name, kind)  # a heading step's window's: a run too short for one has none
     for t_k, t_next in itertools.pairwise([*step_times, t[-1] + 1.0]):
         if not ((t >= t_k - EDGE) & (t < t_next - EDGE)).any():
             continue

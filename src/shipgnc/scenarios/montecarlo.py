@@ -100,8 +100,7 @@ def run(scenario, setup, rebuild: Callable, *, seed: int, progress=None,
     again = np.flatnonzero(figures.pop(accumulated.NEEDS_LOG))
     for block in np.array_split(again, -(-again.size // SHIPS_PER_RERUN)) if again.size else ():
         rows = _scored_from_log(rebuild(), sim, seed, batch.x0[block],
-                                {k: v[:, block] for k, v in scored.tables.items()}, delta_max,
-                                plan)
+                                {k: v[:, block] for k, v in scored.tables.items()}, delta_max)
         if rows is None:
             return None
         for name, values in figures.items():
@@ -165,11 +164,9 @@ def _sim_setup(setup, sim, seed, log_every: int, progress=None):
                      log_every=log_every, navigation=setup.navigation)
 
 
-def _scored_from_log(fresh, sim, seed, x0, tables: dict, delta_max: float,
-                     plan=None) -> dict | None:
+def _scored_from_log(fresh, sim, seed, x0, tables: dict, delta_max: float) -> dict | None:
     """The path-tracking figures of ships ``x0`` of a batch, run again with their per-step
-    ``tables`` from it and scored from their log of every step (None: no compiled loop; the loop
-    the batch's accumulators ``plan`` ran in)."""
+    ``tables`` from it and scored from their log of every step (None: no compiled loop)."""
     from dataclasses import replace
 
     from shipgnc.analysis.path_tracking import path_tracking_arrays
@@ -177,7 +174,7 @@ def _scored_from_log(fresh, sim, seed, x0, tables: dict, delta_max: float,
     from shipgnc.sim.scored import run_with_tables
 
     alone = _sim_setup(replace(fresh, x0=x0), sim, seed, 1)
-    log = run_with_tables(alone, tables, plan)
+    log = run_with_tables(alone, tables)
     if log is None or (log.diverged_at is not None and np.isfinite(log.diverged_at).any()):
         return None
     d = log.data

@@ -99,23 +99,18 @@ class LoopParams(NamedTuple):
 
 
 class ScoreArrays(NamedTuple):
-    """The in-loop scoring step's accumulators (:mod:`shipgnc.sim.score_template`) as the loop
-    reads them: ``order`` (m,) int64 the accumulators group by group and ``bounds`` (groups + 1,)
-    int64 where each group starts in it (:func:`shipgnc.sim.scored.score_groups`; the groups'
-    column, kind, gate and function are the constants of the loop's generated step), ``span``
-    (m, 4) each one's window start and end [s] and two arguments, ``acc`` (ships, 3 m) each ship's
-    numbers. No accumulator (m = 0): nothing is scored."""
+    """The in-loop scoring step's accumulators (:mod:`shipgnc.sim.score_template`): ``ops``
+    (m, 3) int64 log column, kind and gate, ``span`` (m, 4) window start and end [s] and two arguments,
+    ``acc`` (ships, 3 m) each ship's numbers. No accumulator (m = 0): nothing is scored."""
 
-    order: np.ndarray
-    bounds: np.ndarray
+    ops: np.ndarray
     span: np.ndarray
     acc: np.ndarray
 
 
 def no_scoring(n_ships: int) -> ScoreArrays:
     """The scoring step's arrays when nothing is scored in the loop."""
-    return ScoreArrays(np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros((0, 4)),
-                       np.zeros((n_ships, 0)))
+    return ScoreArrays(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4)), np.zeros((n_ships, 0)))
 
 
 class LoopTables(NamedTuple):
@@ -147,7 +142,7 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
              has_ctrl: bool, continuous: bool, has_guid: bool, has_dist: bool, per_stage: bool,
              has_lag: bool, rate_limited: bool, hold_mode: bool, has_cur: bool = False,
              est_slot: str | None = None, nzn: int = 0, nnsig: int = 0, ne: int = 0,
-             score: tuple | None = None):
+             has_score: bool = False, plan: tuple | None = None):
     """The composed loop of one combination (compiled on first use, memoised per process).
     ``cur_fn``: a disturbance's current part (``kernel_current``), called right after ``dist_fn``
     with the same arguments and its own parameters, table and (empty) state. ``est_slot``: None
@@ -156,14 +151,14 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
     ``kf_slot``; or an estimator's own kernel function ``"module:function"`` with the slots'
     signature; :meth:`Navigation.kernel`) that runs after the sensors at each control sample
     with ``nzn`` numbers of state per ship and ``nnsig`` logged signals; ``ne`` the EKF's state
-    dimension (the model's ``nx`` plus its augmented states; 0: ``nx``). ``score``: None, or the
-    loop with the in-loop scoring step (:mod:`shipgnc.sim.score_template`) of the accumulator
-    groups ``score`` (:func:`shipgnc.sim.scored.score_groups`' signature: each group's column,
-    kind, gate and function; unrolled, each accumulator's window and index too), a loop of its
-    own per signature, so that the others compile without it."""
+    dimension (the model's ``nx`` plus its augmented states; 0: ``nx``). ``has_score``: the loop
+    with the in-loop scoring step (:mod:`shipgnc.sim.score_template`), a loop of its own so that
+    the others compile without it; ``plan``: with the step written for one plan
+    (:func:`shipgnc.sim.scored.score_plan`'s signature), a loop per plan, else the generic step
+    that reads the plan at run time."""
     key = (model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
            nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx, score)
+           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx, has_score, plan)
     if key not in _LOOPS:
         _LOOPS[key] = _generate(*key)
     return _LOOPS[key]
@@ -208,9 +203,10 @@ def _resolve(target: str):
 
 def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
             nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-            hold_mode, has_cur, est_slot, nzn, nnsig, ne, score=None, *, imports: bool):
+            hold_mode, has_cur, est_slot, nzn, nnsig, ne, has_score=False, plan=None, *,
+            imports: bool):
     """Source of the combination's module: constants, the components' kernels, the navigation
-    step, the loop body, the scoring step of the accumulator groups ``score``."""
+    step, the loop body, the scoring step (generic, or of ``plan``)."""
     from shipgnc.sim.scored import score_step_source
 
     nl = nu if has_lag else 0
@@ -222,7 +218,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
         "has_dist": has_dist, "per_stage": per_stage, "has_lag": has_lag,
         "rate_limited": rate_limited, "hold_mode": hold_mode, "has_cur": has_cur,
         "has_nav": est_slot is not None, "nzn": nzn, "nnsig": nnsig, "ne": ne,
-        "has_score": score is not None,
+        "has_score": has_score,
         **{f"o_{name}": lay[key] for name, key in (
             ("x", "x"), ("lag", "lag"), ("app", "applied"), ("cmd", "cmd"), ("ref", "ref"),
             ("out", "out"), ("sig", "sig"), ("d", "d"), ("done", "done"), ("zc", "zc"),
@@ -247,7 +243,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
     elif est_slot is not None and not est_slot.isidentifier():
         raise ValueError(f"est_slot = {est_slot!r}: not a slot of the navigation template")
     return ("\n".join(lines) + "\n" + NAV_TEMPLATE.read_text() + slot + "\n" + TEMPLATE.read_text()
-            + "\n" + SCORE_TEMPLATE.read_text() + "\n\n" + score_step_source(score or ())
+            + "\n" + SCORE_TEMPLATE.read_text() + "\n\n" + score_step_source(plan)
             + '\nloop = numba.njit(parallel=True, **{**JIT_OPTIONS, "cache": CACHE})(loop)\n')
 
 
@@ -295,8 +291,7 @@ class Composition:
     (:class:`~shipgnc.sim.transition.Transition`, an agent's episode) a control period at a time
     (:meth:`advance`, :meth:`carried`, :meth:`put_state`), with a log of
     ``log_samples`` samples from sample :attr:`s_base` (set before each call) instead of the whole
-    run's. ``scored``: the loop with the in-loop scoring step, chosen by :meth:`score_in_loop`
-    (one loop per signature of accumulator groups), which comes before the first :meth:`call`."""
+    run's. ``scored``: the loop with the in-loop scoring step (:meth:`score_in_loop`)."""
 
     def __init__(self, setup, log_samples: int | None = None, scored: bool = False):
         from shipgnc.sim.compiled import log_length
@@ -335,7 +330,7 @@ class Composition:
         zn0 = kn.state_for(n) if kn else np.zeros((n, 0))
         nnsig = kn.n_signals if kn else 0
         continuous = bool(getattr(ctrl, "continuous", False))
-        self._loop_for = lambda score: loop_for(
+        self._loop_for = lambda plan: loop_for(
             km.function, kc.function if kc else _no_controller,
             kg.function if kg else _no_guidance, kd.function if kd else _no_disturbance,
             nx=nx, nu=nu, nd=nd, nref=len(refs), nout=nout, nsig=nsig, nerr=err.shape[0],
@@ -345,11 +340,10 @@ class Composition:
             rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold",
             cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None,
             est_slot=kn.estimator if kn else None, nzn=zn0.shape[1], nnsig=nnsig,
-            ne=kn.n_filter if kn else 0, score=score)
-        #: the loop (a scored one: None until :meth:`score_in_loop`)
-        self.loop = None if scored else self._loop_for(None)
+            ne=kn.n_filter if kn else 0, has_score=scored, plan=plan)
+        self.loop = loop = self._loop_for(None)  # compiled at its first call
         #: the file holding the loop's generated source, exactly what runs (:func:`source_path`)
-        self.source_path = None if scored else source_path(self.loop)
+        self.source_path = source_path(loop)
         self._nx = nx
         lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd,
                          zc0.shape[1], zg0.shape[1], zd0.shape[1], zn0.shape[1], nnsig)
@@ -398,15 +392,12 @@ class Composition:
         self.score = no_scoring(n)
 
     def score_in_loop(self, ops: np.ndarray, span: np.ndarray, acc: np.ndarray,
-                      unrolled: bool = False, declared=()) -> None:
-        """Score every step in the loop into ``acc`` (ships, 3 m), updated in place, with the
-        accumulators ``ops`` (m, 3) int64 log column, kind and gate and ``span`` (m, 4)
-        (:mod:`shipgnc.sim.score_template`): the loop of their groups' signature
-        (:func:`shipgnc.sim.scored.score_groups` with the groups ``declared``; ``unrolled``: a
-        loop of this plan's own) is compiled now unless it is in the disk cache; with no
-        accumulator and no group, the loop without scoring (:class:`ScoreArrays`;
-        :mod:`shipgnc.sim.scored`)."""
-        from shipgnc.sim.scored import score_groups
+                      unrolled: bool = False) -> None:
+        """Score every step in the loop into ``acc`` (ships, 3 m), updated in place
+        (:class:`ScoreArrays`; :mod:`shipgnc.sim.scored`); ``unrolled``: in the loop of this
+        plan's own step (:func:`shipgnc.sim.scored.score_plan`: compiled at its first call unless
+        it is in the disk cache), else in the combination's scored loop."""
+        from shipgnc.sim.scored import score_plan
 
         if not self.scored:
             raise ValueError("score_in_loop: the Composition was built without scored=True")
@@ -419,10 +410,11 @@ class Composition:
         if ops.shape[0] and not (0 <= ops[:, 0].min() and ops[:, 0].max() < len(self.signals)):
             raise ValueError(f"score_in_loop: log columns {ops[:, 0].tolist()} outside "
                              f"0 … {len(self.signals) - 1}")
-        signature, order, bounds = score_groups(ops, span, self._nx, unrolled, declared)
-        self.score = ScoreArrays(order, bounds, span, acc)
-        self.loop = self._loop_for(signature or None)
-        self.source_path = source_path(self.loop)
+        signature = score_plan(ops, span, self._nx)  # checks the plan whichever loop runs it
+        if unrolled:
+            self.loop = self._loop_for(signature)
+            self.source_path = source_path(self.loop)
+        self.score = ScoreArrays(ops, span, acc)
 
     def prepare(self, k0: int, k1: int) -> None:
         """The input tables of steps ``k0 … k1 − 1`` (a noise's draws, the sensors' draws)."""
@@ -440,8 +432,6 @@ class Composition:
         """Steps ``k0 <= k < k1`` of every ship without an event (``k_last``: the step logged
         whatever ``log_every`` that ends the run); :meth:`prepare` first."""
         setup, table, params = self.setup, self._table, self._params
-        if self.loop is None:
-            raise ValueError("call: a scored Composition runs after score_in_loop")
         steps = LoopSteps(int(k0), int(k1), int(k_last), int(setup.hold), int(setup.log_every),
                           float(setup.dt), int(self.s_base))
         self.loop(steps, self.S, self.out, self.event,

@@ -43,12 +43,12 @@ cur_fn = inline(getattr(cur_fn, "py_func", cur_fn))
 def loop(steps, S, out, event, done_at, params, tables, limits, err, score):
     """Steps ``steps.k0 <= k < steps.k1`` of every ship whose ``event`` is unset (the arguments:
     :class:`shipgnc.sim.compose.Composition.call`)."""
-    order, bounds, span, acc = score.order, score.bounds, score.span, score.acc  # see score_step
+    ops, span, acc = score.ops, score.span, score.acc  # the scoring step's (see score_step)
     for i in numba.prange(S.shape[0]):
         if event[i] >= 0:  # stopped by its divergence (on_divergence="mask"): skipped
             continue
-        run_ship(np.int64(i), steps, S[i], out, event, done_at, params, tables, limits, err, order,
-                 bounds, span, acc[i])
+        run_ship(np.int64(i), steps, S[i], out, event, done_at, params, tables, limits, err, ops,
+                 span, acc[i])
 
 
 @inline
@@ -58,8 +58,7 @@ def pick(rows, ship):
 
 
 @inline
-def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err, order, bounds, span,
-             scores):
+def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err, ops, span, scores):
     """Steps ``k0 … k1 − 1`` of ship ``i`` (its state carried in ``row``); sets ``event[i]`` (a
     bad command 2k, a bad state after step k 2k + 1) and ``done_at[i]``."""
     k0, k1, k_last, hold, every, dt = (steps.k0, steps.k1, steps.k_last, steps.hold, steps.every,
@@ -131,7 +130,7 @@ def run_ship(i, steps, row, out, event, done_at, params, tables, limits, err, or
             log_sample(out, s, i, x, cmd, u, ref, gout, sig, nsg, err)
             s += 1
         if has_score:  # a study's in-loop scoring: every step's sample into its accumulators
-            score_step(t, x, cmd, u, ref, gout, sig, nsg, err, order, bounds, span, acc)
+            score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc)
         if k == k_last:
             break
         # classic RK4 (sim.integrators.rk4_step) of z = [x, lag]; stage states in their own

@@ -41,13 +41,13 @@ switch recorded by the ``SCORE_SWITCH`` accumulator ``j`` (listed before it). It
 Every value is the log's own arithmetic (:func:`column_value` is ``log_sample``'s), so a finished
 figure equals the one computed from the logged series.
 
-The step that calls these kinds, ``score_step``, is written per plan by
+The step the loop calls, ``score_step``, is :func:`score_step_generic` (each accumulator's
+kind, column and gate read from ``ops`` at every step: one loop for every plan of a
+combination), or, for a study big enough to pay for its compile, the step written for one plan by
 :func:`shipgnc.sim.scored.score_step_source` after this text: each accumulator's column, kind,
-gate and function are constants there (straight-line code, no kind read at run time), its window
-and its two arguments are read from ``span``. Accumulators are updated in groups of the same
-constants (a plan with more heading steps or course steps has longer groups, not other code), the
-switches first; each accumulator sees its samples in time order as before, so the numbers are
-those of one accumulator after another.
+gate, function and index constants (straight-line code), its window and arguments read from
+``span``. Both call the kinds' functions below in the accumulators' order, so their numbers are
+the same to the bit.
 """
 # ruff: noqa: F821
 
@@ -98,8 +98,8 @@ def running_max(acc, a, v):
 
 # one function per kind, ``score_<kind>(acc, a, v, t, arg, level, f, x)``: accumulator ``a`` (its
 # first number) updated with the sample ``v`` at ``t``; ``arg``, ``level`` its span's last two
-# numbers, ``f`` (a constant of the generated step) the function, or the state, that the kind's
-# ``span[m, 3]`` names
+# numbers, ``f`` the function, or the state, that the kind's ``span[m, 3]`` names (a constant of
+# a plan's own step, ``int(level)`` in the generic one)
 
 @inline
 def score_max(acc, a, v, t, arg, level, f, x):
@@ -207,3 +207,45 @@ def score_wrap_diff_squares(acc, a, v, t, arg, level, f, x):
     if not math.isnan(w):
         acc[a] = acc[a] + w * w
         acc[a + 1] = acc[a + 1] + 1.0
+
+
+@inline
+def score_step_generic(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):
+    """Update the ship's accumulators ``acc`` with the sample at time ``t`` (see the module)."""
+    for m in range(ops.shape[0]):
+        if not (t >= span[m, 0] and t < span[m, 1]):
+            continue
+        gate = ops[m, 2]
+        if gate >= 0 and (acc[3 * (gate // 2)] != 0.0) != (gate % 2 == 1):
+            continue
+        v = column_value(ops[m, 0], x, cmd, u, ref, gout, sig, nsg, err)
+        kind, a, arg, level = ops[m, 1], 3 * m, span[m, 2], span[m, 3]
+        f = int(level)
+        if kind == SCORE_MAX:
+            score_max(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_MAX_ABS:
+            score_max_abs(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_SUM_SQUARES:
+            score_sum_squares(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_LAST:
+            score_last(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_FIRST:
+            score_first(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_BAND_EXIT:
+            score_band_exit(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_SUM:
+            score_sum(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_COUNT:
+            score_count(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_SWITCH:
+            score_switch(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_LAST_OUT:
+            score_last_out(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_SUM_TC:
+            score_sum_tc(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_ARGMAX:
+            score_argmax(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_DIFF:
+            score_diff(acc, a, v, t, arg, level, f, x)
+        elif kind == SCORE_WRAP_DIFF_SQUARES:
+            score_wrap_diff_squares(acc, a, v, t, arg, level, f, x)

@@ -34,7 +34,7 @@ class Scored(NamedTuple):
 
 def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
                logged: bool = False, tables: dict | None = None,
-               unrolled: bool = False, declared=()) -> Scored | None:
+               unrolled: bool = False) -> Scored | None:
     """Run ``setup`` (a validated :class:`~shipgnc.sim.simulator.SimSetup`; its ``log_every`` is
     best the run's length, unless ``logged``) in its composed loop with the accumulators ``ops``,
     ``span`` (see :class:`~shipgnc.sim.compose.ScoreArrays`) starting from ``init`` (3 m,) for
@@ -42,9 +42,8 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
     except with ``logged`` (the log then holds the samples up to it). ``tables``: the per-step
     input tables (:attr:`Scored.tables` of a run whose components draw the same ones) used
     instead of drawing them again (and returned as :attr:`Scored.tables`). ``unrolled``: in the
-    loop of this plan's own, its accumulators' indices constants (:func:`score_groups`: faster
-    per step, a compile per plan), else in the loop of the plan's groups and the groups
-    ``declared`` (:attr:`shipgnc.analysis.accumulated.Accumulators.groups`)."""
+    loop of this plan's own scoring step (:func:`score_step_source`: faster per step, a compile
+    per plan), else in the combination's scored loop, whose step reads the plan at run time."""
     from shipgnc.sim.compiled import drive, make_log
     from shipgnc.sim.compose import Composition, unsupported_reason
     from shipgnc.sim.simulator import reset_components
@@ -56,7 +55,7 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
     n = comp.S.shape[0]
     acc = np.empty((n, len(init)))
     acc[:] = np.asarray(init, dtype=np.float64)
-    comp.score_in_loop(ops, span, acc, unrolled, declared)
+    comp.score_in_loop(ops, span, acc, unrolled)
     if tables is not None and table_widths(comp) == _widths(tables, n):
         prepare = _replaying(comp, tables)
     else:  # no tables, or not the ones this loop's kernels draw: draw them
@@ -73,13 +72,12 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
     return Scored(acc, comp.event.copy(), log, tables)
 
 
-def run_with_tables(setup, tables: dict, plan=None):
+def run_with_tables(setup, tables: dict):
     """The :class:`~shipgnc.sim.simulator.Log` of ``setup`` in its composed loop with the per-step
     input ``tables`` (by name, (steps + 1, ships, ·): :attr:`Scored.tables` of the ships ``setup``
     holds) instead of those its components draw: ships of a batch run again on the inputs they had
-    there. None when no compiled loop covers ``setup``. The loop is the scored one of ``plan``
-    (the batch's :class:`~shipgnc.analysis.accumulated.Accumulators`: the loop :func:`run_scored`
-    compiled for the batch, no second compile; its numbers are not kept), or of no accumulator."""
+    there. None when no compiled loop covers ``setup``. The loop is the scored one with no
+    accumulator (the loop :func:`run_scored` compiled for the batch: no second compile)."""
     from shipgnc.sim.compiled import drive, make_log
     from shipgnc.sim.compose import Composition, unsupported_reason
     from shipgnc.sim.simulator import reset_components
@@ -88,12 +86,8 @@ def run_with_tables(setup, tables: dict, plan=None):
         return None
     reset_components(setup)
     comp = Composition(setup, scored=True)
-    ops, span, init, declared = ((plan.ops, plan.span, plan.init, plan.groups) if plan is not None
-                                 else (np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4)),
-                                       np.zeros(0), ()))
-    acc = np.empty((comp.S.shape[0], len(init)))
-    acc[:] = np.asarray(init, dtype=np.float64)
-    comp.score_in_loop(ops, span, acc, declared=declared)
+    comp.score_in_loop(np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4)),
+                       np.zeros((comp.S.shape[0], 0)))
     if table_widths(comp) != _widths(tables, comp.S.shape[0]):
         raise ValueError(f"run_with_tables: the tables {_widths(tables, None)} are not the ones "
                          f"the loop's kernels draw {table_widths(comp)}")
@@ -113,25 +107,15 @@ KIND_FUNCTIONS = ("score_max", "score_max_abs", "score_sum_squares", "score_last
 #: the kinds whose ``span[m, 3]`` names a function (``SCORE_SUM``, ``SCORE_DIFF``) or a state
 #: (``SCORE_WRAP_DIFF_SQUARES``), and how many there are (None: the model's states)
 _NAMED = {6: 4, 12: 3, 13: None}
-_SWITCH = 8
 
 
-def score_groups(ops: np.ndarray, span: np.ndarray, n_states: int, unrolled: bool = False,
-                 declared=()):
-    """The accumulators ``ops`` (m, 3: log column, kind, gate), ``span`` (m, 4) in groups of the
-    same column, kind, gate and function (``span[m, 3]`` of the kinds that name one by it), with
-    the groups ``declared`` (such keys: those a metric set's plans may hold, see
-    :class:`shipgnc.analysis.accumulated.Accumulators`) even when empty, the switches' groups
-    first, the others in the order they first come: the groups' signature (a tuple of those four,
-    whether the accumulator has a window other than −∞ … ∞ and its index, both None here: the
-    constants of the loop's scoring step, :func:`score_step_source`), ``order`` (m,) the
-    accumulators group by group and ``bounds`` (groups + 1,) where each group starts in it. A plan
-    with more or fewer windows of the same kinds (heading steps, course steps) has the same
-    signature, so the same loop. ``unrolled``: each accumulator a group of its own, whether it
-    has a window and its index constants too (straight-line code: ≈ 10 instead of ≈ 27 ns per
-    ship-step for the 16 accumulators of ``boat-autopilot``'s heading steps): a signature, so a
-    loop, per plan."""
-    groups: dict[tuple, list[int]] = {} if unrolled else {key: [] for key in declared}
+def score_plan(ops: np.ndarray, span: np.ndarray, n_states: int) -> tuple:
+    """The signature of the accumulators ``ops`` (m, 3: log column, kind, gate), ``span``
+    (m, 4): per accumulator its column, kind, gate, function (``span[m, 3]`` of the kinds that
+    name one by it, else 0) and whether it has a window other than −∞ … ∞, the constants of a
+    scoring step written for the plan (:func:`score_step_source`). A kind, a function or a gate
+    the step cannot take is a ValueError."""
+    keys = []
     for m, (column, kind, gate) in enumerate(np.asarray(ops, dtype=np.int64).tolist()):
         if not 0 <= kind < len(KIND_FUNCTIONS):
             raise ValueError(f"score_in_loop: accumulator {m} has kind {kind}, not one of "
@@ -145,39 +129,37 @@ def score_groups(ops: np.ndarray, span: np.ndarray, n_states: int, unrolled: boo
         if gate >= 0 and not gate // 2 < m:
             raise ValueError(f"score_in_loop: accumulator {m} has gate {gate}: its switch "
                              f"{gate // 2} must come before it")
-        key = (column, kind, gate, f, None, None)
-        if unrolled:
-            key = (*key[:4], not (span[m, 0] == -math.inf and span[m, 1] == math.inf), m)
-        groups.setdefault(key, []).append(m)
-    keys = sorted(groups, key=lambda key: key[1] != _SWITCH)  # stable: else first come
-    order = np.array([m for key in keys for m in groups[key]], dtype=np.int64)
-    bounds = np.cumsum([0, *(len(groups[key]) for key in keys)], dtype=np.int64)
-    return tuple(keys), order, bounds
+        windowed = not (span[m, 0] == -math.inf and span[m, 1] == math.inf)
+        keys.append((column, kind, gate, f, windowed))
+    return tuple(keys)
 
 
-def score_step_source(signature: tuple) -> str:
-    """The loop's scoring step ``score_step`` for accumulator groups of ``signature``
-    (:func:`score_groups`), as source (written after :mod:`shipgnc.sim.score_template`): each
-    column used read once per sample, then each group's accumulators ``order[bounds[g]:
-    bounds[g + 1]]`` updated by their kind's function with the group's constants (a group of
-    one accumulator of known index ``m``: its update with ``m`` a constant too)."""
+def score_step_source(plan: tuple | None) -> str:
+    """The loop's scoring step ``score_step`` as source (written after
+    :mod:`shipgnc.sim.score_template`): its generic step, or (``plan``: :func:`score_plan`'s
+    signature) straight-line code for that plan, each column used read once per sample, then
+    each accumulator in turn updated by its kind's function with its column, gate, function and
+    index as constants (``boat-autopilot``'s 16 heading-step accumulators: ≈ 10 instead of
+    ≈ 31 ns per ship-step; a loop, so a compile, per plan)."""
+    if plan is None:
+        return "score_step = score_step_generic\n"
     lines = ["@inline",
-             "def score_step(t, x, cmd, u, ref, gout, sig, nsg, err, order, bounds, span, acc):",
+             "def score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):",
              '    """Update the ship\'s accumulators ``acc`` with the sample at time ``t``."""']
-    for column in sorted({key[0] for key in signature}):
+    for column in sorted({key[0] for key in plan}):
         lines.append(f"    v{column} = column_value({column}, x, cmd, u, ref, gout, sig, nsg, err)")
-    for g, (column, kind, gate, f, windowed, index) in enumerate(signature):
-        m, pad = ("m", "        ") if index is None else (str(index), "    ")
-        if index is None:
-            lines += [f"    for q in range(bounds[{g}], bounds[{g + 1}]):", "        m = order[q]"]
-        conditions = [f"t >= span[{m}, 0] and t < span[{m}, 1]"] if windowed is not False else []
+    for m, (column, kind, gate, f, windowed) in enumerate(plan):
+        conditions = [f"t >= span[{m}, 0] and t < span[{m}, 1]"] if windowed else []
         if gate >= 0:  # before (2 j) or from (2 j + 1) switch j's first v > 0
             conditions.append(f"acc[{3 * (gate // 2)}] {'!=' if gate % 2 else '=='} 0.0")
+        pad = "    "
         if conditions:
-            lines.append(f"{pad}if {' and '.join(f'({c})' for c in conditions)}:")
-            pad += "    "
-        lines.append(f"{pad}{KIND_FUNCTIONS[kind]}(acc, 3 * {m}, v{column}, t, span[{m}, 2], "
+            lines.append(f"    if {' and '.join(f'({c})' for c in conditions)}:")
+            pad = "        "
+        lines.append(f"{pad}{KIND_FUNCTIONS[kind]}(acc, {3 * m}, v{column}, t, span[{m}, 2], "
                      f"span[{m}, 3], {f}, x)")
+    if not plan:
+        lines.append("    pass")
     return "\n".join(lines) + "\n"
 
 

@@ -38,12 +38,11 @@ class Chunk:
 
 
 #: the members × steps of a grid point from which a study's chunks are scored in a loop of their
-#: plan's own (each accumulator's index a constant in its code: boat-autopilot's heading steps
-#: cost ≈ 10 instead of ≈ 27 ns per ship-step), compiled once per plan and kept in the disk cache;
-#: a smaller study shares the loop of its metric set's accumulator groups, whatever its schedule or
-#: duration (:func:`shipgnc.sim.scored.score_groups`), so that runs of other schedules or
-#: durations do not each compile a loop. 10⁷ ship-steps: ``shipgnc sweep boat-autopilot --mc
-#: 10000`` (1.4·10⁷), where the loop's work is ≈ 2 CPU-seconds.
+#: plan's own (:func:`shipgnc.sim.scored.score_step_source`: boat-autopilot's heading steps cost
+#: ≈ 10 instead of ≈ 31 ns per ship-step), compiled once per plan and kept in the disk cache; a
+#: smaller study runs in the combination's scored loop, whose step reads any plan at run time, so
+#: that runs of other schedules or durations do not each compile a loop. 10⁷ ship-steps:
+#: ``shipgnc sweep boat-autopilot --mc 10000`` (1.4·10⁷), whose loop works ≈ 2 CPU-seconds.
 UNROLLED_SHIP_STEPS = 10_000_000
 
 
@@ -295,8 +294,7 @@ def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str, series: bool =
     if planned is None:
         return None
     run, plan = planned
-    scored = run_scored(run, plan.ops, plan.span, plan.init, unrolled=unrolled,
-                        declared=plan.groups)
+    scored = run_scored(run, plan.ops, plan.span, plan.init, unrolled=unrolled)
     if scored is None:
         return None
     figures = plan.finish(scored.acc)
