@@ -171,8 +171,8 @@ def test_a_diverged_member_is_scored_alone_from_its_log_and_the_others_in_the_lo
 
     real = scored.run_scored
 
-    def one_diverged(*args):
-        out = real(*args)
+    def one_diverged(*args, **kwargs):
+        out = real(*args, **kwargs)
         out.event[1] = 2 * 10 + 1  # as if member 1's state went bad after step 10
         return out
 
@@ -305,8 +305,8 @@ def test_a_diverged_course_quality_member_is_scored_alone_from_its_log(monkeypat
     reference = _course_chunk(False, members=3)
     real = scored.run_scored
 
-    def one_diverged(*args):
-        out = real(*args)
+    def one_diverged(*args, **kwargs):
+        out = real(*args, **kwargs)
         out.event[1] = 2 * 10 + 1
         return out
 
@@ -348,3 +348,56 @@ def test_the_memory_estimate_takes_the_largest_grid_point_in_any_order(series):
     assert short_first == long_first
     assert short_first["chunk"] == alone["chunk"] > need(20.0)["chunk"]
     assert short_first["result"] == 2 * alone["result"]  # two cells, each as large as the longest
+
+
+def test_a_plan_s_own_loop_scores_to_the_bit_as_the_generic_one(monkeypatch):
+    """A study of at least ``UNROLLED_SHIP_STEPS`` members × steps runs its chunks in a loop of
+    the plan's own (each accumulator's kind, column and index constants of its code): the same
+    accumulators, to the bit, as the combination's scored loop, so the same chunk."""
+    import xarray as xr
+
+    import shipgnc.sim.scored as scored
+    from shipgnc.study import chunk as chunk_module
+
+    study = Study("boat-autopilot", members=4, seed=7, overrides=("simulation.t_end=12",),
+                  perturb=(Perturbation.parse("psi_deg=uniform:-30,30"),))  # one heading step
+    reference = run_chunk(study, Chunk(0, 0, 4))  # 4 members: the generic step
+    real, unrolled = scored.run_scored, []
+
+    def spied(*args, **kwargs):
+        unrolled.append(kwargs.get("unrolled"))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(scored, "run_scored", spied)
+    monkeypatch.setattr(chunk_module, "UNROLLED_SHIP_STEPS", 4 * 239)
+    xr.testing.assert_identical(run_chunk(study, Chunk(0, 0, 4)), reference)
+    assert unrolled == [True]
+
+
+def test_a_plan_s_own_step_is_written_with_each_accumulator_s_constants():
+    """The step written for one plan: each accumulator's update with its column, gate, function
+    and index constants, its window checked only where it has one; a kind, a function or a gate
+    the step cannot take is refused."""
+    from shipgnc.analysis.accumulated import MAX, SUM, SWITCH, WRAP_DIFF_SQUARES
+    from shipgnc.sim.scored import score_plan, score_step_source
+
+    inf = np.inf
+    ops = np.array([[3, SWITCH, -1], [5, MAX, -1], [5, MAX, 1], [4, SUM, -1]])
+    span = np.array([[-inf, inf, 1.0, 0.0], [0.0, 10.0, 1.0, 0.0], [-inf, inf, -1.0, 0.0],
+                     [-inf, inf, 1.0, 2.0]])
+    plan = score_plan(ops, span, 3)
+    assert plan == ((3, SWITCH, -1, 0, False), (5, MAX, -1, 0, True), (5, MAX, 1, 0, False),
+                    (4, SUM, -1, 2, False))
+    source = score_step_source(plan)
+    assert "    score_switch(acc, 0, v3, t, span[0, 2], span[0, 3], 0, x)" in source
+    assert "    if (t >= span[1, 0] and t < span[1, 1]):\n        score_max(acc, 3, v5," in source
+    assert "    if (acc[0] != 0.0):\n        score_max(acc, 6, v5, t, span[2, 2]" in source  # from it
+    assert "    score_sum(acc, 9, v4, t, span[3, 2], span[3, 3], 2, x)" in source
+    assert score_step_source(None) == "score_step = score_step_generic\n"
+    for bad_ops, bad_span, what in (
+            ([[5, 14, -1]], [[-inf, inf, 1.0, 0.0]], "kind 14"),
+            ([[4, SUM, -1]], [[-inf, inf, 1.0, 4.0]], "span\\[m, 3\\] = 4,"),
+            ([[4, WRAP_DIFF_SQUARES, -1]], [[-inf, inf, 1.0, 3.0]], "0 … 2"),
+            ([[4, MAX, 1]], [[-inf, inf, 1.0, 0.0]], "switch 0 must come before")):
+        with pytest.raises(ValueError, match=what):
+            score_plan(np.array(bad_ops), np.array(bad_span), 3)

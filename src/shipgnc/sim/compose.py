@@ -142,7 +142,7 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
              has_ctrl: bool, continuous: bool, has_guid: bool, has_dist: bool, per_stage: bool,
              has_lag: bool, rate_limited: bool, hold_mode: bool, has_cur: bool = False,
              est_slot: str | None = None, nzn: int = 0, nnsig: int = 0, ne: int = 0,
-             has_score: bool = False):
+             has_score: bool = False, plan: tuple | None = None):
     """The composed loop of one combination (compiled on first use, memoised per process).
     ``cur_fn``: a disturbance's current part (``kernel_current``), called right after ``dist_fn``
     with the same arguments and its own parameters, table and (empty) state. ``est_slot``: None
@@ -153,10 +153,12 @@ def loop_for(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn=_no_disturbance, *, nx:
     with ``nzn`` numbers of state per ship and ``nnsig`` logged signals; ``ne`` the EKF's state
     dimension (the model's ``nx`` plus its augmented states; 0: ``nx``). ``has_score``: the loop
     with the in-loop scoring step (:mod:`shipgnc.sim.score_template`), a loop of its own so that
-    the others compile without it."""
+    the others compile without it; ``plan``: with the step written for one plan
+    (:func:`shipgnc.sim.scored.score_plan`'s signature), a loop per plan, else the generic step
+    that reads the plan at run time."""
     key = (model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
            nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx, has_score)
+           hold_mode, has_cur, est_slot, nzn, nnsig, ne or nx, has_score, plan)
     if key not in _LOOPS:
         _LOOPS[key] = _generate(*key)
     return _LOOPS[key]
@@ -201,9 +203,12 @@ def _resolve(target: str):
 
 def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout, nsig, nerr, nzc,
             nzg, nzd, has_ctrl, continuous, has_guid, has_dist, per_stage, has_lag, rate_limited,
-            hold_mode, has_cur, est_slot, nzn, nnsig, ne, has_score=False, *, imports: bool):
+            hold_mode, has_cur, est_slot, nzn, nnsig, ne, has_score=False, plan=None, *,
+            imports: bool):
     """Source of the combination's module: constants, the components' kernels, the navigation
-    step, the loop body."""
+    step, the loop body, the scoring step (generic, or of ``plan``)."""
+    from shipgnc.sim.scored import score_step_source
+
     nl = nu if has_lag else 0
     lay = row_layout(nx, nl, nu, nref, nout, nsig, nd, nzc, nzg, nzd, nzn, nnsig)
     constants = {
@@ -238,7 +243,7 @@ def _source(model_fn, ctrl_fn, guid_fn, dist_fn, cur_fn, nx, nu, nd, nref, nout,
     elif est_slot is not None and not est_slot.isidentifier():
         raise ValueError(f"est_slot = {est_slot!r}: not a slot of the navigation template")
     return ("\n".join(lines) + "\n" + NAV_TEMPLATE.read_text() + slot + "\n" + TEMPLATE.read_text()
-            + "\n" + SCORE_TEMPLATE.read_text()
+            + "\n" + SCORE_TEMPLATE.read_text() + "\n\n" + score_step_source(plan)
             + '\nloop = numba.njit(parallel=True, **{**JIT_OPTIONS, "cache": CACHE})(loop)\n')
 
 
@@ -325,7 +330,7 @@ class Composition:
         zn0 = kn.state_for(n) if kn else np.zeros((n, 0))
         nnsig = kn.n_signals if kn else 0
         continuous = bool(getattr(ctrl, "continuous", False))
-        self.loop = loop = loop_for(
+        self._loop_for = lambda plan: loop_for(
             km.function, kc.function if kc else _no_controller,
             kg.function if kg else _no_guidance, kd.function if kd else _no_disturbance,
             nx=nx, nu=nu, nd=nd, nref=len(refs), nout=nout, nsig=nsig, nerr=err.shape[0],
@@ -335,9 +340,11 @@ class Composition:
             rate_limited=act.has_rate_limit, hold_mode=act.rate_mode == "hold",
             cur_fn=ku.function if ku else _no_disturbance, has_cur=ku is not None,
             est_slot=kn.estimator if kn else None, nzn=zn0.shape[1], nnsig=nnsig,
-            ne=kn.n_filter if kn else 0, has_score=scored)
+            ne=kn.n_filter if kn else 0, has_score=scored, plan=plan)
+        self.loop = loop = self._loop_for(None)  # compiled at its first call
         #: the file holding the loop's generated source, exactly what runs (:func:`source_path`)
         self.source_path = source_path(loop)
+        self._nx = nx
         lay = row_layout(nx, nu if act.has_lag else 0, nu, len(refs), nout, nsig, nd,
                          zc0.shape[1], zg0.shape[1], zd0.shape[1], zn0.shape[1], nnsig)
         self.layout = lay
@@ -384,9 +391,14 @@ class Composition:
         #: the in-loop scoring step's accumulators (none unless :meth:`score_in_loop`)
         self.score = no_scoring(n)
 
-    def score_in_loop(self, ops: np.ndarray, span: np.ndarray, acc: np.ndarray) -> None:
+    def score_in_loop(self, ops: np.ndarray, span: np.ndarray, acc: np.ndarray,
+                      unrolled: bool = False) -> None:
         """Score every step in the loop into ``acc`` (ships, 3 m), updated in place
-        (:class:`ScoreArrays`; :mod:`shipgnc.sim.scored`)."""
+        (:class:`ScoreArrays`; :mod:`shipgnc.sim.scored`); ``unrolled``: in the loop of this
+        plan's own step (:func:`shipgnc.sim.scored.score_plan`: compiled at its first call unless
+        it is in the disk cache), else in the combination's scored loop."""
+        from shipgnc.sim.scored import score_plan
+
         if not self.scored:
             raise ValueError("score_in_loop: the Composition was built without scored=True")
         n = self.S.shape[0]
@@ -398,6 +410,10 @@ class Composition:
         if ops.shape[0] and not (0 <= ops[:, 0].min() and ops[:, 0].max() < len(self.signals)):
             raise ValueError(f"score_in_loop: log columns {ops[:, 0].tolist()} outside "
                              f"0 … {len(self.signals) - 1}")
+        signature = score_plan(ops, span, self._nx)  # checks the plan whichever loop runs it
+        if unrolled:
+            self.loop = self._loop_for(signature)
+            self.source_path = source_path(self.loop)
         self.score = ScoreArrays(ops, span, acc)
 
     def prepare(self, k0: int, k1: int) -> None:

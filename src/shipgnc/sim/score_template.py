@@ -40,6 +40,14 @@ switch recorded by the ``SCORE_SWITCH`` accumulator ``j`` (listed before it). It
 
 Every value is the log's own arithmetic (:func:`column_value` is ``log_sample``'s), so a finished
 figure equals the one computed from the logged series.
+
+The step the loop calls, ``score_step``, is :func:`score_step_generic` (each accumulator's
+kind, column and gate read from ``ops`` at every step: one loop for every plan of a
+combination), or, for a study big enough to pay for its compile, the step written for one plan by
+:func:`shipgnc.sim.scored.score_step_source` after this text: each accumulator's column, kind,
+gate, function and index constants (straight-line code), its window and arguments read from
+``span``. Both call the kinds' functions below in the accumulators' order, so their numbers are
+the same to the bit.
 """
 # ruff: noqa: F821
 
@@ -88,8 +96,121 @@ def running_max(acc, a, v):
         acc[a] = v
 
 
+# one function per kind, ``score_<kind>(acc, a, v, t, arg, level, f, x)``: accumulator ``a`` (its
+# first number) updated with the sample ``v`` at ``t``; ``arg``, ``level`` its span's last two
+# numbers, ``f`` the function, or the state, that the kind's ``span[m, 3]`` names (a constant of
+# a plan's own step, ``int(level)`` in the generic one)
+
 @inline
-def score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):
+def score_max(acc, a, v, t, arg, level, f, x):
+    running_max(acc, a, v * arg)
+
+
+@inline
+def score_max_abs(acc, a, v, t, arg, level, f, x):
+    running_max(acc, a, abs(v))
+
+
+@inline
+def score_sum_squares(acc, a, v, t, arg, level, f, x):
+    w = v * arg
+    acc[a] = acc[a] + w * w
+    acc[a + 1] = acc[a + 1] + 1.0
+
+
+@inline
+def score_last(acc, a, v, t, arg, level, f, x):
+    acc[a] = v
+    acc[a + 1] = 1.0
+
+
+@inline
+def score_first(acc, a, v, t, arg, level, f, x):
+    if acc[a + 1] == 0.0:
+        acc[a] = v
+        acc[a + 1] = 1.0
+
+
+@inline
+def score_band_exit(acc, a, v, t, arg, level, f, x):
+    if abs(v * arg) > level:
+        acc[a] = 1.0
+        acc[a + 1] = math.nan
+        acc[a + 2] = 1.0
+    elif acc[a + 2] != 0.0:
+        acc[a + 1] = t
+        acc[a + 2] = 0.0
+
+
+@inline
+def score_sum(acc, a, v, t, arg, level, f, x):
+    acc[a] = acc[a] + (v if f == 0 else math.sin(v) if f == 1 else
+                       math.cos(v) if f == 2 else abs(v))
+    acc[a + 1] = acc[a + 1] + 1.0
+
+
+@inline
+def score_count(acc, a, v, t, arg, level, f, x):
+    if v * arg >= level:
+        acc[a] = acc[a] + 1.0
+    acc[a + 1] = acc[a + 1] + 1.0
+
+
+@inline
+def score_switch(acc, a, v, t, arg, level, f, x):
+    if acc[a] == 0.0:
+        if v > 0:
+            acc[a] = 1.0
+        else:
+            acc[a + 1] = acc[a + 1] + 1.0
+
+
+@inline
+def score_last_out(acc, a, v, t, arg, level, f, x):
+    acc[a + 1] = acc[a + 1] + 1.0
+    if not (abs(v * arg) < level):
+        acc[a] = acc[a + 1]
+
+
+@inline
+def score_sum_tc(acc, a, v, t, arg, level, f, x):
+    acc[a] = acc[a] + (t - level) * v
+    acc[a + 1] = acc[a + 1] + 1.0
+
+
+@inline
+def score_argmax(acc, a, v, t, arg, level, f, x):
+    if v * arg > acc[a]:
+        acc[a] = v * arg
+        acc[a + 1] = t
+
+
+@inline
+def score_diff(acc, a, v, t, arg, level, f, x):
+    tr = np.rint(t * 1e9) / 1e9  # time_coordinate(t): np.round(t, 9)
+    if not math.isnan(acc[a + 2]):
+        step = v - acc[a + 1]
+        if f == 0:
+            q = step / (tr - acc[a + 2])
+            acc[a] = acc[a] + q * q
+        elif f == 1:
+            acc[a] = acc[a] + abs(step)
+        elif abs(step) / (tr - acc[a + 2]) >= arg:
+            acc[a] = acc[a] + 1.0
+    acc[a + 1] = v
+    acc[a + 2] = tr
+
+
+@inline
+def score_wrap_diff_squares(acc, a, v, t, arg, level, f, x):
+    w = wrap(v - x[f])
+    if not math.isnan(w):
+        acc[a] = acc[a] + w * w
+        acc[a + 1] = acc[a + 1] + 1.0
+
+
+@inline
+def score_step_generic(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):
     """Update the ship's accumulators ``acc`` with the sample at time ``t`` (see the module)."""
     for m in range(ops.shape[0]):
         if not (t >= span[m, 0] and t < span[m, 1]):
@@ -98,72 +219,33 @@ def score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):
         if gate >= 0 and (acc[3 * (gate // 2)] != 0.0) != (gate % 2 == 1):
             continue
         v = column_value(ops[m, 0], x, cmd, u, ref, gout, sig, nsg, err)
-        kind, a = ops[m, 1], 3 * m
+        kind, a, arg, level = ops[m, 1], 3 * m, span[m, 2], span[m, 3]
+        f = int(level)
         if kind == SCORE_MAX:
-            running_max(acc, a, v * span[m, 2])
+            score_max(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_MAX_ABS:
-            running_max(acc, a, abs(v))
+            score_max_abs(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_SUM_SQUARES:
-            w = v * span[m, 2]
-            acc[a] = acc[a] + w * w
-            acc[a + 1] = acc[a + 1] + 1.0
+            score_sum_squares(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_LAST:
-            acc[a] = v
-            acc[a + 1] = 1.0
+            score_last(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_FIRST:
-            if acc[a + 1] == 0.0:
-                acc[a] = v
-                acc[a + 1] = 1.0
+            score_first(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_BAND_EXIT:
-            if abs(v * span[m, 2]) > span[m, 3]:
-                acc[a] = 1.0
-                acc[a + 1] = math.nan
-                acc[a + 2] = 1.0
-            elif acc[a + 2] != 0.0:
-                acc[a + 1] = t
-                acc[a + 2] = 0.0
+            score_band_exit(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_SUM:
-            f = span[m, 3]
-            acc[a] = acc[a] + (v if f == 0.0 else math.sin(v) if f == 1.0 else
-                               math.cos(v) if f == 2.0 else abs(v))
-            acc[a + 1] = acc[a + 1] + 1.0
+            score_sum(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_COUNT:
-            if v * span[m, 2] >= span[m, 3]:
-                acc[a] = acc[a] + 1.0
-            acc[a + 1] = acc[a + 1] + 1.0
+            score_count(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_SWITCH:
-            if acc[a] == 0.0:
-                if v > 0:
-                    acc[a] = 1.0
-                else:
-                    acc[a + 1] = acc[a + 1] + 1.0
+            score_switch(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_LAST_OUT:
-            acc[a + 1] = acc[a + 1] + 1.0
-            if not (abs(v * span[m, 2]) < span[m, 3]):
-                acc[a] = acc[a + 1]
+            score_last_out(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_SUM_TC:
-            acc[a] = acc[a] + (t - span[m, 3]) * v
-            acc[a + 1] = acc[a + 1] + 1.0
+            score_sum_tc(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_ARGMAX:
-            if v * span[m, 2] > acc[a]:
-                acc[a] = v * span[m, 2]
-                acc[a + 1] = t
+            score_argmax(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_DIFF:
-            tr = np.rint(t * 1e9) / 1e9  # time_coordinate(t): np.round(t, 9)
-            if not math.isnan(acc[a + 2]):
-                step = v - acc[a + 1]
-                f = span[m, 3]
-                if f == 0.0:
-                    q = step / (tr - acc[a + 2])
-                    acc[a] = acc[a] + q * q
-                elif f == 1.0:
-                    acc[a] = acc[a] + abs(step)
-                elif abs(step) / (tr - acc[a + 2]) >= span[m, 2]:
-                    acc[a] = acc[a] + 1.0
-            acc[a + 1] = v
-            acc[a + 2] = tr
+            score_diff(acc, a, v, t, arg, level, f, x)
         elif kind == SCORE_WRAP_DIFF_SQUARES:
-            w = wrap(v - x[int(span[m, 3])])
-            if not math.isnan(w):
-                acc[a] = acc[a] + w * w
-                acc[a + 1] = acc[a + 1] + 1.0
+            score_wrap_diff_squares(acc, a, v, t, arg, level, f, x)

@@ -14,6 +14,7 @@ noise depends on the batch it was drawn in).
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -32,14 +33,17 @@ class Scored(NamedTuple):
 
 
 def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
-               logged: bool = False, tables: dict | None = None) -> Scored | None:
+               logged: bool = False, tables: dict | None = None,
+               unrolled: bool = False) -> Scored | None:
     """Run ``setup`` (a validated :class:`~shipgnc.sim.simulator.SimSetup`; its ``log_every`` is
     best the run's length, unless ``logged``) in its composed loop with the accumulators ``ops``,
     ``span`` (see :class:`~shipgnc.sim.compose.ScoreArrays`) starting from ``init`` (3 m,) for
     every ship. None when no compiled loop covers ``setup``. Ctrl-C raises KeyboardInterrupt,
     except with ``logged`` (the log then holds the samples up to it). ``tables``: the per-step
     input tables (:attr:`Scored.tables` of a run whose components draw the same ones) used
-    instead of drawing them again (and returned as :attr:`Scored.tables`)."""
+    instead of drawing them again (and returned as :attr:`Scored.tables`). ``unrolled``: in the
+    loop of this plan's own scoring step (:func:`score_step_source`: faster per step, a compile
+    per plan), else in the combination's scored loop, whose step reads the plan at run time."""
     from shipgnc.sim.compiled import drive, make_log
     from shipgnc.sim.compose import Composition, unsupported_reason
     from shipgnc.sim.simulator import reset_components
@@ -51,7 +55,7 @@ def run_scored(setup, ops: np.ndarray, span: np.ndarray, init: np.ndarray, *,
     n = comp.S.shape[0]
     acc = np.empty((n, len(init)))
     acc[:] = np.asarray(init, dtype=np.float64)
-    comp.score_in_loop(ops, span, acc)
+    comp.score_in_loop(ops, span, acc, unrolled)
     if tables is not None and table_widths(comp) == _widths(tables, n):
         prepare = _replaying(comp, tables)
     else:  # no tables, or not the ones this loop's kernels draw: draw them
@@ -94,6 +98,69 @@ def run_with_tables(setup, tables: dict):
     comp.restore()
     return make_log(setup, comp.signals, comp.out, comp.S, stop.event, state_slot=0,
                     cmd_slot=comp.layout["cmd"], k_end=stop.k_end, events=comp.event)
+
+
+#: the update function of each accumulator kind in :mod:`shipgnc.sim.score_template`, by kind
+KIND_FUNCTIONS = ("score_max", "score_max_abs", "score_sum_squares", "score_last", "score_first",
+                  "score_band_exit", "score_sum", "score_count", "score_switch", "score_last_out",
+                  "score_sum_tc", "score_argmax", "score_diff", "score_wrap_diff_squares")
+#: the kinds whose ``span[m, 3]`` names a function (``SCORE_SUM``, ``SCORE_DIFF``) or a state
+#: (``SCORE_WRAP_DIFF_SQUARES``), and how many there are (None: the model's states)
+_NAMED = {6: 4, 12: 3, 13: None}
+
+
+def score_plan(ops: np.ndarray, span: np.ndarray, n_states: int) -> tuple:
+    """The signature of the accumulators ``ops`` (m, 3: log column, kind, gate), ``span``
+    (m, 4): per accumulator its column, kind, gate, function (``span[m, 3]`` of the kinds that
+    name one by it, else 0) and whether it has a window other than −∞ … ∞, the constants of a
+    scoring step written for the plan (:func:`score_step_source`). A kind, a function or a gate
+    the step cannot take is a ValueError."""
+    keys = []
+    for m, (column, kind, gate) in enumerate(np.asarray(ops, dtype=np.int64).tolist()):
+        if not 0 <= kind < len(KIND_FUNCTIONS):
+            raise ValueError(f"score_in_loop: accumulator {m} has kind {kind}, not one of "
+                             f"0 … {len(KIND_FUNCTIONS) - 1}")
+        f = 0
+        if kind in _NAMED:
+            f, count = int(span[m, 3]), _NAMED[kind] or n_states
+            if f != span[m, 3] or not 0 <= f < count:
+                raise ValueError(f"score_in_loop: accumulator {m} of kind {kind} names span[m, 3] "
+                                 f"= {float(span[m, 3]):g}, not an integer 0 … {count - 1}")
+        if gate >= 0 and not gate // 2 < m:
+            raise ValueError(f"score_in_loop: accumulator {m} has gate {gate}: its switch "
+                             f"{gate // 2} must come before it")
+        windowed = not (span[m, 0] == -math.inf and span[m, 1] == math.inf)
+        keys.append((column, kind, gate, f, windowed))
+    return tuple(keys)
+
+
+def score_step_source(plan: tuple | None) -> str:
+    """The loop's scoring step ``score_step`` as source (written after
+    :mod:`shipgnc.sim.score_template`): its generic step, or (``plan``: :func:`score_plan`'s
+    signature) straight-line code for that plan, each column used read once per sample, then
+    each accumulator in turn updated by its kind's function with its column, gate, function and
+    index as constants (``boat-autopilot``'s 16 heading-step accumulators: ≈ 10 instead of
+    ≈ 31 ns per ship-step; a loop, so a compile, per plan)."""
+    if plan is None:
+        return "score_step = score_step_generic\n"
+    lines = ["@inline",
+             "def score_step(t, x, cmd, u, ref, gout, sig, nsg, err, ops, span, acc):",
+             '    """Update the ship\'s accumulators ``acc`` with the sample at time ``t``."""']
+    for column in sorted({key[0] for key in plan}):
+        lines.append(f"    v{column} = column_value({column}, x, cmd, u, ref, gout, sig, nsg, err)")
+    for m, (column, kind, gate, f, windowed) in enumerate(plan):
+        conditions = [f"t >= span[{m}, 0] and t < span[{m}, 1]"] if windowed else []
+        if gate >= 0:  # before (2 j) or from (2 j + 1) switch j's first v > 0
+            conditions.append(f"acc[{3 * (gate // 2)}] {'!=' if gate % 2 else '=='} 0.0")
+        pad = "    "
+        if conditions:
+            lines.append(f"    if {' and '.join(f'({c})' for c in conditions)}:")
+            pad = "        "
+        lines.append(f"{pad}{KIND_FUNCTIONS[kind]}(acc, {3 * m}, v{column}, t, span[{m}, 2], "
+                     f"span[{m}, 3], {f}, x)")
+    if not plan:
+        lines.append("    pass")
+    return "\n".join(lines) + "\n"
 
 
 def table_widths(comp) -> dict[str, int]:

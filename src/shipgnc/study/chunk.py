@@ -37,6 +37,15 @@ class Chunk:
         return self.stop - self.start
 
 
+#: the members × steps of a grid point from which a study's chunks are scored in a loop of their
+#: plan's own (:func:`shipgnc.sim.scored.score_step_source`: boat-autopilot's heading steps cost
+#: ≈ 10 instead of ≈ 31 ns per ship-step), compiled once per plan and kept in the disk cache; a
+#: smaller study runs in the combination's scored loop, whose step reads any plan at run time, so
+#: that runs of other schedules or durations do not each compile a loop. 10⁷ ship-steps:
+#: ``shipgnc sweep boat-autopilot --mc 10000`` (1.4·10⁷), whose loop works ≈ 2 CPU-seconds.
+UNROLLED_SHIP_STEPS = 10_000_000
+
+
 def plan_chunks(study: Study, variants: list[str] | None, chunk_size: int) -> list[Chunk]:
     """Every chunk of the study, grid point by grid point, at most ``chunk_size`` members each."""
     if not isinstance(chunk_size, (int, np.integer)) or isinstance(chunk_size, bool) or chunk_size < 1:
@@ -118,11 +127,12 @@ def member_initial_states(study: Study, x0: np.ndarray, model, chunk: Chunk) -> 
     pushed beyond the model's state range is a ConfigError naming the member and the field."""
     state_names = names(model.states)
     batch = np.tile(np.asarray(x0, dtype=float), (chunk.size, 1))
-    for row, member in enumerate(range(chunk.start, chunk.stop) if study.offsets else ()):
+    fields = [(state_names.index(PERTURBABLE[p.field][0]), PERTURBABLE[p.field][1], p)
+              for p in study.offsets]  # each member's draws in this order
+    for row, member in enumerate(range(chunk.start, chunk.stop) if fields else ()):
         rng = np.random.default_rng(study.member_stream(member, 0))
-        for p in study.offsets:
-            state, scale = PERTURBABLE[p.field]
-            batch[row, state_names.index(state)] += scale * p.draw(rng)
+        for i, scale, p in fields:
+            batch[row, i] += scale * p.draw(rng)
     limits = np.asarray(model.state_limits, dtype=float)
     for p in study.offsets:
         state, scale = PERTURBABLE[p.field]
@@ -269,11 +279,13 @@ def in_loop_plan(scenario, setup, sim, x0, seeds, backend: str, series: bool = F
     return None if plan is None else (run, plan)
 
 
-def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str, series: bool = False):
+def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str, series: bool = False,
+                   unrolled: bool = False):
     """Every member's metrics scored inside the compiled loop (:mod:`shipgnc.analysis.accumulated`),
     in :func:`~shipgnc.scenarios.runner.metric_arrays`' key order, and which members diverged
     or need their series (their figures NaN here: :func:`run_chunk` runs each again alone with its
-    log); None when the chunk keeps its log (:func:`in_loop_plan`)."""
+    log); None when the chunk keeps its log (:func:`in_loop_plan`). ``unrolled``: in a loop of
+    the plan's own (:func:`shipgnc.sim.scored.run_scored`; :data:`UNROLLED_SHIP_STEPS`)."""
     from shipgnc.analysis.accumulated import NEEDS_LOG
     from shipgnc.scenarios.runner import design_figures
     from shipgnc.sim.scored import run_scored
@@ -282,7 +294,7 @@ def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str, series: bool =
     if planned is None:
         return None
     run, plan = planned
-    scored = run_scored(run, plan.ops, plan.span, plan.init)
+    scored = run_scored(run, plan.ops, plan.span, plan.init, unrolled=unrolled)
     if scored is None:
         return None
     figures = plan.finish(scored.acc)
@@ -384,7 +396,8 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
 
     scenario, setup, sim, x0, seeds, drawn = chunk_setup(study, chunk)
     route = ends_early(setup)
-    in_loop = scored_in_loop(scenario, setup, sim, x0, seeds, backend, study.series)
+    unrolled = study.members * sim.t_end / sim.dt >= UNROLLED_SHIP_STEPS
+    in_loop = scored_in_loop(scenario, setup, sim, x0, seeds, backend, study.series, unrolled)
     if in_loop is not None:  # no series: the members' figures are all the chunk keeps
         (arrays, diverged), result, done_at = in_loop, None, None
         ran_on = {"compiled"} | diverged_alone(scenario, setup, sim, x0, seeds, backend, arrays,
