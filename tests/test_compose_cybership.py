@@ -88,6 +88,29 @@ def test_sincos_quadrants_of_negative_and_positive_arguments():
         assert s == 0.0 and c == 1.0
 
 
+def test_fast_sincos_within_1e14_of_libm():
+    """The wave loads' sin/cos (:func:`wave_kernel.fast_sincos`: two-part reduction, five-term
+    least-squares polynomials) against libm (math.sin, math.cos) on 10⁵ uniform arguments over
+    |x| ≤ SINCOS_LIMIT, 10⁴ over |x| ≤ 10, and on multiples of π/4 (the reduction's quadrant
+    edges and octant midpoints), their neighbours, near zero and far out: within 1e-14, the
+    docstring's measured 5.0e-15 with a margin of 2; NaN stays NaN."""
+    rng = np.random.default_rng(7)
+    limit = wave_kernel.SINCOS_LIMIT
+    k = np.concatenate([np.arange(-400, 401), rng.integers(-int(limit / (math.pi / 4)),
+                                                           int(limit / (math.pi / 4)), 4000)])
+    edges = [float(e) for e in k * (math.pi / 4) if abs(e) <= limit]
+    x = np.concatenate([rng.uniform(-limit, limit, 100_000), rng.uniform(-10.0, 10.0, 10_000),
+                        edges, [math.nextafter(e, math.inf) for e in edges],
+                        [math.nextafter(e, -math.inf) for e in edges],
+                        [0.0, -0.0, 1e-300, 1e-8, limit, -limit]])
+    worst = 0.0
+    for value in x.tolist():
+        s, c = wave_kernel.fast_sincos(value)
+        worst = max(worst, abs(s - math.sin(value)), abs(c - math.cos(value)))
+    assert worst <= 1e-14, worst
+    assert all(math.isnan(v) for v in wave_kernel.fast_sincos(math.nan))
+
+
 @pytest.mark.parametrize("n", [1, 7, 8, 9, 15, 16, 127, 128, 129, 200, 257, 1000, 4099])
 def test_the_three_sums_are_numpys_to_the_bit(n):
     """The wave loads' sums (:func:`wave_kernel.pairwise_sum3`, three rows added eight lanes per

@@ -4,36 +4,39 @@ stage; the numpy loop and every other caller call its batch over ships
 (:func:`shipgnc.derive.per_ship`), so there is no second form to keep equal.
 
 **Cost.** Per component and stage the loads need three sin/cos pairs — of the phase θᵢ and of
-the hull-shape arguments uᵢ, vᵢ — evaluated by :func:`sincos` in one vectorised loop over the
-components (≈ 25 floating-point operations a pair, no libm call); whether every argument lies
-within its fast reduction (:data:`SINCOS_LIMIT`) is one bound per ship and stage
-(|θᵢ| ≤ ω_max|t| + k_max(|n| + |e|) + |φ|_max), not a test per component. Those sin/cos are the
-cost (benchmarks/bench_waves.py). Measured on one 4.1 GHz AVX-512 core, 200 components,
-long-crested: ≈ 2.7 ns (≈ 11 cycles) per component and stage, 2.1–2.2 CPU µs per ship-step,
+the hull-shape arguments uᵢ, vᵢ — evaluated by :func:`fast_sincos` in one vectorised loop over
+the components (a two-part reduction and five-term polynomials, within 5.0e-15 of libm; no libm
+call); whether every argument lies within its fast reduction (:data:`SINCOS_LIMIT`) is one bound
+per ship and stage (|θᵢ| ≤ ω_max|t| + k_max(|n| + |e|) + |φ|_max), not a test per component.
+sinc and j₁ need 1/uᵢ and 1/vᵢ: a long-crested sea takes them from the row 1/(½kᵢL) of
+:data:`ROWS` (1/uᵢ = (1/(½kᵢL))/cos β, 1/vᵢ = (1/(½kᵢL))·L/(B sin β), two divisions per call), a
+short-crested one from one division per component (1/(uᵢvᵢ)). Those sin/cos are the cost
+(benchmarks/bench_waves.py). Measured on one 4.1 GHz AVX-512 core, 200 components, long-crested,
+with :func:`sincos` (libm's last bit, three-part reduction, six-term polynomials) and a division
+per argument: ≈ 2.7 ns (≈ 11 cycles) per component and stage, 2.1–2.2 CPU µs per ship-step,
 eight components per 512-bit vector; one sin/cos pair alone in such a loop takes ≈ 2.2 cycles
-per argument, so the three pairs are ≈ 7 of the 11 cycles. It is not memory bound: a ship's state
-(13 rows of n numbers, 21 KB at n = 200) stays in the L1 cache while the composed loop runs that
-ship through its steps, and one ship takes the same CPU time per ship-step as 500 or 1 000.
+per argument, so the three pairs are ≈ 7 of the 11 cycles. With :func:`fast_sincos` and the
+reciprocal row the kernel takes ≈ 430 instead of ≈ 540 ns per call and cybership-waves' composed
+loop runs ≈ 25 % more ship-steps per CPU second (alternating pairs). It is not memory bound: a
+ship's state (14 rows of n numbers, 22 KB at n = 200) stays in the L1 cache while the composed
+loop runs that ship through its steps, and one ship takes the same CPU time per ship-step as 500
+or 1 000.
+
+The price is the last bits: the loads stay within 3e-14 of the direct libm sum's scale over a
+run (tests/test_waves.py), but the course-changing runs of cybership-waves amplify any last-bit
+change — as much as an initial heading changed by 10⁻¹³° does (the rate-limited rudder flips on
+the sign of command − rudder; the sliding-mode runs chatter) — to per-cent changes of their
+quality indices, so those are one realisation's figures (document 003's page gives the band).
 
 Tried and not kept: rearrangements with the same results to the bit (the three pairs in separate
-loops, the hull-shape factors in a loop before the phases) were slower; a two-part reduction,
-five-term polynomials and shared reciprocals for sinc and j₁ together are ≈ 12 % faster but move
-the loads in their last bits (≈ 5e-14 of their RMS). With the reciprocals 1/(½kᵢL) kept as a row
-(a long-crested sea then divides once per call, not per component), the two-part reduction and
-five-term least-squares polynomials (|error| ≤ 5.0e-15 against libm for |x| ≤ 10⁶) the kernel
-takes ≈ 430 instead of ≈ 540 ns per call and cybership-waves' composed loop runs ≈ 25 % more
-ship-steps per CPU second (alternating pairs): ≈ 9.8·10⁵ ship-steps/s projected on two cores,
-short of 10⁶. The loads stay within 3e-14 of the direct sum's scale over a run, but the
-course-changing runs' metrics move as much as with the initial heading changed by 10⁻¹³° (the
-sliding-mode runs chatter and amplify any change in the last bits to the percent level). A
-rotation recurrence of the phase (e^{iθᵢ} advanced by e^{iωᵢΔt} from stage to stage) does not
-remove a sin/cos: θᵢ = ωᵢt − kᵢ·r + φᵢ
-moves with the ship's position r, and e^{−ikᵢ·Δr} differs per component and stage, so it needs a
-sin/cos (or a polynomial of the same length) of its own. The hull-shape arguments move with ψ
-only, but ½kᵢL reaches ≈ 70 rad in cybership-waves' sea, so rotating e^{iuᵢ} from a reference
-heading by a short series (|Δuᵢ| ≤ 1/8) holds for 0.1–0.2° of heading change only; applied at
-every call it was ≈ 13 % faster than these sin/cos, but ≈ 3 % slower than the two-part,
-five-term ones.
+loops, the hull-shape factors in a loop before the phases) were slower. A rotation recurrence of
+the phase (e^{iθᵢ} advanced by e^{iωᵢΔt} from stage to stage) does not remove a sin/cos:
+θᵢ = ωᵢt − kᵢ·r + φᵢ moves with the ship's position r, and e^{−ikᵢ·Δr} differs per component
+and stage, so it needs a sin/cos (or a polynomial of the same length) of its own. The hull-shape
+arguments move with ψ only, but ½kᵢL reaches ≈ 70 rad in cybership-waves' sea, so rotating
+e^{iuᵢ} from a reference heading by a short series (|Δuᵢ| ≤ 1/8) holds for 0.1–0.2° of heading
+change only; applied at every call it was ≈ 13 % faster than :func:`sincos`, but ≈ 3 % slower
+than :func:`fast_sincos`.
 """
 
 from __future__ import annotations
@@ -49,8 +52,9 @@ from shipgnc.kernels import JIT_OPTIONS, kernel_function
 
 #: rows of a ship's per-component block in the kernel's state (each ``n_components`` long):
 #: the sea (ωᵢ, φᵢ, kᵢcos χᵢ, kᵢsin χᵢ, ½kᵢL, ½kᵢB, χᵢ), the weights −2g_X ρgDᵢaᵢ, −2g_Y ρgDᵢaᵢ,
-#: g_N ρgDᵢaᵢ
-ROWS = ("omega", "phase", "k_north", "k_east", "half_kL", "half_kB", "chi", "wX", "wY", "wN")
+#: g_N ρgDᵢaᵢ, and 1/(½kᵢL) (so a long-crested sea needs no division per component for sinc, j₁)
+ROWS = ("omega", "phase", "k_north", "k_east", "half_kL", "half_kB", "chi", "wX", "wY", "wN",
+        "inv_half_kL")
 #: scratch rows after them: the per-component terms of X, Y and N, summed by :func:`pairwise_sum3`
 N_SCRATCH = 3
 #: numbers after the scratch rows, bounds of the arguments: [ω_max, max |kᵢcos χᵢ|, |kᵢsin χᵢ|,
@@ -184,7 +188,9 @@ def sincos(x):
     negation does): the same results to the bit in fewer vector instructions than a conversion,
     mask tests and blends (the loop over components 201 → 187 instructions per 8 long-crested
     components, 246 → 222 short-crested; cybership-waves' composed loop ≈ 3 % and the
-    short-crested kernel ≈ 7 % less CPU time per ship-step)."""
+    short-crested kernel ≈ 7 % less CPU time per ship-step). The wave loads use the shorter
+    :func:`fast_sincos`; this one is kept as the reference form and for callers that need libm's
+    last bit."""
     qb = x * _INV_PIO2 + _ROUND
     q = qb - _ROUND
     r = x - q * _PIO2_1
@@ -203,24 +209,67 @@ def sincos(x):
             _from_bits(_bits(b) ^ (((m + 1) << 62) & _SIGN_BIT)))
 
 
+_F1, _F2, _F3 = -0.16666666666634747, 0.008333333325725155, -0.0001984126403207385
+_F4, _F5 = 2.75553964597516e-06, -2.4764148998579136e-08
+_G1, _G2, _G3 = 0.041666666666602785, -0.0013888888878344516, 2.4801581000292875e-05
+_G4, _G5 = -2.755557190499262e-07, 2.0648019412154456e-09
+
+
 @numba.njit(inline="always", **JIT_OPTIONS)
-def _sinc_j1(s, c, u):
-    """sinc u = sin u/u and j₁(u) = (sin u − u cos u)/u² from s = sin u, c = cos u (series
-    1 − u²/6, u(1/3 − u²/30) for |u| < 1e-3), without branches."""
+def fast_sincos(x):
+    """(sin x, cos x) for |x| ≤ :data:`SINCOS_LIMIT`, branch-free: the wave loads' sin/cos.
+    The quadrant q and its signs as in :func:`sincos`, but a two-part Cody–Waite reduction
+    r = (x − q·p₁) − q·p₂ (p₁ + p₂ ≈ π/2, the first two of :func:`sincos`'s three parts) and
+    five-term polynomials on |r| ≤ π/4:
+
+        sin r ≈ r + r·z·(F₁ + F₂z + … + F₅z⁴),   cos r ≈ 1 − z/2 + z²·(G₁ + G₂z + … + G₅z⁴),
+        z = r²,
+
+    whose coefficients F₁…F₅, G₁…G₅ were fitted by least squares on |r| ≤ π/4 (near the
+    Taylor coefficients (−1)ᵏ/(2k+1)!, (−1)^{k+1}/(2k+2)!; the fifth differs by ≈ 1 %, which
+    spreads the truncation error over the interval). Measured max |Δ| against libm (math.sin,
+    math.cos) on 4·10⁶ uniform arguments per range and on the multiples of π/4 and their
+    neighbours: 4.0e-15 for |x| ≤ 10⁴, 5.0e-15 for |x| ≤ 10⁶ (the dropped third part of the
+    reduction grows with |x|); tests/test_waves.py checks 1e-14. The loads move in their last
+    bits only (≈ 3e-14 of their scale over a run)."""
+    qb = x * _INV_PIO2 + _ROUND
+    q = qb - _ROUND
+    r = x - q * _PIO2_1
+    r = r - q * _PIO2_2
+    z = r * r
+    s = r + r * z * (_F1 + z * (_F2 + z * (_F3 + z * (_F4 + z * _F5))))
+    c = 1.0 - 0.5 * z + z * z * (_G1 + z * (_G2 + z * (_G3 + z * (_G4 + z * _G5))))
+    m = _bits(qb)
+    a = c if m & 1 else s
+    b = s if m & 1 else c
+    return (_from_bits(_bits(a) ^ ((m << 62) & _SIGN_BIT)),
+            _from_bits(_bits(b) ^ (((m + 1) << 62) & _SIGN_BIT)))
+
+
+@numba.njit(inline="always", **JIT_OPTIONS)
+def _sinc_j1(s, c, u, inv):
+    """sinc u = sin u/u and j₁(u) = (sin u − u cos u)/u² from s = sin u, c = cos u and inv = 1/u
+    (x/u → x·(1/u): round-off only, as arcp allows), without divisions or branches; the series
+    1 − u²/6, u(1/3 − u²/30) for |u| < 1e-3 (inv is then not read and may be anything)."""
     small = abs(u) < 1e-3
-    us = 1.0 if small else u
     u2 = u * u
-    inv = 1.0 / us  # one division for both (x/u → x·(1/u): round-off only, as arcp allows)
     sinc = 1.0 - u2 * (1.0 / 6.0) if small else s * inv
     j1 = u * (1.0 / 3.0 - u2 * (1.0 / 30.0)) if small else (sinc - c) * inv
     return sinc, j1
 
 
 @numba.njit(inline="always", **JIT_OPTIONS)
-def _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v):
-    """Component j's terms of X, Y and N into the scratch rows at ``o_t``."""
-    sinc_u, j1_u = _sinc_j1(s_u, c_u, u)
-    sinc_v, j1_v = _sinc_j1(s_v, c_v, v)
+def _away_from_zero(u):
+    """u, or 1 for |u| < 1e-3 (where :func:`_sinc_j1` takes its series): a safe divisor."""
+    return 1.0 if abs(u) < 1e-3 else u
+
+
+@numba.njit(inline="always", **JIT_OPTIONS)
+def _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v, inv_u, inv_v):
+    """Component j's terms of X, Y and N into the scratch rows at ``o_t``, from the sin/cos of
+    θ, u and v and the reciprocals inv_u = 1/u, inv_v = 1/v."""
+    sinc_u, j1_u = _sinc_j1(s_u, c_u, u, inv_u)
+    sinc_v, j1_v = _sinc_j1(s_v, c_v, v, inv_v)
     z[o_t + j] = z[7 * n + j] * (beam * s_u * sinc_v) * s
     z[o_t + n + j] = z[8 * n + j] * (length * s_v * sinc_u) * s
     z[o_t + 2 * n + j] = z[9 * n + j] * (L2 * s_v * j1_u - B2 * s_u * j1_v) * c
@@ -259,24 +308,31 @@ def froude_krylov_sample(t, x, z, p, w, d):
     if bound <= SINCOS_LIMIT and long_crested:  # one direction: β per ship
         beta = z[6 * n] - psi
         cos_b, sin_b = math.cos(beta), math.sin(beta)
+        # 1/uᵢ = (1/(½kᵢL))/cos β, 1/vᵢ = (1/(½kᵢL))·L/(B sin β): two divisions per call
+        ru = 1.0 / cos_b
+        rv = length / (beam * sin_b)
         for j in range(n):
             theta = z[j] * t - (z[2 * n + j] * north + z[3 * n + j] * east) + z[n + j]
             u = z[4 * n + j] * cos_b
             v = z[5 * n + j] * sin_b
-            s, c = sincos(theta)
-            s_u, c_u = sincos(u)
-            s_v, c_v = sincos(v)
-            _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v)
+            s, c = fast_sincos(theta)
+            s_u, c_u = fast_sincos(u)
+            s_v, c_v = fast_sincos(v)
+            _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v,
+                   z[10 * n + j] * ru, z[10 * n + j] * rv)
     elif bound <= SINCOS_LIMIT:
         for j in range(n):
             theta = z[j] * t - (z[2 * n + j] * north + z[3 * n + j] * east) + z[n + j]
-            sin_b, cos_b = sincos(z[6 * n + j] - psi)
+            sin_b, cos_b = fast_sincos(z[6 * n + j] - psi)
             u = z[4 * n + j] * cos_b
             v = z[5 * n + j] * sin_b
-            s, c = sincos(theta)
-            s_u, c_u = sincos(u)
-            s_v, c_v = sincos(v)
-            _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v)
+            s, c = fast_sincos(theta)
+            s_u, c_u = fast_sincos(u)
+            s_v, c_v = fast_sincos(v)
+            us, vs = _away_from_zero(u), _away_from_zero(v)
+            inv = 1.0 / (us * vs)  # one division for 1/u and 1/v
+            _terms(z, j, n, o_t, length, beam, L2, B2, s, c, s_u, c_u, s_v, c_v, u, v,
+                   vs * inv, us * inv)
     else:  # arguments beyond the fast reduction (a run of hours, a runaway heading): libm
         for j in range(n):
             theta = z[j] * t - (z[2 * n + j] * north + z[3 * n + j] * east) + z[n + j]
@@ -284,5 +340,6 @@ def froude_krylov_sample(t, x, z, p, w, d):
             u = z[4 * n + j] * math.cos(beta)
             v = z[5 * n + j] * math.sin(beta)
             _terms(z, j, n, o_t, length, beam, L2, B2, math.sin(theta), math.cos(theta),
-                   math.sin(u), math.cos(u), math.sin(v), math.cos(v), u, v)
+                   math.sin(u), math.cos(u), math.sin(v), math.cos(v), u, v,
+                   1.0 / _away_from_zero(u), 1.0 / _away_from_zero(v))
     d[0], d[1], d[2] = pairwise_sum3(z, o_t, n, n)

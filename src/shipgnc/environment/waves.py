@@ -1175,7 +1175,7 @@ class FroudeKrylovWaveLoads:
         shape = (*self._batch, n)
         chi = np.broadcast_to(self.direction if self.spreading is None else r.direction, shape)
         rows = (r.omega, r.phase, r._k_north, r._k_east, self._half_kL, self._half_kB, chi,
-                *self._weights)
+                *self._weights, 1.0 / self._half_kL)
         state = np.zeros((math.prod(self._batch), state_width(n)))
         for i, row in enumerate(rows):
             state[:, i * n:(i + 1) * n] = np.broadcast_to(row, shape).reshape(-1, n)
