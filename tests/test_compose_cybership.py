@@ -65,29 +65,6 @@ def test_the_same_seed_gives_the_same_sea():
         assert not np.allclose(different, expected)
 
 
-def test_sincos_within_an_ulp_of_libm():
-    x = np.concatenate([np.random.default_rng(0).uniform(-1e6, 1e6, 5000),
-                        np.linspace(-7, 7, 1001), [0.0, -0.0, 1e-300, math.pi / 4, math.pi / 2]])
-    for value in x:
-        s, c = wave_kernel.sincos(value)
-        assert abs(s - math.sin(value)) <= 2.3e-16 and abs(c - math.cos(value)) <= 2.3e-16
-    assert all(math.isnan(v) for v in wave_kernel.sincos(math.nan))
-
-
-def test_sincos_quadrants_of_negative_and_positive_arguments():
-    """The quadrant (read from the bits of the rounded x·2/π) and the signs, against libm: every
-    quadrant of either sign, on both sides of each multiple of π/4, and at ±0 (the branch-free
-    kernel's sine of −0 is +0 where libm's is −0: equal as numbers)."""
-    for k in range(-400, 401):
-        for value in (k * math.pi / 4, math.nextafter(k * math.pi / 4, math.inf),
-                      math.nextafter(k * math.pi / 4, -math.inf), (k + 0.5) * math.pi / 4):
-            s, c = wave_kernel.sincos(value)
-            assert abs(s - math.sin(value)) <= 2.3e-16 and abs(c - math.cos(value)) <= 2.3e-16
-    for zero in (0.0, -0.0):
-        s, c = wave_kernel.sincos(zero)
-        assert s == 0.0 and c == 1.0
-
-
 def test_fast_sincos_within_1e14_of_libm():
     """The wave loads' sin/cos (:func:`wave_kernel.fast_sincos`: two-part reduction, five-term
     least-squares polynomials) against libm (math.sin, math.cos) on 10⁵ uniform arguments over

@@ -12,7 +12,7 @@ sinc and j₁ need 1/uᵢ and 1/vᵢ: a long-crested sea takes them from the row
 :data:`ROWS` (1/uᵢ = (1/(½kᵢL))/cos β, 1/vᵢ = (1/(½kᵢL))·L/(B sin β), two divisions per call), a
 short-crested one from one division per component (1/(uᵢvᵢ)). Those sin/cos are the cost
 (benchmarks/bench_waves.py). Measured on one 4.1 GHz AVX-512 core, 200 components, long-crested,
-with :func:`sincos` (libm's last bit, three-part reduction, six-term polynomials) and a division
+with the earlier sin/cos of libm's last bit (three-part reduction, fdlibm's six-term kernels) and a division
 per argument: ≈ 2.7 ns (≈ 11 cycles) per component and stage, 2.1–2.2 CPU µs per ship-step,
 eight components per 512-bit vector; one sin/cos pair alone in such a loop takes ≈ 2.2 cycles
 per argument, so the three pairs are ≈ 7 of the 11 cycles. With :func:`fast_sincos` and the
@@ -35,7 +35,7 @@ the phase (e^{iθᵢ} advanced by e^{iωᵢΔt} from stage to stage) does not re
 and stage, so it needs a sin/cos (or a polynomial of the same length) of its own. The hull-shape
 arguments move with ψ only, but ½kᵢL reaches ≈ 70 rad in cybership-waves' sea, so rotating
 e^{iuᵢ} from a reference heading by a short series (|Δuᵢ| ≤ 1/8) holds for 0.1–0.2° of heading
-change only; applied at every call it was ≈ 13 % faster than :func:`sincos`, but ≈ 3 % slower
+change only; applied at every call it was ≈ 13 % faster than that earlier sin/cos, but ≈ 3 % slower
 than :func:`fast_sincos`.
 """
 
@@ -134,20 +134,15 @@ def pairwise_sum3(a, lo, n, stride):
 
 
 # sin and cos of many arguments in one vectorisable loop (no libm call per element): Cody–Waite
-# reduction by π/2 in three parts (exact products for |x| < 2²⁰·π/2) and fdlibm's kernels
-# __kernel_sin / __kernel_cos on |r| ≤ π/4 (error < 1 ulp; libm's own reduction and kernels)
+# reduction by π/2 in two parts (p₁ + p₂ ≈ π/2; p₁ has 33 significant bits, so q·p₁ is exact for
+# |q| < 2²⁰) and polynomials on |r| ≤ π/4 (:func:`fast_sincos`)
 _PIO2_1 = 1.57079632673412561417e+00
 _PIO2_2 = 6.07710050630396597660e-11
-_PIO2_3 = 2.02226624871116645580e-21
 _INV_PIO2 = 6.36619772367581382433e-01
 #: 1.5·2⁵²: (y + _ROUND) − _ROUND rounds |y| < 2⁵¹ to the nearest integer
 _ROUND = 6755399441055744.0
-#: beyond this |x| the three-part reduction loses bits: those arguments go to libm
+#: beyond this |x| the reduction loses bits: those arguments go to libm
 SINCOS_LIMIT = 1.0e6
-_S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
-_S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
-_C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
-_C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
 
 
 @intrinsic
@@ -178,37 +173,6 @@ def _from_bits(typingctx, i):
 _SIGN_BIT = -(2 ** 63)
 
 
-@numba.njit(inline="always", **JIT_OPTIONS)
-def sincos(x):
-    """(sin x, cos x) within 1 ulp of libm for |x| ≤ :data:`SINCOS_LIMIT`, branch-free (so a loop
-    of it vectorises); NaN stays NaN. q = nearest integer to 2x/π by the 1.5·2⁵² rounding trick;
-    the quadrant is read from the low bits of the rounded sum x·2/π + 1.5·2⁵² itself (its last
-    mantissa bit is worth 1 and 1.5·2⁵² has none below 2⁵¹, so they are q's two's-complement
-    bits: no float → int conversion), and the signs are set by flipping the sign bit (what
-    negation does): the same results to the bit in fewer vector instructions than a conversion,
-    mask tests and blends (the loop over components 201 → 187 instructions per 8 long-crested
-    components, 246 → 222 short-crested; cybership-waves' composed loop ≈ 3 % and the
-    short-crested kernel ≈ 7 % less CPU time per ship-step). The wave loads use the shorter
-    :func:`fast_sincos`; this one is kept as the reference form and for callers that need libm's
-    last bit."""
-    qb = x * _INV_PIO2 + _ROUND
-    q = qb - _ROUND
-    r = x - q * _PIO2_1
-    r = r - q * _PIO2_2
-    r = r - q * _PIO2_3
-    z = r * r
-    s = r + r * z * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
-    rc = z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
-    hz = 0.5 * z
-    w = 1.0 - hz
-    c = w + (((1.0 - w) - hz) + z * rc)
-    m = _bits(qb)  # quadrant m = q mod 4: bit 0 swaps sin and cos, bit 1 (of m, m + 1) flips their signs
-    a = c if m & 1 else s
-    b = s if m & 1 else c
-    return (_from_bits(_bits(a) ^ ((m << 62) & _SIGN_BIT)),
-            _from_bits(_bits(b) ^ (((m + 1) << 62) & _SIGN_BIT)))
-
-
 _F1, _F2, _F3 = -0.16666666666634747, 0.008333333325725155, -0.0001984126403207385
 _F4, _F5 = 2.75553964597516e-06, -2.4764148998579136e-08
 _G1, _G2, _G3 = 0.041666666666602785, -0.0013888888878344516, 2.4801581000292875e-05
@@ -218,8 +182,11 @@ _G4, _G5 = -2.755557190499262e-07, 2.0648019412154456e-09
 @numba.njit(inline="always", **JIT_OPTIONS)
 def fast_sincos(x):
     """(sin x, cos x) for |x| ≤ :data:`SINCOS_LIMIT`, branch-free: the wave loads' sin/cos.
-    The quadrant q and its signs as in :func:`sincos`, but a two-part Cody–Waite reduction
-    r = (x − q·p₁) − q·p₂ (p₁ + p₂ ≈ π/2, the first two of :func:`sincos`'s three parts) and
+    q = nearest integer to 2x/π by the 1.5·2⁵² rounding trick; the quadrant is read from the low
+    bits of the rounded sum x·2/π + 1.5·2⁵² itself (its last mantissa bit is worth 1 and 1.5·2⁵²
+    has none below 2⁵¹, so they are q's two's-complement bits: no float → int conversion; bit 0
+    swaps sin and cos, bit 1 of m and of m + 1 flips their signs, set by flipping the sign bit);
+    a two-part Cody–Waite reduction r = (x − q·p₁) − q·p₂ (p₁ + p₂ ≈ π/2) and
     five-term polynomials on |r| ≤ π/4:
 
         sin r ≈ r + r·z·(F₁ + F₂z + … + F₅z⁴),   cos r ≈ 1 − z/2 + z²·(G₁ + G₂z + … + G₅z⁴),
@@ -230,7 +197,7 @@ def fast_sincos(x):
     spreads the truncation error over the interval). Measured max |Δ| against libm (math.sin,
     math.cos) on 4·10⁶ uniform arguments per range and on the multiples of π/4 and their
     neighbours: 4.0e-15 for |x| ≤ 10⁴, 5.0e-15 for |x| ≤ 10⁶ (the dropped third part of the
-    reduction grows with |x|); tests/test_waves.py checks 1e-14. The loads move in their last
+    reduction grows with |x|); tests/test_compose_cybership.py checks 1e-14. The loads move in their last
     bits only (≈ 3e-14 of their scale over a run)."""
     qb = x * _INV_PIO2 + _ROUND
     q = qb - _ROUND
