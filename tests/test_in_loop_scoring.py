@@ -401,3 +401,54 @@ def test_a_plan_s_own_step_is_written_with_each_accumulator_s_constants():
             ([[4, MAX, 1]], [[-inf, inf, 1.0, 0.0]], "switch 0 must come before")):
         with pytest.raises(ValueError, match=what):
             score_plan(np.array(bad_ops), np.array(bad_span), 3)
+
+
+def _two_boats():
+    """A validated run of two boat-autopilot members for 1 s (its composition: no loop run)."""
+    from shipgnc.study.chunk import chunk_setup, in_loop_plan
+
+    study = Study("boat-autopilot", members=2, overrides=("simulation.t_end=1",))
+    return in_loop_plan(*chunk_setup(study, Chunk(0, 0, 2))[:5], "compiled")[0]
+
+
+def test_an_empty_or_too_large_plan_keeps_the_generic_step(monkeypatch):
+    """No loop of a plan's own step for a plan of no accumulator (``metrics: none``) nor for one
+    of more than ``OWN_STEP_MAX_ACCUMULATORS``: the decision and the composition both say so."""
+    from shipgnc.sim import compose
+    from shipgnc.sim.scored import OWN_STEP_MAX_ACCUMULATORS, own_step
+
+    limit = OWN_STEP_MAX_ACCUMULATORS
+    assert not own_step(()) and own_step(((0, 0, -1, 0, False),) * limit)
+    assert not own_step(((0, 0, -1, 0, False),) * (limit + 1))
+    comp = compose.Composition(_two_boats(), scored=True)
+    plans = []
+    real = comp._loop_for
+    comp._loop_for = lambda plan: plans.append(plan) or real(plan)
+    comp.score_in_loop(np.zeros((0, 3), np.int64), np.zeros((0, 4)), np.zeros((2, 0)), True)
+    many = limit + 1
+    ops = np.tile([0, 0, -1], (many, 1))
+    span = np.tile([-np.inf, np.inf, 1.0, 0.0], (many, 1))
+    comp.score_in_loop(ops, span, np.zeros((2, 3 * many)), True)
+    assert plans == [None, None]
+
+
+def test_the_generic_step_comes_back_after_a_plan_s_own(monkeypatch):
+    """A composition scored in a plan's own loop, then asked for the generic step with another
+    plan, runs the generic loop again (a loop of the first plan would read past the second's
+    arrays); the loop checks that its plan is the arrays' plan."""
+    from shipgnc.sim import compose
+
+    comp = compose.Composition(_two_boats(), scored=True)
+    generic = comp.loop
+    plans = []
+    comp._loop_for = lambda plan: plans.append(plan) or (generic if plan is None else "own")
+    one = (np.array([[0, 0, -1]]), np.array([[-np.inf, np.inf, 1.0, 0.0]]))
+    comp.score_in_loop(*one, np.zeros((2, 3)), True)
+    assert comp.loop == "own" and plans == [((0, 0, -1, 0, False),)]
+    comp.score = compose.ScoreArrays(np.zeros((2, 3), np.int64), np.zeros((2, 4)), np.zeros((2, 6)))
+    with pytest.raises(ValueError, match="written for a plan of 1 accumulators"):
+        comp.call(0, 1, 1)
+    two = (np.array([[0, 0, -1], [1, 0, -1]]), np.tile([-np.inf, np.inf, 1.0, 0.0], (2, 1)))
+    comp.score_in_loop(*two, np.zeros((2, 6)), False)
+    assert comp.loop is generic and plans[-1] is None
+

@@ -109,6 +109,18 @@ KIND_FUNCTIONS = ("score_max", "score_max_abs", "score_sum_squares", "score_last
 _NAMED = {6: 4, 12: 3, 13: None}
 
 
+#: the most accumulators a plan's own step is written for (``course-quality`` takes 22 per course
+#: step): a larger plan is scored by the generic step, whose compile does not grow with it
+OWN_STEP_MAX_ACCUMULATORS = 64
+
+
+def own_step(plan: tuple) -> bool:
+    """Whether a loop of ``plan``'s own step (:func:`score_step_source`) is written for the
+    signature ``plan`` (:func:`score_plan`): not for an empty one (nothing to score) nor for one
+    of more than :data:`OWN_STEP_MAX_ACCUMULATORS` accumulators."""
+    return 0 < len(plan) <= OWN_STEP_MAX_ACCUMULATORS
+
+
 def score_plan(ops: np.ndarray, span: np.ndarray, n_states: int) -> tuple:
     """The signature of the accumulators ``ops`` (m, 3: log column, kind, gate), ``span``
     (m, 4): per accumulator its column, kind, gate, function (``span[m, 3]`` of the kinds that
