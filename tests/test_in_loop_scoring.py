@@ -403,6 +403,45 @@ def test_a_plan_s_own_step_is_written_with_each_accumulator_s_constants():
             score_plan(np.array(bad_ops), np.array(bad_span), 3)
 
 
+class _Stop(Exception):
+    """Raised by a spy to end a run once it has seen what it looks at."""
+
+
+def _unrolled_flags(monkeypatch, study, chunks):
+    """The ``unrolled`` flag each chunk hands :func:`~shipgnc.sim.scored.run_scored` (nothing run)."""
+    import shipgnc.sim.scored as scored
+
+    flags = []
+
+    def spied(*args, **kwargs):
+        flags.append(kwargs.get("unrolled"))
+        raise _Stop
+
+    monkeypatch.setattr(scored, "run_scored", spied)
+    for chunk in chunks:
+        with pytest.raises(_Stop):
+            run_chunk(study, chunk)
+    return flags
+
+
+def test_the_grid_points_of_one_plan_count_together_for_its_own_loop(monkeypatch):
+    """The per-plan loop is decided on the members × steps of every grid point sharing the plan:
+    two gains (the same accumulators) of 2 members × 240 steps each reach a threshold of 700
+    together, not alone."""
+    from shipgnc.study import chunk as chunk_module
+
+    chunk_module._plan_of.cache_clear()
+    study = Study("boat-autopilot", grid=(("controller.omega", (0.5, 1.0)),), members=2, seed=3,
+                  overrides=("simulation.t_end=12",))
+    chunks = [Chunk(0, 0, 2), Chunk(1, 0, 2)]
+    monkeypatch.setattr(chunk_module, "UNROLLED_SHIP_STEPS", 700)
+    assert _unrolled_flags(monkeypatch, study, chunks) == [True, True]
+    monkeypatch.setattr(chunk_module, "UNROLLED_SHIP_STEPS", 961)  # above 2 × 2 × 240
+    assert _unrolled_flags(monkeypatch, study, chunks) == [False, False]
+    alone = Study("boat-autopilot", members=2, seed=3, overrides=("simulation.t_end=12",))
+    assert _unrolled_flags(monkeypatch, alone, [Chunk(0, 0, 2)]) == [False]
+
+
 def _two_boats():
     """A validated run of two boat-autopilot members for 1 s (its composition: no loop run)."""
     from shipgnc.study.chunk import chunk_setup, in_loop_plan
