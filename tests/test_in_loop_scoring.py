@@ -491,3 +491,15 @@ def test_the_generic_step_comes_back_after_a_plan_s_own(monkeypatch):
     comp.score_in_loop(*two, np.zeros((2, 6)), False)
     assert comp.loop is generic and plans[-1] is None
 
+
+@pytest.mark.parametrize("level", [np.inf, -np.inf, np.nan, 2.5, 4.0])
+def test_a_plan_naming_no_function_is_refused_in_one_line(level):
+    """A ``SCORE_SUM`` whose ``span[m, 3]`` is not one of its functions 0 … 3 (infinite, NaN, a
+    fraction, too large) is the documented ValueError naming the accumulator and the value."""
+    from shipgnc.sim.scored import score_plan
+
+    ops = np.array([[0, 0, -1], [1, 6, -1]])
+    span = np.array([[-np.inf, np.inf, 1.0, 0.0], [-np.inf, np.inf, 1.0, level]])
+    with pytest.raises(ValueError, match=rf"accumulator 1 of kind 6 names span\[m, 3\] = "
+                                         rf"{float(level):g}, not an integer 0 … 3"):
+        score_plan(ops, span, 6)

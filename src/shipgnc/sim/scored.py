@@ -134,8 +134,9 @@ def score_plan(ops: np.ndarray, span: np.ndarray, n_states: int) -> tuple:
                              f"0 … {len(KIND_FUNCTIONS) - 1}")
         f = 0
         if kind in _NAMED:
-            f, count = int(span[m, 3]), _NAMED[kind] or n_states
-            if f != span[m, 3] or not 0 <= f < count:
+            level, count = float(span[m, 3]), _NAMED[kind] or n_states
+            f = int(level) if math.isfinite(level) else -1
+            if f != level or not 0 <= f < count:
                 raise ValueError(f"score_in_loop: accumulator {m} of kind {kind} names span[m, 3] "
                                  f"= {float(span[m, 3]):g}, not an integer 0 … {count - 1}")
         if gate >= 0 and not gate // 2 < m:
