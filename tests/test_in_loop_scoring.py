@@ -583,3 +583,28 @@ def test_a_plan_s_own_step_updates_every_kind_to_the_bit_as_the_generic_step():
     np.testing.assert_array_equal(acc_own[~nan].view(np.int64), acc_generic[~nan].view(np.int64))
     assert acc_own[:3, 0].tolist() == [1.0] * 3 and acc_own[3, 0] == 0.0  # the switch flipped
     assert np.isfinite(acc_own).mean() > 0.6 and (acc_own != init).mean() > 0.5  # numbers moved
+
+
+def test_the_kind_numbers_agree_in_the_template_the_plan_and_the_formulas():
+    """Each kind's number is the same in the template's ``SCORE_*`` constants, in
+    ``KIND_FUNCTIONS`` (its update function, defined in the template and called for it by the
+    generic step) and in :mod:`shipgnc.analysis.accumulated`'s names; the kinds naming a function
+    or a state are ``SCORE_SUM``, ``SCORE_DIFF`` and ``SCORE_WRAP_DIFF_SQUARES``."""
+    import ast
+    import re
+
+    from shipgnc.analysis import accumulated
+    from shipgnc.sim.compose import SCORE_TEMPLATE
+    from shipgnc.sim.scored import _NAMED, KIND_FUNCTIONS
+
+    source = SCORE_TEMPLATE.read_text()
+    tree = ast.parse(source)
+    kinds = {node.targets[0].id[len("SCORE_"):]: node.value.value for node in tree.body
+             if isinstance(node, ast.Assign) and node.targets[0].id.startswith("SCORE_")}
+    defined = {node.name for node in tree.body if isinstance(node, ast.FunctionDef)}
+    assert sorted(kinds.values()) == list(range(len(KIND_FUNCTIONS)))
+    for name, number in kinds.items():
+        assert KIND_FUNCTIONS[number] == f"score_{name.lower()}" and KIND_FUNCTIONS[number] in defined
+        assert getattr(accumulated, name) == number
+        assert re.search(rf"kind == SCORE_{name}:\n\s+score_{name.lower()}\(", source)
+    assert set(_NAMED) == {kinds["SUM"], kinds["DIFF"], kinds["WRAP_DIFF_SQUARES"]}

@@ -106,7 +106,8 @@ KIND_FUNCTIONS = ("score_max", "score_max_abs", "score_sum_squares", "score_last
                   "score_sum_tc", "score_argmax", "score_diff", "score_wrap_diff_squares")
 #: the kinds whose ``span[m, 3]`` names a function (``SCORE_SUM``, ``SCORE_DIFF``) or a state
 #: (``SCORE_WRAP_DIFF_SQUARES``), and how many there are (None: the model's states)
-_NAMED = {6: 4, 12: 3, 13: None}
+_NAMED = {KIND_FUNCTIONS.index("score_sum"): 4, KIND_FUNCTIONS.index("score_diff"): 3,
+          KIND_FUNCTIONS.index("score_wrap_diff_squares"): None}
 
 
 #: the most accumulators a plan's own step is written for (``course-quality`` takes 22 per course
