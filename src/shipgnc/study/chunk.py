@@ -38,12 +38,15 @@ class Chunk:
         return self.stop - self.start
 
 
-#: the members × steps of a grid point from which a study's chunks are scored in a loop of their
-#: plan's own (:func:`shipgnc.sim.scored.score_step_source`: boat-autopilot's heading steps cost
-#: ≈ 10 instead of ≈ 31 ns per ship-step), compiled once per plan and kept in the disk cache; a
+#: the members × steps, over every grid point of the same plan (:func:`own_loop_pays`), from
+#: which a study's chunks are scored in a loop of their plan's own
+#: (:func:`shipgnc.sim.scored.score_step_source`: boat-autopilot's heading steps cost ≈ 10
+#: instead of ≈ 31 ns per ship-step), compiled once per distinct plan (≈ 15–20 s; another
+#: schedule, or a t_end that changes the plan, compiles again) and kept in the disk cache; a
 #: smaller study runs in the combination's scored loop, whose step reads any plan at run time, so
-#: that runs of other schedules or durations do not each compile a loop. 10⁷ ship-steps:
-#: ``shipgnc sweep boat-autopilot --mc 10000`` (1.4·10⁷), whose loop works ≈ 2 CPU-seconds.
+#: that runs of other schedules or durations do not each compile a loop. A cold first run
+#: compiles one loop either way. 10⁷ ship-steps: ``shipgnc sweep boat-autopilot --mc 10000``
+#: (1.4·10⁷), whose loop works ≈ 2 CPU-seconds.
 UNROLLED_SHIP_STEPS = 10_000_000
 
 
