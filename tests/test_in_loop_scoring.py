@@ -433,7 +433,6 @@ def test_the_grid_points_of_one_plan_count_together_for_its_own_loop(monkeypatch
     together, not alone."""
     from shipgnc.study import chunk as chunk_module
 
-    chunk_module._plan_of.cache_clear()
     study = Study("boat-autopilot", grid=(("controller.omega", (0.5, 1.0)),), members=2, seed=3,
                   overrides=("simulation.t_end=12",))
     chunks = [Chunk(0, 0, 2), Chunk(1, 0, 2)]

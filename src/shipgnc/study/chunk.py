@@ -9,7 +9,6 @@ metrics. The result depends on the members' indices only, not on the slice they 
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, replace
 
@@ -301,11 +300,25 @@ def own_loop_pays(study: Study, chunk: Chunk, sim) -> bool:
         p[1] for p in plans if p is not None and p[0] == mine[0]) >= UNROLLED_SHIP_STEPS
 
 
-@functools.lru_cache(maxsize=256)
 def _plan_of(study: Study, point: int, variant: str | None):
     """The signature of grid ``point``'s plan whose own step the loop would take
     (:func:`shipgnc.sim.scored.own_step`) and its members × steps; None when its chunks are
-    not scored in the loop, or in the generic step whatever their size."""
+    not scored in the loop, or in the generic step whatever their size. Kept per study (by its
+    ``repr``: a grid value may be a list, which does not hash)."""
+    key = (repr(study), point, variant)
+    if key not in _PLANS:
+        if len(_PLANS) >= 256:
+            _PLANS.clear()
+        _PLANS[key] = _signature_steps(study, point, variant)
+    return _PLANS[key]
+
+
+#: :func:`_plan_of`'s answers of this process
+_PLANS: dict = {}
+
+
+def _signature_steps(study: Study, point: int, variant: str | None):
+    """:func:`_plan_of`, worked out."""
     from shipgnc.sim.scored import own_step, score_plan
 
     scenario, setup, sim, x0, seeds, _ = chunk_setup(study, Chunk(point, 0, 1, variant))
