@@ -359,8 +359,11 @@ def test_a_plan_s_own_loop_scores_to_the_bit_as_the_generic_one(monkeypatch):
     import shipgnc.sim.scored as scored
     from shipgnc.study import chunk as chunk_module
 
-    study = Study("boat-autopilot", members=4, seed=7, overrides=("simulation.t_end=12",),
-                  perturb=(Perturbation.parse("psi_deg=uniform:-30,30"),))  # one heading step
+    study = Study("boat-autopilot", members=4, seed=7, overrides=("simulation.t_end=40",),
+                  perturb=(Perturbation.parse("psi_deg=uniform:-30,30"),))  # two heading steps
+    # the plan of the default 70 s study (the benchmark's), so a warm cache loads its loop
+    assert chunk_module._plan_of(study, 0, None)[0] == chunk_module._plan_of(
+        Study("boat-autopilot", members=4), 0, None)[0]
     reference = run_chunk(study, Chunk(0, 0, 4))  # 4 members: the generic step
     real, unrolled = scored.run_scored, []
 
@@ -369,7 +372,7 @@ def test_a_plan_s_own_loop_scores_to_the_bit_as_the_generic_one(monkeypatch):
         return real(*args, **kwargs)
 
     monkeypatch.setattr(scored, "run_scored", spied)
-    monkeypatch.setattr(chunk_module, "UNROLLED_SHIP_STEPS", 4 * 239)
+    monkeypatch.setattr(chunk_module, "UNROLLED_SHIP_STEPS", 4 * 800)
     xr.testing.assert_identical(run_chunk(study, Chunk(0, 0, 4)), reference)
     assert unrolled == [True]
 
@@ -401,3 +404,206 @@ def test_a_plan_s_own_step_is_written_with_each_accumulator_s_constants():
             ([[4, MAX, 1]], [[-inf, inf, 1.0, 0.0]], "switch 0 must come before")):
         with pytest.raises(ValueError, match=what):
             score_plan(np.array(bad_ops), np.array(bad_span), 3)
+
+
+class _Stop(Exception):
+    """Raised by a spy to end a run once it has seen what it looks at."""
+
+
+def _unrolled_flags(monkeypatch, study, chunks):
+    """The ``unrolled`` flag each chunk hands :func:`~shipgnc.sim.scored.run_scored` (nothing run)."""
+    import shipgnc.sim.scored as scored
+
+    flags = []
+
+    def spied(*args, **kwargs):
+        flags.append(kwargs.get("unrolled"))
+        raise _Stop
+
+    monkeypatch.setattr(scored, "run_scored", spied)
+    for chunk in chunks:
+        with pytest.raises(_Stop):
+            run_chunk(study, chunk)
+    return flags
+
+
+def test_the_grid_points_of_one_plan_count_together_for_its_own_loop(monkeypatch):
+    """The per-plan loop is decided on the members × steps of every grid point sharing the plan:
+    two gains (the same accumulators) of 2 members × 240 steps each reach a threshold of 700
+    together, not alone."""
+    from shipgnc.study import chunk as chunk_module
+
+    study = Study("boat-autopilot", grid=(("controller.omega", (0.5, 1.0)),), members=2, seed=3,
+                  overrides=("simulation.t_end=12",))
+    chunks = [Chunk(0, 0, 2), Chunk(1, 0, 2)]
+    monkeypatch.setattr(chunk_module, "UNROLLED_SHIP_STEPS", 700)
+    assert _unrolled_flags(monkeypatch, study, chunks) == [True, True]
+    monkeypatch.setattr(chunk_module, "UNROLLED_SHIP_STEPS", 961)  # above 2 × 2 × 240
+    assert _unrolled_flags(monkeypatch, study, chunks) == [False, False]
+    alone = Study("boat-autopilot", members=2, seed=3, overrides=("simulation.t_end=12",))
+    assert _unrolled_flags(monkeypatch, alone, [Chunk(0, 0, 2)]) == [False]
+
+
+def _two_boats():
+    """A validated run of two boat-autopilot members for 1 s (its composition: no loop run)."""
+    from shipgnc.study.chunk import chunk_setup, in_loop_plan
+
+    study = Study("boat-autopilot", members=2, overrides=("simulation.t_end=1",))
+    return in_loop_plan(*chunk_setup(study, Chunk(0, 0, 2))[:5], "compiled")[0]
+
+
+def test_an_empty_or_too_large_plan_keeps_the_generic_step(monkeypatch):
+    """No loop of a plan's own step for a plan of no accumulator (``metrics: none``) nor for one
+    of more than ``OWN_STEP_MAX_ACCUMULATORS``: the decision and the composition both say so."""
+    from shipgnc.sim import compose
+    from shipgnc.sim.scored import OWN_STEP_MAX_ACCUMULATORS, own_step
+
+    limit = OWN_STEP_MAX_ACCUMULATORS
+    assert not own_step(()) and own_step(((0, 0, -1, 0, False),) * limit)
+    assert not own_step(((0, 0, -1, 0, False),) * (limit + 1))
+    comp = compose.Composition(_two_boats(), scored=True)
+    plans = []
+    real = comp._loop_for
+    comp._loop_for = lambda plan: plans.append(plan) or real(plan)
+    comp.score_in_loop(np.zeros((0, 3), np.int64), np.zeros((0, 4)), np.zeros((2, 0)), True)
+    many = limit + 1
+    ops = np.tile([0, 0, -1], (many, 1))
+    span = np.tile([-np.inf, np.inf, 1.0, 0.0], (many, 1))
+    comp.score_in_loop(ops, span, np.zeros((2, 3 * many)), True)
+    assert plans == [None, None]
+
+
+def test_the_generic_step_comes_back_after_a_plan_s_own(monkeypatch):
+    """A composition scored in a plan's own loop, then asked for the generic step with another
+    plan, runs the generic loop again (a loop of the first plan would read past the second's
+    arrays); the loop checks that its plan is the arrays' plan."""
+    from shipgnc.sim import compose
+
+    comp = compose.Composition(_two_boats(), scored=True)
+    generic = comp.loop
+    plans = []
+    comp._loop_for = lambda plan: plans.append(plan) or (generic if plan is None else "own")
+    one = (np.array([[0, 0, -1]]), np.array([[-np.inf, np.inf, 1.0, 0.0]]))
+    comp.score_in_loop(*one, np.zeros((2, 3)), True)
+    assert comp.loop == "own" and plans == [((0, 0, -1, 0, False),)]
+    comp.score = compose.ScoreArrays(np.zeros((2, 3), np.int64), np.zeros((2, 4)), np.zeros((2, 6)))
+    with pytest.raises(ValueError, match="written for a plan of 1 accumulators"):
+        comp.call(0, 1, 1)
+    two = (np.array([[0, 0, -1], [1, 0, -1]]), np.tile([-np.inf, np.inf, 1.0, 0.0], (2, 1)))
+    comp.score_in_loop(*two, np.zeros((2, 6)), False)
+    assert comp.loop is generic and plans[-1] is None
+
+
+@pytest.mark.parametrize("level", [np.inf, -np.inf, np.nan, 2.5, 4.0])
+def test_a_plan_naming_no_function_is_refused_in_one_line(level):
+    """A ``SCORE_SUM`` whose ``span[m, 3]`` is not one of its functions 0 … 3 (infinite, NaN, a
+    fraction, too large) is the documented ValueError naming the accumulator and the value."""
+    from shipgnc.sim.scored import score_plan
+
+    ops = np.array([[0, 0, -1], [1, 6, -1]])
+    span = np.array([[-np.inf, np.inf, 1.0, 0.0], [-np.inf, np.inf, 1.0, level]])
+    with pytest.raises(ValueError, match=rf"accumulator 1 of kind 6 names span\[m, 3\] = "
+                                         rf"{float(level):g}, not an integer 0 … 3"):
+        score_plan(ops, span, 6)
+
+
+#: a plan of every kind, function and gate (column, kind, gate, window lo, hi, arg, level): two
+#: switches first (on column 5, which turns positive mid-run, and on column 0 in 1 … 5 s)
+_EVERY_KIND = [
+    (5, 8, -1, -np.inf, np.inf, 1.0, 0.0), (0, 8, -1, 1.0, 5.0, 1.0, 0.0),
+    (0, 0, 0, -np.inf, np.inf, 2.0, 0.0), (1, 1, 1, -np.inf, np.inf, 1.0, 0.0),
+    (2, 2, -1, 2.0, 7.0, -0.5, 0.0), (3, 3, 1, -np.inf, np.inf, 1.0, 0.0),
+    (4, 4, -1, 3.0, np.inf, 1.0, 0.0), (1, 5, -1, -np.inf, np.inf, 1.0, 1.5),
+    (2, 6, -1, -np.inf, np.inf, 1.0, 0.0), (2, 6, 0, -np.inf, np.inf, 1.0, 1.0),
+    (2, 6, 1, 0.5, 8.0, 1.0, 2.0), (2, 6, 2, -np.inf, np.inf, 1.0, 3.0),
+    (3, 7, -1, -np.inf, np.inf, -1.0, 0.5), (4, 9, 3, -np.inf, np.inf, 1.0, 1.0),
+    (0, 10, -1, -np.inf, np.inf, 1.0, 2.0), (1, 11, -1, -np.inf, np.inf, 1.0, 0.0),
+    (1, 11, 1, 4.0, 9.0, -2.0, 0.0), (2, 12, -1, -np.inf, np.inf, 1.0, 0.0),
+    (3, 12, 0, -np.inf, np.inf, 1.0, 1.0), (0, 12, -1, 1.0, 9.0, 0.5, 2.0),
+    (4, 13, -1, -np.inf, np.inf, 1.0, 1.0), (3, 13, 1, -np.inf, np.inf, 1.0, 2.0)]
+
+
+def _step_drivers(plan):
+    """Two njit drivers feeding a stream of samples (t, six states) to the template's generic
+    step and to the step written for ``plan``, every log column a state (no whole loop)."""
+    import math
+
+    import numba
+
+    from shipgnc.kernels import wrap
+    from shipgnc.sim.compose import SCORE_TEMPLATE
+    from shipgnc.sim.scored import score_step_source
+
+    names = {"math": math, "np": np, "numba": numba, "wrap": wrap,
+             "inline": numba.njit(inline="always", cache=False),
+             **{f"c_{c}": 6 for c in ("cmd", "app", "ref", "err", "out", "sig", "nav")}}
+    driver = '''
+@numba.njit(cache=False)
+def drive_{0}(ts, xs, ops, span, acc):
+    none, err = np.zeros(0), np.zeros((0, 3), dtype=np.int64)
+    for s in range(xs.shape[0]):
+        for k in range(ts.shape[0]):
+            {0}(ts[k], xs[s, k], none, none, none, none, none, none, err, ops, span, acc[s])
+'''
+    exec(SCORE_TEMPLATE.read_text() + "\n" + score_step_source(plan) + driver.format(
+        "score_step_generic") + driver.format("score_step"), names)
+    return names["drive_score_step_generic"], names["drive_score_step"]
+
+
+def test_a_plan_s_own_step_updates_every_kind_to_the_bit_as_the_generic_step():
+    """Every accumulator kind, each function of ``SCORE_SUM`` and ``SCORE_DIFF``, the wrapped
+    difference to two states, gates before and from two switches, finite and infinite windows:
+    the plan's own step leaves the same accumulators, to the bit, as the generic one, on random
+    samples with NaN and ±∞ (one stream whose switch turns on mid-run, one where it never does).
+    A NaN is NaN in both, its sign bit not always the same (∞ − ∞ in a sum: the processor's
+    default NaN in one step, a positive one in the other), which no figure reads."""
+    from shipgnc.sim.scored import KIND_FUNCTIONS, score_plan
+
+    rows = np.array(_EVERY_KIND)
+    ops, span = rows[:, :3].astype(np.int64), np.ascontiguousarray(rows[:, 3:])
+    assert set(ops[:, 1]) == set(range(len(KIND_FUNCTIONS)))
+    plan = score_plan(ops, span, 6)
+    generic, own = _step_drivers(plan)
+    rng = np.random.default_rng(5)
+    ts = np.arange(200) * 0.05
+    xs = 2.0 * rng.standard_normal((4, ts.size, 6))
+    for value in (np.nan, np.inf, -np.inf):  # ≈ 2 % of the samples each
+        xs[rng.random(xs.shape) < 0.02] = value
+    xs[:, :, 5] = np.where(ts < 4.5, -1.0, 1.0)  # switch 0 turns on at 4.5 s ...
+    xs[3, :, 5] = -1.0  # ... except for the last stream
+    init = np.zeros((4, 3 * len(rows)))
+    init[:, 3 * np.flatnonzero(ops[:, 1] == 11)] = -np.inf  # a maximum starts below any value
+    init[:, 3 * np.flatnonzero(ops[:, 1] == 12) + 2] = np.nan  # no previous sample yet
+    acc_generic, acc_own = init.copy(), init.copy()
+    generic(ts, xs, ops, span, acc_generic)
+    own(ts, xs, ops, span, acc_own)
+    nan = np.isnan(acc_generic)
+    np.testing.assert_array_equal(np.isnan(acc_own), nan)
+    np.testing.assert_array_equal(acc_own[~nan].view(np.int64), acc_generic[~nan].view(np.int64))
+    assert acc_own[:3, 0].tolist() == [1.0] * 3 and acc_own[3, 0] == 0.0  # the switch flipped
+    assert np.isfinite(acc_own).mean() > 0.6 and (acc_own != init).mean() > 0.5  # numbers moved
+
+
+def test_the_kind_numbers_agree_in_the_template_the_plan_and_the_formulas():
+    """Each kind's number is the same in the template's ``SCORE_*`` constants, in
+    ``KIND_FUNCTIONS`` (its update function, defined in the template and called for it by the
+    generic step) and in :mod:`shipgnc.analysis.accumulated`'s names; the kinds naming a function
+    or a state are ``SCORE_SUM``, ``SCORE_DIFF`` and ``SCORE_WRAP_DIFF_SQUARES``."""
+    import ast
+    import re
+
+    from shipgnc.analysis import accumulated
+    from shipgnc.sim.compose import SCORE_TEMPLATE
+    from shipgnc.sim.scored import _NAMED, KIND_FUNCTIONS
+
+    source = SCORE_TEMPLATE.read_text()
+    tree = ast.parse(source)
+    kinds = {node.targets[0].id[len("SCORE_"):]: node.value.value for node in tree.body
+             if isinstance(node, ast.Assign) and node.targets[0].id.startswith("SCORE_")}
+    defined = {node.name for node in tree.body if isinstance(node, ast.FunctionDef)}
+    assert sorted(kinds.values()) == list(range(len(KIND_FUNCTIONS)))
+    for name, number in kinds.items():
+        assert KIND_FUNCTIONS[number] == f"score_{name.lower()}" and KIND_FUNCTIONS[number] in defined
+        assert getattr(accumulated, name) == number
+        assert re.search(rf"kind == SCORE_{name}:\n\s+score_{name.lower()}\(", source)
+    assert set(_NAMED) == {kinds["SUM"], kinds["DIFF"], kinds["WRAP_DIFF_SQUARES"]}

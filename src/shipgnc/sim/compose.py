@@ -390,14 +390,17 @@ class Composition:
         self._pn = _param_rows(kn or empty, n)
         #: the in-loop scoring step's accumulators (none unless :meth:`score_in_loop`)
         self.score = no_scoring(n)
+        self._plan = None  # the plan whose own scoring step the loop takes (None: generic)
 
     def score_in_loop(self, ops: np.ndarray, span: np.ndarray, acc: np.ndarray,
                       unrolled: bool = False) -> None:
         """Score every step in the loop into ``acc`` (ships, 3 m), updated in place
         (:class:`ScoreArrays`; :mod:`shipgnc.sim.scored`); ``unrolled``: in the loop of this
         plan's own step (:func:`shipgnc.sim.scored.score_plan`: compiled at its first call unless
-        it is in the disk cache), else in the combination's scored loop."""
-        from shipgnc.sim.scored import score_plan
+        it is in the disk cache; not for an empty plan nor one of more than
+        :data:`~shipgnc.sim.scored.OWN_STEP_MAX_ACCUMULATORS`), else in the combination's scored
+        loop (also when a loop of another plan's own step ran before)."""
+        from shipgnc.sim.scored import own_step, score_plan
 
         if not self.scored:
             raise ValueError("score_in_loop: the Composition was built without scored=True")
@@ -411,9 +414,11 @@ class Composition:
             raise ValueError(f"score_in_loop: log columns {ops[:, 0].tolist()} outside "
                              f"0 … {len(self.signals) - 1}")
         signature = score_plan(ops, span, self._nx)  # checks the plan whichever loop runs it
-        if unrolled:
-            self.loop = self._loop_for(signature)
-            self.source_path = source_path(self.loop)
+        # the loop of this plan's own step, or the generic one again (a loop written for another
+        # plan would read past this plan's arrays: numba checks no bounds)
+        self._plan = signature if unrolled and own_step(signature) else None
+        self.loop = self._loop_for(self._plan)
+        self.source_path = source_path(self.loop)
         self.score = ScoreArrays(ops, span, acc)
 
     def prepare(self, k0: int, k1: int) -> None:
@@ -432,6 +437,10 @@ class Composition:
         """Steps ``k0 <= k < k1`` of every ship without an event (``k_last``: the step logged
         whatever ``log_every`` that ends the run); :meth:`prepare` first."""
         setup, table, params = self.setup, self._table, self._params
+        if self._plan is not None and len(self._plan) != self.score.ops.shape[0]:
+            raise ValueError(f"Composition.call: the loop is written for a plan of "
+                             f"{len(self._plan)} accumulators, the scoring arrays hold "
+                             f"{self.score.ops.shape[0]}")
         steps = LoopSteps(int(k0), int(k1), int(k_last), int(setup.hold), int(setup.log_every),
                           float(setup.dt), int(self.s_base))
         self.loop(steps, self.S, self.out, self.event,

@@ -47,7 +47,8 @@ combination), or, for a study big enough to pay for its compile, the step writte
 :func:`shipgnc.sim.scored.score_step_source` after this text: each accumulator's column, kind,
 gate, function and index constants (straight-line code), its window and arguments read from
 ``span``. Both call the kinds' functions below in the accumulators' order, so their numbers are
-the same to the bit.
+the same to the bit (a NaN's sign bit aside: ∞ − ∞ may give the processor's default NaN in one
+and a positive NaN in the other; no figure reads it).
 """
 # ruff: noqa: F821
 

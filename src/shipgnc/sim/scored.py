@@ -106,7 +106,20 @@ KIND_FUNCTIONS = ("score_max", "score_max_abs", "score_sum_squares", "score_last
                   "score_sum_tc", "score_argmax", "score_diff", "score_wrap_diff_squares")
 #: the kinds whose ``span[m, 3]`` names a function (``SCORE_SUM``, ``SCORE_DIFF``) or a state
 #: (``SCORE_WRAP_DIFF_SQUARES``), and how many there are (None: the model's states)
-_NAMED = {6: 4, 12: 3, 13: None}
+_NAMED = {KIND_FUNCTIONS.index("score_sum"): 4, KIND_FUNCTIONS.index("score_diff"): 3,
+          KIND_FUNCTIONS.index("score_wrap_diff_squares"): None}
+
+
+#: the most accumulators a plan's own step is written for (``course-quality`` takes 22 per course
+#: step): a larger plan is scored by the generic step, whose compile does not grow with it
+OWN_STEP_MAX_ACCUMULATORS = 64
+
+
+def own_step(plan: tuple) -> bool:
+    """Whether a loop of ``plan``'s own step (:func:`score_step_source`) is written for the
+    signature ``plan`` (:func:`score_plan`): not for an empty one (nothing to score) nor for one
+    of more than :data:`OWN_STEP_MAX_ACCUMULATORS` accumulators."""
+    return 0 < len(plan) <= OWN_STEP_MAX_ACCUMULATORS
 
 
 def score_plan(ops: np.ndarray, span: np.ndarray, n_states: int) -> tuple:
@@ -122,8 +135,9 @@ def score_plan(ops: np.ndarray, span: np.ndarray, n_states: int) -> tuple:
                              f"0 … {len(KIND_FUNCTIONS) - 1}")
         f = 0
         if kind in _NAMED:
-            f, count = int(span[m, 3]), _NAMED[kind] or n_states
-            if f != span[m, 3] or not 0 <= f < count:
+            level, count = float(span[m, 3]), _NAMED[kind] or n_states
+            f = int(level) if math.isfinite(level) else -1
+            if f != level or not 0 <= f < count:
                 raise ValueError(f"score_in_loop: accumulator {m} of kind {kind} names span[m, 3] "
                                  f"= {float(span[m, 3]):g}, not an integer 0 … {count - 1}")
         if gate >= 0 and not gate // 2 < m:

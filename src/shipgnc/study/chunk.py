@@ -37,12 +37,15 @@ class Chunk:
         return self.stop - self.start
 
 
-#: the members × steps of a grid point from which a study's chunks are scored in a loop of their
-#: plan's own (:func:`shipgnc.sim.scored.score_step_source`: boat-autopilot's heading steps cost
-#: ≈ 10 instead of ≈ 31 ns per ship-step), compiled once per plan and kept in the disk cache; a
+#: the members × steps, over every grid point of the same plan (:func:`own_loop_pays`), from
+#: which a study's chunks are scored in a loop of their plan's own
+#: (:func:`shipgnc.sim.scored.score_step_source`: boat-autopilot's heading steps cost ≈ 10
+#: instead of ≈ 31 ns per ship-step), compiled once per distinct plan (≈ 15–20 s; another
+#: schedule, or a t_end that changes the plan, compiles again) and kept in the disk cache; a
 #: smaller study runs in the combination's scored loop, whose step reads any plan at run time, so
-#: that runs of other schedules or durations do not each compile a loop. 10⁷ ship-steps:
-#: ``shipgnc sweep boat-autopilot --mc 10000`` (1.4·10⁷), whose loop works ≈ 2 CPU-seconds.
+#: that runs of other schedules or durations do not each compile a loop. A cold first run
+#: compiles one loop either way. 10⁷ ship-steps: ``shipgnc sweep boat-autopilot --mc 10000``
+#: (1.4·10⁷), whose loop works ≈ 2 CPU-seconds.
 UNROLLED_SHIP_STEPS = 10_000_000
 
 
@@ -279,6 +282,54 @@ def in_loop_plan(scenario, setup, sim, x0, seeds, backend: str, series: bool = F
     return None if plan is None else (run, plan)
 
 
+def own_loop_pays(study: Study, chunk: Chunk, sim) -> bool:
+    """Whether ``chunk`` is scored in a loop of its plan's own: the members × steps of every grid
+    point of the study whose plan has the chunk's signature (:func:`shipgnc.sim.scored.score_plan`;
+    its controller variant) reach :data:`UNROLLED_SHIP_STEPS`, however many grid points share it.
+    The plans are looked at only when the grid point alone is below it and the whole study is not
+    (one build per grid point, once per study)."""
+    here = study.members * round(sim.t_end / sim.dt)
+    if here >= UNROLLED_SHIP_STEPS or len(study.points) == 1:
+        return here >= UNROLLED_SHIP_STEPS and _plan_of(study, chunk.point, chunk.variant) is not None
+    if not any(key.startswith("simulation.") for key in study.dims) and \
+            here * len(study.points) < UNROLLED_SHIP_STEPS:
+        return False  # every grid point runs as many steps: the study as a whole is too small
+    plans = [_plan_of(study, p, chunk.variant) for p in range(len(study.points))]
+    mine = plans[chunk.point]
+    return mine is not None and sum(
+        p[1] for p in plans if p is not None and p[0] == mine[0]) >= UNROLLED_SHIP_STEPS
+
+
+def _plan_of(study: Study, point: int, variant: str | None):
+    """The signature of grid ``point``'s plan whose own step the loop would take
+    (:func:`shipgnc.sim.scored.own_step`) and its members × steps; None when its chunks are
+    not scored in the loop, or in the generic step whatever their size. Kept per study (by its
+    ``repr``: a grid value may be a list, which does not hash)."""
+    key = (repr(study), point, variant)
+    if key not in _PLANS:
+        if len(_PLANS) >= 256:
+            _PLANS.clear()
+        _PLANS[key] = _signature_steps(study, point, variant)
+    return _PLANS[key]
+
+
+#: :func:`_plan_of`'s answers of this process
+_PLANS: dict = {}
+
+
+def _signature_steps(study: Study, point: int, variant: str | None):
+    """:func:`_plan_of`, worked out."""
+    from shipgnc.sim.scored import own_step, score_plan
+
+    scenario, setup, sim, x0, seeds, _ = chunk_setup(study, Chunk(point, 0, 1, variant))
+    planned = in_loop_plan(scenario, setup, sim, x0, seeds, "compiled", study.series)
+    if planned is None:
+        return None
+    run, plan = planned
+    signature = score_plan(plan.ops, plan.span, len(run.model.states))
+    return (signature, study.members * run.n_steps) if own_step(signature) else None
+
+
 def scored_in_loop(scenario, setup, sim, x0, seeds, backend: str, series: bool = False,
                    unrolled: bool = False):
     """Every member's metrics scored inside the compiled loop (:mod:`shipgnc.analysis.accumulated`),
@@ -396,7 +447,7 @@ def run_chunk(study: Study, chunk: Chunk, backend: str = "compiled-or-numpy"):
 
     scenario, setup, sim, x0, seeds, drawn = chunk_setup(study, chunk)
     route = ends_early(setup)
-    unrolled = study.members * sim.t_end / sim.dt >= UNROLLED_SHIP_STEPS
+    unrolled = own_loop_pays(study, chunk, sim)
     in_loop = scored_in_loop(scenario, setup, sim, x0, seeds, backend, study.series, unrolled)
     if in_loop is not None:  # no series: the members' figures are all the chunk keeps
         (arrays, diverged), result, done_at = in_loop, None, None
