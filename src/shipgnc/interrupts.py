@@ -72,9 +72,12 @@ def held() -> bool:
 
 
 def _unraisable(info) -> None:
-    """A latched Ctrl-C that a callback could not raise is not printed (it is acted on later);
-    anything else goes to Python's own hook."""
-    if not (_latched and isinstance(info.exc_value, KeyboardInterrupt)):
+    """A latched Ctrl-C that a callback could not raise is not printed (it is acted on later),
+    nor, once a Ctrl-C is latched, a finaliser's error: an object the KeyboardInterrupt cut short
+    while it was built fails in its ``__del__`` (llvmlite's ``PassBuilder`` interrupted in a
+    compile: "AttributeError: _as_parameter_"), a consequence of the Ctrl-C, not a fault to
+    report in place of its one line. Anything else goes to Python's own hook."""
+    if not _latched:
         _previous_hook(info)
 
 

@@ -102,7 +102,8 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
              on_divergence: str = "raise", observer: Callable | None = None,
              progress: Callable | None = None, log_every: int = 1,
              batch_dims: tuple[str, ...] | None = None, backend: str = "auto",
-             attrs: dict | None = None, navigation=None):
+             attrs: dict | None = None, navigation=None,
+             on_complete: Callable[[], None] | None = None):
     """Simulate ``model`` from ``x0`` (shape ``(..., n)``) for ``t_end`` seconds.
 
     Parameters
@@ -133,6 +134,10 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         KeyboardInterrupt) ends either loop too: it raises :class:`~shipgnc.errors.Interrupted`
         carrying the samples computed so far (``.partial``, ``attrs["interrupted"] = 1``).
     progress : ``progress(k, n_steps)`` called about a hundred times per run.
+    on_complete : ``on_complete()`` called once the loop has ended without a Ctrl-C (every step
+        run, or a divergence stopped it), before the result is built: from then on a Ctrl-C
+        meets a complete run (the runner holds it with ``--keep-partial`` and writes the run
+        whole; building a long run's Dataset takes a noticeable fraction of a second).
     log_every : keep every n-th sample (large batches); the final sample is always kept.
     batch_dims : names of the batch dimensions (default ``("ship",)`` for one batch axis).
     navigation : :class:`~shipgnc.navigation.Navigation` (sensors and an estimator) or None. At
@@ -194,6 +199,8 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         error = Interrupted(last, partial=partial if log.time.size else None)
         note(str(error))  # the line said if the command is not done by the deadline
         raise error
+    if on_complete is not None:
+        on_complete()
     from shipgnc.sim.result import batch_dim_names, build_dataset
 
     result = build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
