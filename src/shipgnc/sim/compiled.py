@@ -133,12 +133,21 @@ def drive(setup, call, S: np.ndarray, div_event: np.ndarray, *, n_chunks: int = 
                 limited(k0, k_done + 1, k_done)
                 if setup.progress is not None:
                     setup.progress(n_steps, n_steps)
-                return Stop(None, k_done)
+                return _complete(setup, Stop(None, k_done))
             limited(k0, event // 2 + 1, n_steps)
-            return Stop(event, event // 2)
+            return _complete(setup, Stop(event, event // 2))
+        return _complete(setup, Stop(None, n_steps))
     except KeyboardInterrupt:  # Ctrl-C between (or within) kernel calls
         return Stop(None, done_through, interrupted=True)
-    return Stop(None, n_steps)
+
+
+def _complete(setup, stop: Stop) -> Stop:
+    """``stop``, a run that ended without a Ctrl-C, after ``setup.on_complete()`` (if any): the
+    caller learns the run is complete before its log is gathered."""
+    on_complete = getattr(setup, "on_complete", None)
+    if on_complete is not None:
+        on_complete()
+    return stop
 
 
 def log_samples_per_call(setup, n_ships: int) -> int:

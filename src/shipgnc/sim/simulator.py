@@ -90,6 +90,9 @@ class SimSetup:
     log_every: int
     u0: np.ndarray
     navigation: object | None = None  # sensors and estimator (shipgnc.navigation)
+    #: called once the loop has ended without a Ctrl-C, before its Log is built (simulate's
+    #: ``on_complete``)
+    on_complete: Callable[[], None] | None = None
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
@@ -134,10 +137,11 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         KeyboardInterrupt) ends either loop too: it raises :class:`~shipgnc.errors.Interrupted`
         carrying the samples computed so far (``.partial``, ``attrs["interrupted"] = 1``).
     progress : ``progress(k, n_steps)`` called about a hundred times per run.
-    on_complete : ``on_complete()`` called once the loop has ended without a Ctrl-C (every step
-        run, or a divergence stopped it), before the result is built: from then on a Ctrl-C
-        meets a complete run (the runner holds it with ``--keep-partial`` and writes the run
-        whole; building a long run's Dataset takes a noticeable fraction of a second).
+    on_complete : ``on_complete()`` called by either loop once it has ended without a Ctrl-C
+        (every step run, every ship finished, or a divergence stopped it), before its log and
+        the result are built: from then on a Ctrl-C meets a complete run (the runner holds it
+        with ``--keep-partial`` and writes the run whole; gathering a long run's log and
+        building its Dataset take a noticeable fraction of a second).
     log_every : keep every n-th sample (large batches); the final sample is always kept.
     batch_dims : names of the batch dimensions (default ``("ship",)`` for one batch axis).
     navigation : :class:`~shipgnc.navigation.Navigation` (sensors and an estimator) or None. At
@@ -167,7 +171,7 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
                       guidance=guidance, disturbance=disturbance, u0=u0, integrator=integrator,
                       method=method, rtol=rtol, atol=atol, seed=seed,
                       on_divergence=on_divergence, observer=observer, progress=progress,
-                      log_every=log_every, navigation=navigation)
+                      log_every=log_every, navigation=navigation, on_complete=on_complete)
     require(backend in BACKENDS, "backend", backend, f"allowed: {', '.join(BACKENDS)}")
     _require_batch_dims(batch_dims, setup.batch_shape)
     log, ran_on = None, "numpy"
@@ -199,8 +203,6 @@ def simulate(model, x0, *, t_end: float, dt: float, controller=None, actuator=No
         error = Interrupted(last, partial=partial if log.time.size else None)
         note(str(error))  # the line said if the command is not done by the deadline
         raise error
-    if on_complete is not None:
-        on_complete()
     from shipgnc.sim.result import batch_dim_names, build_dataset
 
     result = build_dataset(log, setup.batch_shape, batch_dims, run_attrs)
@@ -264,7 +266,7 @@ def _require_batch_dims(batch_dims, batch_shape: tuple[int, ...]) -> None:
 
 def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturbance, u0,
               integrator, method, rtol, atol, seed, on_divergence, observer, progress,
-              log_every, navigation=None) -> SimSetup:
+              log_every, navigation=None, on_complete=None) -> SimSetup:
     _require_component("model", model, ("states", "inputs", "derivatives"), "e.g. CyberShip2()")
     for role, obj, methods, example in (
             ("controller", controller,
@@ -347,7 +349,7 @@ def _validate(model, x0, *, t_end, dt, controller, actuator, guidance, disturban
                     disturbance=disturbance, integrator=integrator,
                     solver_options={"method": method, "rtol": rtol, "atol": atol}, rng=rng,
                     on_divergence=on_divergence, observer=observer, progress=progress,
-                    log_every=log_every, u0=u0, navigation=navigation)
+                    log_every=log_every, u0=u0, navigation=navigation, on_complete=on_complete)
 
 
 def whole_steps(t_end: float, dt: float, *, section: str = "") -> int:
@@ -630,6 +632,8 @@ def run_numpy(setup: SimSetup) -> Log:
                 setup.progress(k, n_steps)
             if last or all_done or not run.advance(t, plan, held_d):
                 break
+        if setup.on_complete is not None:  # before the Log is built (see simulate)
+            setup.on_complete()
     except KeyboardInterrupt:  # Ctrl-C: keep the samples logged so far (see simulate)
         run.interrupted()
     return run.result()
