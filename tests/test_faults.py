@@ -13,6 +13,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import textwrap
 import time
 from pathlib import Path
 
@@ -122,6 +123,32 @@ def test_ctrl_c_at_any_moment_is_one_line_and_exit_130(tmp_path_factory, delay):
     assert "Traceback" not in err and "Exception ignored" not in err, err[-1500:]
     assert len(err.strip().splitlines()) <= 1, err[-1500:]
     assert not out.exists()  # an interrupted run writes only with --keep-partial
+
+
+#: where a Ctrl-C lands outside any command's own handling: typer building the parser (after the
+#: imports, before the command), and the quick exit after it (exit handlers, flushing the output)
+_OUTSIDE_THE_COMMAND = {"parser": "import typer.main as where; name = 'get_command'",
+                        "exit": "import shipgnc.__main__ as where; name = 'flush_output'"}
+
+
+@pytest.mark.parametrize("moment", list(_OUTSIDE_THE_COMMAND))
+def test_a_ctrl_c_outside_the_command_is_one_line(tmp_path, moment):
+    """Found by the test above under load (a delay of 0.25 s): a Ctrl-C while typer built the
+    command's parser from its functions' annotations, after the imports and before any command
+    ran, printed a 40-line traceback. There, and after the command while the process ends, it
+    is the one line and exit 130."""
+    probe = _OUTSIDE_THE_COMMAND[moment] + textwrap.dedent("""
+        import sys
+        def ctrl_c(*args, **kwargs):
+            raise KeyboardInterrupt  # as the handler raises it at that moment
+        setattr(where, name, ctrl_c)
+        sys.argv = ["shipgnc", "list"]
+        from shipgnc.__main__ import main
+        main()
+    """)
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=120, cwd=tmp_path)
+    assert done.returncode == 130 and done.stderr == "interrupted\n", done.stderr[-1500:]
 
 
 def test_a_ctrl_c_a_callback_swallows_still_ends_the_command(capsys):

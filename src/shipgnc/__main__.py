@@ -30,11 +30,17 @@ def main() -> None:
         sys.stderr.write("interrupted while starting\n")
         raise SystemExit(EXIT_INTERRUPTED) from None
     try:
-        cli_main()
-    except SystemExit as done:  # finished: end without tearing the interpreter down
-        if is_program(sys._getframe(1)):
-            exit_finished(done.code)
-        raise
+        try:
+            cli_main()
+        except SystemExit as done:  # finished: end without tearing the interpreter down
+            if is_program(sys._getframe(1)):
+                exit_finished(done.code)
+            raise
+    except KeyboardInterrupt:  # outside the command (its exit handlers): the one line, no traceback
+        from shipgnc.interrupts import noted, say_once
+
+        say_once(noted())
+        raise SystemExit(EXIT_INTERRUPTED) from None
 
 
 def exit_finished(code: object) -> None:

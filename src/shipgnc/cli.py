@@ -387,8 +387,8 @@ def main() -> None:
     sys.warnoptions.append("ignore::UserWarning:multiprocessing.resource_tracker")
     try:
         code = app(standalone_mode=False)
-    except typer.Abort:
-        say_once(noted())
+    except (typer.Abort, KeyboardInterrupt):  # Abort: in a command; KeyboardInterrupt: while typer
+        say_once(noted())                     # builds the parser, before any command runs
         exit_now(130)
     except Exception as exc:  # the parser's own errors (click's, as vendored by typer)
         code = getattr(exc, "exit_code", None)
