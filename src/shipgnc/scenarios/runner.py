@@ -550,8 +550,7 @@ def run_scenario(scenario: Scenario | str, *, overrides=(), observer=None, progr
                     atol=sim.atol, seed=seed, observer=observer, progress=progress,
                     log_every=every, backend="numpy" if observer is not None else sim.backend,
                     on_divergence="stop" if compare else on_divergence, attrs=attrs,
-                    on_complete=scoring)  # before its Dataset is built: a Ctrl-C there keeps it
-                scoring()  # (a batch scored in the loop called it too; idempotent)
+                    on_complete=scoring)  # the loop calls it before gathering the run
         except DivergenceError as exc:  # a controller's note (e.g. poor margins) may say why
             if not getattr(setup.controller, "notes", None):
                 raise
